@@ -1,0 +1,81 @@
+"""cpm_nlp: kinematics and design of compliant parallel mechanisms with CasADi and IPOPT.
+
+Quick start::
+
+    import cpm_nlp as cn
+    model = cn.build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"})
+    pose = cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3])
+    pose.status, pose.x          # Status.SOLVED, (px, py, pz, psi, theta, phi) in SI
+
+or, from a problem file::
+
+    result = cn.solve(cn.load_problem("problems/prs3_forward_kinematics.yaml"))
+"""
+
+import logging
+
+from .api import (
+    Comparison,
+    Coordinate,
+    CpmError,
+    InputError,
+    JacobianReport,
+    LoopClosure,
+    Model,
+    PoseSolution,
+    Problem,
+    RequirementsReport,
+    Result,
+    SolverConfig,
+    SolverInfo,
+    Status,
+    apply_overrides,
+    assess,
+    build_model,
+    forward_kinematics,
+    inverse_kinematics,
+    jacobians,
+    joint_requirements,
+    load_problem,
+    mechanism_type,
+    passive_joints,
+    problem_from_dict,
+    reproduce,
+    residual,
+    solve,
+)
+
+__all__ = [
+    "Comparison",
+    "Coordinate",
+    "CpmError",
+    "InputError",
+    "JacobianReport",
+    "LoopClosure",
+    "Model",
+    "PoseSolution",
+    "Problem",
+    "RequirementsReport",
+    "Result",
+    "SolverConfig",
+    "SolverInfo",
+    "Status",
+    "apply_overrides",
+    "assess",
+    "build_model",
+    "forward_kinematics",
+    "inverse_kinematics",
+    "jacobians",
+    "joint_requirements",
+    "load_problem",
+    "mechanism_type",
+    "passive_joints",
+    "problem_from_dict",
+    "reproduce",
+    "residual",
+    "solve",
+]
+
+__version__ = "0.1.0"
+
+logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -1,0 +1,58 @@
+"""The public API of cpm_nlp (re-exported by the package).
+
+Load a problem file or build a mechanism in code, then call the algorithms
+with numpy arrays, or take the CasADi Functions of the model (``model.closure``:
+``phi``, ``phi_x``, ``phi_q``, ``jacobian``, ``inverse_jacobian``, ``ik``,
+``passive``) into your own CasADi code.  The library never prints; it logs
+to the ``cpm_nlp`` logger.
+"""
+
+from .errors import CpmError, InputError
+from .kinematics import (
+    JacobianReport,
+    PoseSolution,
+    assess,
+    forward_kinematics,
+    inverse_kinematics,
+    jacobians,
+    passive_joints,
+    residual,
+)
+from .mechanisms import build_model, mechanism_type
+from .model import Coordinate, LoopClosure, Model
+from .problem_file import Problem, apply_overrides, load_problem, problem_from_dict, solve
+from .reproduce import Comparison, reproduce
+from .requirements import RequirementsReport, joint_requirements
+from .result import Result, SolverInfo, Status
+from .solver import SolverConfig
+
+__all__ = [
+    "Comparison",
+    "Coordinate",
+    "CpmError",
+    "InputError",
+    "JacobianReport",
+    "LoopClosure",
+    "Model",
+    "PoseSolution",
+    "Problem",
+    "RequirementsReport",
+    "Result",
+    "SolverConfig",
+    "SolverInfo",
+    "Status",
+    "apply_overrides",
+    "assess",
+    "build_model",
+    "forward_kinematics",
+    "inverse_kinematics",
+    "jacobians",
+    "joint_requirements",
+    "load_problem",
+    "mechanism_type",
+    "passive_joints",
+    "problem_from_dict",
+    "reproduce",
+    "residual",
+    "solve",
+]

@@ -1,0 +1,306 @@
+"""The ``cpm-nlp`` command line: a map of subcommands.
+
+Exit status: 0 solved, 1 a solve that did not succeed (the result says why),
+2 bad input (one message naming the file, the key path and what was
+expected), 70 an internal error (a bug: please report it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import sys
+import tempfile
+import traceback
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, TextIO
+
+from .errors import CpmError, InputError
+from .result import STATUS_TEXT, Result
+from .units import DIMENSIONS, format_quantity
+
+EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
+
+
+# -- output helpers -------------------------------------------------------------------------------
+
+
+def write_atomic(path: str, text: str) -> None:
+    """Write ``text`` to ``path`` all at once (temp file + rename)."""
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def check_output_path(path: str | None) -> None:
+    """Fail early (exit 2) if ``-o`` cannot be written, before solving."""
+    if path is None:
+        return
+    target = Path(path)
+    parent = target.parent if str(target.parent) else Path(".")
+    if target.is_dir():
+        raise InputError(f"output path {path} is a directory; expected a file name", path=("-o",))
+    if not parent.is_dir():
+        raise InputError(f"output directory {parent} does not exist", path=("-o",))
+    if not os.access(parent, os.W_OK):
+        raise InputError(f"output directory {parent} is not writable", path=("-o",))
+
+
+def _fmt_scalar(value: Any, dim: str | None) -> tuple[str, str]:
+    if value is None:
+        return "—", ""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return str(value), ""
+    si_unit = DIMENSIONS[dim].si if dim in DIMENSIONS else ""
+    si = f"{value:.10g}" + (f" {si_unit}" if si_unit else "")
+    friendly = format_quantity(value, dim) if dim in DIMENSIONS and DIMENSIONS[dim].display != si_unit else ""
+    return si, friendly
+
+
+def _fmt_list(value: list, dim: str | None) -> str:
+    flat = value
+    if flat and all(isinstance(v, list) for v in flat):
+        return "matrix " + "; ".join("[" + ", ".join(f"{x:.6g}" for x in row) + "]" for row in flat)
+    nums = [v for v in flat if isinstance(v, (int, float))]
+    nulls = len(flat) - len(nums)
+    if len(flat) <= 4:
+        return "[" + ", ".join(_fmt_scalar(v, dim)[1] or _fmt_scalar(v, dim)[0] for v in flat) + "]"
+    text = f"{len(flat)} values"
+    if nums:
+        text += (
+            f", from {_fmt_scalar(min(nums), dim)[1] or _fmt_scalar(min(nums), dim)[0]}"
+            f" to {_fmt_scalar(max(nums), dim)[1] or _fmt_scalar(max(nums), dim)[0]}"
+        )
+    if nulls:
+        text += f", {nulls} not solved"
+    return text
+
+
+def render_result(result: Result, title: str = "") -> str:
+    """A readable table of a result."""
+    lines = []
+    lines.append(f"problem : {result.problem}" + (f"  ({title})" if title else ""))
+    lines.append(f"status  : {result.status.value}  -- {result.message or STATUS_TEXT[result.status]}")
+    s = result.solver
+    lines.append(f"solver  : {s.name}, {s.iterations} iterations, {s.seconds * 1e3:.2f} ms")
+    if result.model:
+        parts = []
+        for k, v in result.model.items():
+            if k == "type":
+                continue
+            parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
+        lines.append("model   : " + result.model.get("type", "") + ": " + ", ".join(parts) + "  (SI)")
+    if not result.values:
+        lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
+        return "\n".join(lines)
+    width = max(len(k) for k in result.values)
+    lines.append("")
+    for name, value in result.values.items():
+        dim = result.dimensions.get(name)
+        if isinstance(value, list):
+            text = _fmt_list(value, dim)
+            unit = result.units.get(name, "")
+            if unit and dim not in DIMENSIONS:
+                text += f"   ({unit})"
+            lines.append(f"{name:<{width}}  {text}")
+        else:
+            si, friendly = _fmt_scalar(value, dim)
+            lines.append(f"{name:<{width}}  {si:<22}" + (f"  {friendly}" if friendly else ""))
+    return "\n".join(lines)
+
+
+# -- subcommands --------------------------------------------------------------------------------
+
+
+def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
+    from .mechanisms import mechanism_type
+    from .problem_file import load_problem, solve
+
+    check_output_path(args.output)
+    problem = load_problem(args.file, args.set or [])
+    result = solve(problem)
+    if args.json:
+        out.write(result.to_json() + "\n")
+    elif not args.quiet:
+        title = mechanism_type(problem.model.name).title
+        out.write(render_result(result, title) + "\n")
+    if args.output:
+        write_atomic(args.output, result.to_json() + "\n")
+    return EXIT_OK if result.ok else EXIT_FAILED
+
+
+def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
+    from .problem_file import load_problem
+
+    problem = load_problem(args.file, args.set or [])
+    out.write(f"{args.file}: ok ({problem.kind.name} on {problem.model.name}, solver {problem.solver.method})\n")
+    return EXIT_OK
+
+
+def render_reproduce(rows: Sequence[Any]) -> str:
+    """The reproduction table, reasons numbered once below it."""
+    header = ("paper", "quantity", "source", "published", "computed", "rel. error", "verdict")
+    table = []
+    reasons: dict[str, int] = {}
+    for r in rows:
+        comp = "—" if r.computed is None else format_quantity(r.computed, r.dimension, 5)
+        rel = "—" if r.rel_error is None else f"{r.rel_error * 100:.2f} %"
+        verdict = r.verdict + ("" if r.expected else "  [UNEXPECTED]")
+        if r.reason and not r.verdict.startswith("agrees"):
+            n = reasons.setdefault(r.reason, len(reasons) + 1)
+            verdict += f" [{n}]"
+        table.append((r.paper, r.quantity, r.source, r.published_text, comp, rel, verdict))
+    widths = [max(len(str(x)) for x in col) for col in zip(header, *table)]
+
+    def line(cells: Sequence[Any]) -> str:
+        return "  ".join(str(c).ljust(w) for c, w in zip(cells, widths)).rstrip()
+
+    out = [line(header), line(["-" * w for w in widths])] + [line(t) for t in table]
+    if reasons:
+        out += ["", "reasons:"] + [f"  [{n}] {text}" for text, n in reasons.items()]
+    return "\n".join(out)
+
+
+def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
+    from .reproduce import reproduce
+
+    check_output_path(args.output)
+    rows = reproduce(args.paths or None)
+    if args.json:
+        out.write(json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+    else:
+        out.write(render_reproduce(rows) + "\n")
+        bad = [r for r in rows if not r.expected]
+        out.write(f"\n{len(rows)} figures, {len(bad)} unexpected\n")
+    if args.output:
+        write_atomic(args.output, json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+    return EXIT_OK if all(r.expected for r in rows) else EXIT_FAILED
+
+
+def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
+    from .mechanisms import MODULES, mechanism_type
+    from .problems import KINDS, problem_kind
+
+    if not args.name:
+        out.write("mechanisms:\n")
+        for name in sorted(MODULES):
+            mt = mechanism_type(name)
+            out.write(f"  {name:<12} {mt.title} [{mt.paper}]\n")
+        out.write("problem kinds:\n")
+        for name in sorted(KINDS):
+            out.write(f"  {name:<20} {problem_kind(name).description}\n")
+        return EXIT_OK
+    if args.name in KINDS:
+        kind = problem_kind(args.name)
+        out.write(f"{kind.name}: {kind.description}\n(inputs depend on the mechanism; see problems/*.yaml)\n")
+        return EXIT_OK
+    mt = mechanism_type(args.name, path=("describe",))
+    out.write(f"{mt.name}: {mt.title} [{mt.paper}]\n\nparameters:\n")
+    for o in mt.parameters:
+        default = "" if o.required or o.default is None else f" (default {o.format_value(o.default)})"
+        out.write(f"  {o.name:<8} {o.expectation()}{default}\n           {o.description}\n")
+    out.write("limits (optional, [low, high]):\n")
+    for o in mt.limits:
+        out.write(f"  {o.name:<8} {o.description}\n")
+    return EXIT_OK
+
+
+# -- entry point ------------------------------------------------------------------------------------
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cpm-nlp",
+        description="Kinematics and design of compliant parallel mechanisms (CasADi + IPOPT).",
+        epilog="Exit status: 0 solved, 1 solve failed, 2 bad input.",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    parser.add_argument("-v", "--verbose", action="count", default=0, help="log progress to stderr (-vv: debug)")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = sub.add_parser("solve", help="solve a problem file and print the result")
+    p.add_argument("file", help="problem file (YAML)")
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="override a value of the file, e.g. --set mechanism.parameters.b='50 mm' (repeatable)",
+    )
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the result as JSON to FILE (atomically)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit status tells")
+    p.set_defaults(func=cmd_solve)
+
+    p = sub.add_parser("check", help="validate a problem file without solving it")
+    p.add_argument("file")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE")
+    p.set_defaults(func=cmd_check)
+
+    p = sub.add_parser("reproduce", help="solve every problem file that reproduces a published figure")
+    p.add_argument("paths", nargs="*", help="problem files or directories (default: problems/)")
+    p.add_argument("--json", action="store_true", help="print the table as JSON")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the table as JSON to FILE")
+    p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser("describe", help="list mechanisms and problem kinds, or describe one")
+    p.add_argument("name", nargs="?")
+    p.set_defaults(func=cmd_describe)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: TextIO | None = None) -> int:
+    """Run the CLI; returns the exit status (also usable in-process by tests)."""
+    out = out or sys.stdout
+    err = err or sys.stderr
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse already printed the usage message
+        return int(exc.code) if isinstance(exc.code, int) else EXIT_INPUT
+    if args.command is None:
+        parser.print_help(out)
+        return EXIT_INPUT
+    handler = logging.StreamHandler(err)
+    handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    root = logging.getLogger("cpm_nlp")
+    root.addHandler(handler)
+    root.setLevel(logging.WARNING - 10 * min(args.verbose, 2))
+    func: Callable[[argparse.Namespace, TextIO], int] = args.func
+    try:
+        return func(args, out)
+    except InputError as exc:
+        err.write(f"error: {exc}\n")
+        return EXIT_INPUT
+    except CpmError as exc:
+        err.write(f"error: {exc}\n")
+        return EXIT_FAILED
+    except KeyboardInterrupt:
+        err.write("interrupted\n")
+        return 130
+    except Exception as exc:  # a bug, not a user error: say so, and how to get details
+        if args.debug:
+            traceback.print_exc(file=err)
+        err.write(f"internal error: {exc.__class__.__name__}: {exc} (please report; rerun with --debug)\n")
+        return EXIT_INTERNAL
+    finally:
+        root.removeHandler(handler)
+
+
+def main_entry() -> None:
+    """Console-script entry point (``cpm-nlp``)."""
+    sys.exit(main())
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main_entry()

@@ -1,0 +1,130 @@
+"""Results and statuses.
+
+Every solve returns a status.  Only ``solved`` carries numbers a user may
+trust; any other status says why there is no answer, and the values of the
+failed points are ``None`` (``null`` in JSON), never a number that looks right.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import numpy as np
+
+
+class Status(str, Enum):
+    """Outcome of a solve (the string value is what files and JSON carry)."""
+
+    SOLVED = "solved"
+    NOT_CONVERGED = "not_converged"
+    RESIDUAL_TOO_LARGE = "residual_too_large"
+    WRONG_BRANCH = "wrong_branch"
+    OUTSIDE_JOINT_LIMITS = "outside_joint_limits"
+    UNREACHABLE = "unreachable"
+    SINGULAR = "singular"
+    INFEASIBLE = "infeasible"
+
+    def __str__(self) -> str:
+        return self.value
+
+    @property
+    def ok(self) -> bool:
+        return self is Status.SOLVED
+
+
+#: Human explanation of each status (printed by the CLI, stored in results).
+STATUS_TEXT = {
+    Status.SOLVED: "converged; residual, assembly branch and joint limits checked",
+    Status.NOT_CONVERGED: "the solver did not converge",
+    Status.RESIDUAL_TOO_LARGE: "the solver stopped but the loop-closure residual is above tolerance",
+    Status.WRONG_BRANCH: "the solution lies on another assembly branch than the one the model designates",
+    Status.OUTSIDE_JOINT_LIMITS: "the pose needs a joint outside its declared limits",
+    Status.UNREACHABLE: "the pose cannot be assembled (no real solution of the loop closures)",
+    Status.SINGULAR: "the pose is singular (the loop-closure Jacobian is rank deficient)",
+    Status.INFEASIBLE: "the problem has no feasible point",
+}
+
+
+def worst_status(statuses: list[Status]) -> Status:
+    """The overall status of a batch: solved only if every point is solved."""
+    for s in statuses:
+        if not s.ok:
+            return s
+    return Status.SOLVED
+
+
+@dataclass
+class SolverInfo:
+    """Which solver ran, how many iterations (summed over points) and how long."""
+
+    name: str
+    iterations: int = 0
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "iterations": int(self.iterations), "seconds": float(self.seconds)}
+
+
+def _jsonable(value: Any) -> Any:
+    """numpy arrays/scalars to lists/floats; non-finite floats to None."""
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, Enum):
+        return value.value
+    return value
+
+
+@dataclass
+class Result:
+    """The answer to one problem.
+
+    values:
+        SI numbers (or lists of them) under the papers' symbols.
+    units:
+        SI unit of each value ("m", "rad", "" ...).
+    dimensions:
+        dimension of each value ("length", "angle", ...), used for printing.
+    """
+
+    problem: str
+    status: Status
+    values: dict[str, Any] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+    dimensions: dict[str, str] = field(default_factory=dict)
+    solver: SolverInfo = field(default_factory=lambda: SolverInfo("none"))
+    message: str = ""
+    statuses: list[Status] | None = None  # per point, for batches
+    model: dict[str, Any] = field(default_factory=dict)  # parameters used, SI
+
+    @property
+    def ok(self) -> bool:
+        return self.status.ok
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {
+            "problem": self.problem,
+            "status": self.status.value,
+            "values": _jsonable(self.values),
+            "solver": self.solver.to_dict(),
+            "message": self.message,
+            "units": dict(self.units),
+        }
+        if self.statuses is not None:
+            out["statuses"] = [s.value for s in self.statuses]
+        if self.model:
+            out["model"] = _jsonable(self.model)
+        return out
+
+    def to_json(self, indent: int | None = 2) -> str:
+        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)

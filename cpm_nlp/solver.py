@@ -1,0 +1,268 @@
+"""Solver configuration and construction.
+
+The method (IPOPT or Newton) is chosen here; problem and mechanism know
+nothing about it.  CasADi options pass through unchanged as a dict, merged
+over quiet defaults (``{"ipopt.tol": 1e-10}`` overrides just that key).
+CasADi itself validates them; its rejection becomes an :class:`InputError`
+naming the option, with a "did you mean" where one can be found.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import re
+import threading
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from .errors import InputError, suggest
+
+log = logging.getLogger(__name__)
+
+METHODS = ("ipopt", "newton")
+
+#: Quiet, tight defaults.  Residuals of the shipped models are lengths in m.
+DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
+    "ipopt": {
+        "ipopt.print_level": 0,
+        "ipopt.sb": "yes",
+        "print_time": False,
+        "ipopt.tol": 1e-12,
+        "ipopt.max_iter": 200,
+    },
+    "newton": {
+        "abstol": 1e-14,
+        "max_iter": 50,
+        "error_on_fail": False,
+        "print_iteration": False,
+    },
+}
+
+#: Commonly used IPOPT option names, for "did you mean" (CasADi does the validation).
+_COMMON_IPOPT = (
+    "tol",
+    "max_iter",
+    "print_level",
+    "acceptable_tol",
+    "acceptable_iter",
+    "constr_viol_tol",
+    "dual_inf_tol",
+    "compl_inf_tol",
+    "mu_strategy",
+    "mu_init",
+    "linear_solver",
+    "hessian_approximation",
+    "nlp_scaling_method",
+    "bound_push",
+    "bound_frac",
+    "warm_start_init_point",
+    "max_cpu_time",
+    "max_wall_time",
+    "sb",
+    "print_timing_statistics",
+    "derivative_test",
+    "fixed_variable_treatment",
+    "bound_relax_factor",
+    "honor_original_bounds",
+    "check_derivatives_for_naninf",
+    "output_file",
+)
+
+
+@dataclass(frozen=True)
+class SolverConfig:
+    """How to solve.
+
+    method:
+        "ipopt" (default; an NLP with bounds that select the assembly branch)
+        or "newton" (CasADi's Newton rootfinder, the fast path).
+    options:
+        CasADi/IPOPT options, passed unchanged, over :data:`DEFAULT_OPTIONS`.
+    tolerance:
+        largest accepted loop-closure residual (max norm, in the model's
+        residual unit, m for every shipped mechanism).
+    preset:
+        name of the preset this came from, for reporting.
+    """
+
+    method: str = "ipopt"
+    options: Mapping[str, Any] = field(default_factory=dict)
+    tolerance: float = 1e-10
+    preset: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise InputError(
+                f"unknown solver method '{self.method}'; expected one of: {', '.join(METHODS)}",
+                path=("solver", "method"),
+                suggestions=suggest(self.method, METHODS),
+            )
+        if not (self.tolerance > 0 and np.isfinite(self.tolerance)):
+            raise InputError(f"expected a positive tolerance, got {self.tolerance!r}", path=("solver", "tolerance"))
+
+    def casadi_options(self) -> dict[str, Any]:
+        merged = dict(DEFAULT_OPTIONS[self.method])
+        merged.update(self.options)
+        return merged
+
+    def validate(self) -> None:
+        """Let CasADi check the options now (on a one-variable problem), so that
+        a bad option is reported while the problem file is read."""
+        _validate_options(self.method, tuple(sorted(self.options.items(), key=lambda kv: kv[0])))
+
+    def key(self) -> tuple:
+        """Hashable identity (for caching built solvers)."""
+        return (self.method, repr(sorted(self.casadi_options().items(), key=lambda kv: kv[0])))
+
+    @property
+    def name(self) -> str:
+        return self.method
+
+
+def _trivial_solver(method: str, options: dict[str, Any]) -> None:
+    y = ca.SX.sym("y")
+    merged = dict(DEFAULT_OPTIONS[method])
+    merged.update(options)
+    if method == "ipopt":
+        ca.nlpsol("check", "ipopt", {"x": y, "f": y**2}, merged)
+    else:
+        ca.rootfinder("check", "newton", ca.Function("g", [y], [y]), merged)
+
+
+@functools.lru_cache(maxsize=64)
+def _validate_options(method: str, items: tuple) -> None:
+    options = dict(items)
+    try:
+        _trivial_solver(method, options)
+    except RuntimeError as exc:
+        error = translate_casadi_error(exc, options)
+        if len(error.path) == 2:  # CasADi did not say which option: find it
+            for key, value in options.items():
+                try:
+                    _trivial_solver(method, {key: value})
+                except RuntimeError as inner:
+                    lines = [ln.strip() for ln in str(inner).splitlines() if ln.strip()]
+                    error = InputError(
+                        f"CasADi rejected the value {value!r} of option '{key}' ({lines[-1] if lines else inner})",
+                        path=("solver", "options", key),
+                    )
+                    break
+        raise error from None
+
+
+def translate_casadi_error(exc: Exception, options: Mapping[str, Any]) -> InputError:
+    """Turn CasADi's rejection of an option into an :class:`InputError`."""
+    text = str(exc)
+    m = re.search(r"No such IPOPT option: (\S+)", text)
+    if m:
+        name = m.group(1)
+        return InputError(
+            f"IPOPT has no option '{name}'",
+            path=("solver", "options", f"ipopt.{name}"),
+            suggestions=[f"ipopt.{s}" for s in suggest(name, _COMMON_IPOPT)],
+            hint="see https://coin-or.github.io/Ipopt/OPTIONS.html",
+        )
+    m = re.search(r"Unknown option: (\S+)", text)
+    if m:
+        name = m.group(1)
+        listed = re.findall(r'^> "([^"]+)"', text, flags=re.M)
+        return InputError(
+            f"CasADi has no option '{name}' for this solver",
+            path=("solver", "options", name),
+            suggestions=listed[:3] or suggest(name, options),
+        )
+    last = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    detail = last[-1] if last else text
+    return InputError(f"CasADi rejected the solver options: {detail}", path=("solver", "options"))
+
+
+class SquareSolver:
+    """A built solver of a square system g(y; w) = 0 for y.
+
+    Built once (per mechanism type and solver configuration) and reused for
+    every call; calls from several threads are safe (CasADi checks out one
+    memory block per call).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        residual: ca.Function,
+        ny: int,
+        nw: int,
+        config: SolverConfig,
+    ) -> None:
+        self.name = name
+        self.config = config
+        y = ca.SX.sym("y", ny)
+        w = ca.SX.sym("w", nw)
+        g = residual(y, w)
+        opts = config.casadi_options()
+        try:
+            if config.method == "ipopt":
+                nlp = {"x": y, "p": w, "f": ca.SX(0), "g": g}
+                self._fn = ca.nlpsol(name, "ipopt", nlp, opts)
+            else:
+                rf = ca.Function(f"{name}_residual", [y, w], [g], ["y", "w"], ["g"])
+                self._fn = ca.rootfinder(name, "newton", rf, opts)
+        except RuntimeError as exc:
+            raise translate_casadi_error(exc, config.options) from exc
+        self._ny = ny
+
+    def solve(
+        self, y0: np.ndarray, w: np.ndarray, lower: np.ndarray | None = None, upper: np.ndarray | None = None
+    ) -> tuple[np.ndarray, bool, int, str, float]:
+        """Return (y, converged, iterations, solver message, seconds)."""
+        t0 = time.perf_counter()
+        if self.config.method == "ipopt":
+            args: dict[str, Any] = {"x0": y0, "p": w, "lbg": 0.0, "ubg": 0.0}
+            if lower is not None:
+                args["lbx"] = lower
+            if upper is not None:
+                args["ubx"] = upper
+            try:
+                out = self._fn(**args)
+            except RuntimeError as exc:  # evaluation errors (NaN at the start point ...)
+                log.debug("%s raised: %s", self.name, exc)
+                return np.full(self._ny, np.nan), False, 0, f"solver error: {exc}".splitlines()[0], 0.0
+            stats = self._fn.stats()
+            y = np.asarray(out["x"]).ravel()
+            ok = bool(stats.get("success", False))
+            status = str(stats.get("return_status", ""))
+            iters = int(stats.get("iter_count", 0))
+        else:
+            try:
+                y = np.asarray(self._fn(y0, w)).ravel()
+            except RuntimeError as exc:
+                log.debug("%s raised: %s", self.name, exc)
+                return np.full(self._ny, np.nan), False, 0, f"solver error: {exc}".splitlines()[0], 0.0
+            stats = self._fn.stats()
+            ok = bool(stats.get("success", False))
+            status = str(stats.get("return_status", ""))
+            iters = int(stats.get("iter_count", 0))
+        seconds = time.perf_counter() - t0
+        log.debug("%s: %s after %d iterations (%.3g s)", self.name, status, iters, seconds)
+        return y, ok and bool(np.all(np.isfinite(y))), iters, status, seconds
+
+
+class SolverCache:
+    """Built solvers keyed by (purpose, configuration); thread-safe."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._solvers: dict[tuple, SquareSolver] = {}
+
+    def get(self, purpose: str, config: SolverConfig, build) -> SquareSolver:
+        key = (purpose,) + config.key()
+        with self._lock:
+            solver = self._solvers.get(key)
+            if solver is None:
+                solver = build()
+                self._solvers[key] = solver
+            return solver

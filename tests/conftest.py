@@ -1,0 +1,41 @@
+"""Shared fixtures: the paper's 3-PRS model and an in-process CLI runner."""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+import cpm_nlp as cn
+from cpm_nlp.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+PROBLEMS = ROOT / "problems"
+
+#: prs3-ruiz.md, section 4: L = 109.215 mm, b = 47.91 mm, alpha = 45 deg at home.
+PAPER_PRS3 = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
+
+
+@pytest.fixture(scope="session")
+def prs3():
+    return cn.build_model("prs3", PAPER_PRS3)
+
+
+@dataclass
+class Run:
+    code: int
+    out: str
+    err: str
+
+
+def run_cli(*argv: str) -> Run:
+    out, err = io.StringIO(), io.StringIO()
+    code = main(list(argv), out=out, err=err)
+    return Run(code, out.getvalue(), err.getvalue())
+
+
+@pytest.fixture
+def cli():
+    return run_cli
