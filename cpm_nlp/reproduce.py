@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import InputError, unknown_key_error
-from .units import DIMENSIONS, format_quantity, parse_quantity
+from .units import DIMENSIONS, article, format_quantity, parse_quantity
 
 ROW_KEYS = ("quantity", "source", "published", "value", "tolerance", "reason", "expect")
 VERDICTS = ("agrees", "differs", "not reproducible", "solve failed")
@@ -198,89 +198,46 @@ def compare(spec: ReproduceSpec, result: Any, file: str) -> list[Comparison]:
     """Compare every row of ``spec`` with a solved ``result``."""
     rows = []
     for fig in spec.rows:
-        if fig.value is None:
-            rows.append(
-                Comparison(
-                    file,
-                    spec.paper,
-                    fig.quantity,
-                    fig.source,
-                    fig.published_text,
-                    None,
-                    None,
-                    fig.dimension,
-                    None,
-                    "not reproducible",
-                    fig.reason,
-                    True,
-                )
-            )
-            continue
-        computed = _lookup(result.values, fig.value) if result.ok else None
-        if not isinstance(computed, (int, float)) or not math.isfinite(computed):
-            why = f"{result.status.value}: {result.message}" if not result.ok else f"no value '{fig.value}'"
-            rows.append(
-                Comparison(
-                    file,
-                    spec.paper,
-                    fig.quantity,
-                    fig.source,
-                    fig.published_text,
-                    fig.published,
-                    None,
-                    fig.dimension,
-                    None,
-                    "solve failed",
-                    why,
-                    False,
-                )
-            )
-            continue
-        dim = result.dimensions.get(fig.value.split("[")[0], fig.dimension)
-        if dim in DIMENSIONS and dim != fig.dimension:
-            rows.append(
-                Comparison(
-                    file,
-                    spec.paper,
-                    fig.quantity,
-                    fig.source,
-                    fig.published_text,
-                    fig.published,
-                    float(computed),
-                    dim,
-                    None,
-                    "differs",
-                    f"published value is a {fig.dimension}, computed is a {dim}",
-                    False,
-                )
-            )
-            continue
-        diff = abs(computed - fig.published)
-        rel = diff / abs(fig.published) if fig.published != 0 else None
-        ok = (rel is not None and rel <= fig.tolerance) if fig.tolerance_kind == "rel" else diff <= fig.tolerance
-        tol_text = (
-            f"{fig.tolerance * 100:g} %"
-            if fig.tolerance_kind == "rel"
-            else format_quantity(fig.tolerance, fig.dimension)
-        )
-        verdict = f"agrees within {tol_text}" if ok else f"differs (tolerance {tol_text})"
-        expected = ok == (fig.expect == "agree")
-        rows.append(
-            Comparison(
+
+        def row(computed, dim, rel, verdict, reason, expected, fig=fig):
+            return Comparison(
                 file,
                 spec.paper,
                 fig.quantity,
                 fig.source,
                 fig.published_text,
                 fig.published,
-                float(computed),
-                fig.dimension,
+                computed,
+                dim,
                 rel,
                 verdict,
-                fig.reason,
+                reason,
                 expected,
             )
-        )
+
+        if fig.value is None:
+            rows.append(row(None, fig.dimension, None, "not reproducible", fig.reason, True))
+            continue
+        computed = _lookup(result.values, fig.value) if result.ok else None
+        if not isinstance(computed, (int, float)) or not math.isfinite(computed):
+            why = f"{result.status.value}: {result.message}" if not result.ok else f"no value '{fig.value}'"
+            rows.append(row(None, fig.dimension, None, "solve failed", why, False))
+            continue
+        dim = result.dimensions.get(fig.value.split("[")[0], fig.dimension)
+        if dim in DIMENSIONS and dim != fig.dimension:
+            why = f"published value is {article(fig.dimension)}, computed is {article(dim)}"
+            rows.append(row(float(computed), dim, None, "differs", why, False))
+            continue
+        diff = abs(computed - fig.published)
+        rel = diff / abs(fig.published) if fig.published != 0 else None
+        if fig.tolerance_kind == "rel":
+            ok = rel is not None and rel <= fig.tolerance
+            tol_text = f"{fig.tolerance * 100:g} %"
+        else:
+            ok = diff <= fig.tolerance
+            tol_text = format_quantity(fig.tolerance, fig.dimension)
+        verdict = f"agrees within {tol_text}" if ok else f"differs (tolerance {tol_text})"
+        rows.append(row(float(computed), fig.dimension, rel, verdict, fig.reason, ok == (fig.expect == "agree")))
     return rows
 
 
