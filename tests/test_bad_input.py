@@ -52,7 +52,7 @@ def test_not_a_mapping(cli, tmp_path):
         tmp_path,
         "- 1\n- 2\n",
         "expected a mapping with keys problem, description, mechanism, inputs, solver, outputs, "
-        "reproduce; got list [1, 2]",
+        "reproduce, sweep; got list [1, 2]",
     )
 
 
@@ -62,7 +62,7 @@ def test_empty_file(cli, tmp_path):
         tmp_path,
         "",
         "expected a mapping with keys problem, description, mechanism, inputs, "
-        "solver, outputs, reproduce; got an empty file",
+        "solver, outputs, reproduce, sweep; got an empty file",
     )
 
 
@@ -72,7 +72,7 @@ def test_unknown_top_level_key(cli, tmp_path):
         tmp_path,
         GOOD + "inputz: {}\n",
         "unknown top-level key 'inputz'; expected one of: description, inputs, mechanism, outputs, "
-        "problem, reproduce, solver; did you mean 'inputs'?",
+        "problem, reproduce, solver, sweep; did you mean 'inputs'?",
     )
 
 

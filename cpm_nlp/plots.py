@@ -1,0 +1,421 @@
+"""Figures designers read, from plain arrays (Matplotlib, headless).
+
+Every function takes SI numbers and the dimension of each axis ("length",
+"angle", ...), converts them for display (lengths to m, mm, µm or nm
+following their size, angles to degrees) and returns a
+``matplotlib.figure.Figure`` (no pyplot, no global state, no display: the
+Agg and SVG renderers write files).  :func:`save` writes PNG, SVG or PDF
+atomically.
+
+* :func:`workspace_figure` -- a reachable workspace as a 3-D point cloud with
+  its inscribed cuboid, and the three projections (pantograph paper,
+  Fig. 9-14);
+* :func:`design_map_figure` -- a value over two design parameters, on a grid
+  or on scattered points of any domain, e.g. the RPR (s, t) triangle (RPR
+  paper, Fig. 4);
+* :func:`panels_figure` -- curves against one abscissa, one panel per
+  quantity: the 3-PRS joint requirements over the studied poses (3-PRS
+  paper, Fig. 6-7), outputs against an input displacement (pantograph
+  paper, Fig. 20-22), a value against one swept parameter.
+
+:mod:`cpm_nlp.figures` chooses and feeds these from results.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+from .units import DIMENSIONS, to_display
+
+#: file types :func:`save` writes
+FIGURE_FORMATS = (".png", ".svg", ".pdf")
+_LENGTHS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
+_GREEK = (
+    "alpha",
+    "beta",
+    "gamma",
+    "delta",
+    "epsilon",
+    "zeta",
+    "eta",
+    "theta",
+    "kappa",
+    "lambda",
+    "mu",
+    "nu",
+    "xi",
+    "rho",
+    "sigma",
+    "tau",
+    "phi",
+    "chi",
+    "psi",
+    "omega",
+)
+
+
+def _figure_class() -> Any:
+    from .sweep import require
+
+    require("matplotlib", "plot", "plotting")
+    from matplotlib.figure import Figure
+
+    return Figure
+
+
+# -- units and labels ---------------------------------------------------------------------------
+
+
+def display_unit(dimension: str | None, values: Any = ()) -> tuple[float, str]:
+    """``(factor, unit)`` to show SI values of a dimension: shown = SI * factor.
+
+    Lengths take the largest of m, mm, µm, nm that keeps the largest value
+    at or above 1; other dimensions their display unit (angles: deg).
+    """
+    if dimension == "length":
+        arr = np.abs(np.asarray(values, dtype=float).ravel())
+        arr = arr[np.isfinite(arr)]
+        peak = float(arr.max()) if arr.size else 0.0
+        if peak == 0.0:
+            return 1e3, "mm"
+        for unit, size in _LENGTHS:
+            if peak >= size * (1 - 1e-9):
+                return 1.0 / size, unit
+        return 1e9, "nm"
+    if dimension in DIMENSIONS and dimension != "dimensionless":
+        factor, unit = to_display(1.0, dimension)
+        return factor, unit
+    return 1.0, ""
+
+
+def pretty(name: str) -> str:
+    """A symbol for axis labels: ``beta_m1`` -> β_m1, ``dz`` -> Δz, ``s_max``
+    -> s_max (Matplotlib mathtext); long plain words stay as they are."""
+    name = str(name).rsplit(".", 1)[-1]
+    head, _, tail = name.partition("_")
+    delta = ""
+    if len(head) > 1 and head[0] == "d" and (head[1:] in ("x", "y", "z") or head[1:].rstrip("0123456789") in _GREEK):
+        delta, head = r"\Delta ", head[1:]
+    m = re.fullmatch(r"([A-Za-z]+?)(\d*)", head)
+    if m is None:
+        return name
+    letters, digits = m.groups()
+    if letters.lower() in _GREEK:
+        symbol = "\\" + letters
+    elif len(letters) <= 2:
+        symbol = letters
+    else:
+        return name
+    sub = ",".join(p for p in (digits, *tail.split("_")) if p)
+    return f"${delta}{symbol}" + (f"_{{{sub}}}" if sub else "") + "$"
+
+
+def axis_label(name: str, unit: str) -> str:
+    return f"{pretty(name)} ({unit})" if unit else pretty(name)
+
+
+# -- saving -----------------------------------------------------------------------------------
+
+
+def check_figure_path(path: str | os.PathLike, option: str = "-o") -> None:
+    """Fail early (an :class:`InputError`) if a figure cannot be written there."""
+    target = Path(path)
+    if target.suffix.lower() not in FIGURE_FORMATS:
+        raise InputError(
+            f"expected a figure file ending in {', '.join(FIGURE_FORMATS)}, got {str(path)!r}", path=(option,)
+        )
+    parent = target.parent if str(target.parent) else Path(".")
+    if target.is_dir():
+        raise InputError(f"{path} is a directory; expected a file name", path=(option,))
+    if not parent.is_dir():
+        raise InputError(f"output directory {parent} does not exist", path=(option,))
+
+
+def save(fig: Any, path: str | os.PathLike) -> None:
+    """Write a figure (format from the suffix) all at once."""
+    target = Path(path)
+    fmt = target.suffix.lower().lstrip(".")
+    directory = target.parent if str(target.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".{fmt}", dir=directory)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, format=fmt, dpi=150)
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+# -- (a) workspace -------------------------------------------------------------------------------
+
+
+def workspace_figure(
+    points: Any,
+    *,
+    cuboid: tuple[Sequence[float], Sequence[float]] | None = None,
+    names: Sequence[str] = ("x", "y", "z"),
+    dimensions: Sequence[str | None] = ("length", "length", "length"),
+    title: str = "",
+    points_label: str = "reachable points",
+    cuboid_label: str = "maximal inscribed cuboid",
+) -> Any:
+    """A point cloud (N x 3, SI) in 3-D and its three projections, with an
+    optional cuboid ``(lower corner, upper corner)`` drawn in."""
+    Figure = _figure_class()
+    from matplotlib.patches import Rectangle
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    if not len(pts):
+        raise InputError("no finite points to plot")
+    box = None if cuboid is None else np.array([np.asarray(c, dtype=float).ravel()[:3] for c in cuboid])
+    scales = []
+    for i in range(3):
+        data = pts[:, i] if box is None else np.r_[pts[:, i], box[:, i]]
+        scales.append(display_unit(dimensions[i], data))
+    f = np.array([s[0] for s in scales])
+    P = pts * f
+    labels = [axis_label(n, s[1]) for n, s in zip(names, scales)]
+    fig = Figure(figsize=(11, 9), layout="constrained")
+    ax = fig.add_subplot(2, 2, 1, projection="3d")
+    size = float(np.clip(3000 / len(P), 2, 25))
+    ax.scatter(
+        P[:, 0], P[:, 1], P[:, 2], s=size, c=P[:, 2], cmap="viridis", alpha=0.6, label=f"{points_label} ({len(P)})"
+    )
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_zlabel(labels[2])
+    B = None
+    if box is not None:
+        B = box * f
+        lo, hi = B.min(axis=0), B.max(axis=0)
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
+        ax.add_collection3d(
+            Poly3DCollection([corners[fc] for fc in faces], facecolor="tab:red", edgecolor="darkred", alpha=0.25)
+        )
+        sizes = " × ".join(f"{d:.3g}" for d in hi - lo)
+        ax.plot([], [], color="tab:red", lw=6, alpha=0.4, label=f"{cuboid_label} ({sizes})")
+    ax.legend(loc="upper left", fontsize="small")
+    for k, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
+        a2 = fig.add_subplot(2, 2, k + 2)
+        a2.scatter(P[:, i], P[:, j], s=size, color="tab:blue", alpha=0.4)
+        if B is not None:
+            lo, hi = B.min(axis=0), B.max(axis=0)
+            a2.add_patch(Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor="tab:red", lw=2))
+        a2.set_xlabel(labels[i])
+        a2.set_ylabel(labels[j])
+        a2.grid(True, alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+# -- (b) design map ----------------------------------------------------------------------------------
+
+
+def _grid_index(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """(unique x, unique y, ix, iy) if the points are a full grid, each node once."""
+    ux, ix = np.unique(x, return_inverse=True)
+    uy, iy = np.unique(y, return_inverse=True)
+    if len(ux) < 2 or len(uy) < 2 or len(ux) * len(uy) != len(x):
+        return None
+    if len(set(zip(ix.tolist(), iy.tolist()))) != len(x):
+        return None
+    return ux, uy, ix, iy
+
+
+def _edges(u: np.ndarray) -> np.ndarray:
+    mid = (u[1:] + u[:-1]) / 2
+    return np.r_[u[0] - (mid[0] - u[0]), mid, u[-1] + (u[-1] - mid[-1])]
+
+
+def design_map_figure(
+    x: Any,
+    y: Any,
+    z: Any,
+    *,
+    names: Sequence[str] = ("x", "y", "value"),
+    dimensions: Sequence[str | None] = (None, None, None),
+    ok: Any = None,
+    domain: Any = None,
+    best: str | None = None,
+    base: tuple[float, float] | None = None,
+    title: str = "",
+) -> Any:
+    """A heat map of ``z`` over two parameters with contour lines.
+
+    Points on a full grid are drawn as cells; scattered points (a random
+    sample, a triangle) are triangulated.  ``ok`` marks the points that
+    solved (default: finite z); the others are drawn as grey crosses and
+    leave a hole.  ``domain``: vertices of the design domain (e.g. the RPR
+    (s, t) triangle), outlined, and no colour is drawn outside it.  ``best``:
+    "max" or "min" marks that point; ``base``: (x, y) of the reference design,
+    marked with a circle.
+    """
+    Figure = _figure_class()
+    from matplotlib.path import Path as MplPath
+    from matplotlib.tri import Triangulation
+
+    x = np.asarray(x, dtype=float).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    z = np.asarray([np.nan if v is None else v for v in np.asarray(z, dtype=object).ravel()], dtype=float)
+    if not (len(x) == len(y) == len(z)):
+        raise InputError(f"x, y and the value must have one entry per point (got {len(x)}, {len(y)}, {len(z)})")
+    good = np.isfinite(z) & np.isfinite(x) & np.isfinite(y)
+    if ok is not None:
+        good &= np.asarray(ok, dtype=bool).ravel()
+    if not good.any():
+        raise InputError(f"no point has a value of {names[2]} to plot (no point solved)")
+    (fx, ux_), (fy, uy_), (fz, uz_) = (
+        display_unit(dimensions[0], x[np.isfinite(x)]),
+        display_unit(dimensions[1], y[np.isfinite(y)]),
+        display_unit(dimensions[2], z[good]),
+    )
+    X, Y, Z = x * fx, y * fy, z * fz
+    poly = None
+    if domain is not None:
+        poly = np.asarray(domain, dtype=float).reshape(-1, 2) * [fx, fy]
+    fig = Figure(figsize=(8, 6.5), layout="constrained")
+    ax = fig.add_subplot(1, 1, 1)
+    grid = _grid_index(x, y)
+    mappable = None
+    zlabel = axis_label(names[2], uz_)
+    if grid is not None:
+        ux, uy, ix, iy = grid
+        cells = np.full((len(uy), len(ux)), np.nan)
+        cells[iy[good], ix[good]] = Z[good]
+        masked = np.ma.masked_invalid(cells)
+        mappable = ax.pcolormesh(_edges(ux * fx), _edges(uy * fy), masked, cmap="viridis", shading="flat")
+        if np.count_nonzero(np.isfinite(cells)) >= 4 and np.nanmax(cells) > np.nanmin(cells):
+            cs = ax.contour(ux * fx, uy * fy, masked, levels=8, colors="k", linewidths=0.6, alpha=0.7)
+            ax.clabel(cs, fontsize="x-small", fmt="%.3g")
+    else:
+        try:
+            tri = Triangulation(X, Y)
+            bad = ~good[tri.triangles].all(axis=1)
+            if poly is not None:
+                centroids = np.c_[X[tri.triangles].mean(axis=1), Y[tri.triangles].mean(axis=1)]
+                bad |= ~MplPath(poly).contains_points(centroids, radius=1e-9)
+            tri.set_mask(bad)
+            if bad.all():
+                raise ValueError("every triangle has a point that did not solve")
+            Zf = np.where(good, Z, np.nanmean(Z[good]))
+            mappable = ax.tripcolor(tri, Zf, cmap="viridis", shading="gouraud")
+            if np.ptp(Z[good]) > 0:
+                cs = ax.tricontour(tri, Zf, levels=8, colors="k", linewidths=0.6, alpha=0.7)
+                ax.clabel(cs, fontsize="x-small", fmt="%.3g")
+        except (ValueError, RuntimeError):  # too few or collinear points: colour the points themselves
+            mappable = None
+        if mappable is None:
+            mappable = ax.scatter(X[good], Y[good], c=Z[good], cmap="viridis", s=30)
+        else:
+            ax.plot(X[good], Y[good], ".", color="k", ms=1.5, alpha=0.5)
+    fig.colorbar(mappable, ax=ax, label=zlabel)
+    n_bad = int((~good).sum())
+    if n_bad:
+        ax.plot(X[~good], Y[~good], "x", color="0.45", ms=5, label=f"not solved ({n_bad})")
+    if poly is not None:
+        closed = np.vstack([poly, poly[:1]])
+        ax.plot(closed[:, 0], closed[:, 1], "--", color="k", lw=1.2, label="design domain")
+    if base is not None and all(v is not None for v in base):
+        ax.plot(base[0] * fx, base[1] * fy, "o", mfc="white", mec="k", ms=9, mew=1.5, label="base design (the file)")
+    if best in ("max", "min"):
+        idx = np.flatnonzero(good)
+        k = idx[np.argmax(Z[idx])] if best == "max" else idx[np.argmin(Z[idx])]
+        ax.plot(X[k], Y[k], "*", color="tab:red", ms=16, mec="k", label=f"{best} {Z[k]:.4g} {uz_}".strip())
+        ax.annotate(
+            f"({X[k]:.4g}, {Y[k]:.4g})", (X[k], Y[k]), textcoords="offset points", xytext=(8, 8), fontsize="small"
+        )
+    ax.set_xlabel(axis_label(names[0], ux_))
+    ax.set_ylabel(axis_label(names[1], uy_))
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best", fontsize="small")
+    ax.set_title((title + "\n" if title else "") + f"{pretty(names[2])} over {pretty(names[0])} and {pretty(names[1])}")
+    return fig
+
+
+# -- (c), (d) curves in panels ----------------------------------------------------------------------
+
+
+@dataclass
+class Panel:
+    """One panel of :func:`panels_figure`: curves of one quantity.
+
+    series: label -> values (SI, one per abscissa point; None/NaN = not
+    solved, a gap); annotate_range: write the range of the values in the
+    panel's title (for requirements).
+    """
+
+    name: str
+    dimension: str | None
+    series: Mapping[str, Any] = field(default_factory=dict)
+    annotate_range: bool = False
+    title: str = ""
+
+
+def _floats(values: Any) -> np.ndarray:
+    return np.asarray([np.nan if v is None else v for v in values], dtype=float)
+
+
+def panels_figure(
+    x: Any,
+    panels: Sequence[Panel],
+    *,
+    xname: str = "pose",
+    xdimension: str | None = None,
+    title: str = "",
+    ncols: int | None = None,
+    markers: bool = True,
+) -> Any:
+    """Curves against one abscissa ``x`` (SI), one panel per quantity.
+
+    ``xdimension`` None means a count (e.g. the number of a studied pose)."""
+    Figure = _figure_class()
+    if not panels:
+        raise InputError("nothing to plot (no quantity given)")
+    xs = _floats(x)
+    fx, ux = display_unit(xdimension, xs) if xdimension else (1.0, "")
+    n = len(panels)
+    ncols = ncols or min(n, 3 if n in (3, 5, 6, 9) else 4)
+    nrows = math.ceil(n / ncols)
+    fig = Figure(figsize=(4.2 * ncols, 3.3 * nrows + 0.5), layout="constrained")
+    drawn = 0
+    for k, panel in enumerate(panels):
+        ax = fig.add_subplot(nrows, ncols, k + 1)
+        ys_all = [_floats(v) for v in panel.series.values()]
+        both = np.concatenate(ys_all) if ys_all else np.array([])
+        fy, uy = display_unit(panel.dimension, both)
+        for label, ys in zip(panel.series, ys_all):
+            if len(ys) != len(xs):
+                raise InputError(f"{label}: expected {len(xs)} values (one per point), got {len(ys)}")
+            ax.plot(xs * fx, ys * fy, marker="o" if markers else None, ms=3, lw=1.2, label=pretty(label))
+            drawn += int(np.isfinite(ys).any())
+        ax.set_ylabel(axis_label(panel.name, uy))
+        ax.set_xlabel(axis_label(xname, ux) if xdimension else xname)
+        ax.grid(True, alpha=0.3)
+        if len(panel.series) > 1:
+            ax.legend(fontsize="x-small", ncol=min(3, len(panel.series)))
+        finite = both[np.isfinite(both)] * fy
+        text = panel.title
+        if panel.annotate_range and finite.size:
+            text = (text + "\n" if text else "") + f"{finite.min():.3g} … {finite.max():.3g} {uy}".strip()
+        if text:
+            ax.set_title(text, fontsize="small")
+    if not drawn:
+        raise InputError("no point has a value to plot (no point solved)")
+    if title:
+        fig.suptitle(title)
+    return fig
