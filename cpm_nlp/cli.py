@@ -163,14 +163,14 @@ def _check_plot_args(args: argparse.Namespace) -> None:
 
 def _result_figure(args: argparse.Namespace, result: Result) -> Any:
     """The figure of a solved result; None (with a warning) if no point solved."""
-    from .figures import figure, from_result
+    from .figures import NothingSolved, figure, from_result
 
     try:
         return figure(from_result(result), args.type, _plot_options(args))
+    except NothingSolved as exc:  # an honest failed solve is not bad input: exit 1, the result is written
+        args.err.write(f"warning: no plot written: {exc.message}\n")
+        return None
     except InputError as exc:
-        if not result.ok and "no point" in exc.message:
-            args.err.write(f"warning: no plot written: {exc.message}\n")
-            return None
         raise exc.at(prefix=("--plot",)) from None
 
 

@@ -63,6 +63,10 @@ class NotApplicable(InputError):
     """This plot type does not fit the result (the message says why)."""
 
 
+class NothingSolved(InputError):
+    """The result has no solved point: there is nothing to draw."""
+
+
 @dataclass
 class PlotOptions:
     """value: the quantity of a map or curves; x, y: the map's axes (names of
@@ -90,6 +94,7 @@ class ResultData:
     statuses: list[str] | None = None
     model: dict[str, Any] = field(default_factory=dict)
     sweep: bool = False
+    status: str = "solved"  # of the whole result
     parameters: list[dict[str, Any]] = field(default_factory=list)
     recorded: list[str] = field(default_factory=list)  # value columns of a sweep
 
@@ -114,7 +119,15 @@ def from_result(result: Any, source: str = "") -> ResultData:
     if not isinstance(d.get("values"), Mapping) or not isinstance(d.get("problem"), str):
         raise InputError("expected a cpm-nlp result (JSON with problem, status, values, units)", file=source or None)
     dims = {k: dim for k, u in (d.get("units") or {}).items() if (dim := _dimension_of_unit(u))}
-    return ResultData(source, d["problem"], dict(d["values"]), dims, d.get("statuses"), dict(d.get("model") or {}))
+    return ResultData(
+        source,
+        d["problem"],
+        dict(d["values"]),
+        dims,
+        d.get("statuses"),
+        dict(d.get("model") or {}),
+        status=str(d.get("status")),
+    )
 
 
 def from_table(table: Any) -> ResultData:
@@ -133,11 +146,11 @@ def from_table(table: Any) -> ResultData:
         str(meta.get("problem")),
         values,
         dims,
-        [str(s) for s in table.column("status")],
-        model,
-        True,
-        table.parameters,
-        table.values,
+        statuses=[str(s) for s in table.column("status")],
+        model=model,
+        sweep=True,
+        parameters=table.parameters,
+        recorded=table.values,
     )
 
 
@@ -167,6 +180,9 @@ def load(path: str | os.PathLike) -> ResultData:
 def figure(data: ResultData, plot_type: str | None = None, options: PlotOptions | None = None) -> tuple[Any, str]:
     """The figure of a result: ``(figure, plot type)``."""
     options = options or PlotOptions()
+    ok = data.ok
+    if (ok is not None and not ok.any()) or (ok is None and data.status != "solved"):
+        raise NothingSolved(f"no point of {data.source or 'the result'} is solved; there is nothing to plot")
     if plot_type is not None:
         if plot_type not in PLOTS:
             raise InputError(

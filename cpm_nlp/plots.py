@@ -120,6 +120,11 @@ def pretty(name: str) -> str:
     return f"${delta}{symbol}" + (f"_{{{sub}}}" if sub else "") + "$"
 
 
+def _number(v: float) -> str:
+    """3 significant digits, without an exponent for values up to 10^5."""
+    return f"{v:.0f}" if 1e3 <= abs(v) < 1e5 else f"{v:.3g}"
+
+
 def axis_label(name: str, unit: str) -> str:
     return f"{pretty(name)} ({unit})" if unit else pretty(name)
 
@@ -181,10 +186,11 @@ def workspace_figure(
     if not len(pts):
         raise InputError("no finite points to plot")
     box = None if cuboid is None else np.array([np.asarray(c, dtype=float).ravel()[:3] for c in cuboid])
-    scales = []
-    for i in range(3):
-        data = pts[:, i] if box is None else np.r_[pts[:, i], box[:, i]]
-        scales.append(display_unit(dimensions[i], data))
+    both = pts if box is None else np.vstack([pts, box])
+    # one unit per dimension, so that three lengths are read on one scale
+    scales = [
+        display_unit(dimensions[i], both[:, [j for j in range(3) if dimensions[j] == dimensions[i]]]) for i in range(3)
+    ]
     f = np.array([s[0] for s in scales])
     P = pts * f
     labels = [axis_label(n, s[1]) for n, s in zip(names, scales)]
@@ -206,7 +212,11 @@ def workspace_figure(
         ax.add_collection3d(
             Poly3DCollection([corners[fc] for fc in faces], facecolor="tab:red", edgecolor="darkred", alpha=0.25)
         )
-        sizes = " × ".join(f"{d:.3g}" for d in hi - lo)
+        units = {s[1] for s in scales}
+        if len(units) == 1:
+            sizes = " × ".join(_number(d) for d in hi - lo) + f" {units.pop()}".rstrip()
+        else:
+            sizes = " × ".join(f"{_number(d)} {u}".rstrip() for d, (_, u) in zip(hi - lo, scales))
         ax.plot([], [], color="tab:red", lw=6, alpha=0.4, label=f"{cuboid_label} ({sizes})")
     ax.legend(loc="upper left", fontsize="small")
     for k, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
