@@ -515,6 +515,32 @@ def require(module: str, extra: str, purpose: str) -> Any:
         ) from None
 
 
+#: Dask settings of the local cluster a sweep starts (benchmarks/bench_sweep.py):
+#: * the worker's statistical profiler samples every thread's stack every
+#:   10 ms; on points that are short CasADi calls wrapped in Python it cost
+#:   about half the solve time: off;
+#: * the nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536 (for large
+#:   dataframes); on many small CasADi allocations it costs about 13 % more
+#:   CPU: left to glibc's default;
+#: * the event-loop, system and memory monitors wake every 20-500 ms (about
+#:   3 % of a core while idle); every 0.5-2 s is plenty for tasks of half a
+#:   second.
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    "distributed.admin.tick.interval": "500ms",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+
+
+def dask_config() -> Any:
+    """The settings under which a sweep starts its local cluster (a context)."""
+    import dask
+
+    return dask.config.set(LOCAL_CLUSTER_CONFIG)
+
+
 class _Connection:
     """A Dask client: to an existing scheduler, or to a local cluster it starts
     (and stops) itself, one single-threaded worker process per core (CasADi
@@ -537,12 +563,13 @@ class _Connection:
                     f"cannot connect to the Dask scheduler {self.scheduler}: {exc}", path=("--scheduler",)
                 ) from None
             return self.client
-        self.cluster = distributed.LocalCluster(
-            n_workers=self.workers or default_workers(),
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # a free port: never "8787 is in use" when two sweeps run
-        )
+        with dask_config():
+            self.cluster = distributed.LocalCluster(
+                n_workers=self.workers or default_workers(),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # a free port: never "8787 is in use" when two sweeps run
+            )
         self.client = distributed.Client(self.cluster)
         log.info("local Dask cluster, dashboard at %s", self.client.dashboard_link)
         return self.client
