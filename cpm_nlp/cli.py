@@ -155,10 +155,13 @@ def _plot_options(args: argparse.Namespace) -> Any:
 
 
 def _check_plot_args(args: argparse.Namespace) -> None:
+    """Before solving: the figure can be written, and Matplotlib is there."""
     if getattr(args, "plot", None):
         from .plots import check_figure_path
+        from .sweep import require
 
         check_figure_path(args.plot, "--plot")
+        require("matplotlib", "plot", "plotting")
 
 
 def _result_figure(args: argparse.Namespace, result: Result) -> Any:
@@ -186,8 +189,10 @@ def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: T
 def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
     from .figures import figure, load
     from .plots import check_figure_path, save
+    from .sweep import require
 
     check_figure_path(args.output)
+    require("matplotlib", "plot", "plotting")
     data = load(args.result)
     fig, kind = figure(data, args.type, _plot_options(args))
     save(fig, args.output)

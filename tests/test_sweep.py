@@ -267,3 +267,65 @@ def test_solve_imports_neither_dask_nor_matplotlib_nor_pyarrow():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"
+
+
+def test_without_the_extras_solve_check_reproduce_work_and_sweep_says_what_to_install(tmp_path):
+    """As after `pip install -e .` alone: the optional packages cannot be imported."""
+    code = f"""
+import sys
+for m in ("distributed", "matplotlib", "pyarrow"):
+    sys.modules[m] = None  # ImportError on import, as when not installed
+from cpm_nlp.cli import main
+assert main(["check", {str(SWEEP_FILE)!r}]) == 0
+assert main(["solve", {str(SWEEP_FILE)!r}, "-q"]) == 0
+assert main(["reproduce", {str(PROBLEMS)!r}]) == 0
+print("exit", main(["sweep", {str(SWEEP_FILE)!r}, "-q", "-o", {str(tmp_path / "r.csv")!r}]))
+print("exit", main(["solve", {str(SWEEP_FILE)!r}, "-q", "--plot", {str(tmp_path / "r.png")!r}]))
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines()[-2:] == ["exit 2", "exit 2"]
+    assert proc.stderr.splitlines()[-2:] == [
+        "error: running a sweep needs the Python package 'distributed', which is not installed "
+        "(pip install 'cpm_nlp[sweep]')",
+        "error: plotting needs the Python package 'matplotlib', which is not installed (pip install 'cpm_nlp[plot]')",
+    ]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_interrupted_cli_sweep_says_how_to_resume(cli, tmp_path, monkeypatch):
+    import cpm_nlp.sweep
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cpm_nlp.sweep, "run_sweep", interrupted)
+    out = tmp_path / "r.csv"
+    run = cli("sweep", str(SWEEP_FILE), "-o", str(out))
+    assert run.code == 130
+    assert run.err == (f"\ninterrupted: the points solved so far are in {out}; run the same command to resume\n")
+
+
+def test_progress_bar_redraws_in_place_on_a_terminal():
+    import io
+
+    from cpm_nlp.cli import ProgressBar
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    stream = Tty()
+    bar = ProgressBar(stream, width=10)
+    for done in (0, 5, 10):
+        bar(done, 10)
+        bar.last_draw = 0.0  # no throttling in the test
+    text = stream.getvalue()
+    assert text.startswith("\r[          ] sweep: 0/10 points (0%)")
+    assert "\r[#####     ] sweep: 5/10 points (50%)" in text and "s left" in text
+    assert text.endswith("\n") and "\r[##########] sweep: 10/10 points (100%)" in text
+    logs = io.StringIO()
+    bar = ProgressBar(logs)
+    for done in range(11):
+        bar(done, 10)
+    assert len(logs.getvalue().splitlines()) == 11  # a line per tenth when not a terminal
