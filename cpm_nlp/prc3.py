@@ -335,11 +335,10 @@ def lagrangian() -> ca.Function:
     IG2, IG3, IG4, IG5 = m[2] * L2**2 / 3, m[3] * L5**2 / 12, m[4] * L4**2 / 3, m[5] * L6**2 / 12  # eq 29
     IG6, IG7 = m[7] * L8**2 / 12, m[7] * L7**2 / 12  # eq 32
     # platform displacement and velocity from the AD Jacobian at home (= -A2 I, eq 26)
-    x0, q0 = ca.SX.zeros(3), ca.SX.zeros(3)
-    phi = loop_closure()
     xs, qs = ca.SX.sym("xs", 3), ca.SX.sym("qs", 3)
-    jac = ca.Function("J", [xs, qs, p], [-ca.solve(ca.jacobian(phi(xs, qs, p), xs), ca.jacobian(phi(xs, qs, p), qs))])
-    J0 = jac(x0, q0, p)
+    phi = loop_closure()(xs, qs, p)
+    J = -ca.solve(ca.jacobian(phi, xs), ca.jacobian(phi, qs))
+    J0 = ca.substitute(J, ca.vertcat(xs, qs), ca.SX.zeros(6))
     P, Pd = J0 @ q, J0 @ qd
     T, U = 0, 0
     for i in range(3):

@@ -2,6 +2,7 @@
 Jacobian of eq 21 against AD and central differences, and the workspace
 (eq 27).  Every FK solution is checked against IK."""
 
+import json
 import math
 
 import numpy as np
@@ -12,7 +13,7 @@ from cpm_nlp import prc3 as P
 from cpm_nlp import workspace as W
 from cpm_nlp.result import Status
 
-from .conftest import central_difference
+from .conftest import PROBLEMS, central_difference
 
 #: Table 1 (kinematic part) and eq 27: l = L7 = 73.5 mm, 0 <= q_i <= 15 um
 TABLE1 = {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}
@@ -203,13 +204,36 @@ def test_contains(prc3):
 
 
 def test_workspace_problem_file(cli):
-    from .conftest import PROBLEMS
-
     run = cli("solve", str(PROBLEMS / "prc3_workspace.yaml"), "--json", "--set", "inputs.samples=3")
     assert run.code == 0, run.err
-    import json
-
     values = json.loads(run.out)["values"]
     assert values["n_points"] == 27
     assert values["x_min"] == pytest.approx(-131.815e-6, rel=1e-5)
     assert values["volume"] == pytest.approx((A2 * QMAX) ** 3, rel=1e-4)
+
+
+def test_other_reading_of_the_c_joint_changes_d_by_at_most_0_118_um(workspace):
+    """prc3.py documents: a C joint sliding along one transverse axis would drop that coordinate
+    from under the root of eq 9, changing d_i by at most 0.118 um over the workspace."""
+    t = workspace.t
+    change = 0.0
+    for i in range(3):
+        a, b = t[:, (i + 1) % 3], t[:, (i + 2) % 3]
+        both = np.sqrt(L**2 - a**2 - b**2)
+        change = max(change, np.max(np.abs(both - np.sqrt(L**2 - a**2))), np.max(np.abs(both - np.sqrt(L**2 - b**2))))
+    assert change == pytest.approx(0.118e-6, abs=0.5e-9)
+
+
+def test_workspace_points_on_request(cli):
+    run = cli(
+        "solve",
+        str(PROBLEMS / "prc3_workspace.yaml"),
+        "--json",
+        "--set",
+        "inputs.samples=2",
+        "--set",
+        "inputs.points=true",
+    )
+    assert run.code == 0, run.err
+    values = json.loads(run.out)["values"]
+    assert len(values["points"]) == 8 and values["points"] == values["vertices"]
