@@ -27,6 +27,7 @@ from .options import Option, validate_mapping
 
 #: mechanism type -> module implementing it
 MODULES = {
+    "prc3": "cpm_nlp.prc3",
     "prs3": "cpm_nlp.prs3",
 }
 

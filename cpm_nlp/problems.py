@@ -31,6 +31,9 @@ KINDS = {
     "inverse_kinematics": "cpm_nlp.kinematic_problems:InverseKinematics",
     "jacobian": "cpm_nlp.kinematic_problems:Jacobian",
     "joint_requirements": "cpm_nlp.kinematic_problems:JointRequirements",
+    "amplifier": "cpm_nlp.analysis_problems:Amplifier",
+    "workspace": "cpm_nlp.analysis_problems:Workspace",
+    "dynamics": "cpm_nlp.analysis_problems:Dynamics",
 }
 
 
