@@ -28,6 +28,7 @@ from .options import Option, validate_mapping
 #: mechanism type -> module implementing it
 MODULES = {
     "prs3": "cpm_nlp.prs3",
+    "rpr": "cpm_nlp.rpr",
 }
 
 
