@@ -143,10 +143,12 @@ def from_plane(s: float, t: float) -> tuple[float, float, float]:
 
 
 def design_space_violation(l1: float, l2: float, l3: float, tol: float = 1e-9) -> str | None:
-    """None if (l1, l2, l3) satisfies eq 22, else which condition it breaks."""
+    """None if (l1, l2, l3) satisfies eq 22, else which condition it breaks.
+    The strict bounds 0 < l_i < 3 keep a margin ``tol`` (a grid point on the
+    excluded edge l3 = 0 is not admitted by round-off); the others allow it."""
     ls = (l1, l2, l3)
     for k, v in enumerate(ls, start=1):
-        if not (0.0 < v < 3.0):
+        if not (tol < v < 3.0 - tol):
             return f"l{k} = {v:.6g} is not in (0, 3)"
     if abs(sum(ls) - 3.0) > tol:
         return f"l1 + l2 + l3 = {sum(ls):.6g}, not 3"
