@@ -96,10 +96,6 @@ def _needs_ipopt(solver: SolverConfig, what: str) -> None:
         )
 
 
-def _pose_solution(model: Model, x: np.ndarray, solver: SolverConfig):
-    return inverse_kinematics(model, x, solver)
-
-
 # -- eq 7-13 --------------------------------------------------------------------------------------
 
 
@@ -209,7 +205,7 @@ class Twists(ProblemKind):
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         x0 = _pose(model, inputs)
-        sol = _pose_solution(model, x0, solver)
+        sol = inverse_kinematics(model, x0, solver)
         if not sol.ok:
             return _finish(self.name, model, sol.status, {}, {}, message=sol.message)
         c = rpr.reference_point(model, sol.x, inputs["reference"], inputs.get("point"))
@@ -592,6 +588,14 @@ class JointDesign(ProblemKind):
             Option("starts", "int", "number of IPOPT starts per joint", default=6, lower=1, upper=100),
         ]
 
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        if not inputs["t_min"] < inputs["box"] / 4:
+            raise InputError(
+                f"expected t_min below a quarter of the box (a notch and its two cuts must fit), got t_min = "
+                f"{inputs['t_min'] * 1e3:g} mm, box = {inputs['box'] * 1e3:g} mm",
+                path=path + ("t_min",),
+            )
+
     def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
         raw, material = _pop_mapping(raw, "material")
         raw, compare = _pop_mapping(raw, "compare")
@@ -792,7 +796,7 @@ class Compliance(ProblemKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         mat = inputs["material"]
         x0 = _pose(model, inputs)
-        sol = _pose_solution(model, x0, solver)
+        sol = inverse_kinematics(model, x0, solver)
         if not sol.ok:
             return _finish(self.name, model, sol.status, {}, {}, message=sol.message)
         amp = inputs["amplifier"]
