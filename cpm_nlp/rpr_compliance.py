@@ -49,6 +49,7 @@ Readings and inputs the paper leaves out (documented, not tuned):
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -66,6 +67,8 @@ from .model import Model
 from .result import Status
 from .rpr_design import optimisation_options
 from .solver import SolverConfig, translate_casadi_error
+
+log = logging.getLogger(__name__)
 
 JOINTS = ("R", "U")
 ROTATION_LIMITS = ("eq32", "notch")
@@ -122,16 +125,13 @@ def design_wrenches(model: Model, couple_arm: float) -> dict[str, np.ndarray]:
     }
 
 
-def constraint_energy(joint: str, C, wrenches) -> Any:
-    """Σ wᵀ C w over the wrenches (eq 27), the joint's working rotations removed."""
+def constraint_energy(joint: str, C: np.ndarray, wrenches: np.ndarray) -> float:
+    """Σ wᵀ C w over the wrenches (columns; eq 27), the joint's working
+    rotations removed (eq 30-31 leave out cr_my, cu_mx, cu_my)."""
     keep = np.ones(6)
     keep[list(FREE_AXES[joint])] = 0.0
     W = np.asarray(wrenches) * keep[:, None]
-    total = 0.0
-    for k in range(W.shape[1]):
-        w = W[:, k]
-        total = total + w @ C @ w if not isinstance(C, (ca.SX, ca.MX)) else total + ca.mtimes([w.reshape(1, -1), C, w])
-    return total
+    return float(np.einsum("ik,ij,jk->", W, np.asarray(C), W))
 
 
 @dataclass
@@ -184,7 +184,7 @@ class _JointSolver:
         keep = np.ones(6)
         keep[list(FREE_AXES[joint])] = 0.0
         Wk = ca.diag(ca.DM(keep)) @ W
-        f = ca.sum1(ca.diag(Wk.T @ C @ Wk))
+        f = ca.sum1(ca.diag(Wk.T @ C @ Wk))  # eq 27, as constraint_energy
         r, t, w = dims
         cap = rotation_capability(mode, E, sy, SF, dims)
         g = [cap / th_des - 1.0, (w - (t + 2 * r)) / box]
@@ -263,6 +263,7 @@ def joint_design(model: Model, joint: str, spec: JointSpec, config: SolverConfig
         try:
             out = built.fn(x0=x0, p=p, lbx=lbx, ubx=ubx, lbg=0.0, ubg=ca.inf)
         except RuntimeError as exc:
+            log.debug("joint %s, start %s: %s", joint, x0, exc)
             failures.append(str(exc).splitlines()[0])
             continue
         stats = built.fn.stats()

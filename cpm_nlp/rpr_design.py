@@ -283,10 +283,12 @@ def synthesis(
         try:
             l, stats = built.solve(x0, lbx, ubx)
         except RuntimeError as exc:
+            log.debug("synthesis start %s: %s", x0, exc)
             failures.append(str(exc).splitlines()[0])
             continue
         iterations += int(stats.get("iter_count", 0))
         if not stats.get("success", False):
+            log.debug("synthesis start %s: %s", x0, stats.get("return_status"))
             failures.append(str(stats.get("return_status", "")))
             continue
         if design_space_violation(*l, tol=1e-7) is not None or np.any(l < lbx - 1e-7) or np.any(l > ubx + 1e-7):

@@ -672,10 +672,10 @@ class JointDesign(ProblemKind):
                     }
                 )
         units = {
-            k: ("m/N or rad/(N m), joint frame (z along the leg)" if k.startswith(("cr_", "cu_")) else None)
+            k: ("m/N" if k[3] == "t" else "rad/(N m)") + ", joint frame (z along the leg)"
             for k in values
+            if k.startswith(("cr_", "cu_"))
         }
-        units = {k: v for k, v in units.items() if v}
         units.update({"f_R": "J per unit wrench (eq 27)", "f_U": "J per unit wrench (eq 27)"})
         return _finish(
             self.name, model, status, values, dims, units, SolverInfo("ipopt", iters, seconds), "; ".join(messages)
