@@ -29,6 +29,7 @@ from .options import Option, validate_mapping
 MODULES = {
     "prc3": "cpm_nlp.prc3",
     "prs3": "cpm_nlp.prs3",
+    "rpr": "cpm_nlp.rpr",
 }
 
 

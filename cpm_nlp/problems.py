@@ -34,6 +34,12 @@ KINDS = {
     "amplifier": "cpm_nlp.analysis_problems:Amplifier",
     "workspace": "cpm_nlp.analysis_problems:Workspace",
     "dynamics": "cpm_nlp.analysis_problems:Dynamics",
+    "rpr_screw_jacobian": "cpm_nlp.rpr_problems:ScrewJacobian",
+    "rpr_twists": "cpm_nlp.rpr_problems:Twists",
+    "rpr_transmission_map": "cpm_nlp.rpr_problems:TransmissionMap",
+    "rpr_synthesis": "cpm_nlp.rpr_problems:Synthesis",
+    "rpr_joint_design": "cpm_nlp.rpr_problems:JointDesign",
+    "rpr_compliance": "cpm_nlp.rpr_problems:Compliance",
 }
 
 
@@ -68,6 +74,10 @@ class ProblemKind:
     def supports(self, model: Model) -> str | None:
         """None if the kind applies to this model, else the reason it does not."""
         return None
+
+    def check_solver(self, solver: SolverConfig) -> None:
+        """Raise :class:`InputError` if the kind cannot use this solver
+        configuration (e.g. an optimisation needs IPOPT)."""
 
 
 def problem_kind(name: Any, path: tuple = ("problem",)) -> ProblemKind:
