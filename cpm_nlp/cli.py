@@ -169,7 +169,7 @@ def render_reproduce(rows: Sequence[Any]) -> str:
         comp = "—" if r.computed is None else format_quantity(r.computed, r.dimension, 5)
         rel = "—" if r.rel_error is None else f"{r.rel_error * 100:.2f} %"
         verdict = r.verdict + ("" if r.expected else "  [UNEXPECTED]")
-        if r.reason and not r.verdict.startswith("agrees"):
+        if r.reason:
             n = reasons.setdefault(r.reason, len(reasons) + 1)
             verdict += f" [{n}]"
         table.append((r.paper, r.quantity, r.source, r.published_text, comp, rel, verdict))
