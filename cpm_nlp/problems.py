@@ -31,6 +31,8 @@ KINDS = {
     "inverse_kinematics": "cpm_nlp.kinematic_problems:InverseKinematics",
     "jacobian": "cpm_nlp.kinematic_problems:Jacobian",
     "joint_requirements": "cpm_nlp.kinematic_problems:JointRequirements",
+    "inscribed_cuboid": "cpm_nlp.workspace_problems:InscribedCuboid",
+    "workspace": "cpm_nlp.workspace_problems:Workspace",
 }
 
 
@@ -65,6 +67,9 @@ class ProblemKind:
     def supports(self, model: Model) -> str | None:
         """None if the kind applies to this model, else the reason it does not."""
         return None
+
+    def check_solver(self, solver: SolverConfig) -> None:
+        """Reject a solver configuration the kind cannot use; raise :class:`InputError`."""
 
 
 def problem_kind(name: Any, path: tuple = ("problem",)) -> ProblemKind:
@@ -158,6 +163,15 @@ def broadcast(columns: Sequence[Any], names: Sequence[str], path: tuple) -> tupl
     n = lengths.pop() if lengths else 1
     arr = np.array([[v[k] if isinstance(v, list) else v for v in columns] for k in range(n)], dtype=float)
     return arr, batch
+
+
+def require_ipopt(solver: SolverConfig, kind: str) -> None:
+    """Optimisation kinds (cuboid, synthesis) need IPOPT, not a rootfinder."""
+    if solver.method != "ipopt":
+        raise InputError(
+            f"problem kind '{kind}' solves an optimisation problem and needs method ipopt, got '{solver.method}'",
+            path=("solver", "method"),
+        )
 
 
 def coordinate_dims(coords: Sequence[Coordinate]) -> dict[str, str]:

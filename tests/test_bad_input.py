@@ -82,7 +82,8 @@ def test_unknown_problem_kind(cli, tmp_path):
         tmp_path,
         GOOD.replace("forward_kinematics", "forward_kinematic"),
         "problem: unknown problem kind 'forward_kinematic'; expected one of: forward_kinematics, "
-        "inverse_kinematics, jacobian, joint_requirements; did you mean 'forward_kinematics' or "
+        "inscribed_cuboid, inverse_kinematics, jacobian, joint_requirements, workspace; "
+        "did you mean 'forward_kinematics' or "
         "'inverse_kinematics'?",
     )
 
@@ -92,7 +93,7 @@ def test_unknown_mechanism_type(cli, tmp_path):
         cli,
         tmp_path,
         GOOD.replace("type: prs3", "type: 3prs"),
-        "mechanism.type: unknown mechanism type '3prs'; expected one of: prs3; did you mean 'prs3'?",
+        "mechanism.type: unknown mechanism type '3prs'; expected one of: pantograph, prs3; did you mean 'prs3'?",
     )
 
 
