@@ -70,6 +70,8 @@ from .solver import SolverConfig
 
 TITLE = "3D compliant pantograph, decoupled XYZ (Elgammal et al.)"
 PAPER = "pantograph-3d-elgammal-2016.md"
+#: the synthesis problem kind dispatches here (see cpm_nlp.synthesis)
+SYNTHESIS = "cpm_nlp.pantograph_synthesis:PantographSynthesis"
 
 HALF_PI = math.pi / 2
 SQRT2 = math.sqrt(2.0)

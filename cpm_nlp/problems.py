@@ -33,6 +33,7 @@ KINDS = {
     "joint_requirements": "cpm_nlp.kinematic_problems:JointRequirements",
     "inscribed_cuboid": "cpm_nlp.workspace_problems:InscribedCuboid",
     "workspace": "cpm_nlp.workspace_problems:Workspace",
+    "synthesis": "cpm_nlp.synthesis:Synthesis",
 }
 
 

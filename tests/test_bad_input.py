@@ -82,7 +82,7 @@ def test_unknown_problem_kind(cli, tmp_path):
         tmp_path,
         GOOD.replace("forward_kinematics", "forward_kinematic"),
         "problem: unknown problem kind 'forward_kinematic'; expected one of: forward_kinematics, "
-        "inscribed_cuboid, inverse_kinematics, jacobian, joint_requirements, workspace; "
+        "inscribed_cuboid, inverse_kinematics, jacobian, joint_requirements, synthesis, workspace; "
         "did you mean 'forward_kinematics' or "
         "'inverse_kinematics'?",
     )
