@@ -226,13 +226,20 @@ def hinge_rotation(limits: dict, path: tuple = ("mechanism", "limits")) -> float
     unused = [d for d in ("l", "t", "r") if d not in dims and limits.get(d) is not None]
     if unused:
         raise InputError(f"hinge {kind} has no dimension {', '.join(unused)} (it takes {', '.join(dims)})", path=path)
-    E, sigma = limits.get("E"), limits.get("sigma_all")
-    name = limits.get("material")
+    E, sigma = elastic_limits(limits, path, f"hinge {kind}")
+    return float(rotation(E, sigma, {d: limits[d] for d in dims}))
+
+
+def elastic_limits(values: dict, path: tuple, what: str = "the hinge") -> tuple[float, float]:
+    """(E, sigma_all) from validated ``material``, ``E`` and ``sigma_all`` values: the
+    material's, overridden by E or sigma_all where given."""
+    E, sigma = values.get("E"), values.get("sigma_all")
+    name = values.get("material")
     if name is not None:
         m = material(name, path + ("material",))
         E = m.E if E is None else E
         sigma = allowable_stress(m, path + ("material",)) if sigma is None else sigma
     if E is None or sigma is None:
         need = " and ".join(n for n, v in (("E", E), ("sigma_all", sigma)) if v is None)
-        raise InputError(f"hinge {kind} needs a material (or {need})", path=path)
-    return float(rotation(E, sigma, {d: limits[d] for d in dims}))
+        raise InputError(f"{what} needs a material (or {need})", path=path)
+    return float(E), float(sigma)

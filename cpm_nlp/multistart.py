@@ -12,6 +12,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .options import Option
+
 #: two objectives agree when they differ by at most this, relative to the best
 AGREEMENT = 1e-4
 
@@ -36,3 +38,11 @@ def best_and_agreement(objectives: Sequence[float | None], tolerance: float = AG
     best, fbest = min(vals, key=lambda kv: kv[1])
     scale = max(abs(fbest), 1e-300)
     return best, sum(1 for _, v in vals if abs(v - fbest) <= tolerance * scale)
+
+
+def start_options(default: int = 8) -> list[Option]:
+    """The inputs ``starts`` and ``seed`` of a multi-start problem kind."""
+    return [
+        Option("starts", "int", "number of IPOPT starts (seeded)", default=default, lower=1, upper=200),
+        Option("seed", "int", "seed of the random starts", default=0, lower=0, upper=2**32 - 1),
+    ]

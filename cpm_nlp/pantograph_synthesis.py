@@ -48,13 +48,13 @@ from . import pantograph as P
 from .errors import InputError
 from .mechanisms import build_model
 from .model import Model
-from .multistart import AGREEMENT, best_and_agreement, uniform_starts
+from .multistart import AGREEMENT, best_and_agreement, start_options, uniform_starts
 from .options import Option, validate_mapping
 from .result import Result, SolverInfo, Status
 from .solver import SolverConfig
 from .synthesis import SynthesisFormulation
 from .units import DIMENSIONS
-from .workspace import check_box
+from .workspace import CHECK_OPTION, check_box
 
 DESIGN = ("a", "b", "l", "t")
 SYNTH_IPOPT = {"ipopt.tol": 1e-10, "ipopt.max_iter": 1000, "ipopt.bound_relax_factor": 0.0}
@@ -166,72 +166,60 @@ class PantographSynthesis(SynthesisFormulation):
 
     def input_options(self, model: Model) -> list[Option]:
         mm = 1e-3
-        return [
-            Option(
-                "cuboid",
-                "length",
-                "required cuboid d1, d2, d3 (eq 36)",
-                shape="list",
-                max_len=3,
-                lower=0.0,
-                strict=True,
-            ),
-            Option("material", "str", f"hinge material, one of: {', '.join(flexure.MATERIALS)}"),
-            Option("E", "stress", "Young's modulus (overrides the material's)", default=None, lower=0.0, strict=True),
-            Option(
-                "sigma_all",
-                "stress",
-                "allowable stress (overrides the material's)",
-                default=None,
-                lower=0.0,
-                strict=True,
-            ),
-            Option(
-                "weights",
-                "dimensionless",
-                "w1 .. w4 of eq 35 (summing to 1)",
-                default=[0.25] * 4,
-                shape="list",
-                max_len=4,
-                lower=0.0,
-            ),
-            Option("a_nom", "length", "nominal a (eq 35)", default=15 * mm, lower=0.0, strict=True),
-            Option("b_nom", "length", "nominal b (eq 35)", default=30 * mm, lower=0.0, strict=True),
-            Option("l_nom", "length", "nominal hinge length l (eq 35)", default=0.2 * mm, lower=0.0, strict=True),
-            Option("t_nom", "length", "nominal hinge thickness t (eq 35)", default=0.1 * mm, lower=0.0, strict=True),
-            Option("hinges", "int", "n, the number of flexure hinges (eq 35)", default=30, lower=1, upper=10_000),
-            Option("a_bounds", "length", "[low, high] of a", shape="range"),
-            Option("b_bounds", "length", "[low, high] of b", shape="range"),
-            Option("l_bounds", "length", "[low, high] of the hinge length l", shape="range"),
-            Option("t_bounds", "length", "[low, high] of the hinge thickness t", shape="range"),
-            Option(
-                "stroke",
-                "length",
-                "actuator strokes delta_x, delta_y, delta_z (eq 37; optional)",
-                default=None,
-                shape="list",
-                max_len=3,
-                lower=0.0,
-                strict=True,
-            ),
-            Option(
-                "paper_reading",
-                "choice",
-                "reading of eq 34c (see pantograph.py)",
-                default="near_face",
-                choices=P.READINGS,
-            ),
-            Option("starts", "int", "IPOPT starts per assignment (seeded)", default=8, lower=1, upper=200),
-            Option("seed", "int", "seed of the random starts", default=0, lower=0, upper=2**32 - 1),
-            Option(
-                "check_per_edge",
-                "int",
-                "points per edge of the membership check of the optimum",
-                default=17,
-                lower=2,
-                upper=65,
-            ),
-        ]
+        return (
+            [
+                Option(
+                    "cuboid",
+                    "length",
+                    "required cuboid d1, d2, d3 (eq 36)",
+                    shape="list",
+                    max_len=3,
+                    lower=0.0,
+                    strict=True,
+                ),
+                Option("material", "str", f"hinge material, one of: {', '.join(flexure.MATERIALS)}"),
+                *(o for o in flexure.HINGE_LIMIT_OPTIONS if o.name in ("E", "sigma_all")),
+                Option(
+                    "weights",
+                    "dimensionless",
+                    "w1 .. w4 of eq 35 (summing to 1)",
+                    default=[0.25] * 4,
+                    shape="list",
+                    max_len=4,
+                    lower=0.0,
+                ),
+                Option("a_nom", "length", "nominal a (eq 35)", default=15 * mm, lower=0.0, strict=True),
+                Option("b_nom", "length", "nominal b (eq 35)", default=30 * mm, lower=0.0, strict=True),
+                Option("l_nom", "length", "nominal hinge length l (eq 35)", default=0.2 * mm, lower=0.0, strict=True),
+                Option(
+                    "t_nom", "length", "nominal hinge thickness t (eq 35)", default=0.1 * mm, lower=0.0, strict=True
+                ),
+                Option("hinges", "int", "n, the number of flexure hinges (eq 35)", default=30, lower=1, upper=10_000),
+                Option("a_bounds", "length", "[low, high] of a", shape="range"),
+                Option("b_bounds", "length", "[low, high] of b", shape="range"),
+                Option("l_bounds", "length", "[low, high] of the hinge length l", shape="range"),
+                Option("t_bounds", "length", "[low, high] of the hinge thickness t", shape="range"),
+                Option(
+                    "stroke",
+                    "length",
+                    "actuator strokes delta_x, delta_y, delta_z (eq 37; optional)",
+                    default=None,
+                    shape="list",
+                    max_len=3,
+                    lower=0.0,
+                    strict=True,
+                ),
+                Option(
+                    "paper_reading",
+                    "choice",
+                    "reading of eq 34c (see pantograph.py)",
+                    default="near_face",
+                    choices=P.READINGS,
+                ),
+            ]
+            + start_options()
+            + [CHECK_OPTION]
+        )
 
     def parse_inputs(self, raw: Any, model: Model, path: tuple) -> dict[str, Any]:
         raw = dict(raw) if isinstance(raw, Mapping) else raw
@@ -407,12 +395,7 @@ class PantographSynthesis(SynthesisFormulation):
 
 
 def _material(inputs: Mapping[str, Any], path: tuple) -> tuple[float, float]:
-    m = flexure.material(inputs["material"], path + ("material",))
-    E = inputs.get("E") if inputs.get("E") is not None else m.E
-    sigma = inputs.get("sigma_all")
-    if sigma is None:
-        sigma = flexure.allowable_stress(m, path + ("material",))
-    return E, sigma
+    return flexure.elastic_limits(inputs, path, "the synthesis")
 
 
 def _start(x, noms, bounds, d_ref, k_ref, E, sigma, phase):

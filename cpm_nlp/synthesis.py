@@ -15,38 +15,18 @@ from typing import Any
 
 from .mechanisms import MODULES
 from .model import Model
-from .options import Option, validate_mapping
+from .options import Option
 from .problems import ProblemKind, require_ipopt
 from .result import Result
 from .solver import SolverConfig
 
 
-class SynthesisFormulation:
-    """A mechanism's synthesis problem (the paper's), as the synthesis kind uses it.
+class SynthesisFormulation(ProblemKind):
+    """A mechanism's synthesis problem (the paper's), as the synthesis kind uses it:
+    a problem kind of its own (inputs, validation, run, outputs) that the
+    ``synthesis`` kind looks up by the mechanism and hands the problem to."""
 
-    Subclasses implement :meth:`input_options`, :meth:`run` and
-    :meth:`output_names`; they may override :meth:`parse_inputs` (e.g. for
-    a nested mapping input) and :meth:`check_inputs`.
-    """
-
-    description = ""
-
-    def input_options(self, model: Model) -> list[Option]:
-        raise NotImplementedError
-
-    def parse_inputs(self, raw: Any, model: Model, path: tuple) -> dict[str, Any]:
-        inputs = validate_mapping(raw, self.input_options(model), path, what="input")
-        self.check_inputs(inputs, model, path)
-        return inputs
-
-    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
-        """Cross-input validation; raise InputError."""
-
-    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
-        raise NotImplementedError
-
-    def output_names(self, model: Model) -> list[str]:
-        raise NotImplementedError
+    name = "synthesis"
 
 
 def formulation(model: Model) -> SynthesisFormulation | None:

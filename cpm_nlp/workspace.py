@@ -40,6 +40,7 @@ import numpy as np
 
 from .model import LoopClosure, Model
 from .multistart import AGREEMENT, best_and_agreement
+from .options import Option
 from .solver import SolverConfig
 
 log = logging.getLogger(__name__)
@@ -271,6 +272,12 @@ def surface_grid(d: int, n: int) -> np.ndarray:
     pts = np.array(list(itertools.product(g, repeat=d)))
     on_face = np.any((pts == 0.0) | (pts == 1.0), axis=1)
     return pts[on_face]
+
+
+#: the input that sets the density of the membership check of a box
+CHECK_OPTION = Option(
+    "check_per_edge", "int", "points per box edge of the membership check afterwards", default=17, lower=2, upper=65
+)
 
 
 def check_grid(d: int, per_edge: int, interior: int = 5) -> np.ndarray:

@@ -20,14 +20,16 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
+from .kinematic_problems import _model_info
 from .mechanisms import MODULES
 from .model import Model
+from .multistart import start_options
 from .options import Option
 from .problems import ProblemKind, broadcast, require_ipopt
 from .result import Result, SolverInfo, Status
 from .solver import SolverConfig
 from .units import DIMENSIONS
-from .workspace import ADDED_PER_ROUND, EXTRA_SLOTS, inscribed_cuboid, membership, sample_workspace
+from .workspace import ADDED_PER_ROUND, CHECK_OPTION, EXTRA_SLOTS, inscribed_cuboid, membership, sample_workspace
 
 
 def _module(model: Model):
@@ -80,9 +82,7 @@ class InscribedCuboid(ProblemKind):
 
     def input_options(self, model: Model) -> list[Option]:
         rounds = EXTRA_SLOTS // ADDED_PER_ROUND
-        opts = [
-            Option("starts", "int", "number of IPOPT starts (seeded)", default=8, lower=1, upper=200),
-            Option("seed", "int", "seed of the random starts", default=0, lower=0, upper=2**32 - 1),
+        opts = start_options() + [
             Option(
                 "samples_per_edge",
                 "int",
@@ -91,14 +91,7 @@ class InscribedCuboid(ProblemKind):
                 lower=2,
                 upper=9,
             ),
-            Option(
-                "check_per_edge",
-                "int",
-                "points per box edge of the membership check afterwards",
-                default=17,
-                lower=2,
-                upper=65,
-            ),
+            CHECK_OPTION,
             Option(
                 "refinements",
                 "int",
@@ -218,7 +211,7 @@ class InscribedCuboid(ProblemKind):
             SolverInfo("ipopt", res.iterations, res.seconds),
             message,
             None,
-            {"type": model.name, **dict(model.parameters), **{k: v for k, v in model.derived.items() if v is not None}},
+            _model_info(model),
         )
 
 
@@ -295,5 +288,5 @@ class Workspace(ProblemKind):
                 message = f"{len(pts)} of {inputs['samples']} points of the search region inside"
         units = {k: _unit(d) for k, d in dims.items()}
         return Result(
-            self.name, status, values, units, dims, SolverInfo(solver.name), message, None, {"type": model.name}
+            self.name, status, values, units, dims, SolverInfo(solver.name), message, None, _model_info(model)
         )

@@ -11,6 +11,8 @@ import cpm_nlp as cn
 from cpm_nlp import pantograph as P
 from cpm_nlp.result import Status
 
+from .test_prs3_kinematics import central_difference
+
 NEWTON = cn.SolverConfig(method="newton")
 IPOPT = cn.SolverConfig(method="ipopt")
 
@@ -79,16 +81,6 @@ def test_jacobian_is_eq_13_everywhere(panto, seed):
         np.testing.assert_allclose(rep.J_task, np.diag([3.5, -2.5, -2.5]), atol=1e-12)
         np.testing.assert_allclose(rep.J_inv, np.diag([1 / 3.5, -1 / 2.5, -1 / 2.5]), atol=1e-12)
         assert rep.manipulability == pytest.approx(21.875, rel=1e-12)  # eq 16: 2.5^2 * 70 / 20^3 (mm)
-
-
-def central_difference(f, x, h):
-    x = np.asarray(x, dtype=float)
-    cols = []
-    for i in range(x.size):
-        e = np.zeros_like(x)
-        e[i] = h
-        cols.append((np.asarray(f(x + e)) - np.asarray(f(x - e))) / (2 * h))
-    return np.column_stack(cols)
 
 
 @pytest.mark.parametrize("seed", range(3))
