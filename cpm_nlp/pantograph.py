@@ -259,8 +259,13 @@ def joint_limits(limits: dict) -> dict:
     """psi_min, psi_max, phi_max (rad; None where unlimited) and delta_max, the hinge
     rotation of eq 30/38 (None unless a hinge is given), from validated limits."""
     delta = flexure.hinge_rotation(limits)
-    if delta is not None:  # eq 31
-        return {"psi_min": HALF_PI - delta, "psi_max": HALF_PI + delta, "phi_max": delta, "delta_max": delta}
+    if delta is not None:  # eq 31; a hinge that turns further than the geometry allows does not limit
+        return {
+            "psi_min": max(HALF_PI - delta, 0.0),
+            "psi_max": min(HALF_PI + delta, math.pi),
+            "phi_max": delta if delta < HALF_PI else None,
+            "delta_max": delta,
+        }
     out = {k: limits.get(k) for k in _DIRECT}
     out["delta_max"] = None
     return out
@@ -302,7 +307,16 @@ def build(closure_: LoopClosure, parameters: dict, limits: dict) -> Model:
     }
     if angles["delta_max"] is not None:
         derived["delta_max"] = angles["delta_max"]
-    dims = {"a": "length", "b": "length", "dx0": "length", "delta_max": "angle"}
+        derived.update({k: limits[k] for k in ("l", "t", "r") if limits.get(k) is not None})  # the hinge
+    dims = {
+        "a": "length",
+        "b": "length",
+        "dx0": "length",
+        "delta_max": "angle",
+        "l": "length",
+        "t": "length",
+        "r": "length",
+    }
     dims.update({k: "dimensionless" for k in ("Mx", "My", "Mz", "omega")})
     dims.update({k: "angle" for k in _DIRECT})
     return Model(
@@ -498,6 +512,9 @@ CUBOID_VALUE_NAMES = (
     "psi_max",
     "phi_max",
     "delta_max",
+    "l",
+    "t",
+    "r",
     "paper_x_hat",
     "paper_y_hat",
     "paper_z_hat",
@@ -531,8 +548,7 @@ def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig
         "psi_max": d["psi_max"],
         "phi_max": d["phi_max"],
     }
-    if "delta_max" in d:
-        values["delta_max"] = d["delta_max"]
+    values.update({k: d[k] for k in ("delta_max", "l", "t", "r") if k in d})
     if lower is not None:
         values.update(
             x_hat=float(upper[0]),
@@ -552,7 +568,7 @@ def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig
         values["paper_check_outside"] = check.outside
         values["paper_check_margin"] = check.margin
         values["paper_check_binding"] = check.binding
-    dims = {k: "length" for k in values if k.endswith(("_hat", "_k", "x_near")) or k in ("a", "b")}
+    dims = {k: "length" for k in values if k.endswith(("_hat", "_k", "x_near")) or k in ("a", "b", "l", "t", "r")}
     dims["paper_check_margin"] = "si"
     dims.update({k: "angle" for k in ("psi_min", "psi_max", "phi_max", "delta_max")})
     dims.update({"paper_volume": "volume"})

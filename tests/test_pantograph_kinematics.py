@@ -212,3 +212,14 @@ def test_joint_requirements_kind_runs_on_the_pantograph(panto):
     assert v["stroke_min"] == pytest.approx(-0.004, rel=1e-12)
     assert v["stroke_max"] == pytest.approx(0.1 / 3.5, rel=1e-12)
     assert 1.49 < v["psi_min"] < v["psi_max"] < 1.65
+
+
+def test_hinge_beyond_the_geometry_does_not_limit():
+    """A hinge that could turn by more than pi/2 leaves psi in its geometric range [0, pi]
+    and phi unlimited (eq 31 clipped), so the workspace is the rigid one (section 5.1)."""
+    m = cn.build_model(
+        "pantograph", PAPER, {"hinge": "leaf_spring", "l": "50 mm", "t": "0.1 mm", "material": "polypropylene"}
+    )
+    assert m.derived["delta_max"] > math.pi / 2
+    assert (m.derived["psi_min"], m.derived["psi_max"], m.derived["phi_max"]) == (0.0, math.pi, None)
+    assert "phi" not in m.limits
