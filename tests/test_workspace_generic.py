@@ -63,3 +63,35 @@ def test_prs3_inscribed_cuboid_from_its_limits(tmp_path):
             check = W.check_box(model, grown_lo, grown_hi, per_edge=9)[0]
             assert check.outside > 0, (i, check)
     assert v["volume"] == pytest.approx(np.prod(upper - lower), rel=1e-12)
+
+
+def test_membership_without_closed_form_ik(prs3):
+    """A mechanism without a closed-form IK: membership solves the IK point by point
+    and agrees with the closed form."""
+    from cpm_nlp import prs3 as P3
+    from cpm_nlp.model import LoopClosure, Model
+
+    solved = LoopClosure(
+        "prs3_solved_ik",
+        x=P3.X,
+        q=P3.Q,
+        parameters=("b", "L", "alpha0"),
+        phi=P3.loop_closure(),
+        task=P3.TASK,
+        passive=P3.passive_joints(),
+        passive_coords=P3.PASSIVE,
+        branch=P3.branch_indicator(),
+        home=P3.home,
+        bounds=P3.bounds,
+    )
+    limits = {"s": (-2e-3, 2e-3), "beta_m": (-0.02, 0.02)}
+    closed = Model(prs3.closure, dict(prs3.parameters), limits, dict(prs3.derived))
+    other = Model(solved, dict(prs3.parameters), limits, dict(prs3.derived))
+    rng = np.random.default_rng(2)
+    T = np.column_stack(
+        [prs3.x_home[2] + rng.uniform(-1e-3, 1e-3, 40), rng.uniform(-0.01, 0.01, 40), rng.uniform(-0.015, 0.015, 40)]
+    )
+    a, b = W.membership(closed, T), W.membership(other, T)
+    assert 5 < np.count_nonzero(a.inside) < 35
+    np.testing.assert_array_equal(a.inside, b.inside)
+    np.testing.assert_allclose(b.Q[b.inside], a.Q[a.inside], atol=1e-10)
