@@ -76,8 +76,8 @@ class Amplifier(ProblemKind):
 # -- workspace ------------------------------------------------------------------------------------
 
 
-class Workspace(ProblemKind):
-    name = "workspace"
+class ActuatorWorkspace(ProblemKind):
+    name = "actuator_workspace"
     description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
 
     def input_options(self, model: Model) -> list[Option]:

@@ -55,6 +55,8 @@ from .model import Coordinate, LoopClosure, Model
 from .options import Option
 
 TITLE = "RPR compliant mechanism from a 2-RPU-UPR (Zhang, Liu, Ding)"
+#: the synthesis formulation of the shared ``synthesis`` kind (eq 19-26)
+SYNTHESIS = "cpm_nlp.rpr_problems:Synthesis"
 PAPER = "rpr-2rpu-upr-zhang-2022.md"
 
 PARAMETERS = (

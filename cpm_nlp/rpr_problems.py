@@ -3,7 +3,7 @@
 * ``rpr_screw_jacobian`` -- eq 7-13 by screw theory beside the AD Jacobians;
 * ``rpr_twists`` -- displacement twists of the platform per actuator (eq 45);
 * ``rpr_transmission_map`` -- η over the (s, t) triangle (Fig. 4), plot-ready;
-* ``rpr_synthesis`` -- maximise η under eq 22 (eq 19-26);
+* ``synthesis`` (the shared kind, via ``rpr.SYNTHESIS``) -- maximise η under eq 22 (eq 19-26);
 * ``rpr_joint_design`` -- the R and U flexure joints (eq 27-32, Table 1);
 * ``rpr_compliance`` -- the pseudo-rigid-body compliance model (eq 33-44).
 
@@ -24,7 +24,7 @@ from .kinematic_problems import Jacobian, _model_info, _si
 from .kinematics import forward_kinematics, inverse_kinematics
 from .model import Model
 from .options import Option, validate_mapping
-from .problems import ProblemKind
+from .problems import ProblemKind, require_ipopt
 from .result import STATUS_TEXT, Result, SolverInfo, Status
 from .solver import SolverConfig
 
@@ -87,13 +87,6 @@ def _material(raw: Any, path: tuple) -> flexure.Material:
     if mat.nu is None or mat.yield_strength is None:
         raise InputError(f"material '{mat.name}' needs nu and yield_strength (eq 32 and the shear modulus)", path=path)
     return mat
-
-
-def _needs_ipopt(solver: SolverConfig, what: str) -> None:
-    if solver.method != "ipopt":
-        raise InputError(
-            f"{what} is an optimisation: expected method ipopt, got '{solver.method}'", path=("solver", "method")
-        )
 
 
 # -- eq 7-13 --------------------------------------------------------------------------------------
@@ -407,7 +400,7 @@ class TransmissionMap(ProblemKind):
 
 
 class Synthesis(ProblemKind):
-    name = "rpr_synthesis"
+    name = "synthesis"
     description = "dimensional synthesis of the RPR: maximise eta (eq 19) under eq 22 by IPOPT multi-start"
 
     def supports(self, model: Model) -> str | None:
@@ -445,7 +438,7 @@ class Synthesis(ProblemKind):
             rpr_design.check_design_space(ls["l1"], ls["l2"], ls["l3"], path + (b,))
 
     def check_solver(self, solver: SolverConfig) -> None:
-        _needs_ipopt(solver, "the synthesis")
+        require_ipopt(solver, self.name)
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         fixed = {k: inputs[k] for k in ("l1", "l2", "l3") if inputs.get(k) is not None}
@@ -615,7 +608,7 @@ class JointDesign(ProblemKind):
         return inputs
 
     def check_solver(self, solver: SolverConfig) -> None:
-        _needs_ipopt(solver, "the joint design")
+        require_ipopt(solver, self.name)
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         spec = rpr_compliance.JointSpec(

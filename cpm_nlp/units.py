@@ -47,6 +47,7 @@ DIMENSIONS: dict[str, Dimension] = {
         Dimension("stress", "Pa", "MPa", "400 MPa", ("Pa", "kPa", "MPa", "GPa")),
         Dimension("force", "N", "N", "20 N", ("N", "mN", "kN")),
         Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg")),
+        Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3")),
         Dimension("density", "kg/m^3", "kg/m^3", "2810 kg/m^3", ("kg/m^3", "g/cm^3")),
         Dimension("time", "s", "s", "5 ms", ("s", "ms", "us")),
         Dimension("frequency", "Hz", "Hz", "93.8 Hz", ("Hz", "kHz")),

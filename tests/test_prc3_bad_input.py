@@ -21,7 +21,7 @@ DYN = (
     .replace("L7: 73.5 mm}", HINGES)
     .replace("inputs: {q1: 15 um, q2: 5 um, q3: 10 um}", "inputs: {material: Al 7075-T6, " + MASSES + "}")
 )
-WS = FK.replace("problem: forward_kinematics", "problem: workspace").replace(
+WS = FK.replace("problem: forward_kinematics", "problem: actuator_workspace").replace(
     "inputs: {q1: 15 um, q2: 5 um, q3: 10 um}", "inputs: {samples: 3}"
 )
 STROKE = "expected a value within the stroke [0 mm, 0.015 mm] declared at mechanism.limits.q"

@@ -197,10 +197,10 @@ def test_workspace_linearity_measures(prc3, workspace):
     np.testing.assert_allclose(workspace.linear_error, 2 * (A2 * QMAX) ** 2 / (2 * L), rtol=5e-3)
 
 
-def test_contains(prc3):
-    assert W.contains(prc3, [-50e-6, -60e-6, -70e-6])
-    assert not W.contains(prc3, [10e-6, -60e-6, -70e-6])  # needs q1 < 0
-    assert not W.contains(prc3, [-140e-6, -60e-6, -70e-6])  # needs q1 > 15 um
+def test_membership(prc3):
+    inside = W.membership(prc3, [[-50e-6, -60e-6, -70e-6], [10e-6, -60e-6, -70e-6], [-140e-6, -60e-6, -70e-6]])
+    # the second needs q1 < 0, the third q1 > 15 um
+    assert inside.inside.tolist() == [True, False, False]
 
 
 def test_workspace_problem_file(cli):

@@ -15,7 +15,7 @@ from .test_bad_input import expect_input_error
 RPR_FILES = sorted(PROBLEMS.glob("rpr_*.yaml"))
 
 SYNTHESIS = """\
-problem: rpr_synthesis
+problem: synthesis
 mechanism:
   type: rpr
   parameters: {r1: 40 mm, r2: 80 mm, P0: 40 mm}
@@ -48,7 +48,7 @@ def test_there_is_a_file_per_question():
         "rpr_screw_jacobian",
         "rpr_twists",
         "rpr_transmission_map",
-        "rpr_synthesis",
+        "synthesis",
         "rpr_joint_design",
         "rpr_compliance",
     }
@@ -108,8 +108,8 @@ def test_rpr_kinds_need_the_rpr_mechanism(cli, tmp_path):
         SYNTHESIS.replace("type: rpr", "type: prs3").replace(
             "{r1: 40 mm, r2: 80 mm, P0: 40 mm}", "{b: 47.91 mm, L: 109.215 mm}"
         ),
-        "problem: problem kind 'rpr_synthesis' does not apply to mechanism 'prs3': it is specific to the RPR "
-        "mechanism (type rpr)",
+        "problem: problem kind 'synthesis' does not apply to mechanism 'prs3': the mechanism module of 'prs3' "
+        "defines no SYNTHESIS formulation",
     )
 
 
@@ -156,7 +156,7 @@ def test_synthesis_needs_ipopt(cli, tmp_path):
         cli,
         tmp_path,
         SYNTHESIS + "solver: newton\n",
-        "solver.method: the synthesis is an optimisation: expected method ipopt, got 'newton'",
+        "solver.method: problem kind 'synthesis' solves an optimisation problem and needs method ipopt, got 'newton'",
     )
 
 
