@@ -25,14 +25,17 @@ from .reproduce import Comparison, reproduce
 from .requirements import RequirementsReport, joint_requirements
 from .result import Result, SolverInfo, Status
 from .solver import SolverConfig
+from .workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 
 __all__ = [
     "Comparison",
     "Coordinate",
+    "CuboidResult",
     "CpmError",
     "InputError",
     "JacobianReport",
     "LoopClosure",
+    "Membership",
     "Model",
     "PoseSolution",
     "Problem",
@@ -44,15 +47,19 @@ __all__ = [
     "apply_overrides",
     "assess",
     "build_model",
+    "check_box",
     "forward_kinematics",
+    "inscribed_cuboid",
     "inverse_kinematics",
     "jacobians",
     "joint_requirements",
     "load_problem",
     "mechanism_type",
+    "membership",
     "passive_joints",
     "problem_from_dict",
     "reproduce",
     "residual",
+    "sample_workspace",
     "solve",
 ]

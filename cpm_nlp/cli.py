@@ -72,7 +72,19 @@ def _fmt_scalar(value: Any, dim: str | None) -> tuple[str, str]:
 def _fmt_list(value: list, dim: str | None) -> str:
     flat = value
     if flat and all(isinstance(v, list) for v in flat):
-        return "matrix " + "; ".join("[" + ", ".join(f"{x:.6g}" for x in row) + "]" for row in flat)
+        cells = [x for row in flat for x in row]
+        if len(cells) > 36:  # a grid: its size and range (the values are in --json / -o)
+            nums = [x for x in cells if isinstance(x, (int, float)) and not isinstance(x, bool)]
+            text = f"matrix {len(flat)} x {max(len(row) for row in flat)}"
+            if nums:
+                text += f", from {min(nums):.6g} to {max(nums):.6g}"
+            nulls = sum(1 for x in cells if x is None)
+            return text + (f", {nulls} null" if nulls else "")
+
+        def cell(x: Any) -> str:
+            return "—" if x is None else str(x) if isinstance(x, bool) else f"{x:.6g}"
+
+        return "matrix " + "; ".join("[" + ", ".join(cell(x) for x in row) + "]" for row in flat)
     nums = [v for v in flat if isinstance(v, (int, float))]
     nulls = len(flat) - len(nums)
     if len(flat) <= 4:
@@ -308,7 +320,7 @@ def render_reproduce(rows: Sequence[Any]) -> str:
         comp = "—" if r.computed is None else format_quantity(r.computed, r.dimension, 5)
         rel = "—" if r.rel_error is None else f"{r.rel_error * 100:.2f} %"
         verdict = r.verdict + ("" if r.expected else "  [UNEXPECTED]")
-        if r.reason and not r.verdict.startswith("agrees"):
+        if r.reason:
             n = reasons.setdefault(r.reason, len(reasons) + 1)
             verdict += f" [{n}]"
         table.append((r.paper, r.quantity, r.source, r.published_text, comp, rel, verdict))

@@ -81,10 +81,13 @@ def passive_joints(model: Model, x: np.ndarray, q: np.ndarray) -> dict[str, floa
     return dict(zip(c.passive_names, vals.tolist()))
 
 
-def _limit_violations(model: Model, q: np.ndarray, passive: np.ndarray | None) -> list[str]:
+def _limit_violations(model: Model, x: np.ndarray, q: np.ndarray, passive: np.ndarray | None) -> list[str]:
+    """Actuators, pose coordinates (e.g. joint angles that are unknowns of the
+    loops) and passive joints outside their declared limits."""
     out = []
-    coords = list(model.closure.q) + (list(model.closure.passive_coords) if passive is not None else [])
-    values = list(q) + (list(passive) if passive is not None else [])
+    c = model.closure
+    coords = list(c.q) + list(c.x) + (list(c.passive_coords) if passive is not None else [])
+    values = list(q) + list(x) + (list(passive) if passive is not None else [])
     for coord, v in zip(coords, values):
         lim = model.limit_of(coord)
         if lim is not None and not (lim[0] <= v <= lim[1]):
@@ -127,7 +130,7 @@ def assess(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tupl
     if not cond < SINGULAR_CONDITION:
         return Status.SINGULAR, f"cond(Φ_x) = {cond:.3g}", details
     passive = np.asarray(c.passive(x, q, model.p)).ravel() if c.passive is not None else None
-    bad = _limit_violations(model, q, passive)
+    bad = _limit_violations(model, x, q, passive)
     if bad:
         return Status.OUTSIDE_JOINT_LIMITS, "; ".join(bad), details
     return Status.SOLVED, "", details

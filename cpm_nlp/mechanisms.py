@@ -5,7 +5,9 @@ Each mechanism is one module of the package that provides
 * ``TITLE``, ``PAPER`` -- what it is and where it comes from,
 * ``PARAMETERS``, ``LIMITS`` -- declared :class:`~cpm_nlp.options.Option` s,
 * ``closure()`` -- its symbolic :class:`~cpm_nlp.model.LoopClosure`,
-* ``build(closure, parameters, limits)`` -- a :class:`~cpm_nlp.model.Model`.
+* ``build(closure, parameters, limits)`` -- a :class:`~cpm_nlp.model.Model`,
+* optionally ``check_parameters(params, path)`` and ``check_limits(limits,
+  path)`` for rules that involve several values.
 
 The symbolic closure is built once per process and shared by every model of
 that type (it holds code, not problem data), so solvers built for one model
@@ -27,7 +29,10 @@ from .options import Option, validate_mapping
 
 #: mechanism type -> module implementing it
 MODULES = {
+    "prc3": "cpm_nlp.prc3",
     "prs3": "cpm_nlp.prs3",
+    "rpr": "cpm_nlp.rpr",
+    "pantograph": "cpm_nlp.pantograph",
 }
 
 
@@ -97,4 +102,7 @@ def build_model(
     check = getattr(mtype.module, "check_parameters", None)
     if check is not None:
         check(params, path + ("parameters",))
+    check_limits = getattr(mtype.module, "check_limits", None)
+    if check_limits is not None:
+        check_limits(lims, path + ("limits",))
     return mtype.module.build(closure_of(mtype), params, lims)

@@ -354,6 +354,7 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
         )
     inputs = kind.parse_inputs(data.get("inputs"), model, ("inputs",))
     solver = parse_solver(data.get("solver"), base_dir)
+    kind.check_solver(solver)
     outputs = _parse_outputs(data.get("outputs"), kind.output_names(model))
     description = data.get("description") or ""
     if not isinstance(description, str):

@@ -31,6 +31,17 @@ KINDS = {
     "inverse_kinematics": "cpm_nlp.kinematic_problems:InverseKinematics",
     "jacobian": "cpm_nlp.kinematic_problems:Jacobian",
     "joint_requirements": "cpm_nlp.kinematic_problems:JointRequirements",
+    "amplifier": "cpm_nlp.analysis_problems:Amplifier",
+    "actuator_workspace": "cpm_nlp.analysis_problems:ActuatorWorkspace",
+    "dynamics": "cpm_nlp.analysis_problems:Dynamics",
+    "rpr_screw_jacobian": "cpm_nlp.rpr_problems:ScrewJacobian",
+    "rpr_twists": "cpm_nlp.rpr_problems:Twists",
+    "rpr_transmission_map": "cpm_nlp.rpr_problems:TransmissionMap",
+    "rpr_joint_design": "cpm_nlp.rpr_problems:JointDesign",
+    "rpr_compliance": "cpm_nlp.rpr_problems:Compliance",
+    "inscribed_cuboid": "cpm_nlp.workspace_problems:InscribedCuboid",
+    "workspace": "cpm_nlp.workspace_problems:Workspace",
+    "synthesis": "cpm_nlp.synthesis:Synthesis",
 }
 
 
@@ -65,6 +76,10 @@ class ProblemKind:
     def supports(self, model: Model) -> str | None:
         """None if the kind applies to this model, else the reason it does not."""
         return None
+
+    def check_solver(self, solver: SolverConfig) -> None:
+        """Raise :class:`InputError` if the kind cannot use this solver
+        configuration (e.g. an optimisation needs IPOPT)."""
 
 
 def problem_kind(name: Any, path: tuple = ("problem",)) -> ProblemKind:
@@ -158,6 +173,15 @@ def broadcast(columns: Sequence[Any], names: Sequence[str], path: tuple) -> tupl
     n = lengths.pop() if lengths else 1
     arr = np.array([[v[k] if isinstance(v, list) else v for v in columns] for k in range(n)], dtype=float)
     return arr, batch
+
+
+def require_ipopt(solver: SolverConfig, kind: str) -> None:
+    """Optimisation kinds (cuboid, synthesis) need IPOPT, not a rootfinder."""
+    if solver.method != "ipopt":
+        raise InputError(
+            f"problem kind '{kind}' solves an optimisation problem and needs method ipopt, got '{solver.method}'",
+            path=("solver", "method"),
+        )
 
 
 def coordinate_dims(coords: Sequence[Coordinate]) -> dict[str, str]:

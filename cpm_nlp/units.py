@@ -47,11 +47,14 @@ DIMENSIONS: dict[str, Dimension] = {
         Dimension("stress", "Pa", "MPa", "400 MPa", ("Pa", "kPa", "MPa", "GPa")),
         Dimension("force", "N", "N", "20 N", ("N", "mN", "kN")),
         Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg")),
+        Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3")),
         Dimension("density", "kg/m^3", "kg/m^3", "2810 kg/m^3", ("kg/m^3", "g/cm^3")),
         Dimension("time", "s", "s", "5 ms", ("s", "ms", "us")),
         Dimension("frequency", "Hz", "Hz", "93.8 Hz", ("Hz", "kHz")),
         Dimension("stiffness", "N/m", "N/um", "2 N/um", ("N/m", "N/mm", "N/um")),
         Dimension("rotational_stiffness", "N*m/rad", "N*m/rad", "98.37 N*m/rad", ("N*m/rad", "N*mm/rad")),
+        Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "um^3", "cm^3")),
+        Dimension("acceleration", "m/s^2", "m/s^2", "9.81 m/s^2", ("m/s^2", "mm/s^2")),
         Dimension("dimensionless", "", "", "0.5", ("", "%")),
     )
 }

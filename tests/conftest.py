@@ -6,6 +6,7 @@ import io
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import cpm_nlp as cn
@@ -39,3 +40,14 @@ def run_cli(*argv: str) -> Run:
 @pytest.fixture
 def cli():
     return run_cli
+
+
+def central_difference(f, x, h):
+    """Central differences of f at x, one column per entry of x (for checking AD Jacobians)."""
+    x = np.asarray(x, dtype=float)
+    cols = []
+    for k in range(x.size):
+        e = np.zeros_like(x)
+        e[k] = h
+        cols.append((np.asarray(f(x + e)) - np.asarray(f(x - e))) / (2 * h))
+    return np.column_stack(cols)

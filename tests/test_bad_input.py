@@ -3,6 +3,9 @@ expected; exit status 2; no traceback; no output file."""
 
 import pytest
 
+from cpm_nlp.mechanisms import MODULES
+from cpm_nlp.problems import KINDS
+
 from .conftest import PROBLEMS
 
 FK = str(PROBLEMS / "prs3_forward_kinematics.yaml")
@@ -81,9 +84,9 @@ def test_unknown_problem_kind(cli, tmp_path):
         cli,
         tmp_path,
         GOOD.replace("forward_kinematics", "forward_kinematic"),
-        "problem: unknown problem kind 'forward_kinematic'; expected one of: forward_kinematics, "
-        "inverse_kinematics, jacobian, joint_requirements; did you mean 'forward_kinematics' or "
-        "'inverse_kinematics'?",
+        "problem: unknown problem kind 'forward_kinematic'; expected one of: "
+        + ", ".join(sorted(KINDS))  # every registered kind, e.g. forward_kinematics, inverse_kinematics ...
+        + "; did you mean 'forward_kinematics' or 'inverse_kinematics'?",
     )
 
 
@@ -92,7 +95,9 @@ def test_unknown_mechanism_type(cli, tmp_path):
         cli,
         tmp_path,
         GOOD.replace("type: prs3", "type: 3prs"),
-        "mechanism.type: unknown mechanism type '3prs'; expected one of: prs3; did you mean 'prs3'?",
+        "mechanism.type: unknown mechanism type '3prs'; expected one of: "
+        + ", ".join(sorted(MODULES))  # every registered mechanism: prc3, prs3 ...
+        + "; did you mean 'prs3'?",
     )
 
 

@@ -13,6 +13,8 @@ import cpm_nlp as cn
 from cpm_nlp import prs3 as P
 from cpm_nlp.result import Status
 
+from .conftest import central_difference
+
 NEWTON = cn.SolverConfig(method="newton")
 IPOPT = cn.SolverConfig(method="ipopt")
 
@@ -83,16 +85,6 @@ def test_solved_ik_matches_closed_form(prs3):
             assert solved.ok, solved.message
             np.testing.assert_allclose(solved.q, closed.q, atol=1e-13)
             np.testing.assert_allclose(solved.x, closed.x, atol=1e-13)
-
-
-def central_difference(f, x, h):
-    x = np.asarray(x, dtype=float)
-    cols = []
-    for k in range(x.size):
-        e = np.zeros_like(x)
-        e[k] = h
-        cols.append((np.asarray(f(x + e)) - np.asarray(f(x - e))) / (2 * h))
-    return np.column_stack(cols)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
