@@ -144,7 +144,7 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     _check_plot_args(args)
     problem = load_problem(args.file, args.set or [])
     result = solve(problem)
-    fig = _result_figure(args, result) if args.plot else None  # before any output: a bad --plot writes nothing
+    fig = _result_figure(args, result, problem.model) if args.plot else None  # a bad --plot writes nothing
     if args.json:
         out.write(result.to_json() + "\n")
     elif not args.quiet:
@@ -176,12 +176,14 @@ def _check_plot_args(args: argparse.Namespace) -> None:
         require("matplotlib", "plot", "plotting")
 
 
-def _result_figure(args: argparse.Namespace, result: Result) -> Any:
+def _result_figure(args: argparse.Namespace, result: Result, model: Any) -> Any:
     """The figure of a solved result; None (with a warning) if no point solved."""
     from .figures import NothingSolved, figure, from_result
 
+    data = from_result(result)
+    data.live = model
     try:
-        return figure(from_result(result), args.type, _plot_options(args))
+        return figure(data, args.type, _plot_options(args))
     except NothingSolved as exc:  # an honest failed solve is not bad input: exit 1, the result is written
         args.err.write(f"warning: no plot written: {exc.message}\n")
         return None

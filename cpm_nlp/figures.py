@@ -9,14 +9,21 @@ Extending: a plot type is one entry in :data:`PLOTS` (name ->
 "module:function"), the function taking ``(data, options)`` and returning a
 Matplotlib figure made by :mod:`cpm_nlp.plots` from arrays, or raising
 :class:`NotApplicable`; a problem kind lists its plot types in
-:data:`DEFAULTS`.  Kinds that make maps or workspaces need no plotting code
-when their values use the names read here:
+:data:`DEFAULTS`.  A kind needs no plotting code of its own when its values
+use the names read here (SI values, units in the result):
 
-* ``workspace``: ``points`` (N x 3 list, SI; ``units["points"]`` its unit),
-  optional ``cuboid_lower`` and ``cuboid_upper`` (3 values each, SI) and
-  ``point_names`` (3 names, default px, py, pz);
-* ``map``: three equal-length lists named by :data:`MAP_AXES` for the kind
-  (or ``--x/--y/--value``), optional ``domain`` (vertices [[x, y], ...]).
+* ``workspace`` -- a point cloud: ``cloud_<t>`` for each task coordinate t
+  (the ``workspace`` kind), or ``points`` (N x 3); a cuboid: ``<t>_min`` and
+  ``<t>_max`` (the ``inscribed_cuboid`` kind), or ``cuboid_lower`` and
+  ``cuboid_upper``; a batch of poses (FK, IK) gives its task coordinates.  A
+  cuboid without a cloud (``inscribed_cuboid``) is drawn in a cloud sampled
+  from the model when the model is at hand (``cpm-nlp solve FILE --plot``);
+* ``map`` -- :data:`MAP_AXES` names (x, y, value) of the kind: x and y
+  lists and the value either a list of the same length or a matrix
+  (rows y, columns x; ``null`` outside the design space); optional
+  ``in_region`` (same shape: outlined), ``<x>_best``/``<y>_best`` and
+  ``<x>_design``/``<y>_design`` (marked), ``domain`` (vertices, outlined).
+  A sweep maps a value over its two swept parameters.
 """
 
 from __future__ import annotations
@@ -50,11 +57,19 @@ DEFAULTS = {
     "forward_kinematics": ("io", "workspace"),
     "inverse_kinematics": ("io", "workspace"),
     "joint_requirements": ("requirements", "workspace"),
+    "workspace": ("workspace",),
+    "inscribed_cuboid": ("workspace",),
+    "rpr_transmission_map": ("map",),
     SWEEP: ("map", "lines", "workspace"),
 }
 
-#: problem kind -> (x, y, value) names of the lists a design map of its result shows
-MAP_AXES: dict[str, tuple[str, str, str]] = {}
+#: problem kind -> (x, y, value) names of the values a design map of its result shows
+MAP_AXES: dict[str, tuple[str, str, str]] = {
+    "rpr_transmission_map": ("s", "t", "eta"),  # rpr-2rpu-upr-zhang-2022.md, Fig. 4
+}
+
+#: sweep statuses of points outside the design space (drawn apart from points that did not solve)
+OUTSIDE = ("infeasible", "invalid_input")
 
 _BY_SI = {d.si: name for name, d in DIMENSIONS.items() if name != "dimensionless"}
 
@@ -95,6 +110,7 @@ class ResultData:
     model: dict[str, Any] = field(default_factory=dict)
     sweep: bool = False
     status: str = "solved"  # of the whole result
+    live: Any = None  # the Model solved, when at hand (solve --plot): lets a plot sample its workspace
     parameters: list[dict[str, Any]] = field(default_factory=list)
     recorded: list[str] = field(default_factory=list)  # value columns of a sweep
 
@@ -178,7 +194,8 @@ def load(path: str | os.PathLike) -> ResultData:
 
 
 def figure(data: ResultData, plot_type: str | None = None, options: PlotOptions | None = None) -> tuple[Any, str]:
-    """The figure of a result: ``(figure, plot type)``."""
+    """The figure of a result: ``(figure, plot type)``.  Raises
+    :class:`NothingSolved` for a result without a solved point."""
     options = options or PlotOptions()
     ok = data.ok
     if (ok is not None and not ok.any()) or (ok is None and data.status != "solved"):
@@ -250,32 +267,54 @@ def _dims(data: ResultData, name: str) -> str | None:
 
 
 def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
-    """A point cloud: the kind's ``points`` (and ``cuboid_lower/upper``), or the
-    task coordinates of a batch of poses (a batch FK sample, an FK sweep)."""
+    """A point cloud with its cuboid (see the module's naming conventions)."""
     from .plots import workspace_figure
 
-    title = f"Workspace ({data.model.get('type') or data.problem})"
-    if data.values.get("points") is not None:
-        pts = np.asarray(data.values["points"], dtype=float)
+    v = data.values
+    title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
+    if v.get("points") is not None:
+        pts = np.asarray(v["points"], dtype=float)
         if pts.ndim != 2 or pts.shape[1] != 3:
             raise NotApplicable(f"'points' must be a list of [x, y, z], got shape {pts.shape}")
-        cuboid = None
-        lower, upper = data.values.get("cuboid_lower"), data.values.get("cuboid_upper")
-        if lower is not None and upper is not None:
-            cuboid = (lower, upper)
-        names = data.values.get("point_names") or ("px", "py", "pz")
+        lower, upper = v.get("cuboid_lower"), v.get("cuboid_upper")
+        cuboid = (lower, upper) if lower is not None and upper is not None else None
         dim = _dims(data, "points") or "length"
+        names = v.get("point_names") or ("x", "y", "z")
         return workspace_figure(pts, cuboid=cuboid, names=names, dimensions=(dim,) * 3, title=title)
     closure = _closure(data)
-    if len(closure.task) != 3:
-        raise NotApplicable(f"a workspace cloud needs 3 task coordinates; {closure.name} has {len(closure.task)}")
-    names = [_pose_name(data, closure, t) for t in closure.task]
-    _require_lists(data, names, "a workspace cloud")
-    pts = np.array([[np.nan if v is None else v for v in data.values[n]] for n in names], dtype=float).T
-    if data.ok is not None:
-        pts = pts[data.ok]
-    dims = [_dims(data, n) or closure.x[closure.x_names.index(t)].kind for n, t in zip(names, closure.task)]
-    return workspace_figure(pts, names=names, dimensions=dims, title=title, points_label="solved poses")
+    task = list(closure.task)
+    if len(task) != 3:
+        raise NotApplicable(f"a workspace cloud needs 3 task coordinates; {closure.name} has {len(task)}")
+    kinds = [closure.x[i].kind for i in closure.task_index]
+    cuboid = None
+    if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
+        cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
+    if all(_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
+        pts = np.array([_floats(v[f"cloud_{t}"]) for t in task]).T
+        label = "reachable points (seeded sample)"
+    elif cuboid is not None:  # inscribed_cuboid: the cloud from the model, if at hand
+        pts, label = np.zeros((0, 3)), ""
+        if data.live is not None:
+            from .workspace import sample_workspace
+
+            pts = sample_workspace(data.live, 20000, 0)[0]
+            label = "reachable points (sample of 20000, seed 0)"
+        else:
+            title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
+        return workspace_figure(pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label)
+    else:  # a batch of poses, one sweep point per pose
+        names = [_pose_name(data, closure, t) for t in task]
+        _require_lists(data, names, "a workspace cloud")
+        pts = np.array([_floats(v[n]) for n in names]).T
+        if data.ok is not None:
+            pts = pts[data.ok]
+        kinds = [_dims(data, n) or k for n, k in zip(names, kinds)]
+        task, label = names, "solved poses"
+    return workspace_figure(pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label)
+
+
+def _floats(values: Any) -> np.ndarray:
+    return np.array([np.nan if x is None else x for x in values], dtype=float)
 
 
 # -- map ---------------------------------------------------------------------------------------------
@@ -317,57 +356,83 @@ def _value_column(data: ResultData, options: PlotOptions) -> str:
 
 
 def map_plot(data: ResultData, options: PlotOptions) -> Any:
-    """A design map: a value over two swept parameters (or, for a kind in
-    :data:`MAP_AXES`, over two of its lists)."""
-    from .plots import design_map_figure
+    """A design map: a value over two swept parameters, or over the two grids
+    of a kind in :data:`MAP_AXES` (see the module's naming conventions)."""
+    from .plots import design_map_figure, pretty
 
     if data.sweep:
-        params = _numeric_columns(data, [p["key"] for p in data.parameters])
-        if options.x or options.y:
-            xk = _sweep_key(data, options.x or params[0], "--x")
-            yk = _sweep_key(data, options.y or next(p for p in params if p != xk), "--y")
-        elif len(params) >= 2:
-            xk, yk = params[0], params[1]
-        else:
-            raise NotApplicable(f"a map needs two swept numeric parameters; this sweep has {len(params)}")
-        zk = _value_column(data, options)
-        ok = data.ok
-        domain = None
-        bases = {p["key"]: p.get("base") for p in data.parameters}
-        base = (bases.get(xk), bases.get(yk))
+        return _sweep_map(data, options)
+    v = data.values
+    axes = MAP_AXES.get(data.problem) or (None, None, None)
+    xk, yk, zk = options.x or axes[0], options.y or axes[1], options.value or axes[2]
+    if not (xk and yk and zk):
+        raise NotApplicable("a map of a single result needs --x, --y and --value naming three of its lists")
+    for n, opt in ((xk, "--x"), (yk, "--y"), (zk, "--value")):
+        if _list(data, n) is None:
+            raise InputError(
+                f"expected the name of a list of the result, got {n!r}",
+                path=(opt,),
+                suggestions=suggest(n, [k for k in v if _list(data, k) is not None]),
+            )
+    x, y, z = v[xk], v[yk], v[zk]
+    region = v.get("in_region")
+    if z and isinstance(z[0], list):  # a matrix over the grids: rows y, columns x
+        if len(z) != len(y) or any(len(row) != len(x) for row in z):
+            raise NotApplicable(f"{zk} is not a {len(y)} x {len(x)} matrix over {yk} and {xk}")
+        x, y = [xi for _ in y for xi in x], [yi for yi in y for _ in x]
+        z = [zij for row in z for zij in row]
+        if isinstance(region, list) and region and isinstance(region[0], list):
+            region = [rij for row in region for rij in row]
+        outside = [zij is None for zij in z]  # null: outside the design space
     else:
-        axes = MAP_AXES.get(data.problem)
-        xk, yk, zk = (
-            options.x or (axes and axes[0]),
-            options.y or (axes and axes[1]),
-            options.value or (axes and axes[2]),
-        )
-        if not (xk and yk and zk):
-            raise NotApplicable("a map of a single result needs --x, --y and --value naming three of its lists")
-        for n, opt in ((xk, "--x"), (yk, "--y"), (zk, "--value")):
-            if _list(data, n) is None:
-                raise InputError(
-                    f"expected the name of a list of the result, got {n!r}",
-                    path=(opt,),
-                    suggestions=suggest(n, [k for k in data.values if _list(data, k) is not None]),
-                )
-        ok = data.ok
-        domain = data.values.get("domain")
-        base = None
-    others = [p["key"] for p in data.parameters if p["key"] not in (xk, yk)] if data.sweep else []
+        outside = None
+    marks = []
+    for suffix, label in (("_design", "design (the file)"), ("_best", f"best {pretty(zk)} (the result)")):
+        mx, my = v.get(xk + suffix), v.get(yk + suffix)
+        if isinstance(mx, (int, float)) and isinstance(my, (int, float)):
+            marks.append((mx, my, label))
+    return design_map_figure(
+        x,
+        y,
+        z,
+        names=(xk, yk, zk),
+        dimensions=(_dims(data, xk), _dims(data, yk), _dims(data, zk) if _dims(data, zk) != "matrix" else None),
+        outside=outside,
+        region=region if isinstance(region, list) and len(region) == len(z) else None,
+        domain=v.get("domain"),
+        best=options.best,
+        marks=marks,
+        title=f"{data.problem}, {data.model.get('type') or ''}",
+    )
+
+
+def _sweep_map(data: ResultData, options: PlotOptions) -> Any:
+    from .plots import design_map_figure
+
+    params = _numeric_columns(data, [p["key"] for p in data.parameters])
+    if options.x or options.y:
+        xk = _sweep_key(data, options.x or params[0], "--x")
+        yk = _sweep_key(data, options.y or next(p for p in params if p != xk), "--y")
+    elif len(params) >= 2:
+        xk, yk = params[0], params[1]
+    else:
+        raise NotApplicable(f"a map needs two swept numeric parameters; this sweep has {len(params)}")
+    others = [p["key"] for p in data.parameters if p["key"] not in (xk, yk)]
     if others:
         raise NotApplicable(f"a map shows two parameters; this sweep also varies {', '.join(others)}")
+    zk = _value_column(data, options)
+    bases = {p["key"]: p.get("base") for p in data.parameters}
     return design_map_figure(
         data.values[xk],
         data.values[yk],
         data.values[zk],
         names=(xk, yk, zk),
         dimensions=(_dims(data, xk), _dims(data, yk), _dims(data, zk)),
-        ok=ok,
-        domain=domain,
+        ok=data.ok,
+        outside=[s in OUTSIDE for s in data.statuses or []] or None,
         best=options.best,
-        base=base,
-        title=f"{data.problem}, {data.model.get('type') or ''}",
+        marks=[(bases.get(xk), bases.get(yk), "base design (the file)")],
+        title=f"sweep of {data.problem}, {data.model.get('type') or ''}",
     )
 
 

@@ -87,6 +87,7 @@ class Axis:
     high: float | None = None
     distribution: str = "uniform"
     dimension: str | None = None
+    base: float | None = None  # the value (SI) of the base problem at this key, if a number
 
     @property
     def name(self) -> str:
@@ -104,6 +105,7 @@ class Axis:
             out.update({"distribution": self.distribution, "from": self.low, "to": self.high})
         else:
             out["count"] = len(self.values)
+        out["base"] = self.base
         return out
 
 
@@ -230,6 +232,32 @@ def _jsonable_raw(raw: Any) -> Any:
 
 
 def _parse_axis(
+    key: str, spec: Any, data: Mapping[str, Any], kind: Any, model: Any, base_dir: Path | None, path: tuple
+) -> Axis:
+    axis = _axis(key, spec, data, kind, model, base_dir, path)
+    option = _resolve(key, kind, model, path)[0]
+    return dataclasses.replace(axis, base=_base_value(data, key, option))
+
+
+def _base_value(data: Mapping[str, Any], key: str, option: Option | None) -> float | None:
+    """The base problem's value at ``key`` in SI, if it is one number (else None)."""
+    node: Any = data
+    for part in key.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            return None
+        node = node[part]
+    if isinstance(node, list) and len(node) == 1:
+        node = node[0]
+    if option is None or option.kind not in DIMENSIONS:
+        return float(node) if _is_number(node) else None
+    try:
+        value = dataclasses.replace(option, shape="scalar").parse(node, ())
+    except InputError:  # a list, a pair, a mapping: no single base value
+        return None
+    return float(value) if _is_number(value) else None
+
+
+def _axis(
     key: str, spec: Any, data: Mapping[str, Any], kind: Any, model: Any, base_dir: Path | None, path: tuple
 ) -> Axis:
     option, solver_key = _resolve(key, kind, model, path)
@@ -437,17 +465,6 @@ def fingerprint(job: Job) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def base_value(problem: Any, key: str) -> Any:
-    """The value (SI) the base problem has at a swept key, if it is a number."""
-    parts = key.split(".")
-    value = None
-    if parts[:2] == ["mechanism", "parameters"]:
-        value = problem.model.parameters.get(parts[2])
-    elif parts[0] == "inputs":
-        value = problem.inputs.get(parts[1])
-    return float(value) if _is_number(value) else None
-
-
 def metadata(problem: Any, job: Job) -> dict[str, Any]:
     """What a results file says about itself (besides its rows); a parameter's
     ``base`` is its value in the base problem (the design of the file)."""
@@ -458,7 +475,7 @@ def metadata(problem: Any, job: Job) -> dict[str, Any]:
         "file": job.file,
         "fingerprint": fingerprint(job),
         "points": job.spec.size,
-        "parameters": [dict(a.describe(), base=base_value(problem, a.key)) for a in job.spec.axes],
+        "parameters": [a.describe() for a in job.spec.axes],
         "values": list(job.values),
         "units": {},
         "dimensions": {},

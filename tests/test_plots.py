@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
@@ -18,32 +17,9 @@ from cpm_nlp.sweep import columns, job_of, metadata, solve_points
 from cpm_nlp.sweep_files import open_store, read_results
 
 from .conftest import PROBLEMS
+from .figure_checks import assert_png_drawn, assert_svg_drawn
 
 matplotlib = pytest.importorskip("matplotlib")
-from matplotlib.image import imread  # noqa: E402
-
-SVG = "{http://www.w3.org/2000/svg}"
-
-
-def assert_png_drawn(path, min_ink=0.03):
-    """A PNG with a real picture: enough non-white pixels, varied colours."""
-    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    rgb = imread(path)[..., :3]
-    ink = (rgb < 0.9).any(axis=-1).mean()
-    colours = len(np.unique((rgb * 15).round().reshape(-1, 3), axis=0))
-    assert ink > min_ink and rgb.std() > 0.05 and colours > 8, (ink, rgb.std(), colours)
-    return rgb
-
-
-def assert_svg_drawn(path, min_paths=50):
-    root = ET.parse(path).getroot()
-    assert root.tag == f"{SVG}svg"
-    n = sum(1 for _ in root.iter(f"{SVG}path")) + sum(1 for _ in root.iter(f"{SVG}use"))
-    assert n >= min_paths, n
-
-
-def labels(fig):
-    return [ax.get_xlabel() for ax in fig.axes] + [ax.get_ylabel() for ax in fig.axes]
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +60,7 @@ def test_requirements_plot_like_fig_6_7(requirements, tmp_path):
     fig, kind = figure(from_result(requirements))
     assert kind == "requirements" and len(fig.axes) == 8
     assert [ax.get_ylabel() for ax in fig.axes] == [
-        r"$\Delta z$ (mm)",
+        "$d_{z}$ (mm)",
         r"$\psi$ (deg)",
         r"$\theta$ (deg)",
         "$s$ (mm)",
@@ -122,28 +98,28 @@ def test_io_plot_outputs_against_the_varied_input(tmp_path, cli):
     assert kind == "io" and len(fig.axes) == 6
     assert {ax.get_xlabel() for ax in fig.axes} == {"$s_{1}$ (mm)"}
     ylabels = [ax.get_ylabel() for ax in fig.axes]
-    assert ylabels[2] == r"$\Delta z$ (µm)" and ylabels[3] == r"$\psi$ (deg)"  # about 0.65 mm: shown in µm
+    assert ylabels[2] == "$d_{z}$ (µm)" and ylabels[3] == r"$\psi$ (deg)"  # about 0.65 mm: shown in µm
     dz = json.loads(result.read_text())["values"]["dz"]
     assert np.allclose(fig.axes[2].lines[0].get_ydata(), np.array(dz) * 1e6)
 
 
-def test_workspace_cloud_from_a_batch_fk_sample(fk_sample, tmp_path):
+def test_workspace_cloud_from_a_batch_fk_sample(fk_sample):
     assert fk_sample.ok
     fig, kind = figure(from_result(fk_sample), "workspace")
     assert kind == "workspace" and len(fig.axes) == 4
     cloud = fig.axes[0].collections[0]
     assert len(cloud.get_offsets()) == 150
-    assert fig.axes[0].get_xlabel() == r"$\Delta z$ (mm)" and fig.axes[0].get_zlabel() == r"$\theta$ (deg)"
-    save(fig, tmp_path / "ws.png")
-    assert_png_drawn(tmp_path / "ws.png")
+    assert fig.axes[0].get_xlabel() == "$d_{z}$ (mm)" and fig.axes[0].get_zlabel() == r"$\theta$ (deg)"
+    dz = np.array(fk_sample.values["dz"]) * 1e3
+    assert np.allclose(np.sort(cloud.get_offsets()[:, 0]), np.sort(dz))  # the solved poses, in mm
 
 
 def test_workspace_with_its_inscribed_cuboid(tmp_path):
     """Synthetic: points inside an ellipsoid (semi-axes 3, 2, 1 mm) and the
     largest box inside it, (2/sqrt 3) x the semi-axes."""
     rng = np.random.default_rng(0)
-    u = rng.normal(size=(2000, 3))
-    u *= (rng.uniform(size=(2000, 1)) ** (1 / 3)) / np.linalg.norm(u, axis=1, keepdims=True)
+    u = rng.normal(size=(600, 3))
+    u *= (rng.uniform(size=(600, 1)) ** (1 / 3)) / np.linalg.norm(u, axis=1, keepdims=True)
     semi = np.array([3e-3, 2e-3, 1e-3])
     pts = u * semi
     half = semi / math.sqrt(3)
@@ -175,7 +151,7 @@ def test_map_of_s_max_over_b_and_L_from_a_sweep_file(map_file, tmp_path, cli):
     assert sorted(np.asarray(cells).ravel()) == pytest.approx(sorted(r["s_max"] * 1e3 for r in rows))
     assert ax.get_xlabel() == "$b$ (mm)" and ax.get_ylabel() == "$L$ (mm)"
     assert fig.axes[1].get_ylabel() == "$s_{max}$ (mm)"  # the colour bar
-    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
     assert legend[0] == "base design (the file)" and legend[1].startswith("max ")
     run = cli("plot", str(map_file), "-o", str(tmp_path / "m.png"), "--value", "dalpha_max")
     assert run.code == 0, run.err
@@ -308,7 +284,7 @@ def test_display_units_and_symbols():
     assert unit == "deg" and f == pytest.approx(180 / math.pi)
     assert display_unit("dimensionless", [3]) == (1.0, "")
     assert pretty("beta_m1") == r"$\beta_{m1}$" and pretty("dalpha_max") == r"$\Delta \alpha_{max}$"
-    assert pretty("alpha0") == r"$\alpha_{0}$" and pretty("s2") == "$s_{2}$" and pretty("dz") == r"$\Delta z$"
+    assert pretty("alpha0") == r"$\alpha_{0}$" and pretty("s2") == "$s_{2}$" and pretty("dz") == "$d_{z}$"
     assert pretty("mechanism.parameters.L") == "$L$" and pretty("manipulability") == "manipulability"
 
 
@@ -319,3 +295,74 @@ def test_sweep_table_and_result_views(map_file, requirements):
     assert list(data.ok) == [True] * 12
     view = from_result(requirements.to_dict())
     assert view.kind == "joint_requirements" and view.dimensions["psi"] == "angle"
+
+
+# -- the kinds of the pantograph and the RPR ----------------------------------------------------
+
+
+def test_pantograph_cuboid_in_its_workspace_like_fig_13(cli, tmp_path):
+    """pantograph-3d-elgammal-2016.md, Fig. 13: the maximal cuboid in the reachable workspace."""
+    out, png = tmp_path / "c.json", tmp_path / "c.png"
+    path = PROBLEMS / "pantograph_cuboid.yaml"
+    run = cli("solve", str(path), "-q", "-o", str(out), "--plot", str(png))
+    assert run.code == 0, run.err
+    assert_png_drawn(png)
+    v = json.loads(out.read_text())["values"]
+    data = load(out)
+    data.live = cn.load_problem(path).model  # as solve --plot has it
+    fig, kind = figure(data)
+    assert kind == "workspace"
+    assert len(fig.axes[0].collections[0].get_offsets()) > 1000  # the cloud sampled from the model
+    rect = fig.axes[1].patches[0]  # px-py projection, in mm
+    assert rect.get_width() == pytest.approx((v["px_max"] - v["px_min"]) * 1e3)
+    assert rect.get_height() == pytest.approx((v["py_max"] - v["py_min"]) * 1e3)
+    assert fig.axes[1].get_xlabel() == "$px$ (mm)" and fig.axes[1].get_ylabel() == "$py$ (mm)"
+    alone, _ = figure(load(out))  # from the JSON alone: the cuboid, and how to see it in its workspace
+    assert len(alone.axes[0].collections[0].get_offsets()) == 0 and len(alone.axes[1].patches) == 1
+    assert "`cpm-nlp solve FILE --plot` draws the workspace around it" in alone._suptitle.get_text()
+
+
+def test_workspace_kind_cloud(tmp_path):
+    result = cn.solve(cn.load_problem(PROBLEMS / "pantograph_workspace.yaml"))
+    fig, kind = figure(from_result(result))
+    assert kind == "workspace"
+    assert len(fig.axes[0].collections[0].get_offsets()) == result.values["cloud_count"]
+    save(fig, tmp_path / "w.svg")
+    assert_svg_drawn(tmp_path / "w.svg", 300)
+
+
+def test_rpr_transmission_map_like_fig_4(tmp_path):
+    """rpr-2rpu-upr-zhang-2022.md, Fig. 4: eta over the (s, t) triangle, the optimum region marked."""
+    result = cn.solve(cn.load_problem(PROBLEMS / "rpr_transmission_map.yaml"))
+    fig, kind = figure(from_result(result))
+    assert kind == "map"
+    ax = fig.axes[0]
+    cells = ax.collections[0].get_array()
+    eta = result.values["eta"]
+    assert cells.shape == (len(result.values["t"]), len(result.values["s"]))
+    assert np.ma.count_masked(cells) == sum(v is None for row in eta for v in row)  # blank outside eq 22
+    assert np.nanmax(cells.filled(np.nan)) == pytest.approx(result.values["eta_best"])
+    red = [c for c in ax.collections[1:] if np.allclose(c.get_edgecolor()[0][:3], matplotlib.colors.to_rgb("tab:red"))]
+    assert red  # the optimum region eta >= 0.99 is outlined
+    marks = {ln.get_label(): (ln.get_xdata()[0], ln.get_ydata()[0]) for ln in ax.lines if len(ln.get_xdata()) == 1}
+    assert marks["design (the file)"] == pytest.approx((1.5, 0.0))  # eq 24
+    assert marks[r"best $\eta$ (the result)"] == pytest.approx((result.values["s_best"], result.values["t_best"]))
+    save(fig, tmp_path / "eta.png")
+    assert_png_drawn(tmp_path / "eta.png", min_ink=0.2)
+
+
+def test_pantograph_outputs_against_dx_like_fig_20(tmp_path):
+    """pantograph-3d-elgammal-2016.md, Fig. 20: px, py, pz against d_x (28.234 ... 28.334 mm, section 7);
+    the rigid model gives px/d_x = Mx = 1 + b/a = 3.5 (eq 9) and no parasitic motion."""
+    path = tmp_path / "fk.yaml"
+    path.write_text(
+        "problem: forward_kinematics\nmechanism: {type: pantograph, parameters: {a: 20 mm, b: 50 mm}}\n"
+        "inputs: {dx: {from: 28.234 mm, to: 28.334 mm, count: 11}, dy: 0 mm, dz: 0 mm}\n"
+    )
+    fig, kind = figure(from_result(cn.solve(cn.load_problem(path))))
+    assert kind == "io" and fig.axes[0].get_xlabel() == "$d_{x}$ (mm)"
+    px, py, pz = (fig.axes[i].lines[0] for i in range(3))
+    slope = np.polyfit(px.get_xdata(), px.get_ydata(), 1)[0]
+    assert slope == pytest.approx(3.5, rel=1e-6)
+    assert not np.any(py.get_ydata()) and not np.any(pz.get_ydata())  # exact zeros shown as zero
+    assert fig.axes[1].get_ylabel() == "$py$ (mm)"

@@ -125,9 +125,46 @@ def test_solve_on_a_sweep_file_solves_the_base_problem(cli):
     assert cli("check", str(SWEEP_FILE)).code == 0
 
 
-def test_shipped_sweep_file_is_small_enough_to_run_in_a_minute():
-    spec = cn.load_problem(SWEEP_FILE).sweep
-    assert 100 <= spec.size <= 400  # about 10 ms a point, 27 IK each
+def test_shipped_sweep_files_are_small_enough_to_run_in_a_minute(cli):
+    sizes = {p.name: cn.load_problem(p).sweep.size for p in sorted(PROBLEMS.glob("sweep_*.yaml"))}
+    assert sizes == {
+        "sweep_pantograph_cuboid.yaml": 54,  # about 0.4 s a point (IPOPT, 4 starts): 11 s on 2 cores
+        "sweep_prs3_requirements.yaml": 169,  # about 10 ms a point, 27 IK each
+        "sweep_rpr_transmission.yaml": 1500,  # about 3 ms a point
+    }
+    for name in sizes:
+        assert cli("check", str(PROBLEMS / name)).code == 0
+
+
+def test_pantograph_cuboid_sweep_points_are_solves_of_the_file():
+    problem = cn.load_problem(PROBLEMS / "sweep_pantograph_cuboid.yaml")
+    job = job_of(problem)
+    point = job.spec.point(21)
+    assert point == {"mechanism.parameters.b": pytest.approx(0.05), "mechanism.limits.t": pytest.approx(2e-4)}
+    record = solve_point(job, 21)[0]
+    expected = cn.solve(
+        cn.load_problem(PROBLEMS / "sweep_pantograph_cuboid.yaml", [override(k, v) for k, v in point.items()])
+    )
+    assert record["status"] == "solved" and record["volume"] == expected.values["volume"]
+    # a thicker hinge turns less (eq 30-31): a smaller cuboid than the paper's t = 0.1 mm
+    assert record["volume"] < cn.solve(problem).values["volume"]
+    assert [a.base for a in job.spec.axes] == pytest.approx([0.05, 1e-4])  # the paper's design
+
+
+def test_rpr_sweep_points_inside_and_outside_the_design_triangle():
+    problem = cn.load_problem(PROBLEMS / "sweep_rpr_transmission.yaml")
+    base = cn.solve(problem)
+    assert base.values["eta_best"] == pytest.approx(0.913, abs=5e-4)  # eta(1.5, 0), rpr_transmission_map.yaml
+    job = job_of(problem)
+    records = [solve_point(job, k)[0] for k in range(20)]
+    statuses = {r["status"] for r in records}
+    assert statuses == {"solved", "infeasible"}
+    for r in records:
+        s, t = r["inputs.s"], r["inputs.t"]
+        l1, l2, l3 = (3 - s - math.sqrt(3) * t) / 2, s, (3 - s + math.sqrt(3) * t) / 2  # eq 23
+        inside = min(l1, l3) > 0 and l1 / 2 <= l2 <= 2 * l1  # eq 22
+        assert (r["status"] == "solved") == inside, r
+        assert (r["eta_best"] is not None) == inside
 
 
 @pytest.mark.parametrize(
@@ -278,7 +315,7 @@ for m in ("distributed", "matplotlib", "pyarrow"):
 from cpm_nlp.cli import main
 assert main(["check", {str(SWEEP_FILE)!r}]) == 0
 assert main(["solve", {str(SWEEP_FILE)!r}, "-q"]) == 0
-assert main(["reproduce", {str(PROBLEMS)!r}]) == 0
+assert main(["reproduce", {str(PROBLEMS / "prs3_joint_requirements.yaml")!r}]) == 0
 print("exit", main(["sweep", {str(SWEEP_FILE)!r}, "-q", "-o", {str(tmp_path / "r.csv")!r}]))
 print("exit", main(["solve", {str(SWEEP_FILE)!r}, "-q", "--plot", {str(tmp_path / "r.png")!r}]))
 """

@@ -14,6 +14,9 @@ import cpm_nlp as cn
 from cpm_nlp.sweep import job_of, run_sweep, solve_points
 from cpm_nlp.sweep_files import read_results
 
+from .conftest import PROBLEMS
+from .figure_checks import assert_png_drawn
+
 distributed = pytest.importorskip("distributed")
 
 MAP = """\
@@ -179,3 +182,31 @@ def test_scheduler_that_does_not_answer(cli, tmp_path):
     assert run.code == 2
     assert run.err.startswith("error: --scheduler: cannot connect to the Dask scheduler tcp://127.0.0.1:9")
     assert not (tmp_path / "r.csv").exists()  # bad input writes nothing
+
+
+def test_shipped_rpr_sweep_maps_the_design_triangle(cluster, cli, tmp_path):
+    """problems/sweep_rpr_transmission.yaml with a smaller sample: points outside eq 22 are
+    recorded as infeasible, the map is drawn over the triangle the solved points span."""
+    cl, _ = cluster
+    out, png = tmp_path / "eta.csv", tmp_path / "eta.png"
+    run = cli(
+        "sweep",
+        str(PROBLEMS / "sweep_rpr_transmission.yaml"),
+        "--set",
+        "sweep.samples=300",
+        "-o",
+        str(out),
+        "--scheduler",
+        cl.scheduler_address,
+        "-q",
+        "--plot",
+        str(png),
+        "--best",
+        "max",
+    )
+    assert run.code == 1, run.err  # points outside the design space are not solved: the file says so
+    rows = read_results(out).rows
+    counts = {s: sum(r["status"] == s for r in rows) for s in ("solved", "infeasible")}
+    assert counts["solved"] + counts["infeasible"] == 300 and 50 < counts["solved"] < 150  # the triangle: 30 %
+    assert all(0 < r["eta_best"] <= 1 for r in rows if r["status"] == "solved")
+    assert_png_drawn(png, min_ink=0.15)
