@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError, suggest
+from .plots import as_floats
 from .units import DIMENSIONS
 
 SWEEP = "sweep"  # the "kind" of a sweep results file in DEFAULTS
@@ -290,7 +291,7 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
     if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
         cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
     if all(_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
-        pts = np.array([_floats(v[f"cloud_{t}"]) for t in task]).T
+        pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
         label = "reachable points (seeded sample)"
     elif cuboid is not None:  # inscribed_cuboid: the cloud from the model, if at hand
         pts, label = np.zeros((0, 3)), ""
@@ -305,16 +306,12 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
     else:  # a batch of poses, one sweep point per pose
         names = [_pose_name(data, closure, t) for t in task]
         _require_lists(data, names, "a workspace cloud")
-        pts = np.array([_floats(v[n]) for n in names]).T
+        pts = np.array([as_floats(v[n]) for n in names]).T
         if data.ok is not None:
             pts = pts[data.ok]
         kinds = [_dims(data, n) or k for n, k in zip(names, kinds)]
         task, label = names, "solved poses"
     return workspace_figure(pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label)
-
-
-def _floats(values: Any) -> np.ndarray:
-    return np.array([np.nan if x is None else x for x in values], dtype=float)
 
 
 # -- map ---------------------------------------------------------------------------------------------

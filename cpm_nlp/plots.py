@@ -137,16 +137,16 @@ def axis_label(name: str, unit: str) -> str:
 
 def check_figure_path(path: str | os.PathLike, option: str = "-o") -> None:
     """Fail early (an :class:`InputError`) if a figure cannot be written there."""
-    target = Path(path)
-    if target.suffix.lower() not in FIGURE_FORMATS:
+    from .cli import check_output_path
+
+    if Path(path).suffix.lower() not in FIGURE_FORMATS:
         raise InputError(
             f"expected a figure file ending in {', '.join(FIGURE_FORMATS)}, got {str(path)!r}", path=(option,)
         )
-    parent = target.parent if str(target.parent) else Path(".")
-    if target.is_dir():
-        raise InputError(f"{path} is a directory; expected a file name", path=(option,))
-    if not parent.is_dir():
-        raise InputError(f"output directory {parent} does not exist", path=(option,))
+    try:
+        check_output_path(str(path))
+    except InputError as exc:
+        raise InputError(exc.message, path=(option,)) from None
 
 
 def save(fig: Any, path: str | os.PathLike) -> None:
@@ -298,7 +298,7 @@ def design_map_figure(
 
     x = np.asarray(x, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
-    z = _floats(np.asarray(z, dtype=object).ravel())
+    z = as_floats(np.asarray(z, dtype=object).ravel())
     if not (len(x) == len(y) == len(z)):
         raise InputError(f"x, y and the value must have one entry per point (got {len(x)}, {len(y)}, {len(z)})")
     good = np.isfinite(z) & np.isfinite(x) & np.isfinite(y)
@@ -430,7 +430,8 @@ class Panel:
 NUMERICAL_ZERO = 1e-13
 
 
-def _floats(values: Any) -> np.ndarray:
+def as_floats(values: Any) -> np.ndarray:
+    """SI values (None: not solved) as floats, NaN for None, rounding noise of zero as 0."""
     arr = np.asarray([np.nan if v is None else v for v in values], dtype=float)
     return np.where(np.abs(arr) < NUMERICAL_ZERO, 0.0, arr)
 
@@ -451,7 +452,7 @@ def panels_figure(
     Figure = _figure_class()
     if not panels:
         raise InputError("nothing to plot (no quantity given)")
-    xs = _floats(x)
+    xs = as_floats(x)
     fx, ux = display_unit(xdimension, xs) if xdimension else (1.0, "")
     n = len(panels)
     ncols = ncols or min(n, 3 if n in (3, 5, 6, 9) else 4)
@@ -460,7 +461,7 @@ def panels_figure(
     drawn = 0
     for k, panel in enumerate(panels):
         ax = fig.add_subplot(nrows, ncols, k + 1)
-        ys_all = [_floats(v) for v in panel.series.values()]
+        ys_all = [as_floats(v) for v in panel.series.values()]
         both = np.concatenate(ys_all) if ys_all else np.array([])
         fy, uy = display_unit(panel.dimension, both)
         for label, ys in zip(panel.series, ys_all):

@@ -308,13 +308,11 @@ def journal_path(path: Path) -> Path:
 
 def open_store(path: str | os.PathLike, meta: dict[str, Any], columns: list[str], *, overwrite: bool = False) -> _Store:
     """The results file of a sweep, ready to append to (existing rows adopted)."""
+    from .cli import check_output_path
+
     target = Path(path)
     fmt = results_format(target)
-    parent = target.parent if str(target.parent) else Path(".")
-    if target.is_dir():
-        raise InputError(f"output path {path} is a directory; expected a file name", path=("-o",))
-    if not parent.is_dir():
-        raise InputError(f"output directory {parent} does not exist", path=("-o",))
+    check_output_path(str(target))
     meta = json.loads(json.dumps(meta))  # a copy: the store adds units as it learns them
     if fmt == ".csv":
         return CsvStore(target, meta, columns, overwrite)
