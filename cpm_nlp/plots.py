@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from .cli import check_output_path, replace_atomically
 from .errors import InputError
 from .units import DIMENSIONS, to_display
 
@@ -137,8 +137,6 @@ def axis_label(name: str, unit: str) -> str:
 
 def check_figure_path(path: str | os.PathLike, option: str = "-o") -> None:
     """Fail early (an :class:`InputError`) if a figure cannot be written there."""
-    from .cli import check_output_path
-
     if Path(path).suffix.lower() not in FIGURE_FORMATS:
         raise InputError(
             f"expected a figure file ending in {', '.join(FIGURE_FORMATS)}, got {str(path)!r}", path=(option,)
@@ -151,18 +149,8 @@ def check_figure_path(path: str | os.PathLike, option: str = "-o") -> None:
 
 def save(fig: Any, path: str | os.PathLike) -> None:
     """Write a figure (format from the suffix) all at once."""
-    target = Path(path)
-    fmt = target.suffix.lower().lstrip(".")
-    directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".{fmt}", dir=directory)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, format=fmt, dpi=150)
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    fmt = Path(path).suffix.lower().lstrip(".")
+    replace_atomically(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=150), suffix=f".{fmt}")
 
 
 # -- (a) workspace -------------------------------------------------------------------------------

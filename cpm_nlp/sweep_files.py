@@ -28,7 +28,6 @@ import io
 import json
 import math
 import os
-import tempfile
 import time
 from collections import Counter
 from collections.abc import Mapping
@@ -36,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .cli import check_output_path, replace_atomically
 from .errors import InputError
 
 META_PREFIX = "# cpm_nlp sweep "
@@ -70,20 +70,6 @@ def results_format(path: str | os.PathLike) -> str:
     if suffix not in FORMATS:
         raise InputError(f"expected a results file ending in .parquet or .csv, got {str(path)!r}", path=("-o",))
     return suffix
-
-
-def _atomic_bytes(path: Path, write) -> None:
-    """Create ``path`` all at once: ``write(tmp_path)`` then rename."""
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 # -- cells ------------------------------------------------------------------------------------
@@ -223,7 +209,7 @@ class CsvStore(_Store):
 
     def _open(self) -> None:
         if not self.resumed:
-            _atomic_bytes(self.path, lambda tmp: Path(tmp).write_text(self._head(), encoding="utf-8"))
+            replace_atomically(self.path, lambda tmp: Path(tmp).write_text(self._head(), encoding="utf-8"))
             self._meta_seen = json.dumps(self.meta, sort_keys=True)
         self._fh = open(self.path, "a", encoding="utf-8", newline="")  # noqa: SIM115 - closed in close()
         self._csv = csv.writer(self._fh, lineterminator="\n")
@@ -236,7 +222,7 @@ class CsvStore(_Store):
     def _finish(self) -> None:
         if self._fh is not None and self._meta_changed():  # units learned: refresh line 1
             body = self.path.read_text(encoding="utf-8").split("\n", 2)[2]
-            _atomic_bytes(self.path, lambda tmp: Path(tmp).write_text(self._head() + body, encoding="utf-8"))
+            replace_atomically(self.path, lambda tmp: Path(tmp).write_text(self._head() + body, encoding="utf-8"))
 
 
 def _truncate_partial_line(path: Path) -> None:
@@ -308,8 +294,6 @@ def journal_path(path: Path) -> Path:
 
 def open_store(path: str | os.PathLike, meta: dict[str, Any], columns: list[str], *, overwrite: bool = False) -> _Store:
     """The results file of a sweep, ready to append to (existing rows adopted)."""
-    from .cli import check_output_path
-
     target = Path(path)
     fmt = results_format(target)
     check_output_path(str(target))
@@ -415,7 +399,7 @@ def write_parquet(path: Path, meta: Mapping[str, Any], columns: list[str], rows:
     full = dict(meta, json_columns=json_cols)
     schema = pa.schema(fields, metadata={b"cpm_nlp": json.dumps(full, sort_keys=True).encode()})
     table = pa.Table.from_arrays(arrays, schema=schema)
-    _atomic_bytes(path, lambda tmp: pq.write_table(table, tmp))
+    replace_atomically(path, lambda tmp: pq.write_table(table, tmp))
 
 
 def read_results(path: str | os.PathLike) -> SweepTable:

@@ -5,6 +5,8 @@ with another sweep's rows.  The records are real solves; no Dask here."""
 from __future__ import annotations
 
 import json
+import os
+import stat
 
 import pytest
 
@@ -59,6 +61,9 @@ def test_rows_round_trip_exactly(problem, solved, tmp_path, suffix):
     assert table.parameters[0]["base"] == pytest.approx(0.109215) and table.parameters[0]["dimension"] == "length"
     assert list(table.rows[0]) == columns(job_of(problem))
     assert not journal_path(path).exists()
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~umask  # as any new file, not mkstemp's 0600
 
 
 def test_csv_is_readable_as_plain_csv(problem, solved, tmp_path):
