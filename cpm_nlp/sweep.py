@@ -94,10 +94,6 @@ class Axis:
         """The last part of the key (``L`` for ``mechanism.parameters.L``)."""
         return self.key.rsplit(".", 1)[-1]
 
-    @property
-    def numeric(self) -> bool:
-        return self.mode == "random" or all(_is_number(v) for v in self.values)
-
     def describe(self) -> dict[str, Any]:
         """JSON-able description (stored with the results)."""
         out: dict[str, Any] = {"key": self.key, "name": self.name, "mode": self.mode, "dimension": self.dimension}

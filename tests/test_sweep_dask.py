@@ -120,6 +120,21 @@ def test_interrupted_sweep_resumes_without_solving_twice(cluster, tmp_path):
     assert again.solved_now == 0 and again.ok and again.workers == 0  # nothing left: no task at all
 
 
+def _kill_a_busy_worker(client, killed):
+    """A progress callback: at the first result, SIGKILL a worker that is processing a task."""
+
+    def callback(done, total):
+        if done == 0 or killed:
+            return
+        busy = [w for w, keys in client.processing().items() if keys]
+        pids = client.run(os.getpid, workers=busy[:1])
+        victim = next(iter(pids.values()))
+        os.kill(victim, signal.SIGKILL)
+        killed.append(victim)
+
+    return callback
+
+
 def test_a_worker_that_dies_is_retried_and_the_sweep_completes(tmp_path):
     problem = problem_of(tmp_path, MAP)
     out = tmp_path / "map.parquet"
@@ -127,19 +142,32 @@ def test_a_worker_that_dies_is_retried_and_the_sweep_completes(tmp_path):
         distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cl,
         distributed.Client(cl) as client,
     ):
-        before = client.run(os.getpid)
         killed = []
-
-        def kill_one(done, total):
-            if done > 0 and not killed:  # tasks of both workers are in flight now
-                victim = next(iter(before.values()))
-                os.kill(victim, signal.SIGKILL)
-                killed.append(victim)
-
-        summary = run_sweep(problem, out, client=client, chunk_size=2, progress=kill_one)
+        summary = run_sweep(problem, out, client=client, chunk_size=2, progress=_kill_a_busy_worker(client, killed))
         client.wait_for_workers(2, timeout=30)
         after = set(client.run(os.getpid).values())
     assert killed and killed[0] not in after  # the worker died (its nanny started a new process)
+    assert summary.ok and summary.statuses == {"solved": 20}
+    assert sorted(r["point"] for r in read_results(out).rows) == list(range(20))
+
+
+def test_a_task_that_fails_beyond_the_retries_is_split_into_points(tmp_path, caplog):
+    """With no retry allowed, the task of the killed worker fails (KilledWorker): its
+    points are solved one by one, none is lost."""
+    import dask
+
+    problem = problem_of(tmp_path, MAP)
+    out = tmp_path / "map.csv"
+    with (
+        dask.config.set({"distributed.scheduler.allowed-failures": 0}),
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cl,
+        distributed.Client(cl) as client,
+    ):
+        killed = []
+        with caplog.at_level("WARNING", logger="cpm_nlp.sweep"):
+            summary = run_sweep(problem, out, client=client, chunk_size=4, progress=_kill_a_busy_worker(client, killed))
+    assert killed
+    assert any("a task of 4 points failed" in r.getMessage() and "one by one" in r.getMessage() for r in caplog.records)
     assert summary.ok and summary.statuses == {"solved": 20}
     assert sorted(r["point"] for r in read_results(out).rows) == list(range(20))
 
