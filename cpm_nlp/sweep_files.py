@@ -164,6 +164,7 @@ class _Store:
     def _adopt(self, table: SweepTable) -> None:
         """Take over the rows and metadata of an existing file of the same sweep."""
         _check_same_sweep(table, self.meta, self.columns, self.path)
+        self._meta_seen = json.dumps(table.meta, sort_keys=True)  # what the file says now
         for key in ("units", "dimensions"):
             self.meta[key] = {**table.meta.get(key, {}), **self.meta[key]}
         for r in table.rows:
@@ -199,7 +200,6 @@ class CsvStore(_Store):
             _read_meta_line(path)  # a file of ours, before anything is changed in it
             _truncate_partial_line(path)
             self._adopt(read_csv(path))
-            self._meta_seen = json.dumps(self.meta, sort_keys=True)
 
     def _head(self) -> str:
         buf = io.StringIO()
@@ -248,7 +248,6 @@ class ParquetStore(_Store):
             table = read_parquet(path)
             self._adopt(table)
             self.rows = {r["point"]: r for r in table.rows}
-            self._meta_seen = json.dumps(self.meta, sort_keys=True)
             if self.journal.exists():
                 _truncate_partial_line(self.journal)
                 self._dirty = True  # a run that stopped before writing its Parquet file

@@ -171,3 +171,24 @@ def test_a_file_that_is_not_a_results_file_is_left_alone(problem, tmp_path):
     with pytest.raises(cn.InputError) as err:
         read_results(bad)
     assert "is not a readable Parquet file" in str(err.value)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_more_samples_resume_and_the_metadata_follows(tmp_path, suffix):
+    text = TEXT.split("sweep:")[0] + (
+        "sweep:\n  parameters:\n    mechanism.parameters.L: {random: uniform, from: 100 mm, to: 120 mm}\n"
+        "  samples: {n}\n"
+    )
+    path = tmp_path / "s.yaml"
+    out = tmp_path / f"r{suffix}"
+    for n in (3, 5):
+        path.write_text(text.replace("{n}", str(n)))
+        problem = cn.load_problem(path)
+        store = store_for(problem, out)
+        todo = [k for k in range(n) if k not in store.done]
+        solved = solve_points(job_of(problem), todo)
+        store.append(solved["records"], solved["units"], solved["dimensions"])
+        store.close()
+        assert store.added == (3 if n == 3 else 2)  # the first three are kept, not solved again
+    table = read_results(out)
+    assert [r["point"] for r in table.rows] == [0, 1, 2, 3, 4] and table.meta["points"] == 5
