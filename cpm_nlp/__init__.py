@@ -15,6 +15,8 @@ or, from a problem file::
 import logging
 
 from .api import (
+    BatchJacobians,
+    BatchResult,
     Comparison,
     Coordinate,
     CpmError,
@@ -22,6 +24,7 @@ from .api import (
     JacobianReport,
     LoopClosure,
     Model,
+    ModelFunctions,
     PoseSolution,
     Problem,
     RequirementsReport,
@@ -31,11 +34,17 @@ from .api import (
     Status,
     apply_overrides,
     assess,
+    batch_forward_kinematics,
+    batch_inverse_kinematics,
+    batch_jacobians,
     build_model,
+    export_kinematics,
     forward_kinematics,
+    functions,
     inverse_kinematics,
     jacobians,
     joint_requirements,
+    load_exported,
     load_problem,
     mechanism_type,
     passive_joints,
@@ -46,6 +55,15 @@ from .api import (
 )
 
 __all__ = [
+    "ModelFunctions",
+    "export_kinematics",
+    "functions",
+    "load_exported",
+    "BatchJacobians",
+    "BatchResult",
+    "batch_forward_kinematics",
+    "batch_inverse_kinematics",
+    "batch_jacobians",
     "Comparison",
     "Coordinate",
     "CpmError",

@@ -7,7 +7,10 @@ with numpy arrays, or take the CasADi Functions of the model (``model.closure``:
 to the ``cpm_nlp`` logger.
 """
 
+from .batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
+from .embed import ModelFunctions, functions
 from .errors import CpmError, InputError
+from .export import export_kinematics, load_exported
 from .kinematics import (
     JacobianReport,
     PoseSolution,
@@ -27,6 +30,15 @@ from .result import Result, SolverInfo, Status
 from .solver import SolverConfig
 
 __all__ = [
+    "ModelFunctions",
+    "export_kinematics",
+    "functions",
+    "load_exported",
+    "BatchJacobians",
+    "BatchResult",
+    "batch_forward_kinematics",
+    "batch_inverse_kinematics",
+    "batch_jacobians",
     "Comparison",
     "Coordinate",
     "CpmError",

@@ -224,6 +224,11 @@ def newton_options(config: SolverConfig | None) -> dict[str, Any]:
     return opts
 
 
+def batch_newton_supported(config: SolverConfig) -> bool:
+    """Whether the kernels' Newton solver honours every option of ``config``."""
+    return config.method == "newton" and all(k in NEWTON_OPTIONS + _IGNORED_NEWTON for k in config.options)
+
+
 def _options_key(opts: Mapping[str, Any]) -> tuple:
     return tuple(sorted((k, repr(v)) for k, v in opts.items()))
 
@@ -244,6 +249,7 @@ class Kernel:
     kind: str
     pose_inputs: tuple[str, ...]
     outputs: tuple[str, ...]
+    key: tuple = ()  # identity in the closure's cache
 
     @property
     def name(self) -> str:
@@ -277,7 +283,8 @@ def _converged(y: ca.MX, residual: ca.MX, tol: ca.MX) -> ca.MX:
 def _rootfinder(name: str, residual: ca.Function, ny: int, nw: int, opts: Mapping[str, Any]) -> ca.Function:
     y, w = ca.SX.sym("y", ny), ca.SX.sym("w", nw)
     g = ca.Function(f"{name}_residual", [y, w], [residual(y, w)], ["y", "w"], ["g"])
-    return ca.rootfinder(name, "fast_newton", g, dict(opts))
+    # a pose Newton cannot solve is reported by its status, never by an exception
+    return ca.rootfinder(name, "fast_newton", g, {**opts, "error_on_fail": False})
 
 
 def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
@@ -300,9 +307,10 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         names = ("x", "passive", *_STATUS_OUTPUTS)
         outs = [x] + [chk[n] for n in names[1:-1]] + [status]
         fn = ca.Function(f"{c.name}_fk", [q, x0, *shared], outs, ["q", "x0", *SHARED_INPUTS], list(names))
-        return Kernel(fn, "fk", ("q", "x0"), names)
+        return Kernel(fn, "fk", ("q", "x0"), names, key)
 
-    return closure.solvers.memo(("fk_kernel", _options_key(opts)), build)
+    key = ("fk_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
 
 
 def ik_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
@@ -341,9 +349,10 @@ def ik_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         names = ("x", "q", "passive", "reach", *_STATUS_OUTPUTS)
         outs = [x, q, chk["passive"], reach] + [chk[n] for n in _STATUS_OUTPUTS[:-1]] + [status]
         fn = ca.Function(f"{c.name}_ik", [*ins, *shared], outs, [*pose_inputs, *SHARED_INPUTS], list(names))
-        return Kernel(fn, "ik", pose_inputs, names)
+        return Kernel(fn, "ik", pose_inputs, names, key)
 
-    return closure.solvers.memo(("ik_kernel", _options_key(opts)), build)
+    key = ("ik_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
 
 
 def jacobian_kernel(closure: LoopClosure) -> Kernel:
@@ -355,9 +364,10 @@ def jacobian_kernel(closure: LoopClosure) -> Kernel:
         outs = [ca.densify(f(x, q, p)) for f in (c.jacobian, c.inverse_jacobian, c.phi_x, c.phi_q)]
         names = ("J", "J_inv", "Phi_x", "Phi_q")
         fn = ca.Function(f"{c.name}_jacobian", [x, q, p], outs, ["x", "q", "p"], list(names))
-        return Kernel(fn, "jacobian", ("x", "q"), names)
+        return Kernel(fn, "jacobian", ("x", "q"), names, key)
 
-    return closure.solvers.memo(("jacobian_kernel",), build)
+    key = ("jacobian_kernel",)
+    return closure.solvers.memo(key, build)
 
 
 def kernel(closure: LoopClosure, kind: str, config: SolverConfig | None = None) -> Kernel:
@@ -401,11 +411,17 @@ class FastFunction:
 
     Uses one :class:`casadi.FunctionBuffer` per thread (a few µs per call
     instead of the ~30 µs of a regular call from Python); safe to call from
-    several threads.  Returns the outputs as flat float arrays (column-major
-    nonzeros, as CasADi stores them).
+    several threads.  Returns the outputs as flat float arrays (dense,
+    column-major, as CasADi stores them).
     """
 
     def __init__(self, function: ca.Function) -> None:
+        if not all(function.sparsity_out(i).is_dense() for i in range(function.n_out())):
+            args = function.mx_in()
+            res = function.call(args)
+            function = ca.Function(
+                function.name(), args, [ca.densify(r) for r in res], function.name_in(), function.name_out()
+            )
         self.function = function
         self.names_out = tuple(function.name_out())
         self._nnz_in = [function.nnz_in(i) for i in range(function.n_in())]

@@ -192,7 +192,11 @@ def forward_kinematics(
     x, ok, iters, msg, sec = built.solve(x0, np.concatenate([qv, model.p]), model.x_lower, model.x_upper)
     if not ok:
         return PoseSolution(
-            Status.NOT_CONVERGED, iterations=iters, seconds=sec, solver=config.name, message=f"{config.name}: {msg}"
+            Status.NOT_CONVERGED,
+            iterations=iters,
+            seconds=sec,
+            solver=config.name,
+            message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
         )
     return _checked(model, x, qv, config.tolerance, iters, sec, config.name)
 
@@ -225,13 +229,9 @@ def inverse_kinematics(
         x, q, reach = fast(c, ("ik",), lambda: c.ik)(tv, model.p)
         sec = time.perf_counter() - t0
         if not reach[0] >= 0:
-            return PoseSolution(
-                Status.UNREACHABLE,
-                seconds=sec,
-                solver="closed_form",
-                message=f"the closed-form IK has no real solution (reach margin {reach[0]:.3g} < 0)",
-                details={"reach": float(reach[0])},
-            )
+            details = {"reach": float(reach[0])}
+            message = failure_message(model, Status.UNREACHABLE, details, None, None, config.tolerance)
+            return PoseSolution(Status.UNREACHABLE, seconds=sec, solver="closed_form", message=message, details=details)
         return _checked(model, x, q, config.tolerance, 0, sec, "closed_form")
     built = c.ik_solver(config)
     nd = len(c.dep_index)
@@ -241,7 +241,11 @@ def inverse_kinematics(
     y, ok, iters, msg, sec = built.solve(y0, np.r_[tv, model.p], lower, upper)
     if not ok:
         return PoseSolution(
-            Status.NOT_CONVERGED, iterations=iters, seconds=sec, solver=config.name, message=f"{config.name}: {msg}"
+            Status.NOT_CONVERGED,
+            iterations=iters,
+            seconds=sec,
+            solver=config.name,
+            message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
         )
     x = c.assemble_x(tv, y[:nd])
     q = y[nd:]
