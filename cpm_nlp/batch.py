@@ -189,6 +189,16 @@ def _rows(values, n_cols: int, name: str) -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
+def _guess(values, n: int, n_cols: int) -> np.ndarray:
+    """One guess for every pose (1-D, shared) or one per pose (N rows)."""
+    arr = _rows(values, n_cols, "guess")
+    if arr.shape[0] == 1:
+        return arr[0]
+    if arr.shape[0] != n:
+        raise InputError(f"expected 1 or {n} rows, got {arr.shape[0]}", path=("guess",))
+    return arr
+
+
 def _broadcast_rows(values, n: int, n_cols: int, name: str) -> np.ndarray:
     arr = _rows(values, n_cols, name)
     if arr.shape[0] == 1 and n != 1:
@@ -218,39 +228,37 @@ def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Func
 
 def evaluate(
     function: ca.Function,
-    inputs: Sequence[np.ndarray],
-    shared: Sequence[np.ndarray] = (),
+    args: Sequence[np.ndarray],
     threads: int | None = None,
     chunk: int = CHUNK,
 ) -> list[np.ndarray]:
     """Evaluate a Function over N poses.
 
-    inputs: the per-pose inputs, (N, nnz_in(k)) C-contiguous arrays; shared:
-    the values of the remaining inputs, the same for every pose.  Returns
+    args: one array per input of ``function``: (N, nnz_in(k)) C-contiguous
+    for a per-pose input, 1-D for a value shared by every pose.  Returns
     (N, nnz_out(k)) arrays (dense, column-major per pose).  Chunks of
     ``chunk`` poses go through ``function.map(chunk)`` (one FunctionBuffer
     each), spread over ``threads`` threads.
     """
-    n = inputs[0].shape[0] if inputs else 0
+    per_pose = [a for a in args if a.ndim == 2]
+    n = per_pose[0].shape[0] if per_pose else 1
     outs = [np.empty((n, function.nnz_out(k))) for k in range(function.n_out())]
     if n == 0:
         return outs
     threads = default_threads() if threads is None else max(1, int(threads))
     chunk = max(1, min(int(chunk), -(-n // threads)))
     starts = list(range(0, n, chunk))
-    maps: dict[int, tuple[ca.Function, list[np.ndarray]]] = {}
+    maps: dict[int, tuple[ca.Function, list[np.ndarray | None]]] = {}
     for size in {min(chunk, n - a) for a in starts}:  # built before the threads start
-        tiled = [np.ascontiguousarray(np.broadcast_to(np.ravel(v), (size, np.size(v)))) for v in shared]
+        tiled = [None if a.ndim == 2 else np.ascontiguousarray(np.broadcast_to(a, (size, a.size))) for a in args]
         maps[size] = (function.map(size) if size > 1 else function, tiled)
 
     def run(start: int) -> int:
         stop = min(start + chunk, n)
         mapped, tiled = maps[stop - start]
         buf, call = mapped.buffer()
-        for k, arr in enumerate(inputs):
-            buf.set_arg(k, memoryview(arr[start:stop].reshape(-1)))
-        for k, arr in enumerate(tiled, start=len(inputs)):
-            buf.set_arg(k, memoryview(arr.reshape(-1)))
+        for k, (arr, rep) in enumerate(zip(args, tiled)):
+            buf.set_arg(k, memoryview((arr[start:stop] if rep is None else rep).reshape(-1)))
         for k, arr in enumerate(outs):
             buf.set_res(k, memoryview(arr[start:stop].reshape(-1)))
         call()
@@ -340,12 +348,12 @@ def batch_forward_kinematics(
     c = model.closure
     t0 = time.perf_counter()
     qa = _rows(q, c.nq, "q")
-    x0 = _broadcast_rows(model.x_home if guess is None else guess, qa.shape[0], c.nx, "guess")
+    x0 = _guess(model.x_home if guess is None else guess, qa.shape[0], c.nx)
     kern = fk_kernel(c, config)
     fn, used = _backend_function(kern, model, backend)
     nthreads = default_threads() if threads is None else max(1, int(threads))
     shared = shared_values(kern, model, config.tolerance)
-    out = dict(zip(kern.outputs, evaluate(fn, [qa, x0], shared, nthreads)))
+    out = dict(zip(kern.outputs, evaluate(fn, [qa, x0, *shared], nthreads)))
     return _finish(
         "forward_kinematics",
         model,
@@ -380,10 +388,10 @@ def batch_inverse_kinematics(
     inputs = [ta]
     if "y0" in kern.pose_inputs:
         y0 = np.concatenate([model.x_home[c.dep_index], model.q_home])
-        inputs.append(_broadcast_rows(y0, ta.shape[0], y0.size, "guess"))
+        inputs.append(y0)
     nthreads = default_threads() if threads is None else max(1, int(threads))
     shared = shared_values(kern, model, config.tolerance)
-    out = dict(zip(kern.outputs, evaluate(fn, inputs, shared, nthreads)))
+    out = dict(zip(kern.outputs, evaluate(fn, [*inputs, *shared], nthreads)))
     return _finish(
         "inverse_kinematics",
         model,
@@ -418,7 +426,7 @@ def batch_jacobians(model: Model, x, q, *, backend: str = "map", threads: int | 
     qa = _broadcast_rows(q, xa.shape[0], c.nq, "q")
     kern = jacobian_kernel(c)
     fn, used = _backend_function(kern, model, backend)
-    outs = evaluate(fn, [xa, qa], [model.p], threads)
+    outs = evaluate(fn, [xa, qa, model.p], threads)
     mats = []
     for k, arr in enumerate(outs):
         rows, cols = kern.function.size_out(k)

@@ -138,4 +138,4 @@ def compiled_function(closure: LoopClosure, kern: Kernel) -> ca.Function:
         lib = build_library(source, kern.name)
         return ca.external(kern.name, str(lib))
 
-    return closure.solvers.memo(("compiled",) + kern.key, build)
+    return closure.solvers.memo(("compiled", str(cache_dir())) + kern.key, build)

@@ -259,10 +259,10 @@ def manifest(
 ) -> dict[str, Any]:
     """What the exported files contain and how to call them."""
     from . import __version__
-    from .mechanisms import mechanism_type
+    from .mechanisms import MODULES, mechanism_type
 
     c = model.closure
-    mt = mechanism_type(model.name)
+    mt = mechanism_type(model.name) if model.name in MODULES else None
     lower, upper = limit_vectors(model)
     joints = list(c.q) + list(c.passive_coords)
 
@@ -283,8 +283,8 @@ def manifest(
         "format": fmt,
         "mechanism": {
             "type": model.name,
-            "title": mt.title,
-            "paper": mt.paper,
+            "title": mt.title if mt else None,
+            "paper": mt.paper if mt else None,
             "parameters": {k: quantity(v, model.dimensions.get(k, "")) for k, v in model.parameters.items()},
             "derived": {k: quantity(v, model.dimensions.get(k, "")) for k, v in model.derived.items()},
             "joint_limits": {

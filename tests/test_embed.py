@@ -3,7 +3,6 @@ and the compiled batch backend."""
 
 import importlib.util
 import math
-import os
 import threading
 from pathlib import Path
 
@@ -103,16 +102,11 @@ def test_example_uses_the_fk_in_its_own_optimization():
 # -- compiled backend ----------------------------------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def compiled_cache(tmp_path_factory):
-    """Compile into a throwaway cache (once for this module)."""
-    old = os.environ.get("CPM_NLP_CACHE")
-    os.environ["CPM_NLP_CACHE"] = str(tmp_path_factory.mktemp("cache"))
-    yield os.environ["CPM_NLP_CACHE"]
-    if old is None:
-        del os.environ["CPM_NLP_CACHE"]
-    else:
-        os.environ["CPM_NLP_CACHE"] = old
+@pytest.fixture
+def compiled_cache(tmp_path, monkeypatch):
+    """A fresh cache for this test (the session's may hold libraries already)."""
+    monkeypatch.setenv("CPM_NLP_CACHE", str(tmp_path / "cache"))
+    return tmp_path / "cache"
 
 
 @pytest.mark.skipif(not compiler_available(), reason="no C compiler")
