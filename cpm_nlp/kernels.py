@@ -143,7 +143,10 @@ def check_expressions(
         out["round_trip_error"] = ca.SX(0)
     phi_x = c.phi_x(x, q, p)
     out["phi_x"] = phi_x
-    out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
+    if ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
+        out["cond1"] = ca.SX(ca.inf)
+    else:
+        out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
     passive = c.passive(x, q, p) if c.passive is not None else ca.SX(0, 1)
     out["passive"] = passive
     joints = ca.vertcat(q, passive)

@@ -82,3 +82,22 @@ def test_export_c_compiles(model, tmp_path):
         ["gcc", "-O2", "-shared", "-fPIC", str(tmp_path / "c" / "twobar_kinematics.c"), "-o", str(tmp_path / "t.so")],
         check=True,
     )
+
+
+def test_structurally_singular_mechanism_is_singular():
+    """Φ independent of one pose coordinate (a broken mechanism module): the
+    pose checks still build and call every pose singular."""
+    x, q, p = ca.SX.sym("x", 2), ca.SX.sym("q", 2), ca.SX.sym("p", 1)
+    closure = LoopClosure(
+        "degenerate",
+        x=(Coordinate("u", "length"), Coordinate("v", "length")),
+        q=(Coordinate("a", "length"), Coordinate("b", "length")),
+        parameters=("d",),
+        phi=ca.Function("phi", [x, q, p], [ca.vertcat(x[0] - q[0], p[0] * (x[0] - q[1]))], ["x", "q", "p"], ["phi"]),
+        task=("u", "v"),
+        home=lambda pv: (np.zeros(2), np.zeros(2)),
+        bounds=lambda pv: (np.full(2, -1.0), np.full(2, 1.0)),
+    )
+    model = Model(closure, {"d": 1.0})
+    status, message, details = cn.assess(model, [0.1, 0.0], [0.1, 0.1], 1e-10)
+    assert status is Status.SINGULAR and details["cond_phi_x"] == np.inf
