@@ -52,9 +52,11 @@ from .api import (
     reproduce,
     residual,
     solve,
+    status_of,
 )
 
 __all__ = [
+    "status_of",
     "ModelFunctions",
     "export_kinematics",
     "functions",

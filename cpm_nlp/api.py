@@ -11,6 +11,7 @@ from .batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_
 from .embed import ModelFunctions, functions
 from .errors import CpmError, InputError
 from .export import export_kinematics, load_exported
+from .kernels import status_of
 from .kinematics import (
     JacobianReport,
     PoseSolution,
@@ -30,6 +31,7 @@ from .result import Result, SolverInfo, Status
 from .solver import SolverConfig
 
 __all__ = [
+    "status_of",
     "ModelFunctions",
     "export_kinematics",
     "functions",

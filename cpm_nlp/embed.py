@@ -12,12 +12,12 @@ joint limits and tolerance built in::
     x = fns.fk(q=q, x0=fns.x_home)["x"]          # differentiable (implicit function theorem)
     nlp = {"x": q, "f": -x[3], "g": x[2]}          # ... your own optimization
 
-Every Function is symbolic-friendly (SX or MX arguments) and numeric
-(numpy arrays).  The FK is Newton's method from ``x0`` (CasADi
-``fast_newton``); its ``status`` output is 0 only where the pose passed every
-check of cpm_nlp (code meanings: ``cpm_nlp.kernels.STATUSES``).  Nothing here
-prints or keeps global state; the Functions may be called from several
-threads.
+Every Function takes numbers (numpy arrays) or CasADi symbols: MX for
+``fk`` and ``ik`` (they contain a rootfinder), SX or MX for the others.  The
+FK is Newton's method from ``x0`` (CasADi ``fast_newton``); its ``status``
+output is 0 only where the pose passed every check of cpm_nlp
+(``cn.status_of(code)`` names it).  Nothing here prints or keeps global
+state; the Functions may be called from several threads.
 """
 
 from __future__ import annotations

@@ -64,6 +64,12 @@ def code_of(status: Status) -> int:
     return STATUSES.index(status)
 
 
+def status_of(code: Any) -> Status:
+    """The :class:`Status` of a code output by a kernel, an exported function or a batch."""
+    value = code.full() if isinstance(code, ca.DM) else code
+    return STATUSES[int(np.asarray(value, dtype=float).reshape(-1)[0])]
+
+
 # -- the status rule, symbolic or numeric ----------------------------------------------------
 
 
@@ -263,13 +269,13 @@ SHARED_INPUTS = ("p", "lower", "upper", "tol")
 _STATUS_OUTPUTS = ("residual", "branch_margin", "round_trip_error", "cond1", "limit_margin", "status")
 
 
-def _shared_symbols(c: LoopClosure) -> list[ca.MX]:
+def _shared_symbols(c: LoopClosure, sym: Any = ca.MX) -> list[Any]:
     nl = n_joints(c)
-    return [ca.MX.sym("p", c.np), ca.MX.sym("lower", nl), ca.MX.sym("upper", nl), ca.MX.sym("tol")]
+    return [sym.sym("p", c.np), sym.sym("lower", nl), sym.sym("upper", nl), sym.sym("tol")]
 
 
-def _checks(c: LoopClosure, x: ca.MX, q: ca.MX, shared: list[ca.MX]) -> dict[str, ca.MX]:
-    """The checks of (x, q) inside an MX kernel, by name (status: the checks' verdict)."""
+def _checks(c: LoopClosure, x: Any, q: Any, shared: list[Any]) -> dict[str, Any]:
+    """The checks of (x, q) inside a kernel, by name (status: the checks' verdict)."""
     fn = checks_function(c)
     return dict(zip(fn.name_out(), fn(x, q, *shared)))
 
@@ -328,8 +334,11 @@ def ik_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
     opts = newton_options(config) if c.ik is None else {}
 
     def build() -> Kernel:
-        t = ca.MX.sym("t", c.nq)
-        shared = _shared_symbols(c)
+        # SX where there is no rootfinder: CasADi's virtual machine runs SX
+        # Functions in parallel threads, MX Functions one at a time
+        sym = ca.SX if c.ik is not None else ca.MX
+        t = sym.sym("t", c.nq)
+        shared = _shared_symbols(c, sym)
         if c.ik is not None:
             x, q, reach = c.ik(t, shared[0])
             pose_inputs: tuple[str, ...] = ("t",)

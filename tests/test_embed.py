@@ -39,7 +39,7 @@ def test_functions_from_a_problem_file():
     fns = cn.functions(PROBLEMS / "prs3_forward_kinematics.yaml")
     assert fns.model.limits["s"] == pytest.approx((-3e-3, 3e-3))
     out = fns.fk(q=[4e-3, 0, 0], x0=fns.x_home)  # beyond the file's stroke
-    assert int(out["status"]) == list(Status).index(Status.OUTSIDE_JOINT_LIMITS)
+    assert cn.status_of(out["status"]) is Status.OUTSIDE_JOINT_LIMITS
     with pytest.raises(cn.InputError, match="expected a Model or the path of a problem file"):
         cn.functions(42)
 
