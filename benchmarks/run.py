@@ -11,6 +11,7 @@ Measurements
   batch_fk_compiled   3-PRS batch FK, compiled kernel, all threads (poses/s)
   batch_fk_map        3-PRS batch FK, CasADi VM through map, all threads
   batch_fk_casadi_thread_map  the kernel through CasADi's own map(n, "thread") (for the record)
+  batch_ik_map, batch_ik_casadi_thread_map  closed-form IK (an SX kernel), both ways of threading
   fsolve_casadi       scipy.optimize.fsolve loop on the same equations, Φ and Φ_x as
                       ordinary CasADi Function calls (what a script would write)
   fsolve_buffer       the same loop, Φ and Φ_x through CasADi FunctionBuffers (the
@@ -47,7 +48,7 @@ from scipy.optimize import fsolve
 import cpm_nlp as cn
 from cpm_nlp.batch import default_threads
 from cpm_nlp.compiled import compiler_available
-from cpm_nlp.kernels import FastFunction, fk_kernel, shared_values
+from cpm_nlp.kernels import FastFunction, fk_kernel, ik_kernel, shared_values
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
@@ -110,6 +111,22 @@ def fsolve_loop(model: cn.Model, q: np.ndarray, buffered: bool) -> None:
         fsolve(f, model.x_home, args=(qi,), fprime=jac, xtol=1e-13)
 
 
+def casadi_thread_map_rate(kern, model: cn.Model, per_pose: list[np.ndarray], repeats: int) -> float:
+    """Poses/s of ``kern.function.map(n, "thread", threads)`` (one FunctionBuffer, no Python threads)."""
+    n = per_pose[0].shape[0]
+    tmap = kern.function.map(n, "thread", default_threads())
+    args = [np.broadcast_to(a, (n, np.size(a) if a.ndim == 1 else a.shape[1])) for a in per_pose]
+    args += [np.broadcast_to(v, (n, v.size)) for v in shared_values(kern, model, 1e-10)]
+    args = [np.ascontiguousarray(a) for a in args]
+    outs = [np.empty(tmap.nnz_out(k)) for k in range(tmap.n_out())]
+    buf, call = tmap.buffer()
+    for k, a in enumerate(args):
+        buf.set_arg(k, memoryview(a.reshape(-1)))
+    for k, a in enumerate(outs):
+        buf.set_res(k, memoryview(a))
+    return best_rate(call, n, repeats)
+
+
 def bench_batch(model: cn.Model, quick: bool, repeats: int) -> dict:
     out: dict = {"threads": default_threads()}
     n_c, n_m, n_f = (20_000, 5_000, 200) if quick else (400_000, 100_000, 2_000)
@@ -130,19 +147,18 @@ def bench_batch(model: cn.Model, quick: bool, repeats: int) -> dict:
         out["note_compiled"] = "no C compiler on this machine: compiled path not measured"
     q = actuators(n_m, 1)
     out["batch_fk_map"] = best_rate(lambda: cn.batch_forward_kinematics(model, q, backend="map"), n_m, repeats)
+    out["batch_fk_map_1_thread"] = best_rate(
+        lambda: cn.batch_forward_kinematics(model, q[: n_m // 4], backend="map", threads=1), n_m // 4, repeats
+    )
     # CasADi's own threaded map of the same kernel (why cpm_nlp threads over chunks itself)
-    kern = fk_kernel(model.closure, cn.SolverConfig("newton"))
     n_t = n_m // 4
-    shared = shared_values(kern, model, 1e-10)
-    tmap = kern.function.map(n_t, "thread", default_threads())
-    args = [q[:n_t], np.tile(model.x_home, (n_t, 1))] + [np.tile(v, (n_t, 1)) for v in shared]
-    outs = [np.empty((n_t, tmap.nnz_out(k) // n_t)) for k in range(tmap.n_out())]
-    buf, call = tmap.buffer()
-    for k, a in enumerate(args):
-        buf.set_arg(k, memoryview(np.ascontiguousarray(a).reshape(-1)))
-    for k, a in enumerate(outs):
-        buf.set_res(k, memoryview(a.reshape(-1)))
-    out["batch_fk_casadi_thread_map"] = best_rate(call, n_t, repeats)
+    out["batch_fk_casadi_thread_map"] = casadi_thread_map_rate(
+        fk_kernel(model.closure, cn.SolverConfig("newton")), model, [q[:n_t], model.x_home], repeats
+    )
+    # closed-form IK (an SX kernel) on the map path, both ways of threading
+    t = np.column_stack([model.derived["pz0"] + q[:, 0], q[:, 1], q[:, 2]])
+    out["batch_ik_map"] = best_rate(lambda: cn.batch_inverse_kinematics(model, t, backend="map"), n_m, repeats)
+    out["batch_ik_casadi_thread_map"] = casadi_thread_map_rate(ik_kernel(model.closure), model, [t[:n_t]], repeats)
     qf = actuators(n_f, 2)
     out["fsolve_buffer"] = best_rate(lambda: fsolve_loop(model, qf, True), n_f, 1)
     out["fsolve_casadi"] = best_rate(lambda: fsolve_loop(model, qf[: n_f // 2], False), n_f // 2, 1)
@@ -238,6 +254,9 @@ UNITS = {
     "batch_fk_compiled_1_thread": "poses/s",
     "batch_fk_map": "poses/s",
     "batch_fk_casadi_thread_map": "poses/s",
+    "batch_fk_map_1_thread": "poses/s",
+    "batch_ik_map": "poses/s",
+    "batch_ik_casadi_thread_map": "poses/s",
     "fsolve_casadi": "poses/s",
     "fsolve_buffer": "poses/s",
     "single_fk_newton": "µs",
