@@ -88,7 +88,7 @@ def median_call(fn, n: int) -> float:
     return statistics.median(times)
 
 
-def fsolve_loop(model: cn.Model, q: np.ndarray, buffered: bool) -> None:
+def fsolve_loop(model: cn.Model, q: np.ndarray, buffered: bool) -> np.ndarray:
     c, p = model.closure, model.p
     if buffered:
         phi, phi_x = FastFunction(c.phi), FastFunction(c.phi_x)
@@ -107,8 +107,7 @@ def fsolve_loop(model: cn.Model, q: np.ndarray, buffered: bool) -> None:
         def jac(x, qi):
             return np.asarray(c.phi_x(x, qi, p))
 
-    for qi in q:
-        fsolve(f, model.x_home, args=(qi,), fprime=jac, xtol=1e-13)
+    return np.array([fsolve(f, model.x_home, args=(qi,), fprime=jac, xtol=1e-13) for qi in q])
 
 
 def casadi_thread_map_rate(kern, model: cn.Model, per_pose: list[np.ndarray], repeats: int) -> float:
@@ -162,6 +161,10 @@ def bench_batch(model: cn.Model, quick: bool, repeats: int) -> dict:
     qf = actuators(n_f, 2)
     out["fsolve_buffer"] = best_rate(lambda: fsolve_loop(model, qf, True), n_f, 1)
     out["fsolve_casadi"] = best_rate(lambda: fsolve_loop(model, qf[: n_f // 2], False), n_f // 2, 1)
+    # the baseline solves the same equations: its poses agree with the batch's
+    batch = cn.batch_forward_kinematics(model, qf[:200])
+    x_fs = fsolve_loop(model, qf[:200], True)
+    out["fsolve_vs_batch_max_abs_difference"] = float(np.max(np.abs(x_fs[batch.ok] - batch.x[batch.ok])))
     for base in ("fsolve_casadi", "fsolve_buffer"):
         if "batch_fk_compiled" in out:
             out[f"ratio_compiled_vs_{base}"] = out["batch_fk_compiled"] / out[base]
@@ -272,7 +275,7 @@ def table(results: dict) -> str:
     rows = [("measurement", "value", "unit", "target", "verdict")]
     flat = {**results["batch"], **results["single"], **results["reproduce"], **results["memory"]}
     for name, value in flat.items():
-        if not isinstance(value, (int, float)) or name.endswith(("_exit", "_mb", "_poses", "threads")):
+        if not isinstance(value, (int, float)) or name.endswith(("_exit", "_mb", "_poses", "threads", "difference")):
             continue
         unit = UNITS.get(name, "x" if name.startswith("ratio") else "")
         target = ""
