@@ -111,7 +111,12 @@ def failure_message(model: Model, status: Status, details: dict, q, passive, tol
     """Why a pose with these check values has this status ("" when solved)."""
     unit = model.closure.residual_unit
     if status is Status.NOT_CONVERGED:
+        res = details.get("residual", float("nan"))
+        if np.isfinite(res):  # Newton ran out of iterations
+            return f"Newton stopped at max |Φ| = {res:.3g} {unit} > tolerance {tolerance:.3g} {unit}"
         return "the solver returned non-finite values"
+    if status is Status.UNREACHABLE:
+        return f"the closed-form IK has no real solution (reach margin {details['reach']:.3g} < 0)"
     if status is Status.RESIDUAL_TOO_LARGE:
         res = details["residual"]
         return f"max |Φ| = {res:.3g} {unit} > tolerance {tolerance:.3g} {unit}"

@@ -63,6 +63,7 @@ def test_batch_ik_matches_single_solves(limited):
     t[::60, 0] = 0.2  # 200 mm high: unreachable
     res = cn.batch_inverse_kinematics(limited, t)
     assert {"solved", "outside_joint_limits", "unreachable"} <= set(res.counts())
+    assert res.message(0).startswith("the closed-form IK has no real solution (reach margin -")
     for k in range(0, 600, 6):
         assert_same_as_single(limited, res, cn.inverse_kinematics(limited, t[k]), k)
 
@@ -86,6 +87,9 @@ def test_wrong_branch_in_batch(prs3):
     q = [[0.5e-3, 0.2e-3, 0.1e-3], [0.0, 0.0, 0.0]]
     res = cn.batch_forward_kinematics(prs3, q, NEWTON, guess=guess)
     assert res.statuses == [Status.WRONG_BRANCH] * 2
+    far = cn.batch_forward_kinematics(prs3, [[0.3, -0.3, 0.0]])
+    assert far.statuses == [Status.NOT_CONVERGED]
+    assert far.message(0).startswith("Newton stopped at max |Φ| = ")
     single = cn.forward_kinematics(prs3, q[0], NEWTON, guess=guess)
     assert res.message(0) == single.message
     assert np.all(np.isnan(res.x))
