@@ -272,11 +272,16 @@ class SquareSolver:
 
 
 class SolverCache:
-    """Built solvers (and other built code) keyed by (purpose, configuration); thread-safe."""
+    """Built solvers (and other built code) keyed by (purpose, configuration); thread-safe.
+
+    A build (an IPOPT set-up, a C compilation) holds only the lock of its own
+    key, so it never stalls threads that need other entries.
+    """
 
     def __init__(self) -> None:
-        self._lock = threading.RLock()
+        self._lock = threading.Lock()
         self._solvers: dict[tuple, Any] = {}
+        self._building: dict[tuple, threading.RLock] = {}
 
     def get(self, purpose: str, config: SolverConfig, build) -> SquareSolver:
         return self.memo((purpose,) + config.key(), build)
@@ -286,7 +291,15 @@ class SolverCache:
         a loaded compiled library): code, never problem data."""
         with self._lock:
             built = self._solvers.get(key)
+            if built is not None:
+                return built
+            key_lock = self._building.setdefault(key, threading.RLock())
+        with key_lock:
+            with self._lock:
+                built = self._solvers.get(key)
             if built is None:
                 built = build()
-                self._solvers[key] = built
+                with self._lock:
+                    self._solvers[key] = built
+                    self._building.pop(key, None)
             return built

@@ -136,3 +136,24 @@ def test_compiled_backend_equals_map(compiled_cache):
     other = cn.build_model("prs3", {"b": "40 mm", "L": "100 mm"})
     assert cn.batch_forward_kinematics(other, q[1:11], backend="compiled").ok.all()
     assert sorted(Path(compiled_cache).glob("compiled/*/*.so")) == libs
+
+
+def test_a_slow_build_does_not_block_other_entries():
+    """A C compilation in one thread must not stall single solves in others."""
+    from cpm_nlp.solver import SolverCache
+
+    cache = SolverCache()
+    started, release = threading.Event(), threading.Event()
+
+    def slow():
+        started.set()
+        release.wait(5)
+        return "slow"
+
+    builder = threading.Thread(target=lambda: cache.memo(("a",), slow))
+    builder.start()
+    assert started.wait(5)
+    assert cache.memo(("b",), lambda: "fast") == "fast"  # returned while "a" is still building
+    release.set()
+    builder.join()
+    assert cache.memo(("a",), lambda: "again") == "slow"
