@@ -7,7 +7,11 @@ with numpy arrays, or take the CasADi Functions of the model (``model.closure``:
 to the ``cpm_nlp`` logger.
 """
 
+from .batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
+from .embed import ModelFunctions, functions
 from .errors import CpmError, InputError
+from .export import export_kinematics, load_exported
+from .kernels import status_of
 from .kinematics import (
     JacobianReport,
     PoseSolution,
@@ -28,6 +32,16 @@ from .solver import SolverConfig
 from .workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 
 __all__ = [
+    "status_of",
+    "ModelFunctions",
+    "export_kinematics",
+    "functions",
+    "load_exported",
+    "BatchJacobians",
+    "BatchResult",
+    "batch_forward_kinematics",
+    "batch_inverse_kinematics",
+    "batch_jacobians",
     "Comparison",
     "Coordinate",
     "CuboidResult",

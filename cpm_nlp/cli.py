@@ -362,6 +362,20 @@ def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
     return EXIT_OK if all(r.expected for r in rows) else EXIT_FAILED
 
 
+def cmd_export(args: argparse.Namespace, out: TextIO) -> int:
+    from .export import check_format, check_out_dir, export_kinematics, parse_what
+    from .problem_file import load_problem
+
+    what = parse_what(args.what)
+    check_format(args.format)
+    check_out_dir(args.out)
+    problem = load_problem(args.file, args.set or [])
+    data = export_kinematics(problem.model, args.out, what, args.format, problem.solver, source=args.file)
+    for f in [*data["files"], "manifest.json"]:
+        out.write(f"{Path(args.out) / f}\n")
+    return EXIT_OK
+
+
 def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
     from .mechanisms import MODULES, mechanism_type
     from .problems import KINDS, problem_kind
@@ -459,6 +473,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the table as JSON")
     p.add_argument("-o", "--output", metavar="FILE", help="write the table as JSON to FILE")
     p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser(
+        "export",
+        help="write the mechanism's FK, IK and Jacobian as CasADi files or C code, with a manifest",
+        description="Export the kinematics of the mechanism of a problem file (its parameters, limits and "
+        "solver tolerance built in) as serialized CasADi Functions or as C source and header.",
+    )
+    p.add_argument("file", help="problem file (YAML); its mechanism and solver section are used")
+    p.add_argument("--what", default="fk,ik,jacobian", help="comma-separated: fk, ik, jacobian (default: all)")
+    p.add_argument("--format", default="casadi", help="casadi (.casadi files) or c (source + header)")
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file")
+    p.set_defaults(func=cmd_export)
 
     p = sub.add_parser("describe", help="list mechanisms and problem kinds, or describe one")
     p.add_argument("name", nargs="?")

@@ -12,7 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from .batch import batch_forward_kinematics, batch_inverse_kinematics
 from .errors import InputError
+from .kernels import batch_newton_supported
 from .kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
 from .model import Model
 from .options import Option, validate_mapping
@@ -150,7 +152,10 @@ class ForwardKinematics(ProblemKind):
         names = model.closure.q_names
         qs, batch = broadcast([inputs[n] for n in names], names, ("inputs",))
         guess = inputs.get("guess")
-        sols = [forward_kinematics(model, q, solver, guess) for q in qs]
+        if batch and batch_newton_supported(solver):  # one vectorized Newton over every point
+            sols = batch_forward_kinematics(model, qs, solver, guess).solutions()
+        else:
+            sols = [forward_kinematics(model, q, solver, guess) for q in qs]
         return _result(self.name, model, sols, batch, solver)
 
     def output_names(self, model: Model) -> list[str]:
@@ -182,7 +187,10 @@ class InverseKinematics(ProblemKind):
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         ts, batch = broadcast(task_values(inputs, model, ("inputs",)), list(model.closure.task), ("inputs",))
-        sols = [inverse_kinematics(model, t, solver, inputs["method"]) for t in ts]
+        if batch and model.closure.ik is not None and inputs["method"] != "solve":  # closed form, vectorized
+            sols = batch_inverse_kinematics(model, ts, solver).solutions()
+        else:
+            sols = [inverse_kinematics(model, t, solver, inputs["method"]) for t in ts]
         return _result(self.name, model, sols, batch, solver)
 
     def output_names(self, model: Model) -> list[str]:

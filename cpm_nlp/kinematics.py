@@ -21,16 +21,23 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InputError
+from .kernels import ROUND_TRIP_FACTOR as ROUND_TRIP_FACTOR  # noqa: F401 - re-exported (defined in kernels)
+from .kernels import (
+    SCALAR,
+    STATUSES,
+    checks_function,
+    fast,
+    is_singular,
+    limit_vectors,
+    status_code,
+    status_rules,
+)
+from .kernels import SINGULAR_CONDITION as SINGULAR_CONDITION  # noqa: F401
 from .model import Model
 from .result import Status
 from .solver import SolverConfig
 
 log = logging.getLogger(__name__)
-
-#: FK/IK round trips must agree to this multiple of the residual tolerance.
-ROUND_TRIP_FACTOR = 100.0
-#: Φ_x (or Φ_y) with a larger condition number is reported singular.
-SINGULAR_CONDITION = 1e10
 
 
 @dataclass
@@ -95,58 +102,82 @@ def _limit_violations(model: Model, x: np.ndarray, q: np.ndarray, passive: np.nd
     return out
 
 
+def pose_checks(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> dict[str, np.ndarray]:
+    """The kernel checks of one pose (see :mod:`cpm_nlp.kernels`), one fast call."""
+    c = model.closure
+    fn = fast(c, ("pose_checks",), lambda: checks_function(c))
+    lower, upper = limit_vectors(model)
+    return fn.named(x, q, model.p, lower, upper, [tolerance])
+
+
+def failure_message(model: Model, status: Status, details: dict, x, q, passive, tolerance: float) -> str:
+    """Why a pose with these check values has this status ("" when solved)."""
+    unit = model.closure.residual_unit
+    if status is Status.NOT_CONVERGED:
+        res = details.get("residual", float("nan"))
+        if np.isfinite(res):  # Newton ran out of iterations
+            return f"Newton stopped at max |Φ| = {res:.3g} {unit} > tolerance {tolerance:.3g} {unit}"
+        return "the solver returned non-finite values"
+    if status is Status.UNREACHABLE:
+        return f"the closed-form IK has no real solution (reach margin {details['reach']:.3g} < 0)"
+    if status is Status.RESIDUAL_TOO_LARGE:
+        res = details["residual"]
+        return f"max |Φ| = {res:.3g} {unit} > tolerance {tolerance:.3g} {unit}"
+    if status is Status.WRONG_BRANCH:
+        margin = details.get("branch_margin", np.inf)
+        if not margin > 0:
+            return f"branch indicator {margin:.3g} <= 0"
+        err = details.get("round_trip_error", np.inf)
+        if not np.isfinite(err):
+            return "the closed-form IK has no real solution at this pose's task coordinates"
+        return f"closed-form IK of this pose gives other joints (max difference {err:.3g})"
+    if status is Status.SINGULAR:
+        return f"cond(Φ_x) = {details['cond_phi_x']:.3g}"
+    if status is Status.OUTSIDE_JOINT_LIMITS:
+        return "; ".join(_limit_violations(model, x, q, passive))
+    return ""
+
+
+def _assess(
+    model: Model, x: np.ndarray, q: np.ndarray, tolerance: float
+) -> tuple[Status, str, dict, np.ndarray | None]:
+    c = model.closure
+    x = np.asarray(x, dtype=float)
+    q = np.asarray(q, dtype=float)
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(q))):
+        return Status.NOT_CONVERGED, "the solver returned non-finite values", {}, None
+    chk = pose_checks(model, x, q, tolerance)
+    sv = np.linalg.svd(chk["phi_x"].reshape(c.nx, c.nx), compute_uv=False)  # cond is transpose-invariant
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    values = {k: float(chk[k][0]) for k in ("residual", "branch_margin", "round_trip_error", "limit_margin")}
+    values["finite"] = True
+    code = status_code(status_rules(values, tolerance, is_singular(cond, SCALAR), SCALAR), SCALAR)
+    status = STATUSES[int(code)]
+    details = {"residual": values["residual"]}
+    if c.branch is not None:
+        details["branch_margin"] = values["branch_margin"]
+    if c.ik is not None:
+        details["round_trip_error"] = values["round_trip_error"]
+    details["cond_phi_x"] = cond
+    passive = chk["passive"] if c.passive is not None else None
+    return status, failure_message(model, status, details, x, q, passive, tolerance), details, passive
+
+
 def assess(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tuple[Status, str, dict]:
     """Check a candidate pose: residual, assembly branch, IK round trip,
-    singularity, joint limits.  Returns (status, message, details)."""
-    c = model.closure
-    details: dict = {}
-    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(q))):
-        return Status.NOT_CONVERGED, "the solver returned non-finite values", details
-    res = float(np.max(np.abs(residual(model, x, q))))
-    details["residual"] = res
-    if res > tolerance:
-        return (
-            Status.RESIDUAL_TOO_LARGE,
-            f"max |Φ| = {res:.3g} {c.residual_unit} > tolerance {tolerance:.3g} {c.residual_unit}",
-            details,
-        )
-    if c.branch is not None:
-        g = np.asarray(c.branch(x, q, model.p)).ravel()
-        details["branch_margin"] = float(g.min())
-        if g.min() <= 0:
-            return Status.WRONG_BRANCH, f"branch indicator {g.min():.3g} <= 0", details
-    if c.ik is not None:
-        x_ik, q_ik, reach = (np.asarray(v).ravel() for v in c.ik(model.task_of(x), model.p))
-        err = max(float(np.max(np.abs(q_ik - q))), float(np.max(np.abs(x_ik - x))))
-        details["round_trip_error"] = err
-        if not (reach[0] >= 0 and err <= ROUND_TRIP_FACTOR * tolerance):
-            return (
-                Status.WRONG_BRANCH,
-                f"closed-form IK of this pose gives other joints (max difference {err:.3g})",
-                details,
-            )
-    cond = float(np.linalg.cond(np.asarray(c.phi_x(x, q, model.p))))
-    details["cond_phi_x"] = cond
-    if not cond < SINGULAR_CONDITION:
-        return Status.SINGULAR, f"cond(Φ_x) = {cond:.3g}", details
-    passive = np.asarray(c.passive(x, q, model.p)).ravel() if c.passive is not None else None
-    bad = _limit_violations(model, x, q, passive)
-    if bad:
-        return Status.OUTSIDE_JOINT_LIMITS, "; ".join(bad), details
-    return Status.SOLVED, "", details
+    singularity, joint limits (in this order; the first failure gives the
+    status, see :func:`cpm_nlp.kernels.status_rules`).  Returns (status,
+    message, details)."""
+    status, message, details, _ = _assess(model, x, q, tolerance)
+    return status, message, details
 
 
-def _finish(
-    model: Model, status: Status, x, q, message: str, details: dict, iterations: int, seconds: float, solver: str
-) -> PoseSolution:
+def _checked(model: Model, x, q, tolerance: float, iterations: int, seconds: float, solver: str) -> PoseSolution:
+    status, message, details, passive = _assess(model, x, q, tolerance)
+    residual = details.get("residual", float("nan"))
     if status is Status.SOLVED:
-        passive = np.asarray(model.closure.passive(x, q, model.p)).ravel() if model.closure.passive else None
-        return PoseSolution(
-            status, x, q, passive, details.get("residual", float("nan")), iterations, seconds, solver, message, details
-        )
-    return PoseSolution(
-        status, None, None, None, details.get("residual", float("nan")), iterations, seconds, solver, message, details
-    )
+        return PoseSolution(status, x, q, passive, residual, iterations, seconds, solver, message, details)
+    return PoseSolution(status, None, None, None, residual, iterations, seconds, solver, message, details)
 
 
 def forward_kinematics(
@@ -166,13 +197,16 @@ def forward_kinematics(
     qv = _vector(q, c.nq, "q")
     x0 = model.x_home if guess is None else _vector(guess, c.nx, "guess")
     built = c.fk_solver(config)
-    x, ok, iters, msg, sec = built.solve(x0, np.r_[qv, model.p], model.x_lower, model.x_upper)
+    x, ok, iters, msg, sec = built.solve(x0, np.concatenate([qv, model.p]), model.x_lower, model.x_upper)
     if not ok:
         return PoseSolution(
-            Status.NOT_CONVERGED, iterations=iters, seconds=sec, solver=config.name, message=f"{config.name}: {msg}"
+            Status.NOT_CONVERGED,
+            iterations=iters,
+            seconds=sec,
+            solver=config.name,
+            message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
         )
-    status, message, details = assess(model, x, qv, config.tolerance)
-    return _finish(model, status, x, qv, message, details, iters, sec, config.name)
+    return _checked(model, x, qv, config.tolerance, iters, sec, config.name)
 
 
 def inverse_kinematics(
@@ -200,18 +234,13 @@ def inverse_kinematics(
         )
     if use_closed:
         t0 = time.perf_counter()
-        x, q, reach = (np.asarray(v).ravel() for v in c.ik(tv, model.p))
+        x, q, reach = fast(c, ("ik",), lambda: c.ik)(tv, model.p)
         sec = time.perf_counter() - t0
         if not reach[0] >= 0:
-            return PoseSolution(
-                Status.UNREACHABLE,
-                seconds=sec,
-                solver="closed_form",
-                message=f"the closed-form IK has no real solution (reach margin {reach[0]:.3g} < 0)",
-                details={"reach": float(reach[0])},
-            )
-        status, message, details = assess(model, x, q, config.tolerance)
-        return _finish(model, status, x, q, message, details, 0, sec, "closed_form")
+            details = {"reach": float(reach[0])}
+            message = failure_message(model, Status.UNREACHABLE, details, None, None, None, config.tolerance)
+            return PoseSolution(Status.UNREACHABLE, seconds=sec, solver="closed_form", message=message, details=details)
+        return _checked(model, x, q, config.tolerance, 0, sec, "closed_form")
     built = c.ik_solver(config)
     nd = len(c.dep_index)
     y0 = np.r_[model.x_home[c.dep_index], model.q_home]
@@ -220,12 +249,15 @@ def inverse_kinematics(
     y, ok, iters, msg, sec = built.solve(y0, np.r_[tv, model.p], lower, upper)
     if not ok:
         return PoseSolution(
-            Status.NOT_CONVERGED, iterations=iters, seconds=sec, solver=config.name, message=f"{config.name}: {msg}"
+            Status.NOT_CONVERGED,
+            iterations=iters,
+            seconds=sec,
+            solver=config.name,
+            message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
         )
     x = c.assemble_x(tv, y[:nd])
     q = y[nd:]
-    status, message, details = assess(model, x, q, config.tolerance)
-    return _finish(model, status, x, q, message, details, iters, sec, config.name)
+    return _checked(model, x, q, config.tolerance, iters, sec, config.name)
 
 
 @dataclass

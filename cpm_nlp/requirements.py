@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .batch import batch_inverse_kinematics
 from .kinematics import PoseSolution, inverse_kinematics, passive_joints
 from .model import Model
 from .result import Status, worst_status
@@ -57,7 +58,10 @@ def joint_requirements(
     c = model.closure
     t0 = time.perf_counter()
     poses = full_factorial(grid)
-    solutions = [inverse_kinematics(model, t, solver) for t in poses]
+    if c.ik is not None:  # the closed form, vectorized over the grid
+        solutions = batch_inverse_kinematics(model, poses, solver).solutions()
+    else:
+        solutions = [inverse_kinematics(model, t, solver) for t in poses]
     status = worst_status([s.status for s in solutions])
     report = RequirementsReport(poses, solutions, status, seconds=time.perf_counter() - t0)
     if status is not Status.SOLVED:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +18,18 @@ PROBLEMS = ROOT / "problems"
 
 #: prs3-ruiz.md, section 4: L = 109.215 mm, b = 47.91 mm, alpha = 45 deg at home.
 PAPER_PRS3 = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
+
+
+@pytest.fixture(scope="session", autouse=True)
+def compiled_cache_dir(tmp_path_factory):
+    """Libraries compiled by the tests go to a throwaway cache, never the user's."""
+    old = os.environ.get("CPM_NLP_CACHE")
+    os.environ["CPM_NLP_CACHE"] = str(tmp_path_factory.mktemp("cpm_nlp_cache"))
+    yield Path(os.environ["CPM_NLP_CACHE"])
+    if old is None:
+        os.environ.pop("CPM_NLP_CACHE", None)
+    else:
+        os.environ["CPM_NLP_CACHE"] = old
 
 
 @pytest.fixture(scope="session")

@@ -169,6 +169,7 @@ def test_wrong_branch_is_reported_not_returned(prs3):
 def test_unreachable_pose(prs3):
     sol = cn.inverse_kinematics(prs3, [0.2, 0.0, 0.0])  # 200 mm high: legs are 109 mm
     assert sol.status is Status.UNREACHABLE
+    assert sol.message.startswith("the closed-form IK has no real solution (reach margin -")
     assert sol.x is None and sol.q is None
 
 

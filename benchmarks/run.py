@@ -1,0 +1,345 @@
+"""Speed benchmarks of cpm_nlp (issue 6), measured in one run on this machine.
+
+    python benchmarks/run.py [--quick] [--skip NAMES] [-o benchmarks/results.json]
+
+prints a table and writes JSON.  Every speed is compared with a baseline
+measured in the same run (ratios), and with the issue's target where there is
+one.  Rates are the best of ``--repeats`` runs (the machine is shared; the best
+run is the least disturbed), times of single calls the median of many.
+
+Measurements
+  batch_fk_compiled   3-PRS batch FK, compiled kernel, all threads (poses/s)
+  batch_fk_map        3-PRS batch FK, CasADi VM through map, all threads
+  batch_fk_casadi_thread_map  the kernel through CasADi's own map(n, "thread") (for the record)
+  batch_ik_map, batch_ik_casadi_thread_map  closed-form IK (an SX kernel), both ways of threading
+  fsolve_casadi       scipy.optimize.fsolve loop on the same equations, Φ and Φ_x as
+                      ordinary CasADi Function calls (what a script would write)
+  fsolve_buffer       the same loop, Φ and Φ_x through CasADi FunctionBuffers (the
+                      fastest way to evaluate them from Python)
+  single_fk_newton    one cn.forward_kinematics(model, q, newton) call (µs, median)
+  single_fk_ipopt     one cn.forward_kinematics(model, q) call (IPOPT)
+  single_fk_function  one call of cn.functions(model).fk (the embedding Function)
+  reproduce           `cpm-nlp reproduce`, end to end in a fresh process (s)
+  memory_1m           batch FK of 1,000,000 poses in a fresh process: peak RSS (MB)
+  cases               problem files listed in benchmarks/cases.yaml (median s)
+
+The batch rates include every check of every pose (residual, branch, IK round
+trip, conditioning, limits, passive joints); the fsolve loops only solve.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import scipy
+import yaml
+from scipy.optimize import fsolve
+
+import cpm_nlp as cn
+from cpm_nlp.batch import default_threads
+from cpm_nlp.compiled import compiler_available
+from cpm_nlp.kernels import FastFunction, fk_kernel, ik_kernel, shared_values
+
+ROOT = Path(__file__).resolve().parent.parent
+PAPER = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
+STROKE = 2.3e-3  # m, the actuator range of prs3-ruiz.md Fig. 6
+
+#: issue-6 targets: name -> (kind, value); kind "min" (at least) or "max" (at most)
+TARGETS = {
+    "batch_fk_compiled": ("min", 300_000.0),
+    "ratio_compiled_vs_fsolve_casadi": ("min", 200.0),
+    "ratio_compiled_vs_fsolve_buffer": ("min", 200.0),
+    "single_fk_newton": ("max", 100.0),
+    "reproduce": ("max", 60.0),
+    "memory_1m": ("max", 1024.0),
+}
+
+
+def actuators(n: int, seed: int = 0) -> np.ndarray:
+    return np.random.default_rng(seed).uniform(-STROKE, STROKE, (n, 3))
+
+
+def best_rate(fn, n: int, repeats: int) -> float:
+    rates = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        rates.append(n / (time.perf_counter() - t0))
+    return max(rates)
+
+
+def median_call(fn, n: int) -> float:
+    fn()
+    times = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def fsolve_loop(model: cn.Model, q: np.ndarray, buffered: bool) -> np.ndarray:
+    c, p = model.closure, model.p
+    if buffered:
+        phi, phi_x = FastFunction(c.phi), FastFunction(c.phi_x)
+
+        def f(x, qi):
+            return phi(x, qi, p)[0]
+
+        def jac(x, qi):
+            return phi_x(x, qi, p)[0].reshape(c.nx, c.nx).T
+
+    else:
+
+        def f(x, qi):
+            return np.asarray(c.phi(x, qi, p)).ravel()
+
+        def jac(x, qi):
+            return np.asarray(c.phi_x(x, qi, p))
+
+    return np.array([fsolve(f, model.x_home, args=(qi,), fprime=jac, xtol=1e-13) for qi in q])
+
+
+def casadi_thread_map_rate(kern, model: cn.Model, per_pose: list[np.ndarray], repeats: int) -> float:
+    """Poses/s of ``kern.function.map(n, "thread", threads)`` (one FunctionBuffer, no Python threads)."""
+    n = per_pose[0].shape[0]
+    tmap = kern.function.map(n, "thread", default_threads())
+    args = [np.broadcast_to(a, (n, np.size(a) if a.ndim == 1 else a.shape[1])) for a in per_pose]
+    args += [np.broadcast_to(v, (n, v.size)) for v in shared_values(kern, model, 1e-10)]
+    args = [np.ascontiguousarray(a) for a in args]
+    outs = [np.empty(tmap.nnz_out(k)) for k in range(tmap.n_out())]
+    buf, call = tmap.buffer()
+    for k, a in enumerate(args):
+        buf.set_arg(k, memoryview(a.reshape(-1)))
+    for k, a in enumerate(outs):
+        buf.set_res(k, memoryview(a))
+    return best_rate(call, n, repeats)
+
+
+def bench_batch(model: cn.Model, quick: bool, repeats: int) -> dict:
+    out: dict = {"threads": default_threads()}
+    n_c, n_m, n_f = (20_000, 5_000, 200) if quick else (400_000, 100_000, 2_000)
+    if compiler_available():
+        q = actuators(n_c)
+        t0 = time.perf_counter()
+        cn.batch_forward_kinematics(model, q[:10], backend="compiled")
+        out["compile_or_load_seconds"] = time.perf_counter() - t0
+        res = cn.batch_forward_kinematics(model, q, backend="compiled")
+        out["compiled_statuses"] = res.counts()
+        out["batch_fk_compiled"] = best_rate(
+            lambda: cn.batch_forward_kinematics(model, q, backend="compiled"), n_c, repeats
+        )
+        out["batch_fk_compiled_1_thread"] = best_rate(
+            lambda: cn.batch_forward_kinematics(model, q[: n_c // 4], backend="compiled", threads=1), n_c // 4, repeats
+        )
+    else:
+        out["note_compiled"] = "no C compiler on this machine: compiled path not measured"
+    q = actuators(n_m, 1)
+    out["batch_fk_map"] = best_rate(lambda: cn.batch_forward_kinematics(model, q, backend="map"), n_m, repeats)
+    out["batch_fk_map_1_thread"] = best_rate(
+        lambda: cn.batch_forward_kinematics(model, q[: n_m // 4], backend="map", threads=1), n_m // 4, repeats
+    )
+    # CasADi's own threaded map of the same kernel (why cpm_nlp threads over chunks itself)
+    n_t = n_m // 4
+    out["batch_fk_casadi_thread_map"] = casadi_thread_map_rate(
+        fk_kernel(model.closure, cn.SolverConfig("newton")), model, [q[:n_t], model.x_home], repeats
+    )
+    # closed-form IK (an SX kernel) on the map path, both ways of threading
+    t = np.column_stack([model.derived["pz0"] + q[:, 0], q[:, 1], q[:, 2]])
+    out["batch_ik_map"] = best_rate(lambda: cn.batch_inverse_kinematics(model, t, backend="map"), n_m, repeats)
+    out["batch_ik_casadi_thread_map"] = casadi_thread_map_rate(ik_kernel(model.closure), model, [t[:n_t]], repeats)
+    qf = actuators(n_f, 2)
+    out["fsolve_buffer"] = best_rate(lambda: fsolve_loop(model, qf, True), n_f, 1)
+    out["fsolve_casadi"] = best_rate(lambda: fsolve_loop(model, qf[: n_f // 2], False), n_f // 2, 1)
+    # the baseline solves the same equations: its poses agree with the batch's
+    batch = cn.batch_forward_kinematics(model, qf[:200])
+    x_fs = fsolve_loop(model, qf[:200], True)
+    out["fsolve_vs_batch_max_abs_difference"] = float(np.max(np.abs(x_fs[batch.ok] - batch.x[batch.ok])))
+    for base in ("fsolve_casadi", "fsolve_buffer"):
+        if "batch_fk_compiled" in out:
+            out[f"ratio_compiled_vs_{base}"] = out["batch_fk_compiled"] / out[base]
+        out[f"ratio_map_vs_{base}"] = out["batch_fk_map"] / out[base]
+    return out
+
+
+def bench_single(model: cn.Model, quick: bool) -> dict:
+    q = [1e-3, 0.5e-3, -0.3e-3]
+    newton = cn.SolverConfig("newton")
+    fns = cn.functions(model)
+    n = 200 if quick else 3000
+    return {
+        "single_fk_newton": 1e6 * median_call(lambda: cn.forward_kinematics(model, q, newton), n),
+        "single_fk_ipopt": 1e6 * median_call(lambda: cn.forward_kinematics(model, q), max(50, n // 10)),
+        "single_fk_function": 1e6 * median_call(lambda: fns.fk(q, model.x_home), n),
+    }
+
+
+def bench_reproduce(repeats: int) -> dict:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        run = subprocess.run(
+            [sys.executable, "-m", "cpm_nlp.cli", "reproduce"], cwd=ROOT, capture_output=True, text=True, check=False
+        )
+        times.append(time.perf_counter() - t0)
+    return {"reproduce": statistics.median(times), "reproduce_exit": run.returncode}
+
+
+MEMORY_SCRIPT = """
+import json, resource, time, numpy as np, cpm_nlp as cn
+model = cn.build_model("prs3", {params!r})
+q = np.random.default_rng(3).uniform(-{stroke}, {stroke}, ({n}, 3))
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+t0 = time.perf_counter()
+res = cn.batch_forward_kinematics(model, q, backend={backend!r})
+seconds = time.perf_counter() - t0
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps({{"peak_mb": peak / 1024, "before_mb": before / 1024, "seconds": seconds,
+                   "solved": int(res.ok.sum()), "n": len(res)}}))
+"""
+
+
+def bench_memory(quick: bool) -> dict:
+    n = 20_000 if quick else 1_000_000
+    backend = "compiled" if compiler_available() else "map"
+    script = MEMORY_SCRIPT.format(params=PAPER, stroke=STROKE, n=n, backend=backend)
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    data = json.loads(run.stdout)
+    return {
+        "memory_1m": data["peak_mb"],
+        "memory_1m_before_mb": data["before_mb"],
+        "memory_1m_seconds": data["seconds"],
+        "memory_1m_poses": data["n"],
+        "memory_1m_backend": backend,
+    }
+
+
+def bench_cases(quick: bool) -> list[dict]:
+    spec = yaml.safe_load((Path(__file__).parent / "cases.yaml").read_text())
+    out = []
+    for case in spec["cases"]:
+        path = ROOT / case["file"]
+        entry = {"name": case["name"], "file": case["file"], "target_seconds": case.get("target_seconds")}
+        if not path.exists():
+            entry["note"] = f"skipped: {case['file']} is not in this checkout (yet)"
+            out.append(entry)
+            continue
+        problem = cn.load_problem(path)
+        result = cn.solve(problem)
+        repeats = 2 if quick else int(case.get("repeats", 5))
+        entry["seconds"] = median_call(lambda problem=problem: cn.solve(problem), repeats)
+        entry["status"] = result.status.value
+        out.append(entry)
+    return out
+
+
+def verdict(name: str, value: float) -> str:
+    if name not in TARGETS:
+        return ""
+    kind, target = TARGETS[name]
+    if kind == "min":
+        return "met" if value >= target else f"MISSED by {100 * (1 - value / target):.0f} % (x{target / value:.2f})"
+    return "met" if value <= target else f"MISSED by {100 * (value / target - 1):.0f} %"
+
+
+UNITS = {
+    "batch_fk_compiled": "poses/s",
+    "batch_fk_compiled_1_thread": "poses/s",
+    "batch_fk_map": "poses/s",
+    "batch_fk_casadi_thread_map": "poses/s",
+    "batch_fk_map_1_thread": "poses/s",
+    "batch_ik_map": "poses/s",
+    "batch_ik_casadi_thread_map": "poses/s",
+    "fsolve_casadi": "poses/s",
+    "fsolve_buffer": "poses/s",
+    "single_fk_newton": "µs",
+    "single_fk_ipopt": "µs",
+    "single_fk_function": "µs",
+    "reproduce": "s",
+    "memory_1m": "MB peak RSS",
+    "memory_1m_seconds": "s",
+}
+
+
+def table(results: dict) -> str:
+    rows = [("measurement", "value", "unit", "target", "verdict")]
+    flat = {**results["batch"], **results["single"], **results["reproduce"], **results["memory"]}
+    for name, value in flat.items():
+        if not isinstance(value, (int, float)) or name.endswith(("_exit", "_mb", "_poses", "threads", "difference")):
+            continue
+        unit = UNITS.get(name, "x" if name.startswith("ratio") else "")
+        target = ""
+        if name in TARGETS:
+            kind, t = TARGETS[name]
+            target = (">= " if kind == "min" else "<= ") + f"{t:,.0f}"
+        text = f"{value:,.0f}" if value >= 1e4 else f"{value:,.1f}" if value >= 10 else f"{value:.3g}"
+        rows.append((name, text, unit, target, verdict(name, value)))
+    for case in results["cases"]:
+        target = f"<= {case['target_seconds']} s" if case.get("target_seconds") else ""
+        if "seconds" in case:
+            v = case["seconds"]
+            ok = "" if not case.get("target_seconds") else ("met" if v <= case["target_seconds"] else "MISSED")
+            rows.append((f"case: {case['name']}", f"{v * 1e3:,.2f}", "ms", target, f"{case['status']} {ok}".strip()))
+        else:
+            rows.append((f"case: {case['name']}", "-", "", target, case["note"]))
+    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run, not a measurement)")
+    parser.add_argument("--repeats", type=int, default=3, help="runs per rate (the best is kept)")
+    parser.add_argument("--skip", default="", help="comma-separated: batch, single, reproduce, memory, cases")
+    parser.add_argument("-o", "--output", default=str(Path(__file__).parent / "results.json"))
+    args = parser.parse_args(argv)
+    skip = {s.strip() for s in args.skip.split(",") if s.strip()}
+    model = cn.build_model("prs3", PAPER)
+    results: dict = {
+        "machine": {
+            "cpus": os.cpu_count(),
+            "threads_used": default_threads(),
+            "platform": platform.platform(),
+            "python": platform.python_version(),
+            "casadi": ca.__version__,
+            "numpy": np.__version__,
+            "scipy": scipy.__version__,
+            "quick": args.quick,
+        },
+        "batch": {} if "batch" in skip else bench_batch(model, args.quick, args.repeats),
+        "single": {} if "single" in skip else bench_single(model, args.quick),
+        "reproduce": {} if "reproduce" in skip else bench_reproduce(1 if args.quick else 3),
+        "memory": {} if "memory" in skip else bench_memory(args.quick),
+        "cases": [] if "cases" in skip else bench_cases(args.quick),
+    }
+    flat = {**results["batch"], **results["single"], **results["reproduce"], **results["memory"]}
+    results["targets"] = {
+        name: {
+            "target": TARGETS[name][1],
+            "kind": TARGETS[name][0],
+            "value": flat[name],
+            "verdict": verdict(name, flat[name]),
+        }
+        for name in TARGETS
+        if name in flat
+    }
+    print(table(results))
+    Path(args.output).write_text(json.dumps(results, indent=2) + "\n")
+    print(f"\nwritten: {args.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,37 @@
+"""The benchmark harness runs (a smoke run with small sizes; no timing is asserted)."""
+
+import importlib.util
+import json
+
+from .conftest import ROOT
+
+
+def test_benchmark_harness_smoke(tmp_path, capsys):
+    spec = importlib.util.spec_from_file_location("bench_run", ROOT / "benchmarks" / "run.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = tmp_path / "results.json"
+    assert bench.main(["--quick", "--repeats", "1", "--skip", "reproduce,memory", "-o", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert {"batch_fk_map", "fsolve_casadi", "fsolve_buffer", "ratio_map_vs_fsolve_casadi"} <= set(data["batch"])
+    assert {"single_fk_newton", "single_fk_ipopt", "single_fk_function"} <= set(data["single"])
+    cases = {c["file"]: c for c in data["cases"]}
+    assert cases["problems/prs3_joint_requirements.yaml"]["status"] == "solved"
+    for missing in ("problems/pantograph_cuboid.yaml", "problems/pantograph_synthesis.yaml"):
+        if not (ROOT / missing).exists():
+            assert cases[missing]["note"].startswith("skipped:")
+    printed = capsys.readouterr().out
+    assert "batch_fk_map" in printed and "written:" in printed
+
+
+def test_sweep_benchmark_smoke(tmp_path, capsys):
+    """benchmarks/bench_sweep.py runs end to end (a few points; no timing is asserted)."""
+    spec = importlib.util.spec_from_file_location("bench_sweep", ROOT / "benchmarks" / "bench_sweep.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = tmp_path / "bench_sweep.json"
+    assert bench.main(["--scale", "0.02", "--repeats", "1", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert [c["case"] for c in data["cases"]] == ["fk", "requirements"]
+    assert all(c["ratio_wall"] > 0 and c["ratio_cpu"] > 0 and c["speed_up"] > 0 for c in data["cases"])
+    assert "sweep on 1 worker process / plain loop" in capsys.readouterr().out
