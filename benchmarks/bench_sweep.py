@@ -169,7 +169,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", default=str(ROOT / "benchmarks" / "bench_sweep.json"), help="JSON output")
     args = parser.parse_args(argv)
     fk_points = max(20, int(1500 * args.scale))
-    req_rows = max(2, int(10 * args.scale))
+    req_rows = max(2, int(50 * args.scale))
     rows = []
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)

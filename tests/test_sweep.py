@@ -129,7 +129,7 @@ def test_shipped_sweep_files_are_small_enough_to_run_in_a_minute(cli):
     sizes = {p.name: cn.load_problem(p).sweep.size for p in sorted(PROBLEMS.glob("sweep_*.yaml"))}
     assert sizes == {
         "sweep_pantograph_cuboid.yaml": 54,  # about 0.4 s a point (IPOPT, 4 starts): 11 s on 2 cores
-        "sweep_prs3_requirements.yaml": 169,  # about 10 ms a point, 27 IK each
+        "sweep_prs3_requirements.yaml": 169,  # about 3 ms a point, 27 IK each
         "sweep_rpr_transmission.yaml": 1500,  # about 3 ms a point
     }
     for name in sizes:
