@@ -60,6 +60,7 @@ DEFAULTS = {
     "joint_requirements": ("requirements", "workspace"),
     "workspace": ("workspace",),
     "inscribed_cuboid": ("workspace",),
+    "actuator_workspace": ("workspace",),  # its points (inputs.points: true): the images of the stroke grid
     "rpr_transmission_map": ("map",),
     SWEEP: ("map", "lines", "workspace"),
 }
@@ -287,6 +288,7 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
     if len(task) != 3:
         raise NotApplicable(f"a workspace cloud needs 3 task coordinates; {closure.name} has {len(task)}")
     kinds = [closure.x[i].kind for i in closure.task_index]
+    box_label = "maximal inscribed cuboid" if data.problem == "inscribed_cuboid" else "box <t>_min ... <t>_max"
     cuboid = None
     if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
         cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
@@ -296,13 +298,13 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
     elif cuboid is not None:  # inscribed_cuboid: the cloud from the model, if at hand
         pts, label = np.zeros((0, 3)), ""
         if data.live is not None:
-            from .workspace import sample_workspace
-
-            pts = sample_workspace(data.live, 20000, 0)[0]
+            pts = _cloud_around(data.live, cuboid)
             label = "reachable points (sample of 20000, seed 0)"
         else:
             title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
-        return workspace_figure(pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label)
+        return workspace_figure(
+            pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label, cuboid_label=box_label
+        )
     else:  # a batch of poses, one sweep point per pose
         names = [_pose_name(data, closure, t) for t in task]
         _require_lists(data, names, "a workspace cloud")
@@ -311,7 +313,23 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
             pts = pts[data.ok]
         kinds = [_dims(data, n) or k for n, k in zip(names, kinds)]
         task, label = names, "solved poses"
-    return workspace_figure(pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label)
+    return workspace_figure(
+        pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label, cuboid_label=box_label
+    )
+
+
+def _cloud_around(model: Any, cuboid: tuple) -> np.ndarray:
+    """Reachable points in a box holding the region probed from home and the
+    cuboid, a quarter wider each way: the workspace's boundary near the cuboid
+    shows even where the probe from home stops short of it."""
+    from .workspace import probe_region, sample_workspace
+
+    lo, hi = (np.asarray(c, dtype=float) for c in cuboid)
+    probed = probe_region(model)
+    if probed is not None:
+        lo, hi = np.minimum(lo, probed[0]), np.maximum(hi, probed[1])
+    margin = 0.25 * (hi - lo)
+    return sample_workspace(model, 20000, 0, (lo - margin, hi + margin))[0]
 
 
 # -- map ---------------------------------------------------------------------------------------------

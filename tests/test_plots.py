@@ -317,9 +317,36 @@ def test_pantograph_cuboid_in_its_workspace_like_fig_13(cli, tmp_path):
     assert rect.get_width() == pytest.approx((v["px_max"] - v["px_min"]) * 1e3)
     assert rect.get_height() == pytest.approx((v["py_max"] - v["py_min"]) * 1e3)
     assert fig.axes[1].get_xlabel() == "$px$ (mm)" and fig.axes[1].get_ylabel() == "$py$ (mm)"
+    assert_cloud_covers_cuboid(fig, v, ("px", "py", "pz"), 1e3)
     alone, _ = figure(load(out))  # from the JSON alone: the cuboid, and how to see it in its workspace
     assert len(alone.axes[0].collections[0].get_offsets()) == 0 and len(alone.axes[1].patches) == 1
     assert "`cpm-nlp solve FILE --plot` draws the workspace around it" in alone._suptitle.get_text()
+
+
+def assert_cloud_covers_cuboid(fig, values, task, shown):
+    """The sampled workspace reaches every face of the cuboid inscribed in it (``shown``: SI -> drawn)."""
+    cloud = np.array(fig.axes[0].collections[0]._offsets3d).T
+    lo = np.array([values[f"{t}_min"] for t in task]) * shown
+    hi = np.array([values[f"{t}_max"] for t in task]) * shown
+    slack = 0.05 * (hi - lo)
+    assert np.all(cloud.min(axis=0) <= lo + slack) and np.all(cloud.max(axis=0) >= hi - slack)
+
+
+def test_prc3_cuboid_in_its_workspace():
+    """3-PRC (prc3-li-2018.md): the probe from home stops short of the cuboid; the cloud must not."""
+    problem = cn.load_problem(PROBLEMS / "prc3_cuboid.yaml")
+    result = cn.solve(problem)
+    data = from_result(result)
+    data.live = problem.model
+    fig, kind = figure(data)
+    assert kind == "workspace" and fig.axes[1].get_xlabel() == "$x$ (µm)"
+    assert_cloud_covers_cuboid(fig, result.values, ("x", "y", "z"), 1e6)
+
+
+def test_actuator_workspace_points():
+    result = cn.solve(cn.load_problem(PROBLEMS / "prc3_workspace.yaml", ["inputs.points=true"]))
+    fig, kind = figure(from_result(result))
+    assert kind == "workspace" and len(fig.axes[0].collections[0].get_offsets()) == result.values["n_points"]
 
 
 def test_workspace_kind_cloud(tmp_path):
