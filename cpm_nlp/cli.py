@@ -13,6 +13,7 @@ import logging
 import os
 import sys
 import tempfile
+import time
 import traceback
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -28,19 +29,28 @@ EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 # -- output helpers -------------------------------------------------------------------------------
 
 
-def write_atomic(path: str, text: str) -> None:
-    """Write ``text`` to ``path`` all at once (temp file + rename)."""
+def replace_atomically(path: str | os.PathLike, write: Callable[[str], Any], suffix: str = ".tmp") -> None:
+    """Create ``path`` all at once: ``write(temporary path)``, then rename.  The
+    file gets the permissions of any new file (the umask), not mkstemp's 0600."""
     target = Path(path)
     directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=directory)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
+        write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, target)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+def write_atomic(path: str, text: str) -> None:
+    """Write ``text`` to ``path`` all at once (temp file + rename)."""
+    replace_atomically(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 def check_output_path(path: str | None) -> None:
@@ -140,8 +150,10 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     from .problem_file import load_problem, solve
 
     check_output_path(args.output)
+    _check_plot_args(args)
     problem = load_problem(args.file, args.set or [])
     result = solve(problem)
+    fig = _result_figure(args, result, problem.model) if args.plot else None  # a bad --plot writes nothing
     if args.json:
         out.write(result.to_json() + "\n")
     elif not args.quiet:
@@ -149,7 +161,157 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
         out.write(render_result(result, title) + "\n")
     if args.output:
         write_atomic(args.output, result.to_json() + "\n")
+    if fig is not None:
+        _save_figure(args, fig, out)
     return EXIT_OK if result.ok else EXIT_FAILED
+
+
+# -- plots ------------------------------------------------------------------------------------
+
+
+def _plot_options(args: argparse.Namespace) -> Any:
+    from .figures import PlotOptions
+
+    return PlotOptions(value=args.value, x=getattr(args, "x", None), y=getattr(args, "y", None), best=args.best)
+
+
+def _check_plot_args(args: argparse.Namespace) -> None:
+    """Before solving: the figure can be written, and Matplotlib is there."""
+    if getattr(args, "plot", None):
+        from .plots import check_figure_path
+        from .sweep import require
+
+        check_figure_path(args.plot, "--plot")
+        require("matplotlib", "plot", "plotting")
+
+
+def _result_figure(args: argparse.Namespace, result: Result, model: Any) -> Any:
+    """The figure of a solved result; None (with a warning) if no point solved."""
+    from .figures import NothingSolved, figure, from_result
+
+    data = from_result(result)
+    data.live = model
+    try:
+        return figure(data, args.type, _plot_options(args))
+    except NothingSolved as exc:  # an honest failed solve is not bad input: exit 1, the result is written
+        args.err.write(f"warning: no plot written: {exc.message}\n")
+        return None
+    except InputError as exc:
+        raise exc.at(prefix=("--plot",)) from None
+
+
+def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: TextIO) -> None:
+    from .plots import save
+
+    fig, kind = fig_and_type
+    save(fig, args.plot)
+    if not args.quiet and not getattr(args, "json", False):
+        out.write(f"plot    : {args.plot} ({kind})\n")
+
+
+def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
+    from .figures import figure, load
+    from .plots import check_figure_path, save
+    from .sweep import require
+
+    check_figure_path(args.output)
+    require("matplotlib", "plot", "plotting")
+    data = load(args.result)
+    fig, kind = figure(data, args.type, _plot_options(args))
+    save(fig, args.output)
+    out.write(f"{args.output}: {kind} plot of {args.result}\n")
+    return EXIT_OK
+
+
+# -- sweeps -------------------------------------------------------------------------------------
+
+
+class ProgressBar:
+    """Points done of a sweep, on stderr: redrawn in place on a terminal, a
+    line per tenth otherwise (logs)."""
+
+    def __init__(self, stream: TextIO, width: int = 30) -> None:
+        self.stream, self.width = stream, width
+        self.tty = bool(getattr(stream, "isatty", lambda: False)())
+        self.t0 = time.monotonic()
+        self.first: int | None = None
+        self.last_draw = 0.0
+        self.last_tenth = -1
+
+    def __call__(self, done: int, total: int) -> None:
+        if self.first is None:
+            self.first = done
+        now = time.monotonic()
+        frac = done / total if total else 1.0
+        elapsed = now - self.t0
+        new = done - self.first
+        eta = ""
+        if 0 < new and done < total:
+            eta = f", about {elapsed / new * (total - done):.0f} s left"
+        text = f"sweep: {done}/{total} points ({frac:.0%}), {elapsed:.1f} s{eta}"
+        if self.tty:
+            if done < total and now - self.last_draw < 0.1:
+                return
+            bar = "#" * int(frac * self.width)
+            self.stream.write(f"\r[{bar:<{self.width}}] {text}\033[K" + ("\n" if done >= total else ""))
+            self.last_draw = now
+        else:
+            tenth = int(frac * 10)
+            if tenth == self.last_tenth:
+                return
+            self.last_tenth = tenth
+            self.stream.write(text + "\n")
+        self.stream.flush()
+
+
+def render_sweep(summary: Any, args: argparse.Namespace, problem: Any) -> str:
+    counts = ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items(), key=lambda kv: -kv[1]))
+    where = args.scheduler or f"a local cluster of {summary.workers} worker processes"
+    lines = [
+        f"sweep   : {args.file} ({problem.kind.name} on {problem.model.name})",
+        f"points  : {summary.total} ({counts or 'none yet'})",
+        f"this run: {summary.solved_now} points in {summary.seconds:.1f} s"
+        + (f" on {where}" if summary.solved_now else " (all points were already in the results file)"),
+        f"results : {summary.output}",
+    ]
+    return "\n".join(lines)
+
+
+def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
+    from .problem_file import load_problem
+    from .sweep import job_of, run_sweep
+    from .sweep_files import results_format
+
+    output = args.output or f"{Path(args.file).stem}.parquet"
+    results_format(output)
+    _check_plot_args(args)
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"expected a positive number of workers, got {args.workers}", path=("--workers",))
+    if args.chunk is not None and args.chunk < 1:
+        raise InputError(f"expected a positive number of points per task, got {args.chunk}", path=("--chunk",))
+    problem = load_problem(args.file, args.set or [])
+    job_of(problem)  # a file without a sweep section is bad input, before any cluster starts
+    progress = None if args.quiet else ProgressBar(args.err)
+    try:
+        summary = run_sweep(
+            problem,
+            output,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            chunk_size=args.chunk,
+            overwrite=args.overwrite,
+            progress=progress,
+        )
+    except KeyboardInterrupt:
+        args.err.write(f"\ninterrupted: the points solved so far are in {output}; run the same command to resume\n")
+        return 130
+    if not args.quiet:
+        out.write(render_sweep(summary, args, problem) + "\n")
+    if args.plot:
+        from .figures import figure, load
+
+        _save_figure(args, figure(load(output), args.type, _plot_options(args)), out)
+    return EXIT_OK if summary.ok else EXIT_FAILED
 
 
 def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
@@ -266,7 +428,40 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("-o", "--output", metavar="FILE", help="write the result as JSON to FILE (atomically)")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit status tells")
+    _add_plot_arguments(p, "--plot")
     p.set_defaults(func=cmd_solve)
+
+    p = sub.add_parser(
+        "sweep",
+        help="solve a problem at every point of its sweep section, on Dask",
+        description="Solve the problem of FILE at every point of its 'sweep' section (each point as "
+        "'cpm-nlp solve FILE --set KEY=VALUE' would), on a local Dask cluster or an existing one, "
+        "streaming one row per point to a Parquet or CSV file; a sweep run again resumes.",
+    )
+    p.add_argument("file", help="problem file (YAML) with a sweep section")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file (repeatable)")
+    p.add_argument(
+        "-o", "--output", metavar="RESULTS", help="results file, .parquet or .csv (default: FILE's name, .parquet)"
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="address of an existing Dask scheduler (default: start a local cluster, one process per core)",
+    )
+    p.add_argument("--workers", type=int, metavar="N", help="worker processes of the local cluster (default: cores)")
+    p.add_argument("--chunk", type=int, metavar="N", help="points per Dask task (default: about 0.5 s of work)")
+    p.add_argument("--overwrite", action="store_true", help="discard RESULTS and start again instead of resuming")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
+    _add_plot_arguments(p, "--plot")
+    p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("plot", help="plot a result (JSON of solve -o) or a sweep results file")
+    p.add_argument("result", help="JSON result of 'cpm-nlp solve -o', or a sweep results file (.parquet, .csv)")
+    p.add_argument("-o", "--output", metavar="FIGURE", required=True, help="figure file: .png, .svg or .pdf")
+    p.add_argument("--x", metavar="NAME", help="map: parameter (or value) on the horizontal axis")
+    p.add_argument("--y", metavar="NAME", help="map: parameter (or value) on the vertical axis")
+    _add_plot_arguments(p, None)
+    p.set_defaults(func=cmd_plot)
 
     p = sub.add_parser("check", help="validate a problem file without solving it")
     p.add_argument("file")
@@ -298,6 +493,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _add_plot_arguments(p: argparse.ArgumentParser, flag: str | None) -> None:
+    if flag:
+        p.add_argument(flag, metavar="FIGURE", help="also plot the result to FIGURE (.png, .svg or .pdf)")
+    p.add_argument(
+        "--type",
+        metavar="TYPE",
+        help="plot type: workspace, map, requirements, io or lines (default: chosen from the result)",
+    )
+    p.add_argument("--value", metavar="NAME", help="the value to plot (map colour, curves)")
+    p.add_argument("--best", choices=("max", "min"), help="map: mark the largest or smallest value")
+
+
 def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: TextIO | None = None) -> int:
     """Run the CLI; returns the exit status (also usable in-process by tests)."""
     out = out or sys.stdout
@@ -316,6 +523,7 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
     root.addHandler(handler)
     root.setLevel(logging.WARNING - 10 * min(args.verbose, 2))
     func: Callable[[argparse.Namespace, TextIO], int] = args.func
+    args.err = err
     try:
         return func(args, out)
     except InputError as exc:

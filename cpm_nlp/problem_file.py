@@ -13,6 +13,7 @@ One schema family for every problem kind::
     #   {preset: ..., method: ipopt|newton, options: {ipopt.tol: 1e-12}, tolerance: 1e-10}
     outputs: {values: [pz, psi, theta]}  # optional selection
     reproduce: {paper: ..., rows: [...]} # optional published figures
+    sweep: {parameters: {...}}           # optional design sweep (cpm_nlp.sweep)
 
 Every error names the file and the key path and says what was expected.
 """
@@ -44,6 +45,7 @@ TOP_LEVEL = {
     "solver": "a preset name or {preset, method, options, tolerance}",
     "outputs": "optional {values: [names]} selection",
     "reproduce": "published figures the file reproduces",
+    "sweep": "values to sweep (cpm-nlp sweep)",
 }
 
 SOLVER_OPTIONS = (
@@ -75,6 +77,7 @@ class Problem:
     file: str | None = None
     description: str = ""
     data: dict[str, Any] = field(default_factory=dict)
+    sweep: Any = None  # a cpm_nlp.sweep.SweepSpec when the file has a sweep section
 
 
 # -- reading ------------------------------------------------------------------------------------
@@ -361,7 +364,12 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
         from .reproduce import parse_reproduce
 
         reproduce = parse_reproduce(data["reproduce"], ("reproduce",))
-    return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data)
+    sweep = None
+    if data.get("sweep") is not None:
+        from .sweep import parse_sweep
+
+        sweep = parse_sweep(data["sweep"], data, kind, model, base_dir)
+    return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data, sweep)
 
 
 def _parse_outputs(raw: Any, names: list[str]) -> list[str] | None:

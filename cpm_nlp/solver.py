@@ -114,7 +114,13 @@ class SolverConfig:
     def validate(self) -> None:
         """Let CasADi check the options now (on a one-variable problem), so that
         a bad option is reported while the problem file is read."""
-        _validate_options(self.method, tuple(sorted(self.options.items(), key=lambda kv: kv[0])))
+        items = tuple(sorted(self.options.items(), key=lambda kv: kv[0]))
+        try:
+            hash(items)
+        except TypeError:  # a mapping or list as an option value: checked, not cached
+            _validate_options.__wrapped__(self.method, items)
+            return
+        _validate_options(self.method, items)
 
     def key(self) -> tuple:
         """Hashable identity (for caching built solvers)."""

@@ -55,7 +55,7 @@ def test_not_a_mapping(cli, tmp_path):
         tmp_path,
         "- 1\n- 2\n",
         "expected a mapping with keys problem, description, mechanism, inputs, solver, outputs, "
-        "reproduce; got list [1, 2]",
+        "reproduce, sweep; got list [1, 2]",
     )
 
 
@@ -65,7 +65,7 @@ def test_empty_file(cli, tmp_path):
         tmp_path,
         "",
         "expected a mapping with keys problem, description, mechanism, inputs, "
-        "solver, outputs, reproduce; got an empty file",
+        "solver, outputs, reproduce, sweep; got an empty file",
     )
 
 
@@ -75,7 +75,7 @@ def test_unknown_top_level_key(cli, tmp_path):
         tmp_path,
         GOOD + "inputz: {}\n",
         "unknown top-level key 'inputz'; expected one of: description, inputs, mechanism, outputs, "
-        "problem, reproduce, solver; did you mean 'inputs'?",
+        "problem, reproduce, solver, sweep; did you mean 'inputs'?",
     )
 
 
@@ -296,3 +296,13 @@ def test_bad_command_line(cli):
 def test_missing_task_coordinate(cli, tmp_path, kind):
     text = GOOD.replace("forward_kinematics", kind).replace("{s1: 1 mm, s2: 0.5 mm, s3: -0.3 mm}", "{dz: 1 mm, psi: 0}")
     expect_input_error(cli, tmp_path, text, "inputs: missing input 'theta' (rotation about y (eq 4))")
+
+
+def test_solver_option_given_a_mapping(cli, tmp_path):
+    """An unhashable option value is checked by CasADi like any other (it was a crash, exit 70)."""
+    expect_input_error(
+        cli,
+        tmp_path,
+        GOOD + "solver: {options: {ipopt.tol: {a: 1}}}\n",
+        "solver.options.ipopt.tol: CasADi rejected the value {'a': 1} of option 'ipopt.tol' (type mismatch)",
+    )

@@ -22,3 +22,16 @@ def test_benchmark_harness_smoke(tmp_path, capsys):
             assert cases[missing]["note"].startswith("skipped:")
     printed = capsys.readouterr().out
     assert "batch_fk_map" in printed and "written:" in printed
+
+
+def test_sweep_benchmark_smoke(tmp_path, capsys):
+    """benchmarks/bench_sweep.py runs end to end (a few points; no timing is asserted)."""
+    spec = importlib.util.spec_from_file_location("bench_sweep", ROOT / "benchmarks" / "bench_sweep.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = tmp_path / "bench_sweep.json"
+    assert bench.main(["--scale", "0.02", "--repeats", "1", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert [c["case"] for c in data["cases"]] == ["fk", "requirements"]
+    assert all(c["ratio_wall"] > 0 and c["ratio_cpu"] > 0 and c["speed_up"] > 0 for c in data["cases"])
+    assert "sweep on 1 worker process / plain loop" in capsys.readouterr().out
