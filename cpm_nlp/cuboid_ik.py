@@ -49,7 +49,7 @@ from .solver import SolverConfig
 
 log = logging.getLogger(__name__)
 
-#: row slots of the smallest working-set NLP (then doubled as needed)
+#: row slots of the smallest working-set NLP (see :func:`slots`)
 MIN_SLOTS = 16
 #: a row is active (kept for the next starts) when its multiplier exceeds this, relative to the largest
 ACTIVE_MULTIPLIER = 1e-6
@@ -81,19 +81,30 @@ def row_function(closure: LoopClosure, limited: ca.Function, rows: tuple[int, ..
     return closure.solvers.memo(row_key(rows), build)
 
 
-class SlotNLP:
-    """IPOPT on the working-set cuboid NLP with K row slots (see the module docstring)."""
+def slots(rows: int) -> int:
+    """Slots of the smallest working-set NLP that holds ``rows`` rows: MIN_SLOTS times
+    1, 1.5, 2, 3, 4, 6, 8, ... (one IPOPT solver per size)."""
+    K = MIN_SLOTS
+    while K < rows:
+        K = K * 3 // 2 if K & (K - 1) == 0 else K * 4 // 3
+    return K
 
-    def __init__(self, closure: LoopClosure, rows_fn: ca.Function, K: int, options: dict):
+
+class SlotNLP:
+    """IPOPT on the working-set cuboid NLP with K row slots (see the module docstring),
+    for the quantities ``sel`` (positions in the output of ``rows_fn``; the others
+    are not evaluated)."""
+
+    def __init__(self, closure: LoopClosure, rows_fn: ca.Function, sel: tuple[int, ...], K: int, options: dict):
         c = closure
-        d, m = c.nq, rows_fn.size1_out(0)
+        d, m = c.nq, len(sel)
         self.d, self.m, self.K = d, m, K
         u, w = ca.SX.sym("u", d), ca.SX.sym("w", d)
         p = ca.SX.sym("p", c.np)
         S, E = ca.SX.sym("S", d, K), ca.SX.sym("E", m, K)
         centre, size = ca.SX.sym("c", d), ca.SX.sym("D", d)
         T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + S * ca.repmat(w, 1, K))
-        G = rows_fn.map(K)(T, ca.repmat(p, 1, K))
+        G = rows_fn.map(K)(T, ca.repmat(p, 1, K))[list(sel), :]
         nlp = {
             "x": ca.vertcat(u, w),
             "p": ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size),
@@ -186,20 +197,21 @@ class ClosedFormCuboid:
 
     # -- the NLP ----------------------------------------------------------------------------------
 
-    def _nlp(self, K: int) -> SlotNLP:
-        key = ("cuboid_slots", self.rows, K, repr(sorted(self.options.items())))
-        return self.closure.solvers.get(repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, K, self.options))
+    def _nlp(self, sel: tuple[int, ...], K: int) -> SlotNLP:
+        key = ("cuboid_slots", self.rows, sel, K, repr(sorted(self.options.items())))
+        return self.closure.solvers.get(
+            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, sel, K, self.options)
+        )
 
     def _solve(self, z0: np.ndarray, work: list[tuple[int, int]]):
-        K = MIN_SLOTS
-        while K < len(work):
-            K *= 2
-        S, E = np.full((K, self.d), 0.5), np.zeros((K, self.m))
+        K = slots(len(work))
+        sel = tuple(sorted({r for _, r in work}))  # the quantities with rows: only those are evaluated
+        S, E = np.full((K, self.d), 0.5), np.zeros((K, len(sel)))
         lbg, ubg = np.full(K, -np.inf), np.full(K, np.inf)
         for k, (j, r) in enumerate(work):
-            S[k], E[k, r], lbg[k], ubg[k] = self.S[j], 1.0, self.lo[r], self.hi[r]
+            S[k], E[k, sel.index(r)], lbg[k], ubg[k] = self.S[j], 1.0, self.lo[r], self.hi[r]
         params = np.r_[self.model.p, S.ravel(), E.ravel(), self.centre, self.size]
-        return self._nlp(K).solve(z0, params, self._lbx, lbg, ubg)
+        return self._nlp(sel, K).solve(z0, params, self._lbx, lbg, ubg)
 
     def values(self, z: np.ndarray) -> np.ndarray:
         """Every quantity at every sample of the box z: (N, m)."""
