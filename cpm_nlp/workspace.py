@@ -5,7 +5,9 @@ assembles there on the branch the model designates and every actuator, pose
 coordinate and passive joint with declared limits lies within them:
 
 * :func:`membership` -- that test for many points at once (the closed-form
-  IK of the model when it has one, else the IK solved point by point);
+  IK of the model when it has one, with the limited quantities, residuals
+  and Φ_x of all points in one mapped CasADi call; else the IK solved point
+  by point);
 * :func:`probe_region` and :func:`sample_workspace` -- a box around the home
   pose found by probing along the task axes, and a seeded point cloud;
 * :func:`inscribed_cuboid` -- the largest axis-aligned box in the task
@@ -18,7 +20,10 @@ region's centre c and size D) carries N sample points s_j on its surface
 (a grid of n per edge, so corners, edge and face centres are among them);
 each sample has its own pose unknowns y_j = (dependent pose coordinates,
 actuators) with Φ(t_j, y_j) = 0 and the limits as bounds on the limited
-quantities; the objective is -Σ log w_i (the log of the volume).  The dense
+quantities; the objective is -Σ log w_i (the log of the volume).  With a
+closed-form IK the same NLP is solved without pose unknowns, the limited
+quantities being functions of the sample points through the IK, on working
+sets of its rows (:mod:`cpm_nlp.cuboid_ik`; ``formulation`` chooses).  The dense
 check afterwards finds any point of the box that is outside (between the
 samples, or a hole inside); its worst points become extra samples and the
 NLP is solved again (an exchange method), a few rounds at most.  If points
