@@ -55,13 +55,17 @@ MIN_SLOTS = 16
 ACTIVE_MULTIPLIER = 1e-6
 #: rows of one quantity added per solve (the most violated ones)
 ADD_PER_QUANTITY = 4
-#: solves of one start (each adds the violated rows) before it is reported not settled
-MAX_SETTLE = 25
+#: after this many solves of one start every violated row is added (the working set then
+#: reaches all violated rows in a few solves)
+ESCALATE = 6
+#: solves of one start before it is reported not settled (each adds at least one row)
+MAX_SETTLE = 40
 #: CasADi options of the working-set NLP: NaN (no assembly) is a rejected trial point, not a warning
 QUIET = {"show_eval_warnings": False, "calc_lam_p": False}
 
 
 def row_key(rows: tuple[int, ...]) -> tuple:
+    """The key of :func:`row_function` in the closure's cache."""
     return ("cuboid_rows", tuple(rows))
 
 
@@ -183,9 +187,6 @@ class ClosedFormCuboid:
         self.m = len(self.rows) + 1
         self.lo = np.r_[lower, reach_lower]
         self.hi = np.r_[upper, np.inf]
-        # violations compare across samples of a quantity only; this keeps them O(1)
-        span = np.where(np.isfinite(self.hi - self.lo), self.hi - self.lo, np.nan)
-        self.scale = np.where(np.isfinite(span) & (span > 0), span, 1.0)
         self.S = np.array(samples, dtype=float)
         self.centre, self.size = np.asarray(centre, dtype=float), np.asarray(size, dtype=float)
         self.options = {**options, **QUIET}
@@ -218,18 +219,19 @@ class ClosedFormCuboid:
         T = self.centre + self.size * (z[: self.d] + self.S * z[self.d :])
         return evaluate_points(self.closure, row_key(self.rows), self.fn, [T], self.model.p)[0]
 
-    def _violated(self, V: np.ndarray, work: set[tuple[int, int]]) -> set[tuple[int, int]]:
+    def _violated(self, V: np.ndarray, work: set[tuple[int, int]], per_quantity: int | None) -> set[tuple[int, int]]:
         """Rows outside the working set that V (N, m) violates: of each quantity the
-        ADD_PER_QUANTITY worst (NaN, a sample that does not assemble, counts as worst)."""
+        ``per_quantity`` worst (all if None; NaN, a sample that does not assemble,
+        counts as worst)."""
         with np.errstate(invalid="ignore"):
-            excess = np.maximum(self.lo - V, V - self.hi) / self.scale
+            excess = np.maximum(self.lo - V, V - self.hi)
         excess = np.where(np.isnan(excess), np.inf, excess)
         for j, r in work:
             excess[j, r] = -np.inf
         new = set()
         for r in range(self.m):
             col = excess[:, r]
-            worst = np.argsort(-col, kind="stable")[:ADD_PER_QUANTITY]
+            worst = np.argsort(-col, kind="stable")[:per_quantity]
             new |= {(int(j), r) for j in worst if col[j] > 0}
         return new
 
@@ -239,13 +241,13 @@ class ClosedFormCuboid:
         active rows of the final solution)."""
         work = set(work)
         iterations = 0
-        for _ in range(MAX_SETTLE):
+        for solve in range(MAX_SETTLE):
             order = sorted(work)
             z, ok, status, iters, lam = self._solve(z0, order)
             iterations += iters
             if not ok:
                 return z, False, status, iterations, set()
-            new = self._violated(self.values(z), work)
+            new = self._violated(self.values(z), work, ADD_PER_QUANTITY if solve < ESCALATE else None)
             if not new:
                 lam = np.abs(lam[: len(order)])
                 top = float(lam.max()) if lam.size else 0.0
@@ -260,7 +262,12 @@ class ClosedFormCuboid:
     def start(self, u0: np.ndarray, w0: np.ndarray, *_poses) -> tuple[bool, np.ndarray | None, str, int]:
         """One start from the box (u0, w0) (the poses of its samples are not
         unknowns here): (converged, z, status, iterations)."""
-        z, ok, status, iters, active = self.settle(np.r_[u0, w0], self.memory or self.initial)
+        z0 = np.r_[u0, w0]
+        z, ok, status, iters, active = self.settle(z0, self.memory or self.initial)
+        if not ok and self.memory:  # the rows of other optima did not hold the box: add the corners'
+            log.debug("start from the active rows failed (%s); again with the corner rows", status)
+            z, ok, status, more, active = self.settle(z0, self.memory | self.initial)
+            iters += more
         if ok:
             self.memory |= active
         return ok, (z if ok else None), status, iters

@@ -686,7 +686,10 @@ def inscribed_cuboid(
     from (default: probed around home); formulation: "poses" (pose unknowns at
     every sample, any mechanism), "closed_form" (the limited quantities through
     the closed-form IK, :mod:`cpm_nlp.cuboid_ik`) or "auto" (closed_form when
-    the mechanism has a closed-form IK).  Both formulations solve the same NLP.
+    the mechanism has a closed-form IK and every point of the cloud drawn for
+    the starts assembles: where the IK's reach margin bounds the workspace its
+    derivatives grow without bound, and IPOPT converges there less reliably
+    than with pose unknowns).  Both formulations solve the same NLP.
     """
     if formulation not in FORMULATIONS:
         raise InputError(
@@ -733,7 +736,10 @@ def inscribed_cuboid(
             seconds=time.perf_counter() - t_start,
         )
     base = surface_grid(d, samples_per_edge)
-    closed_form = formulation == "closed_form" or (formulation == "auto" and c.ik is not None)
+    # auto: the closed form unless the IK's own reach limit shapes the workspace in the
+    # region (a cloud point that does not assemble): its derivatives are unbounded there
+    assembles = "no assembly" not in {cloud_mem.binding[k] for k in np.flatnonzero(~cloud_mem.inside)}
+    closed_form = formulation == "closed_form" or (formulation == "auto" and c.ik is not None and assembles)
     if closed_form:
         engine = _closed_form_cuboid(model, config, base, centre, size, cloud_mem)
     else:

@@ -131,3 +131,16 @@ def test_membership_of_many_and_few_points_agree():
     few = W.membership(m, T[:1000])
     np.testing.assert_array_equal(few.inside, big.inside[:1000])
     np.testing.assert_array_equal(few.margin, big.margin[:1000])
+
+
+def test_auto_keeps_pose_unknowns_where_the_ik_reach_bounds_the_workspace():
+    """Without joint limits the pantograph's workspace ends where the links stretch out
+    (the IK's reach margin 2a - |AB| reaches 0, its derivatives unbounded): "auto" then
+    solves with pose unknowns; "closed_form" can be asked for and finds the same box to
+    the tolerance of its ill-conditioned boundary."""
+    m = cn.build_model("pantograph", {"a": 0.02, "b": 0.05}, {})
+    auto = W.inscribed_cuboid(m, starts=4)
+    poses = W.inscribed_cuboid(m, starts=4, formulation="poses")
+    np.testing.assert_array_equal(auto.lower, poses.lower)
+    closed = W.inscribed_cuboid(m, starts=4, formulation="closed_form")
+    assert closed.found and closed.converged == 4 and closed.volume == pytest.approx(poses.volume, rel=1e-5)
