@@ -51,7 +51,7 @@ from .kernels import (
     status_rules,
 )
 from .kinematics import PoseSolution, failure_message
-from .model import Model
+from .model import LoopClosure, Model
 from .result import Status
 from .solver import SolverConfig
 
@@ -60,6 +60,8 @@ log = logging.getLogger(__name__)
 BACKENDS = ("map", "compiled", "auto")
 #: poses per mapped evaluation (one FunctionBuffer); chunks are spread over threads
 CHUNK = 4096
+#: points below which :func:`evaluate_points` makes one mapped call on one thread
+THREADED_POINTS = 16384
 
 
 def default_threads() -> int:
@@ -277,6 +279,43 @@ def evaluate(
     if any(codes):
         raise RuntimeError(f"evaluation of {function.name()} failed")
     return outs
+
+
+def evaluate_points(
+    closure: LoopClosure, key: tuple, function: ca.Function, per_point: list[np.ndarray], p: np.ndarray
+) -> list[np.ndarray]:
+    """``function`` of one mechanism type (per-point inputs, then p) over N points:
+    (N, nnz) arrays in, (N, nnz_out) arrays out.  ``key`` names the function in
+    the closure's cache (the key it was built under).
+
+    Large N goes through :func:`evaluate` (chunks on all threads); smaller N
+    through one mapped call on one thread (faster here than two threads below
+    :data:`THREADED_POINTS`), of a size rounded up to a power of two (to a
+    multiple of 256 above 256), the mapped Functions kept with the closure
+    (CasADi keeps them only while referenced) and the padding rows repeating
+    the first point.
+    """
+    n = per_point[0].shape[0]
+    args = [np.ascontiguousarray(a, dtype=float) for a in per_point]
+    p = np.asarray(p, dtype=float)
+    if n == 0:
+        return [np.empty((0, function.nnz_out(k))) for k in range(function.n_out())]
+    if n >= THREADED_POINTS:
+        return evaluate(function, args + [p])
+    size = max(8, 1 << (n - 1).bit_length()) if n <= 256 else -(-n // 256) * 256
+    mapped = closure.solvers.memo(("mapped", size) + tuple(key), lambda: function.map(size))
+    padded = [np.vstack([a, np.repeat(a[:1], size - n, axis=0)]) if size > n else a for a in args]
+    flat = [np.ascontiguousarray(a).reshape(-1) for a in padded] + [np.ascontiguousarray(np.tile(p, size))]
+    outs = [np.empty((size, function.nnz_out(k))) for k in range(function.n_out())]
+    buf, call = mapped.buffer()
+    for k, a in enumerate(flat):
+        buf.set_arg(k, memoryview(a))
+    for k, o in enumerate(outs):
+        buf.set_res(k, memoryview(o.reshape(-1)))
+    call()
+    if buf.ret() != 0:
+        raise RuntimeError(f"evaluation of {function.name()} failed")
+    return [o[:n] for o in outs]
 
 
 def _refine_singular(model: Model, codes: np.ndarray, x: np.ndarray, q: np.ndarray, checks: dict, tol: float) -> None:

@@ -374,7 +374,9 @@ def test_exchange_rounds_and_shrink():
     res = W.inscribed_cuboid(m, starts=2, samples_per_edge=2)
     assert res.found and res.refinements >= 1 and res.shrink == 1.0
     assert res.volume == pytest.approx(1.786095e-6, rel=1e-5)
-    shrunk = W.inscribed_cuboid(m, starts=2, samples_per_edge=2, refinements=0)
+    # corners only have two local optima; from these starts the pose formulation reaches
+    # the one beside the inner ellipsoid (see the next test for the other)
+    shrunk = W.inscribed_cuboid(m, starts=2, samples_per_edge=2, refinements=0, formulation="poses")
     assert shrunk.found and shrunk.check.passed and shrunk.shrink < 1.0
     assert shrunk.volume < res.volume and "shrunk by a factor" in shrunk.message
     assert paper_check(m, shrunk.lower, shrunk.upper)[0] == 0
