@@ -31,8 +31,11 @@ from .solver import SolverConfig
 MM = 1e-3
 
 
-def _only_rpr(model: Model) -> str | None:
-    return None if model.name == "rpr" else "it is specific to the RPR mechanism (type rpr)"
+class RprKind(ProblemKind):
+    """A problem kind that applies to the RPR mechanism only."""
+
+    def supports(self, model: Model) -> str | None:
+        return None if model.name == "rpr" else "it is specific to the RPR mechanism (type rpr)"
 
 
 def _pose_options() -> list[Option]:
@@ -92,12 +95,9 @@ def _material(raw: Any, path: tuple) -> flexure.Material:
 # -- eq 7-13 --------------------------------------------------------------------------------------
 
 
-class ScrewJacobian(Jacobian):
+class ScrewJacobian(RprKind, Jacobian):
     name = "rpr_screw_jacobian"
     description = "RPR Jacobian J, G and passive rates G_p by screw theory (eq 7-13) beside the AD Jacobians"
-
-    def supports(self, model: Model) -> str | None:
-        return _only_rpr(model)
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         res = super().run(model, inputs, solver)
@@ -142,12 +142,9 @@ class ScrewJacobian(Jacobian):
 # -- section 5.1 ------------------------------------------------------------------------------------
 
 
-class Twists(ProblemKind):
+class Twists(RprKind):
     name = "rpr_twists"
     description = "displacement twists of the RPR platform for a small displacement of each actuator (eq 45)"
-
-    def supports(self, model: Model) -> str | None:
-        return _only_rpr(model)
 
     def input_options(self, model: Model) -> list[Option]:
         return _pose_options() + [
@@ -289,12 +286,9 @@ def _design_values(model: Model, eta_max: str) -> tuple[dict, dict]:
     return values, dims
 
 
-class TransmissionMap(ProblemKind):
+class TransmissionMap(RprKind):
     name = "rpr_transmission_map"
     description = "output transmission index eta over a grid of the (s, t) design triangle (eq 19-23, Fig. 4)"
-
-    def supports(self, model: Model) -> str | None:
-        return _only_rpr(model)
 
     def input_options(self, model: Model) -> list[Option]:
         return [
@@ -399,12 +393,9 @@ class TransmissionMap(ProblemKind):
         ]
 
 
-class Synthesis(ProblemKind):
+class Synthesis(RprKind):
     name = "synthesis"
     description = "dimensional synthesis of the RPR: maximise eta (eq 19) under eq 22 by IPOPT multi-start"
-
-    def supports(self, model: Model) -> str | None:
-        return _only_rpr(model)
 
     def input_options(self, model: Model) -> list[Option]:
         return [
@@ -525,12 +516,9 @@ def _joint_dims(joint: str, geometry: Mapping[str, Any]) -> tuple[float, float, 
     return (geometry["r"], geometry["t"], geometry["b" if joint == "R" else "h"])
 
 
-class JointDesign(ProblemKind):
+class JointDesign(RprKind):
     name = "rpr_joint_design"
     description = "optimal R and U flexure joints of the RPR (eq 27-32, Table 1) by IPOPT multi-start"
-
-    def supports(self, model: Model) -> str | None:
-        return _only_rpr(model)
 
     def input_options(self, model: Model) -> list[Option]:
         return [
@@ -718,12 +706,9 @@ _LEAF = (
 )
 
 
-class Compliance(ProblemKind):
+class Compliance(RprKind):
     name = "rpr_compliance"
     description = "pseudo-rigid-body compliance C and input compliance C_in of the RPR (eq 33-44)"
-
-    def supports(self, model: Model) -> str | None:
-        return _only_rpr(model)
 
     def input_options(self, model: Model) -> list[Option]:
         return _pose_options() + [
