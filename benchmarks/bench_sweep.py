@@ -7,7 +7,7 @@ Two 3-PRS sweeps, each solved twice in the same run:
 * **plain loop** -- in this process, one point after the other, each point
   exactly as ``cpm-nlp solve FILE --set KEY=VALUE`` solves it
   (``apply_overrides`` + ``problem_from_dict`` + ``solve``), nothing written;
-* **sweep** -- :func:`cpm_nlp.sweep.run_sweep` on a Dask LocalCluster of ONE
+* **sweep** -- :func:`cpm_nlp.sweep.run.run_sweep` on a Dask LocalCluster of ONE
   single-threaded worker process (so both do the same work on one core),
   streaming every record to a Parquet file.
 
@@ -45,8 +45,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import cpm_nlp as cn  # noqa: E402
-from cpm_nlp.problem_file import apply_overrides, problem_from_dict, solve  # noqa: E402
-from cpm_nlp.sweep import dask_config, default_workers, job_of, override, run_sweep, solve_point  # noqa: E402
+from cpm_nlp.problems.file import apply_overrides, problem_from_dict, solve  # noqa: E402
+from cpm_nlp.sweep.run import dask_config, default_workers, job_of, override, run_sweep, solve_point  # noqa: E402
 
 TARGET = 1.10
 

@@ -46,9 +46,9 @@ import yaml
 from scipy.optimize import fsolve
 
 import cpm_nlp as cn
-from cpm_nlp.batch import default_threads
-from cpm_nlp.compiled import compiler_available
-from cpm_nlp.kernels import FastFunction, fk_kernel, ik_kernel, shared_values
+from cpm_nlp.core.batch import default_threads
+from cpm_nlp.core.compiled import compiler_available
+from cpm_nlp.core.kernels import FastFunction, fk_kernel, ik_kernel, shared_values
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
@@ -189,7 +189,11 @@ def bench_reproduce(repeats: int) -> dict:
     for _ in range(repeats):
         t0 = time.perf_counter()
         run = subprocess.run(
-            [sys.executable, "-m", "cpm_nlp.cli", "reproduce"], cwd=ROOT, capture_output=True, text=True, check=False
+            [sys.executable, "-m", "cpm_nlp.cli.main", "reproduce"],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            check=False,
         )
         times.append(time.perf_counter() - t0)
     return {"reproduce": statistics.median(times), "reproduce_exit": run.returncode}

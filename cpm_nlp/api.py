@@ -7,12 +7,12 @@ with numpy arrays, or take the CasADi Functions of the model (``model.closure``:
 to the ``cpm_nlp`` logger.
 """
 
-from .batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
-from .embed import ModelFunctions, functions
-from .errors import CpmError, InputError
-from .export import export_kinematics, load_exported
-from .kernels import status_of
-from .kinematics import (
+from .analysis.requirements import RequirementsReport, joint_requirements
+from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
+from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
+from .core.errors import CpmError, InputError
+from .core.kernels import status_of
+from .core.kinematics import (
     JacobianReport,
     PoseSolution,
     assess,
@@ -22,14 +22,14 @@ from .kinematics import (
     passive_joints,
     residual,
 )
-from .mechanisms import build_model, mechanism_type
-from .model import Coordinate, LoopClosure, Model
-from .problem_file import Problem, apply_overrides, load_problem, problem_from_dict, solve
-from .reproduce import Comparison, reproduce
-from .requirements import RequirementsReport, joint_requirements
-from .result import Result, SolverInfo, Status
-from .solver import SolverConfig
-from .workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
+from .core.model import Coordinate, LoopClosure, Model
+from .core.result import Result, SolverInfo, Status
+from .core.solver import SolverConfig
+from .io.embed import ModelFunctions, functions
+from .io.export import export_kinematics, load_exported
+from .mechanisms.registry import build_model, mechanism_type
+from .problems.file import Problem, apply_overrides, load_problem, problem_from_dict, solve
+from .problems.reproduce import Comparison, reproduce
 
 __all__ = [
     "status_of",

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.cli import main
+from cpm_nlp.cli.main import main
 
 ROOT = Path(__file__).resolve().parent.parent
 PROBLEMS = ROOT / "problems"

@@ -3,8 +3,8 @@ expected; exit status 2; no traceback; no output file."""
 
 import pytest
 
-from cpm_nlp.mechanisms import MODULES
-from cpm_nlp.problems import KINDS
+from cpm_nlp.core.kind import KINDS
+from cpm_nlp.mechanisms.registry import MODULES
 
 from .conftest import PROBLEMS
 

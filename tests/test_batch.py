@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.result import Status
+from cpm_nlp.core.result import Status
 
 from .conftest import PAPER_PRS3, PROBLEMS
 from .test_prs3_kinematics import central_difference, random_task

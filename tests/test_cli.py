@@ -130,7 +130,7 @@ def test_check_and_describe(cli):
 def test_console_script_runs_out_of_process():
     """The installed entry point, exactly as a user runs it."""
     proc = subprocess.run(
-        [sys.executable, "-m", "cpm_nlp.cli", "solve", FK, "--json"],
+        [sys.executable, "-m", "cpm_nlp.cli.main", "solve", FK, "--json"],
         capture_output=True,
         text=True,
         cwd=ROOT,

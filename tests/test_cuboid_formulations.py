@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp import workspace as W
-from cpm_nlp.errors import InputError
+from cpm_nlp.analysis import workspace as W
+from cpm_nlp.core.errors import InputError
 
 from .conftest import PROBLEMS
 
@@ -50,8 +50,8 @@ def test_corners_only_closed_form_finds_the_larger_local_optimum():
 def test_formulation_is_checked(prs3):
     with pytest.raises(InputError, match="unknown cuboid formulation 'pose'.*did you mean 'poses'"):
         W.inscribed_cuboid(prs3, formulation="pose")
-    from cpm_nlp import prs3 as P3
-    from cpm_nlp.model import LoopClosure, Model
+    from cpm_nlp.core.model import LoopClosure, Model
+    from cpm_nlp.mechanisms import prs3 as P3
 
     no_ik = LoopClosure(
         "prs3_no_ik",

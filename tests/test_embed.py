@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.compiled import compiler_available
-from cpm_nlp.result import Status
+from cpm_nlp.core.compiled import compiler_available
+from cpm_nlp.core.result import Status
 
 from .conftest import PAPER_PRS3, PROBLEMS, ROOT
 from .test_prs3_kinematics import central_difference
@@ -140,7 +140,7 @@ def test_compiled_backend_equals_map(compiled_cache):
 
 def test_a_slow_build_does_not_block_other_entries():
     """A C compilation in one thread must not stall single solves in others."""
-    from cpm_nlp.solver import SolverCache
+    from cpm_nlp.core.solver import SolverCache
 
     cache = SolverCache()
     started, release = threading.Event(), threading.Event()

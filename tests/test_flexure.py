@@ -5,8 +5,8 @@ import math
 import casadi as ca
 import pytest
 
-from cpm_nlp import flexure
-from cpm_nlp.errors import InputError
+from cpm_nlp.analysis import flexure
+from cpm_nlp.core.errors import InputError
 
 
 def test_circular_notch_stiffness_hand_value():

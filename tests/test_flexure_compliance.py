@@ -1,4 +1,4 @@
-"""Six-axis notch compliances (cpm_nlp.flexure_compliance) against adaptive
+"""Six-axis notch compliances (cpm_nlp.analysis.flexure_compliance) against adaptive
 quadrature of the Lobontiu integrals, the Paros-Weisbord closed form, AD
 against central differences, and the U joint as two notches in series."""
 
@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from cpm_nlp import flexure, screws
-from cpm_nlp import flexure_compliance as fc
+from cpm_nlp.analysis import flexure
+from cpm_nlp.analysis import flexure_compliance as fc
+from cpm_nlp.core import screws
 
 AL = flexure.MATERIALS["Al 7075-T6"]
 

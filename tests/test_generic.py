@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.model import Coordinate, LoopClosure, Model
-from cpm_nlp.result import Status
+from cpm_nlp.core.model import Coordinate, LoopClosure, Model
+from cpm_nlp.core.result import Status
 
 NEWTON = cn.SolverConfig("newton")
 

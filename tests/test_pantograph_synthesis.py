@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp import pantograph as P
-from cpm_nlp import workspace as W
-from cpm_nlp.result import Status
+from cpm_nlp.analysis import workspace as W
+from cpm_nlp.core.result import Status
+from cpm_nlp.mechanisms.pantograph import kinematics as P
 
 from .conftest import PROBLEMS
 

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.figures import PlotOptions, figure, from_result, from_table, load
-from cpm_nlp.plots import design_map_figure, display_unit, pretty, save, workspace_figure
-from cpm_nlp.sweep import columns, job_of, metadata, solve_points
-from cpm_nlp.sweep_files import open_store, read_results
+from cpm_nlp.io.results import open_store, read_results
+from cpm_nlp.plot.draw import design_map_figure, display_unit, pretty, save, workspace_figure
+from cpm_nlp.plot.figures import PlotOptions, figure, from_result, from_table, load
+from cpm_nlp.sweep.run import columns, job_of, metadata, solve_points
 
 from .conftest import PROBLEMS
 from .figure_checks import assert_png_drawn, assert_svg_drawn

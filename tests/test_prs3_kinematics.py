@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp import prs3 as P
-from cpm_nlp.result import Status
+from cpm_nlp.core.result import Status
+from cpm_nlp.mechanisms import prs3 as P
 
 from .conftest import central_difference
 

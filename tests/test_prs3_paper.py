@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.result import Status
+from cpm_nlp.core.result import Status
 
 from .conftest import PROBLEMS
 

@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp import flexure, rpr
-from cpm_nlp import flexure_compliance as fc
-from cpm_nlp import rpr_compliance as rc
+from cpm_nlp.analysis import flexure
+from cpm_nlp.analysis import flexure_compliance as fc
+from cpm_nlp.mechanisms.rpr import compliance as rc
+from cpm_nlp.mechanisms.rpr import kinematics as rpr
 
 AL = flexure.MATERIALS["Al 7075-T6"]
 SPEC = rc.JointSpec(AL, SF=2.0, theta_des=math.radians(2), box=12e-3, t_min=0.3e-3, couple_arm=1.0)

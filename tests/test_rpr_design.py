@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp import rpr_design as rd
-from cpm_nlp import screws
-from cpm_nlp.errors import InputError
+from cpm_nlp.core import screws
+from cpm_nlp.core.errors import InputError
+from cpm_nlp.mechanisms.rpr import design as rd
 
 PAPER_RPR = {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp import rpr, screws
+from cpm_nlp.core import screws
+from cpm_nlp.mechanisms.rpr import kinematics as rpr
 
 #: eq 26: r1 = 40 mm, r2 = 80 mm, P = 40 mm
 PAPER_RPR = {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}

@@ -1,11 +1,11 @@
-"""Twists and wrenches (cpm_nlp.screws): reciprocal product, transport,
+"""Twists and wrenches (cpm_nlp.core.screws): reciprocal product, transport,
 velocity at a point, screw axes and compliance transforms, numeric and symbolic."""
 
 import casadi as ca
 import numpy as np
 import pytest
 
-from cpm_nlp import screws
+from cpm_nlp.core import screws
 
 RNG = np.random.default_rng(7)
 

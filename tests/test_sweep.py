@@ -11,7 +11,7 @@ import sys
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.sweep import ERROR, INVALID_INPUT, fingerprint, job_of, override, require, solve_point
+from cpm_nlp.sweep.run import ERROR, INVALID_INPUT, fingerprint, job_of, override, require, solve_point
 
 from .conftest import PROBLEMS, ROOT
 
@@ -296,7 +296,7 @@ def test_missing_optional_dependency_names_the_extra(monkeypatch):
 def test_solve_imports_neither_dask_nor_matplotlib_nor_pyarrow():
     # (pint imports the light `dask` core when it is installed; the cluster is `distributed`)
     code = (
-        "import sys, io; from cpm_nlp.cli import main; "
+        "import sys, io; from cpm_nlp.cli.main import main; "
         f"assert main(['solve', {str(PROBLEMS / 'prs3_forward_kinematics.yaml')!r}, '-q']) == 0; "
         "heavy = [m for m in ('distributed', 'matplotlib', 'pyarrow') if m in sys.modules]; "
         "print(heavy)"
@@ -312,7 +312,7 @@ def test_without_the_extras_solve_check_reproduce_work_and_sweep_says_what_to_in
 import sys
 for m in ("distributed", "matplotlib", "pyarrow"):
     sys.modules[m] = None  # ImportError on import, as when not installed
-from cpm_nlp.cli import main
+from cpm_nlp.cli.main import main
 assert main(["check", {str(SWEEP_FILE)!r}]) == 0
 assert main(["solve", {str(SWEEP_FILE)!r}, "-q"]) == 0
 assert main(["reproduce", {str(PROBLEMS / "prs3_joint_requirements.yaml")!r}]) == 0
@@ -331,12 +331,12 @@ print("exit", main(["solve", {str(SWEEP_FILE)!r}, "-q", "--plot", {str(tmp_path 
 
 
 def test_interrupted_cli_sweep_says_how_to_resume(cli, tmp_path, monkeypatch):
-    import cpm_nlp.sweep
+    import cpm_nlp.sweep.run
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cpm_nlp.sweep, "run_sweep", interrupted)
+    monkeypatch.setattr(cpm_nlp.sweep.run, "run_sweep", interrupted)
     out = tmp_path / "r.csv"
     run = cli("sweep", str(SWEEP_FILE), "-o", str(out))
     assert run.code == 130
@@ -346,7 +346,7 @@ def test_interrupted_cli_sweep_says_how_to_resume(cli, tmp_path, monkeypatch):
 def test_progress_bar_redraws_in_place_on_a_terminal():
     import io
 
-    from cpm_nlp.cli import ProgressBar
+    from cpm_nlp.cli.main import ProgressBar
 
     class Tty(io.StringIO):
         def isatty(self):

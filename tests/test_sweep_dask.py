@@ -11,8 +11,8 @@ import signal
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.sweep import job_of, run_sweep, solve_points
-from cpm_nlp.sweep_files import read_results
+from cpm_nlp.io.results import read_results
+from cpm_nlp.sweep.run import job_of, run_sweep, solve_points
 
 from .conftest import PROBLEMS
 from .figure_checks import assert_png_drawn
@@ -164,7 +164,7 @@ def test_a_task_that_fails_beyond_the_retries_is_split_into_points(tmp_path, cap
         distributed.Client(cl) as client,
     ):
         killed = []
-        with caplog.at_level("WARNING", logger="cpm_nlp.sweep"):
+        with caplog.at_level("WARNING", logger="cpm_nlp.sweep.run"):
             summary = run_sweep(problem, out, client=client, chunk_size=4, progress=_kill_a_busy_worker(client, killed))
     assert killed
     assert any("a task of 4 points failed" in r.getMessage() and "one by one" in r.getMessage() for r in caplog.records)

@@ -11,8 +11,8 @@ import stat
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.sweep import columns, job_of, metadata, solve_points
-from cpm_nlp.sweep_files import journal_path, open_store, read_results
+from cpm_nlp.io.results import journal_path, open_store, read_results
+from cpm_nlp.sweep.run import columns, job_of, metadata, solve_points
 
 TEXT = """\
 problem: joint_requirements

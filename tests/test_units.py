@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from cpm_nlp.errors import InputError
-from cpm_nlp.units import format_quantity, parse_quantity
+from cpm_nlp.core.errors import InputError
+from cpm_nlp.core.units import format_quantity, parse_quantity
 
 
 @pytest.mark.parametrize(

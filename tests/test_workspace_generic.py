@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp import workspace as W
-from cpm_nlp.multistart import best_and_agreement, uniform_starts
-from cpm_nlp.result import Status
+from cpm_nlp.analysis import workspace as W
+from cpm_nlp.core.multistart import best_and_agreement, uniform_starts
+from cpm_nlp.core.result import Status
 
 from .conftest import PAPER_PRS3
 
@@ -68,8 +68,8 @@ def test_prs3_inscribed_cuboid_from_its_limits(tmp_path):
 def test_membership_without_closed_form_ik(prs3):
     """A mechanism without a closed-form IK: membership solves the IK point by point
     and agrees with the closed form."""
-    from cpm_nlp import prs3 as P3
-    from cpm_nlp.model import LoopClosure, Model
+    from cpm_nlp.core.model import LoopClosure, Model
+    from cpm_nlp.mechanisms import prs3 as P3
 
     solved = LoopClosure(
         "prs3_solved_ik",

@@ -1,0 +1,281 @@
+"""The cuboid NLP of :func:`cpm_nlp.analysis.workspace.inscribed_cuboid` for a mechanism
+with a closed-form IK: no pose unknowns.
+
+The same discretised semi-infinite program as the general formulation (box
+[c + D∘u, c + D∘(u + w)], sample points s_j of its surface, objective
+-Σ log w_i), but every limited quantity is an explicit function of its
+sample point through the closed-form IK, v_r(t_j) = v_r(x(t_j), q(t_j)), and
+the unknowns are the 2d box variables (u, w) alone.  The IK's reach margin is
+one more quantity (>= 0); where it is negative every quantity evaluates to
+NaN, so that IPOPT's line search never accepts a trial point at which the
+mechanism does not assemble.
+
+Such an NLP has few unknowns and many constraint rows (samples × quantities),
+and IPOPT's cost per iteration grows with the rows; at the optimum only a
+handful are active.  It is therefore solved on a **working set** of rows
+(j, r), with every row verified afterwards:
+
+1. solve IPOPT with the rows of the working set only;
+2. evaluate every quantity at every sample at the solution (one mapped call);
+3. add the rows outside their bounds to the working set and solve again, until
+   none is.
+
+The result satisfies every row; the rows left out are inactive, with zero
+multipliers, so it is a KKT point of the NLP with all rows -- the optimum the
+full NLP has, not an approximation of it.  The first start begins with the
+corners' rows of the quantities that bind somewhere in the search region;
+the later ones with the rows active at the optima found before (a warm start
+of the working set across starts), and each start runs from its own initial
+box.  An exchange round adds sample points and continues from the current
+optimum the same way.
+
+The working-set NLP has K row slots (K = 16, 32, 64, ...; one IPOPT solver
+per K, built once per mechanism type and configuration); a slot holds a
+sample point s_k and a one-hot selector e_k of the quantity it bounds, both
+parameters, and unused slots are free (bounds ±inf).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+
+import casadi as ca
+import numpy as np
+
+from ..core.batch import evaluate_points
+from ..core.model import LoopClosure, Model
+from ..core.solver import SolverConfig
+
+log = logging.getLogger(__name__)
+
+#: row slots of the smallest working-set NLP (see :func:`slots`)
+MIN_SLOTS = 16
+#: a row is active (kept for the next starts) when its multiplier exceeds this, relative to the largest
+ACTIVE_MULTIPLIER = 1e-6
+#: rows of one quantity added per solve (the most violated ones)
+ADD_PER_QUANTITY = 4
+#: after this many solves of one start every violated row is added (the working set then
+#: reaches all violated rows in a few solves)
+ESCALATE = 6
+#: solves of one start before it is reported not settled (each adds at least one row)
+MAX_SETTLE = 40
+#: CasADi options of the working-set NLP: NaN (no assembly) is a rejected trial point, not a warning
+QUIET = {"show_eval_warnings": False, "calc_lam_p": False}
+
+
+def row_key(rows: tuple[int, ...]) -> tuple:
+    """The key of :func:`row_function` in the closure's cache."""
+    return ("cuboid_rows", tuple(rows))
+
+
+def row_function(closure: LoopClosure, limited: ca.Function, rows: tuple[int, ...]) -> ca.Function:
+    """``<name>_cuboid_rows: (t, p) -> g``: the limited quantities ``rows`` of
+    ``limited(x, q, p)`` at the closed-form IK of the task point t, then the
+    reach margin; all NaN where the reach margin is negative."""
+
+    def build() -> ca.Function:
+        c = closure
+        t, p = ca.SX.sym("t", c.nq), ca.SX.sym("p", c.np)
+        x, q, reach = c.ik(t, p)
+        v = ca.vertcat(limited(x, q, p)[list(rows)], reach)
+        g = ca.if_else(reach >= 0, v, ca.DM.nan(v.size1()))
+        return ca.Function(f"{c.name}_cuboid_rows", [t, p], [g], ["t", "p"], ["g"])
+
+    return closure.solvers.memo(row_key(rows), build)
+
+
+def slots(rows: int) -> int:
+    """Slots of the smallest working-set NLP that holds ``rows`` rows: MIN_SLOTS times
+    1, 1.5, 2, 3, 4, 6, 8, ... (one IPOPT solver per size)."""
+    K = MIN_SLOTS
+    while K < rows:
+        K = K * 3 // 2 if K & (K - 1) == 0 else K * 4 // 3
+    return K
+
+
+class SlotNLP:
+    """IPOPT on the working-set cuboid NLP with K row slots (see the module docstring),
+    for the quantities ``sel`` (positions in the output of ``rows_fn``; the others
+    are not evaluated)."""
+
+    def __init__(self, closure: LoopClosure, rows_fn: ca.Function, sel: tuple[int, ...], K: int, options: dict):
+        c = closure
+        d, m = c.nq, len(sel)
+        self.d, self.m, self.K = d, m, K
+        u, w = ca.SX.sym("u", d), ca.SX.sym("w", d)
+        p = ca.SX.sym("p", c.np)
+        S, E = ca.SX.sym("S", d, K), ca.SX.sym("E", m, K)
+        centre, size = ca.SX.sym("c", d), ca.SX.sym("D", d)
+        T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + S * ca.repmat(w, 1, K))
+        G = rows_fn.map(K)(T, ca.repmat(p, 1, K))[list(sel), :]
+        nlp = {
+            "x": ca.vertcat(u, w),
+            "p": ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size),
+            "f": -ca.sum1(ca.log(w)),
+            "g": ca.sum1(E * G).T,
+        }
+        self._solver = ca.nlpsol(f"{c.name}_cuboid_slots_{K}", "ipopt", nlp, options)
+        self._out = {name: k for k, name in enumerate(self._solver.name_out())}
+        self._local = threading.local()
+
+    def solve(self, z0, params, lbx, lbg, ubg) -> tuple[np.ndarray, bool, str, int, np.ndarray]:
+        """(z, converged, IPOPT status, iterations, multipliers of the slots).
+
+        Called through a FunctionBuffer (one per thread): numpy in and out,
+        without the conversions of a regular call.
+        """
+        buf, run = self._buffer()
+        n, K = len(z0), self.K
+        given = {"x0": z0, "p": params, "lbx": lbx, "ubx": np.full(n, np.inf), "lbg": lbg, "ubg": ubg}
+        ins = [
+            np.ascontiguousarray(given.get(name, np.zeros(self._solver.nnz_in(k))), dtype=float)
+            for k, name in enumerate(self._solver.name_in())
+        ]
+        outs = [np.empty(self._solver.nnz_out(k)) for k in range(self._solver.n_out())]
+        for k, a in enumerate(ins):
+            buf.set_arg(k, memoryview(a))
+        for k, a in enumerate(outs):
+            buf.set_res(k, memoryview(a))
+        try:
+            run()
+        except RuntimeError as exc:  # an evaluation error: a failed start, not a crash
+            log.debug("working-set cuboid NLP raised: %s", exc)
+            return np.full(n, np.nan), False, f"solver error: {exc}".splitlines()[0], 0, np.zeros(K)
+        stats = buf.stats()
+        z = outs[self._out["x"]]
+        ok = bool(stats.get("success", False)) and bool(np.all(np.isfinite(z)))
+        return z, ok, str(stats.get("return_status", "")), int(stats.get("iter_count", 0)), outs[self._out["lam_g"]]
+
+    def _buffer(self):
+        state = getattr(self._local, "buffer", None)
+        if state is None:
+            state = self._local.buffer = self._solver.buffer()
+        return state
+
+
+class ClosedFormCuboid:
+    """The cuboid NLP of one model through its closed-form IK, on working sets of rows.
+
+    rows: indices of the bounded limited quantities in ``limited``'s output;
+    lower, upper: their bounds as the NLP keeps them (inside the declared
+    ones by the caller's margin); reach_lower: the bound of the reach margin;
+    samples: the unit-box sample points (N, d); centre, size: the
+    normalisation of the box; initial: quantities (positions in ``rows``, and
+    len(rows) for the reach margin) whose corner rows start the first solve.
+    """
+
+    def __init__(
+        self,
+        model: Model,
+        config: SolverConfig,
+        limited: ca.Function,
+        rows: tuple[int, ...],
+        lower: np.ndarray,
+        upper: np.ndarray,
+        reach_lower: float,
+        samples: np.ndarray,
+        centre: np.ndarray,
+        size: np.ndarray,
+        options: dict,
+        initial: list[int],
+    ):
+        c = model.closure
+        self.model, self.config, self.closure = model, config, c
+        self.rows = tuple(rows)
+        self.fn = row_function(c, limited, self.rows)
+        self.m = len(self.rows) + 1
+        self.lo = np.r_[lower, reach_lower]
+        self.hi = np.r_[upper, np.inf]
+        self.S = np.array(samples, dtype=float)
+        self.centre, self.size = np.asarray(centre, dtype=float), np.asarray(size, dtype=float)
+        self.options = {**options, **QUIET}
+        self.d = c.nq
+        self._lbx = np.r_[np.full(self.d, -np.inf), np.full(self.d, 1e-10)]
+        corners = np.flatnonzero(np.all((self.S == 0.0) | (self.S == 1.0), axis=1))
+        self.initial = {(int(j), int(r)) for j in corners for r in (initial or range(self.m))}
+        self.memory: set[tuple[int, int]] = set()  # rows active at the optima found so far
+
+    # -- the NLP ----------------------------------------------------------------------------------
+
+    def _nlp(self, sel: tuple[int, ...], K: int) -> SlotNLP:
+        key = ("cuboid_slots", self.rows, sel, K, repr(sorted(self.options.items())))
+        return self.closure.solvers.get(
+            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, sel, K, self.options)
+        )
+
+    def _solve(self, z0: np.ndarray, work: list[tuple[int, int]]):
+        K = slots(len(work))
+        sel = tuple(sorted({r for _, r in work}))  # the quantities with rows: only those are evaluated
+        S, E = np.full((K, self.d), 0.5), np.zeros((K, len(sel)))
+        lbg, ubg = np.full(K, -np.inf), np.full(K, np.inf)
+        for k, (j, r) in enumerate(work):
+            S[k], E[k, sel.index(r)], lbg[k], ubg[k] = self.S[j], 1.0, self.lo[r], self.hi[r]
+        params = np.r_[self.model.p, S.ravel(), E.ravel(), self.centre, self.size]
+        return self._nlp(sel, K).solve(z0, params, self._lbx, lbg, ubg)
+
+    def values(self, z: np.ndarray) -> np.ndarray:
+        """Every quantity at every sample of the box z: (N, m)."""
+        T = self.centre + self.size * (z[: self.d] + self.S * z[self.d :])
+        return evaluate_points(self.closure, row_key(self.rows), self.fn, [T], self.model.p)[0]
+
+    def _violated(self, V: np.ndarray, work: set[tuple[int, int]], per_quantity: int | None) -> set[tuple[int, int]]:
+        """Rows outside the working set that V (N, m) violates: of each quantity the
+        ``per_quantity`` worst (all if None; NaN, a sample that does not assemble,
+        counts as worst)."""
+        with np.errstate(invalid="ignore"):
+            excess = np.maximum(self.lo - V, V - self.hi)
+        excess = np.where(np.isnan(excess), np.inf, excess)
+        for j, r in work:
+            excess[j, r] = -np.inf
+        new = set()
+        for r in range(self.m):
+            col = excess[:, r]
+            worst = np.argsort(-col, kind="stable")[:per_quantity]
+            new |= {(int(j), r) for j in worst if col[j] > 0}
+        return new
+
+    def settle(self, z0: np.ndarray, work: set[tuple[int, int]]) -> tuple[np.ndarray, bool, str, int, set]:
+        """Solve from z0 on the working set ``work``, adding the rows the solution
+        violates until it violates none.  Returns (z, ok, status, iterations, the
+        active rows of the final solution)."""
+        work = set(work)
+        iterations = 0
+        for solve in range(MAX_SETTLE):
+            order = sorted(work)
+            z, ok, status, iters, lam = self._solve(z0, order)
+            iterations += iters
+            if not ok:
+                return z, False, status, iterations, set()
+            new = self._violated(self.values(z), work, ADD_PER_QUANTITY if solve < ESCALATE else None)
+            if not new:
+                lam = np.abs(lam[: len(order)])
+                top = float(lam.max()) if lam.size else 0.0
+                active = {row for row, v in zip(order, lam) if v > ACTIVE_MULTIPLIER * top}
+                return z, True, status, iterations, active
+            log.debug("working set: %d rows violated outside %d, solving again", len(new), len(work))
+            work |= new
+        return z, False, f"the working set did not settle in {MAX_SETTLE} solves", iterations, set()
+
+    # -- what inscribed_cuboid calls --------------------------------------------------------------
+
+    def start(self, u0: np.ndarray, w0: np.ndarray, *_poses) -> tuple[bool, np.ndarray | None, str, int]:
+        """One start from the box (u0, w0) (the poses of its samples are not
+        unknowns here): (converged, z, status, iterations)."""
+        z0 = np.r_[u0, w0]
+        z, ok, status, iters, active = self.settle(z0, self.memory or self.initial)
+        if not ok and self.memory:  # the rows of other optima did not hold the box: add the corners'
+            log.debug("start from the active rows failed (%s); again with the corner rows", status)
+            z, ok, status, more, active = self.settle(z0, self.memory | self.initial)
+            iters += more
+        if ok:
+            self.memory |= active
+        return ok, (z if ok else None), status, iters
+
+    def exchange(self, z: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, bool, str, int]:
+        """Add sample points (unit box) and solve again from z."""
+        self.S = np.vstack([self.S, points])
+        z_new, ok, status, iters, active = self.settle(z, self.memory)
+        if ok:
+            self.memory |= active
+        return z_new, ok, status, iters

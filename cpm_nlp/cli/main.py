@@ -1,0 +1,553 @@
+"""The ``cpm-nlp`` command line: a map of subcommands.
+
+Exit status: 0 solved, 1 a solve that did not succeed (the result says why),
+2 bad input (one message naming the file, the key path and what was
+expected), 70 an internal error (a bug: please report it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import sys
+import tempfile
+import time
+import traceback
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, TextIO
+
+from ..core.errors import CpmError, InputError
+from ..core.result import STATUS_TEXT, Result
+from ..core.units import DIMENSIONS, format_quantity
+
+EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
+
+
+# -- output helpers -------------------------------------------------------------------------------
+
+
+def replace_atomically(path: str | os.PathLike, write: Callable[[str], Any], suffix: str = ".tmp") -> None:
+    """Create ``path`` all at once: ``write(temporary path)``, then rename.  The
+    file gets the permissions of any new file (the umask), not mkstemp's 0600."""
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=directory)
+    os.close(fd)
+    try:
+        write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def write_atomic(path: str, text: str) -> None:
+    """Write ``text`` to ``path`` all at once (temp file + rename)."""
+    replace_atomically(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+def check_output_path(path: str | None) -> None:
+    """Fail early (exit 2) if ``-o`` cannot be written, before solving."""
+    if path is None:
+        return
+    target = Path(path)
+    parent = target.parent if str(target.parent) else Path(".")
+    if target.is_dir():
+        raise InputError(f"output path {path} is a directory; expected a file name", path=("-o",))
+    if not parent.is_dir():
+        raise InputError(f"output directory {parent} does not exist", path=("-o",))
+    if not os.access(parent, os.W_OK):
+        raise InputError(f"output directory {parent} is not writable", path=("-o",))
+
+
+def _fmt_scalar(value: Any, dim: str | None) -> tuple[str, str]:
+    if value is None:
+        return "—", ""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return str(value), ""
+    si_unit = DIMENSIONS[dim].si if dim in DIMENSIONS else ""
+    si = f"{value:.10g}" + (f" {si_unit}" if si_unit else "")
+    friendly = format_quantity(value, dim) if dim in DIMENSIONS and DIMENSIONS[dim].display != si_unit else ""
+    return si, friendly
+
+
+def _fmt_list(value: list, dim: str | None) -> str:
+    flat = value
+    if flat and all(isinstance(v, list) for v in flat):
+        cells = [x for row in flat for x in row]
+        if len(cells) > 36:  # a grid: its size and range (the values are in --json / -o)
+            nums = [x for x in cells if isinstance(x, (int, float)) and not isinstance(x, bool)]
+            text = f"matrix {len(flat)} x {max(len(row) for row in flat)}"
+            if nums:
+                text += f", from {min(nums):.6g} to {max(nums):.6g}"
+            nulls = sum(1 for x in cells if x is None)
+            return text + (f", {nulls} null" if nulls else "")
+
+        def cell(x: Any) -> str:
+            return "—" if x is None else str(x) if isinstance(x, bool) else f"{x:.6g}"
+
+        return "matrix " + "; ".join("[" + ", ".join(cell(x) for x in row) + "]" for row in flat)
+    nums = [v for v in flat if isinstance(v, (int, float))]
+    nulls = len(flat) - len(nums)
+    if len(flat) <= 4:
+        return "[" + ", ".join(_fmt_scalar(v, dim)[1] or _fmt_scalar(v, dim)[0] for v in flat) + "]"
+    text = f"{len(flat)} values"
+    if nums:
+        text += (
+            f", from {_fmt_scalar(min(nums), dim)[1] or _fmt_scalar(min(nums), dim)[0]}"
+            f" to {_fmt_scalar(max(nums), dim)[1] or _fmt_scalar(max(nums), dim)[0]}"
+        )
+    if nulls:
+        text += f", {nulls} not solved"
+    return text
+
+
+def render_result(result: Result, title: str = "") -> str:
+    """A readable table of a result."""
+    lines = []
+    lines.append(f"problem : {result.problem}" + (f"  ({title})" if title else ""))
+    lines.append(f"status  : {result.status.value}  -- {result.message or STATUS_TEXT[result.status]}")
+    s = result.solver
+    lines.append(f"solver  : {s.name}, {s.iterations} iterations, {s.seconds * 1e3:.2f} ms")
+    if result.model:
+        parts = []
+        for k, v in result.model.items():
+            if k == "type":
+                continue
+            parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
+        lines.append("model   : " + result.model.get("type", "") + ": " + ", ".join(parts) + "  (SI)")
+    if not result.values:
+        lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
+        return "\n".join(lines)
+    width = max(len(k) for k in result.values)
+    lines.append("")
+    for name, value in result.values.items():
+        dim = result.dimensions.get(name)
+        if isinstance(value, list):
+            text = _fmt_list(value, dim)
+            unit = result.units.get(name, "")
+            if unit and dim not in DIMENSIONS:
+                text += f"   ({unit})"
+            lines.append(f"{name:<{width}}  {text}")
+        else:
+            si, friendly = _fmt_scalar(value, dim)
+            lines.append(f"{name:<{width}}  {si:<22}" + (f"  {friendly}" if friendly else ""))
+    return "\n".join(lines)
+
+
+# -- subcommands --------------------------------------------------------------------------------
+
+
+def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
+    from ..mechanisms.registry import mechanism_type
+    from ..problems.file import load_problem, solve
+
+    check_output_path(args.output)
+    _check_plot_args(args)
+    problem = load_problem(args.file, args.set or [])
+    result = solve(problem)
+    fig = _result_figure(args, result, problem.model) if args.plot else None  # a bad --plot writes nothing
+    if args.json:
+        out.write(result.to_json() + "\n")
+    elif not args.quiet:
+        title = mechanism_type(problem.model.name).title
+        out.write(render_result(result, title) + "\n")
+    if args.output:
+        write_atomic(args.output, result.to_json() + "\n")
+    if fig is not None:
+        _save_figure(args, fig, out)
+    return EXIT_OK if result.ok else EXIT_FAILED
+
+
+# -- plots ------------------------------------------------------------------------------------
+
+
+def _plot_options(args: argparse.Namespace) -> Any:
+    from ..plot.figures import PlotOptions
+
+    return PlotOptions(value=args.value, x=getattr(args, "x", None), y=getattr(args, "y", None), best=args.best)
+
+
+def _check_plot_args(args: argparse.Namespace) -> None:
+    """Before solving: the figure can be written, and Matplotlib is there."""
+    if getattr(args, "plot", None):
+        from ..plot.draw import check_figure_path
+        from ..sweep.run import require
+
+        check_figure_path(args.plot, "--plot")
+        require("matplotlib", "plot", "plotting")
+
+
+def _result_figure(args: argparse.Namespace, result: Result, model: Any) -> Any:
+    """The figure of a solved result; None (with a warning) if no point solved."""
+    from ..plot.figures import NothingSolved, figure, from_result
+
+    data = from_result(result)
+    data.live = model
+    try:
+        return figure(data, args.type, _plot_options(args))
+    except NothingSolved as exc:  # an honest failed solve is not bad input: exit 1, the result is written
+        args.err.write(f"warning: no plot written: {exc.message}\n")
+        return None
+    except InputError as exc:
+        raise exc.at(prefix=("--plot",)) from None
+
+
+def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: TextIO) -> None:
+    from ..plot.draw import save
+
+    fig, kind = fig_and_type
+    save(fig, args.plot)
+    if not args.quiet and not getattr(args, "json", False):
+        out.write(f"plot    : {args.plot} ({kind})\n")
+
+
+def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
+    from ..plot.draw import check_figure_path, save
+    from ..plot.figures import figure, load
+    from ..sweep.run import require
+
+    check_figure_path(args.output)
+    require("matplotlib", "plot", "plotting")
+    data = load(args.result)
+    fig, kind = figure(data, args.type, _plot_options(args))
+    save(fig, args.output)
+    out.write(f"{args.output}: {kind} plot of {args.result}\n")
+    return EXIT_OK
+
+
+# -- sweeps -------------------------------------------------------------------------------------
+
+
+class ProgressBar:
+    """Points done of a sweep, on stderr: redrawn in place on a terminal, a
+    line per tenth otherwise (logs)."""
+
+    def __init__(self, stream: TextIO, width: int = 30) -> None:
+        self.stream, self.width = stream, width
+        self.tty = bool(getattr(stream, "isatty", lambda: False)())
+        self.t0 = time.monotonic()
+        self.first: int | None = None
+        self.last_draw = 0.0
+        self.last_tenth = -1
+
+    def __call__(self, done: int, total: int) -> None:
+        if self.first is None:
+            self.first = done
+        now = time.monotonic()
+        frac = done / total if total else 1.0
+        elapsed = now - self.t0
+        new = done - self.first
+        eta = ""
+        if 0 < new and done < total:
+            eta = f", about {elapsed / new * (total - done):.0f} s left"
+        text = f"sweep: {done}/{total} points ({frac:.0%}), {elapsed:.1f} s{eta}"
+        if self.tty:
+            if done < total and now - self.last_draw < 0.1:
+                return
+            bar = "#" * int(frac * self.width)
+            self.stream.write(f"\r[{bar:<{self.width}}] {text}\033[K" + ("\n" if done >= total else ""))
+            self.last_draw = now
+        else:
+            tenth = int(frac * 10)
+            if tenth == self.last_tenth:
+                return
+            self.last_tenth = tenth
+            self.stream.write(text + "\n")
+        self.stream.flush()
+
+
+def render_sweep(summary: Any, args: argparse.Namespace, problem: Any) -> str:
+    counts = ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items(), key=lambda kv: -kv[1]))
+    where = args.scheduler or f"a local cluster of {summary.workers} worker processes"
+    lines = [
+        f"sweep   : {args.file} ({problem.kind.name} on {problem.model.name})",
+        f"points  : {summary.total} ({counts or 'none yet'})",
+        f"this run: {summary.solved_now} points in {summary.seconds:.1f} s"
+        + (f" on {where}" if summary.solved_now else " (all points were already in the results file)"),
+        f"results : {summary.output}",
+    ]
+    return "\n".join(lines)
+
+
+def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
+    from ..io.results import results_format
+    from ..problems.file import load_problem
+    from ..sweep.run import job_of, run_sweep
+
+    output = args.output or f"{Path(args.file).stem}.parquet"
+    results_format(output)
+    _check_plot_args(args)
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"expected a positive number of workers, got {args.workers}", path=("--workers",))
+    if args.chunk is not None and args.chunk < 1:
+        raise InputError(f"expected a positive number of points per task, got {args.chunk}", path=("--chunk",))
+    problem = load_problem(args.file, args.set or [])
+    job_of(problem)  # a file without a sweep section is bad input, before any cluster starts
+    progress = None if args.quiet else ProgressBar(args.err)
+    try:
+        summary = run_sweep(
+            problem,
+            output,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            chunk_size=args.chunk,
+            overwrite=args.overwrite,
+            progress=progress,
+        )
+    except KeyboardInterrupt:
+        args.err.write(f"\ninterrupted: the points solved so far are in {output}; run the same command to resume\n")
+        return 130
+    if not args.quiet:
+        out.write(render_sweep(summary, args, problem) + "\n")
+    if args.plot:
+        from ..plot.figures import figure, load
+
+        _save_figure(args, figure(load(output), args.type, _plot_options(args)), out)
+    return EXIT_OK if summary.ok else EXIT_FAILED
+
+
+def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
+    from ..problems.file import load_problem
+
+    problem = load_problem(args.file, args.set or [])
+    out.write(f"{args.file}: ok ({problem.kind.name} on {problem.model.name}, solver {problem.solver.method})\n")
+    return EXIT_OK
+
+
+def render_reproduce(rows: Sequence[Any]) -> str:
+    """The reproduction table, reasons numbered once below it."""
+    header = ("paper", "quantity", "source", "published", "computed", "rel. error", "verdict")
+    table = []
+    reasons: dict[str, int] = {}
+    for r in rows:
+        comp = "—" if r.computed is None else format_quantity(r.computed, r.dimension, 5)
+        rel = "—" if r.rel_error is None else f"{r.rel_error * 100:.2f} %"
+        verdict = r.verdict + ("" if r.expected else "  [UNEXPECTED]")
+        if r.reason:
+            n = reasons.setdefault(r.reason, len(reasons) + 1)
+            verdict += f" [{n}]"
+        table.append((r.paper, r.quantity, r.source, r.published_text, comp, rel, verdict))
+    widths = [max(len(str(x)) for x in col) for col in zip(header, *table)]
+
+    def line(cells: Sequence[Any]) -> str:
+        return "  ".join(str(c).ljust(w) for c, w in zip(cells, widths)).rstrip()
+
+    out = [line(header), line(["-" * w for w in widths])] + [line(t) for t in table]
+    if reasons:
+        out += ["", "reasons:"] + [f"  [{n}] {text}" for text, n in reasons.items()]
+    return "\n".join(out)
+
+
+def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
+    from ..problems.reproduce import reproduce
+
+    check_output_path(args.output)
+    rows = reproduce(args.paths or None)
+    if args.json:
+        out.write(json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+    else:
+        out.write(render_reproduce(rows) + "\n")
+        bad = [r for r in rows if not r.expected]
+        out.write(f"\n{len(rows)} figures, {len(bad)} unexpected\n")
+    if args.output:
+        write_atomic(args.output, json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+    return EXIT_OK if all(r.expected for r in rows) else EXIT_FAILED
+
+
+def cmd_export(args: argparse.Namespace, out: TextIO) -> int:
+    from ..io.export import check_format, check_out_dir, export_kinematics, parse_what
+    from ..problems.file import load_problem
+
+    what = parse_what(args.what)
+    check_format(args.format)
+    check_out_dir(args.out)
+    problem = load_problem(args.file, args.set or [])
+    data = export_kinematics(problem.model, args.out, what, args.format, problem.solver, source=args.file)
+    for f in [*data["files"], "manifest.json"]:
+        out.write(f"{Path(args.out) / f}\n")
+    return EXIT_OK
+
+
+def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
+    from ..core.kind import KINDS, problem_kind
+    from ..mechanisms.registry import MODULES, mechanism_type
+
+    if not args.name:
+        out.write("mechanisms:\n")
+        for name in sorted(MODULES):
+            mt = mechanism_type(name)
+            out.write(f"  {name:<12} {mt.title} [{mt.paper}]\n")
+        out.write("problem kinds:\n")
+        for name in sorted(KINDS):
+            out.write(f"  {name:<20} {problem_kind(name).description}\n")
+        return EXIT_OK
+    if args.name in KINDS:
+        kind = problem_kind(args.name)
+        out.write(f"{kind.name}: {kind.description}\n(inputs depend on the mechanism; see problems/*.yaml)\n")
+        return EXIT_OK
+    mt = mechanism_type(args.name, path=("describe",))
+    out.write(f"{mt.name}: {mt.title} [{mt.paper}]\n\nparameters:\n")
+    for o in mt.parameters:
+        default = "" if o.required or o.default is None else f" (default {o.format_value(o.default)})"
+        out.write(f"  {o.name:<8} {o.expectation()}{default}\n           {o.description}\n")
+    out.write("limits (optional, [low, high]):\n")
+    for o in mt.limits:
+        out.write(f"  {o.name:<8} {o.description}\n")
+    return EXIT_OK
+
+
+# -- entry point ------------------------------------------------------------------------------------
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cpm-nlp",
+        description="Kinematics and design of compliant parallel mechanisms (CasADi + IPOPT).",
+        epilog="Exit status: 0 solved, 1 solve failed, 2 bad input.",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
+    parser.add_argument("-v", "--verbose", action="count", default=0, help="log progress to stderr (-vv: debug)")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = sub.add_parser("solve", help="solve a problem file and print the result")
+    p.add_argument("file", help="problem file (YAML)")
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="override a value of the file, e.g. --set mechanism.parameters.b='50 mm' (repeatable)",
+    )
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the result as JSON to FILE (atomically)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit status tells")
+    _add_plot_arguments(p, "--plot")
+    p.set_defaults(func=cmd_solve)
+
+    p = sub.add_parser(
+        "sweep",
+        help="solve a problem at every point of its sweep section, on Dask",
+        description="Solve the problem of FILE at every point of its 'sweep' section (each point as "
+        "'cpm-nlp solve FILE --set KEY=VALUE' would), on a local Dask cluster or an existing one, "
+        "streaming one row per point to a Parquet or CSV file; a sweep run again resumes.",
+    )
+    p.add_argument("file", help="problem file (YAML) with a sweep section")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file (repeatable)")
+    p.add_argument(
+        "-o", "--output", metavar="RESULTS", help="results file, .parquet or .csv (default: FILE's name, .parquet)"
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="address of an existing Dask scheduler (default: start a local cluster, one process per core)",
+    )
+    p.add_argument("--workers", type=int, metavar="N", help="worker processes of the local cluster (default: cores)")
+    p.add_argument("--chunk", type=int, metavar="N", help="points per Dask task (default: about 0.5 s of work)")
+    p.add_argument("--overwrite", action="store_true", help="discard RESULTS and start again instead of resuming")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
+    _add_plot_arguments(p, "--plot")
+    p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("plot", help="plot a result (JSON of solve -o) or a sweep results file")
+    p.add_argument("result", help="JSON result of 'cpm-nlp solve -o', or a sweep results file (.parquet, .csv)")
+    p.add_argument("-o", "--output", metavar="FIGURE", required=True, help="figure file: .png, .svg or .pdf")
+    p.add_argument("--x", metavar="NAME", help="map: parameter (or value) on the horizontal axis")
+    p.add_argument("--y", metavar="NAME", help="map: parameter (or value) on the vertical axis")
+    _add_plot_arguments(p, None)
+    p.set_defaults(func=cmd_plot)
+
+    p = sub.add_parser("check", help="validate a problem file without solving it")
+    p.add_argument("file")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE")
+    p.set_defaults(func=cmd_check)
+
+    p = sub.add_parser("reproduce", help="solve every problem file that reproduces a published figure")
+    p.add_argument("paths", nargs="*", help="problem files or directories (default: problems/)")
+    p.add_argument("--json", action="store_true", help="print the table as JSON")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the table as JSON to FILE")
+    p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser(
+        "export",
+        help="write the mechanism's FK, IK and Jacobian as CasADi files or C code, with a manifest",
+        description="Export the kinematics of the mechanism of a problem file (its parameters, limits and "
+        "solver tolerance built in) as serialized CasADi Functions or as C source and header.",
+    )
+    p.add_argument("file", help="problem file (YAML); its mechanism and solver section are used")
+    p.add_argument("--what", default="fk,ik,jacobian", help="comma-separated: fk, ik, jacobian (default: all)")
+    p.add_argument("--format", default="casadi", help="casadi (.casadi files) or c (source + header)")
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file")
+    p.set_defaults(func=cmd_export)
+
+    p = sub.add_parser("describe", help="list mechanisms and problem kinds, or describe one")
+    p.add_argument("name", nargs="?")
+    p.set_defaults(func=cmd_describe)
+    return parser
+
+
+def _add_plot_arguments(p: argparse.ArgumentParser, flag: str | None) -> None:
+    if flag:
+        p.add_argument(flag, metavar="FIGURE", help="also plot the result to FIGURE (.png, .svg or .pdf)")
+    p.add_argument(
+        "--type",
+        metavar="TYPE",
+        help="plot type: workspace, map, requirements, io or lines (default: chosen from the result)",
+    )
+    p.add_argument("--value", metavar="NAME", help="the value to plot (map colour, curves)")
+    p.add_argument("--best", choices=("max", "min"), help="map: mark the largest or smallest value")
+
+
+def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: TextIO | None = None) -> int:
+    """Run the CLI; returns the exit status (also usable in-process by tests)."""
+    out = out or sys.stdout
+    err = err or sys.stderr
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse already printed the usage message
+        return int(exc.code) if isinstance(exc.code, int) else EXIT_INPUT
+    if args.command is None:
+        parser.print_help(out)
+        return EXIT_INPUT
+    handler = logging.StreamHandler(err)
+    handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    root = logging.getLogger("cpm_nlp")
+    root.addHandler(handler)
+    root.setLevel(logging.WARNING - 10 * min(args.verbose, 2))
+    func: Callable[[argparse.Namespace, TextIO], int] = args.func
+    args.err = err
+    try:
+        return func(args, out)
+    except InputError as exc:
+        err.write(f"error: {exc}\n")
+        return EXIT_INPUT
+    except CpmError as exc:
+        err.write(f"error: {exc}\n")
+        return EXIT_FAILED
+    except KeyboardInterrupt:
+        err.write("interrupted\n")
+        return 130
+    except Exception as exc:  # a bug, not a user error: say so, and how to get details
+        if args.debug:
+            traceback.print_exc(file=err)
+        err.write(f"internal error: {exc.__class__.__name__}: {exc} (please report; rerun with --debug)\n")
+        return EXIT_INTERNAL
+    finally:
+        root.removeHandler(handler)
+
+
+def main_entry() -> None:
+    """Console-script entry point (``cpm-nlp``)."""
+    sys.exit(main())
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main_entry()

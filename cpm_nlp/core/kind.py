@@ -1,0 +1,188 @@
+"""Problem kinds: what question a problem file asks about a mechanism.
+
+A problem kind declares its inputs (as :class:`~cpm_nlp.core.options.Option` s,
+which may depend on the mechanism), validates them, and runs an algorithm on
+a :class:`~cpm_nlp.core.model.Model` with a :class:`~cpm_nlp.core.solver.SolverConfig`,
+returning a :class:`~cpm_nlp.core.result.Result`.  Problem, method (the algorithm
+modules) and solver stay separate.
+
+Kinds are registered in :data:`KINDS` (name -> "module:Class"); later
+mechanisms add theirs there.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError, suggest
+from .model import Coordinate, Model
+from .options import Option, validate_mapping
+from .result import Result
+from .solver import SolverConfig
+from .units import format_quantity
+
+#: problem kind -> "module:Class"
+KINDS = {
+    "forward_kinematics": "cpm_nlp.kinds.kinematic:ForwardKinematics",
+    "inverse_kinematics": "cpm_nlp.kinds.kinematic:InverseKinematics",
+    "jacobian": "cpm_nlp.kinds.kinematic:Jacobian",
+    "joint_requirements": "cpm_nlp.kinds.kinematic:JointRequirements",
+    "amplifier": "cpm_nlp.kinds.analysis:Amplifier",
+    "actuator_workspace": "cpm_nlp.kinds.analysis:ActuatorWorkspace",
+    "dynamics": "cpm_nlp.kinds.analysis:Dynamics",
+    "rpr_screw_jacobian": "cpm_nlp.mechanisms.rpr.kinds:ScrewJacobian",
+    "rpr_twists": "cpm_nlp.mechanisms.rpr.kinds:Twists",
+    "rpr_transmission_map": "cpm_nlp.mechanisms.rpr.kinds:TransmissionMap",
+    "rpr_joint_design": "cpm_nlp.mechanisms.rpr.kinds:JointDesign",
+    "rpr_compliance": "cpm_nlp.mechanisms.rpr.kinds:Compliance",
+    "inscribed_cuboid": "cpm_nlp.kinds.workspace:InscribedCuboid",
+    "workspace": "cpm_nlp.kinds.workspace:Workspace",
+    "synthesis": "cpm_nlp.kinds.synthesis:Synthesis",
+}
+
+
+class ProblemKind:
+    """Base class of problem kinds.
+
+    Subclasses set ``name`` and ``description`` and implement
+    :meth:`input_options`, :meth:`run` and :meth:`output_names`; they may
+    override :meth:`check_inputs` for rules that involve several inputs.
+    """
+
+    name = ""
+    description = ""
+
+    def input_options(self, model: Model) -> list[Option]:
+        raise NotImplementedError
+
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        inputs = validate_mapping(raw, self.input_options(model), path, what="input")
+        self.check_inputs(inputs, model, path)
+        return inputs
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        """Cross-input validation; raise :class:`InputError`."""
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        raise NotImplementedError
+
+    def output_names(self, model: Model) -> list[str]:
+        raise NotImplementedError
+
+    def supports(self, model: Model) -> str | None:
+        """None if the kind applies to this model, else the reason it does not."""
+        return None
+
+    def check_solver(self, solver: SolverConfig) -> None:
+        """Raise :class:`InputError` if the kind cannot use this solver
+        configuration (e.g. an optimisation needs IPOPT)."""
+
+
+def problem_kind(name: Any, path: tuple = ("problem",)) -> ProblemKind:
+    """Look up a problem kind by name (with a "did you mean" if unknown)."""
+    if not isinstance(name, str) or name not in KINDS:
+        raise InputError(
+            f"unknown problem kind {name!r}; expected one of: {', '.join(sorted(KINDS))}",
+            path=path,
+            suggestions=suggest(str(name), KINDS),
+        )
+    module, cls = KINDS[name].split(":")
+    return getattr(importlib.import_module(module), cls)()
+
+
+# -- helpers shared by the kinematic kinds ------------------------------------------
+
+
+def task_options(model: Model, shape: str) -> list[Option]:
+    """Inputs naming the task coordinates (and their offsets from home)."""
+    c = model.closure
+    out = []
+    for i in c.task_index:
+        coord = c.x[i]
+        out.append(Option(coord.name, coord.kind, coord.description, default=None, shape=shape))
+    for off, target in c.offsets.items():
+        coord = c.x[c.x_names.index(target)]
+        out.append(Option(off, coord.kind, f"{target} relative to the home pose", default=None, shape=shape))
+    return out
+
+
+def actuator_options(model: Model, shape: str) -> list[Option]:
+    return [Option(q.name, q.kind, q.description, default=None, shape=shape) for q in model.closure.q]
+
+
+def given(inputs: Mapping[str, Any], names: Sequence[str]) -> list[str]:
+    return [n for n in names if inputs.get(n) is not None]
+
+
+def task_values(inputs: Mapping[str, Any], model: Model, path: tuple) -> list[Any]:
+    """The task coordinates from the inputs, offsets resolved; one entry per
+    task coordinate (a scalar or a list, as given)."""
+    c = model.closure
+    out = []
+    for i in c.task_index:
+        name = c.x[i].name
+        alts = [o for o, target in c.offsets.items() if target == name]
+        have = given(inputs, [name] + alts)
+        if len(have) > 1:
+            raise InputError(f"give only one of {', '.join(repr(h) for h in have)}", path=path)
+        if not have:
+            either = " or ".join(repr(n) for n in [name] + alts)
+            raise InputError(f"missing input {either} ({c.x[i].description})", path=path)
+        value = inputs[have[0]]
+        home = float(model.x_home[i])
+        if have[0] != name:
+            value = [v + home for v in value] if isinstance(value, list) else value + home
+        out.append(value)
+    return out
+
+
+def check_actuator_limits(model: Model, inputs: Mapping[str, Any], path: tuple) -> None:
+    """Actuator inputs must lie within the declared stroke (an input error)."""
+    for coord in model.closure.q:
+        lim = model.limit_of(coord)
+        value = inputs.get(coord.name)
+        if lim is None or value is None:
+            continue
+        values = value if isinstance(value, list) else [value]
+        for k, v in enumerate(values):
+            if not lim[0] <= v <= lim[1]:
+                where = path + ((coord.name, k) if isinstance(value, list) else (coord.name,))
+                hint = None
+                if abs(v) > 100 * max(abs(lim[0]), abs(lim[1])):
+                    hint = "a bare number is read in SI; write the unit, e.g. '1.5 mm'"
+                raise InputError(
+                    f"actuator displacement {format_quantity(v, coord.kind)} is out of reach: expected a value "
+                    f"within the stroke [{format_quantity(lim[0], coord.kind)}, "
+                    f"{format_quantity(lim[1], coord.kind)}] declared at mechanism.limits.{coord.group}",
+                    path=where,
+                    hint=hint,
+                )
+
+
+def broadcast(columns: Sequence[Any], names: Sequence[str], path: tuple) -> tuple[np.ndarray, bool]:
+    """Align scalar/list inputs into an (N, k) array; lists must share a length."""
+    lengths = {len(v) for v in columns if isinstance(v, list)}
+    batch = bool(lengths)
+    if len(lengths) > 1:
+        detail = ", ".join(f"{n}: {len(v)}" for n, v in zip(names, columns) if isinstance(v, list))
+        raise InputError(f"lists of inputs must have the same length (got {detail})", path=path)
+    n = lengths.pop() if lengths else 1
+    arr = np.array([[v[k] if isinstance(v, list) else v for v in columns] for k in range(n)], dtype=float)
+    return arr, batch
+
+
+def require_ipopt(solver: SolverConfig, kind: str) -> None:
+    """Optimisation kinds (cuboid, synthesis) need IPOPT, not a rootfinder."""
+    if solver.method != "ipopt":
+        raise InputError(
+            f"problem kind '{kind}' solves an optimisation problem and needs method ipopt, got '{solver.method}'",
+            path=("solver", "method"),
+        )
+
+
+def coordinate_dims(coords: Sequence[Coordinate]) -> dict[str, str]:
+    return {c.name: c.kind for c in coords}

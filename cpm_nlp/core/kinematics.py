@@ -1,0 +1,325 @@
+"""Kinematics algorithms: free functions over a :class:`~cpm_nlp.core.model.Model`.
+
+* :func:`forward_kinematics` -- x from q, by IPOPT (default) or Newton;
+* :func:`inverse_kinematics` -- q (and the dependent pose coordinates) from
+  the task coordinates, in closed form where the paper gives one, else solved;
+* :func:`jacobians` -- Φ_x, Φ_q, forward and inverse Jacobians and singularity
+  measures, all from algorithmic differentiation of Φ;
+* :func:`passive_joints` -- passive joint angles of a pose;
+* :func:`assess` -- the checks every pose passes before it is reported solved.
+
+Sizes: nx = pose coordinates, nq = actuated joints (= task coordinates).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InputError
+from .kernels import ROUND_TRIP_FACTOR as ROUND_TRIP_FACTOR  # noqa: F401 - re-exported (defined in kernels)
+from .kernels import (
+    SCALAR,
+    STATUSES,
+    checks_function,
+    fast,
+    is_singular,
+    limit_vectors,
+    status_code,
+    status_rules,
+)
+from .kernels import SINGULAR_CONDITION as SINGULAR_CONDITION  # noqa: F401
+from .model import Model
+from .result import Status
+from .solver import SolverConfig
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class PoseSolution:
+    """Outcome of one FK or IK solve.
+
+    x: pose, size nx; q: actuated joints, size nq; passive: passive joint
+    angles (model.closure.passive_names).  All three are None unless
+    ``status`` is ``solved``.  ``residual`` is max |Φ| at the last iterate.
+    """
+
+    status: Status
+    x: np.ndarray | None = None
+    q: np.ndarray | None = None
+    passive: np.ndarray | None = None
+    residual: float = float("nan")
+    iterations: int = 0
+    seconds: float = 0.0
+    solver: str = ""
+    message: str = ""
+    details: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status.ok
+
+
+def _vector(values, n: int, name: str) -> np.ndarray:
+    arr = np.asarray(values, dtype=float).ravel()
+    if arr.size != n:
+        raise InputError(f"expected {n} values, got {arr.size}", path=(name,))
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"expected finite numbers, got {arr.tolist()}", path=(name,))
+    return arr
+
+
+def residual(model: Model, x: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Φ(x, q; p), size nx, in the model's residual unit."""
+    return np.asarray(model.closure.phi(x, q, model.p)).ravel()
+
+
+def passive_joints(model: Model, x: np.ndarray, q: np.ndarray) -> dict[str, float]:
+    """Passive joint angles of a pose (empty if the model declares none)."""
+    c = model.closure
+    if c.passive is None:
+        return {}
+    vals = np.asarray(c.passive(x, q, model.p)).ravel()
+    return dict(zip(c.passive_names, vals.tolist()))
+
+
+def _limit_violations(model: Model, x: np.ndarray, q: np.ndarray, passive: np.ndarray | None) -> list[str]:
+    """Actuators, pose coordinates (e.g. joint angles that are unknowns of the
+    loops) and passive joints outside their declared limits."""
+    out = []
+    c = model.closure
+    coords = list(c.q) + list(c.x) + (list(c.passive_coords) if passive is not None else [])
+    values = list(q) + list(x) + (list(passive) if passive is not None else [])
+    for coord, v in zip(coords, values):
+        lim = model.limit_of(coord)
+        if lim is not None and not (lim[0] <= v <= lim[1]):
+            out.append(f"{coord.name} = {v:.6g} outside [{lim[0]:.6g}, {lim[1]:.6g}]")
+    return out
+
+
+def pose_checks(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> dict[str, np.ndarray]:
+    """The kernel checks of one pose (see :mod:`cpm_nlp.core.kernels`), one fast call."""
+    c = model.closure
+    fn = fast(c, ("pose_checks",), lambda: checks_function(c))
+    lower, upper = limit_vectors(model)
+    return fn.named(x, q, model.p, lower, upper, [tolerance])
+
+
+def failure_message(model: Model, status: Status, details: dict, x, q, passive, tolerance: float) -> str:
+    """Why a pose with these check values has this status ("" when solved)."""
+    unit = model.closure.residual_unit
+    if status is Status.NOT_CONVERGED:
+        res = details.get("residual", float("nan"))
+        if np.isfinite(res):  # Newton ran out of iterations
+            return f"Newton stopped at max |Φ| = {res:.3g} {unit} > tolerance {tolerance:.3g} {unit}"
+        return "the solver returned non-finite values"
+    if status is Status.UNREACHABLE:
+        return f"the closed-form IK has no real solution (reach margin {details['reach']:.3g} < 0)"
+    if status is Status.RESIDUAL_TOO_LARGE:
+        res = details["residual"]
+        return f"max |Φ| = {res:.3g} {unit} > tolerance {tolerance:.3g} {unit}"
+    if status is Status.WRONG_BRANCH:
+        margin = details.get("branch_margin", np.inf)
+        if not margin > 0:
+            return f"branch indicator {margin:.3g} <= 0"
+        err = details.get("round_trip_error", np.inf)
+        if not np.isfinite(err):
+            return "the closed-form IK has no real solution at this pose's task coordinates"
+        return f"closed-form IK of this pose gives other joints (max difference {err:.3g})"
+    if status is Status.SINGULAR:
+        return f"cond(Φ_x) = {details['cond_phi_x']:.3g}"
+    if status is Status.OUTSIDE_JOINT_LIMITS:
+        return "; ".join(_limit_violations(model, x, q, passive))
+    return ""
+
+
+def _assess(
+    model: Model, x: np.ndarray, q: np.ndarray, tolerance: float
+) -> tuple[Status, str, dict, np.ndarray | None]:
+    c = model.closure
+    x = np.asarray(x, dtype=float)
+    q = np.asarray(q, dtype=float)
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(q))):
+        return Status.NOT_CONVERGED, "the solver returned non-finite values", {}, None
+    chk = pose_checks(model, x, q, tolerance)
+    sv = np.linalg.svd(chk["phi_x"].reshape(c.nx, c.nx), compute_uv=False)  # cond is transpose-invariant
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    values = {k: float(chk[k][0]) for k in ("residual", "branch_margin", "round_trip_error", "limit_margin")}
+    values["finite"] = True
+    code = status_code(status_rules(values, tolerance, is_singular(cond, SCALAR), SCALAR), SCALAR)
+    status = STATUSES[int(code)]
+    details = {"residual": values["residual"]}
+    if c.branch is not None:
+        details["branch_margin"] = values["branch_margin"]
+    if c.ik is not None:
+        details["round_trip_error"] = values["round_trip_error"]
+    details["cond_phi_x"] = cond
+    passive = chk["passive"] if c.passive is not None else None
+    return status, failure_message(model, status, details, x, q, passive, tolerance), details, passive
+
+
+def assess(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tuple[Status, str, dict]:
+    """Check a candidate pose: residual, assembly branch, IK round trip,
+    singularity, joint limits (in this order; the first failure gives the
+    status, see :func:`cpm_nlp.core.kernels.status_rules`).  Returns (status,
+    message, details)."""
+    status, message, details, _ = _assess(model, x, q, tolerance)
+    return status, message, details
+
+
+def _checked(model: Model, x, q, tolerance: float, iterations: int, seconds: float, solver: str) -> PoseSolution:
+    status, message, details, passive = _assess(model, x, q, tolerance)
+    residual = details.get("residual", float("nan"))
+    if status is Status.SOLVED:
+        return PoseSolution(status, x, q, passive, residual, iterations, seconds, solver, message, details)
+    return PoseSolution(status, None, None, None, residual, iterations, seconds, solver, message, details)
+
+
+def forward_kinematics(
+    model: Model,
+    q: Sequence[float],
+    solver: SolverConfig | None = None,
+    guess: Sequence[float] | None = None,
+) -> PoseSolution:
+    """Solve Φ(x, q; p) = 0 for the pose x.
+
+    q: actuated joints, size nq (SI).  guess: initial pose, size nx (default:
+    the home pose).  The answer is checked (:func:`assess`) before it is
+    reported solved.
+    """
+    config = solver or SolverConfig()
+    c = model.closure
+    qv = _vector(q, c.nq, "q")
+    x0 = model.x_home if guess is None else _vector(guess, c.nx, "guess")
+    built = c.fk_solver(config)
+    x, ok, iters, msg, sec = built.solve(x0, np.concatenate([qv, model.p]), model.x_lower, model.x_upper)
+    if not ok:
+        return PoseSolution(
+            Status.NOT_CONVERGED,
+            iterations=iters,
+            seconds=sec,
+            solver=config.name,
+            message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
+        )
+    return _checked(model, x, qv, config.tolerance, iters, sec, config.name)
+
+
+def inverse_kinematics(
+    model: Model,
+    t: Sequence[float],
+    solver: SolverConfig | None = None,
+    method: str = "auto",
+) -> PoseSolution:
+    """Actuated joints (and dependent pose coordinates) for task coordinates t.
+
+    t: the model's task coordinates (closure.task), size nq.
+    method: "closed_form" (the paper's IK), "solve" (Φ = 0 for the
+    dependent coordinates and q, by the configured solver), or "auto"
+    (closed form when the model has one).
+    """
+    config = solver or SolverConfig()
+    c = model.closure
+    tv = _vector(t, c.nq, "t")
+    if method not in ("auto", "closed_form", "solve"):
+        raise InputError(f"unknown IK method {method!r}; expected auto, closed_form or solve", path=("method",))
+    use_closed = c.ik is not None and method in ("auto", "closed_form")
+    if method == "closed_form" and c.ik is None:
+        raise InputError(
+            f"mechanism {c.name} has no closed-form inverse kinematics; use method 'solve'", path=("method",)
+        )
+    if use_closed:
+        t0 = time.perf_counter()
+        x, q, reach = fast(c, ("ik",), lambda: c.ik)(tv, model.p)
+        sec = time.perf_counter() - t0
+        if not reach[0] >= 0:
+            details = {"reach": float(reach[0])}
+            message = failure_message(model, Status.UNREACHABLE, details, None, None, None, config.tolerance)
+            return PoseSolution(Status.UNREACHABLE, seconds=sec, solver="closed_form", message=message, details=details)
+        return _checked(model, x, q, config.tolerance, 0, sec, "closed_form")
+    built = c.ik_solver(config)
+    nd = len(c.dep_index)
+    y0 = np.r_[model.x_home[c.dep_index], model.q_home]
+    lower = np.r_[model.x_lower[c.dep_index], np.full(c.nq, -np.inf)]
+    upper = np.r_[model.x_upper[c.dep_index], np.full(c.nq, np.inf)]
+    y, ok, iters, msg, sec = built.solve(y0, np.r_[tv, model.p], lower, upper)
+    if not ok:
+        return PoseSolution(
+            Status.NOT_CONVERGED,
+            iterations=iters,
+            seconds=sec,
+            solver=config.name,
+            message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
+        )
+    x = c.assemble_x(tv, y[:nd])
+    q = y[nd:]
+    return _checked(model, x, q, config.tolerance, iters, sec, config.name)
+
+
+@dataclass
+class JacobianReport:
+    """Differential kinematics at one pose (all from AD of Φ).
+
+    phi_x (nx x nx), phi_q (nx x nq);
+    J = -Φ_x⁻¹ Φ_q (nx x nq): pose rates from actuator rates;
+    J_task (nq x nq): the task rows of J;
+    J_inv (nq x nq): actuator rates from task rates, from Φ with the
+    dependent coordinates and q as unknowns (equals J_task⁻¹);
+    det_phi_x: zero at forward (type II) singularities;
+    det_phi_y: zero at inverse (type I) singularities;
+    cond, manipulability: condition number and Yoshikawa's sqrt(det(J Jᵀ)) of
+    J_task with angle rows multiplied by ``characteristic_length`` so that
+    every row is a length rate (the measures are then dimensionless).
+    """
+
+    phi_x: np.ndarray
+    phi_q: np.ndarray
+    J: np.ndarray
+    J_task: np.ndarray
+    J_inv: np.ndarray
+    det_phi_x: float
+    det_phi_y: float
+    cond: float
+    manipulability: float
+    characteristic_length: float
+
+
+def jacobians(
+    model: Model, x: Sequence[float], q: Sequence[float], characteristic_length: float | None = None
+) -> JacobianReport:
+    """Jacobians and singularity measures at the pose (x, q).
+
+    characteristic_length: length that turns angle rates into length rates for
+    ``cond`` and ``manipulability`` (default: the model's, e.g. b for the 3-PRS).
+    """
+    c = model.closure
+    xv = _vector(x, c.nx, "x")
+    qv = _vector(q, c.nq, "q")
+    p = model.p
+    phi_x = np.asarray(c.phi_x(xv, qv, p))
+    phi_q = np.asarray(c.phi_q(xv, qv, p))
+    J = np.asarray(c.jacobian(xv, qv, p))
+    J_inv = np.asarray(c.inverse_jacobian(xv, qv, p))
+    J_task = J[c.task_index, :]
+    lc = model.characteristic_length if characteristic_length is None else float(characteristic_length)
+    weights = np.array([lc if c.x[i].kind == "angle" else 1.0 for i in c.task_index])
+    Jh = weights[:, None] * J_task
+    sv = np.linalg.svd(Jh, compute_uv=False)
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    manip = float(np.sqrt(max(np.linalg.det(Jh @ Jh.T), 0.0)))
+    return JacobianReport(
+        phi_x=phi_x,
+        phi_q=phi_q,
+        J=J,
+        J_task=J_task,
+        J_inv=J_inv,
+        det_phi_x=float(np.linalg.det(phi_x)),
+        det_phi_y=float(np.linalg.det(np.asarray(c.phi_y(xv, qv, p)))),
+        cond=cond,
+        manipulability=manip,
+        characteristic_length=float(lc),
+    )

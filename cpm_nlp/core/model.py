@@ -1,0 +1,242 @@
+"""Mechanisms as symbolic loop closures.
+
+A mechanism type is a :class:`LoopClosure`: the CasADi equations
+Φ(x, q; p) = 0 with
+
+* x -- platform pose plus any passive coordinates, size nx,
+* q -- actuated joints, size nq,
+* p -- geometry parameters, size np,
+
+and, optionally, a closed-form inverse kinematics, the passive joint angles
+and an assembly-branch indicator.  Everything else -- Φ_x, Φ_q, the forward
+and inverse Jacobians -- is derived from Φ by algorithmic differentiation,
+once per mechanism type.
+
+A :class:`Model` is a mechanism type with numbers: parameter values and joint
+limits (Pinocchio's split: the model holds constants, algorithms in
+:mod:`cpm_nlp.core.kinematics` are free functions over it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from .solver import SolverCache, SolverConfig, SquareSolver
+
+
+@dataclass(frozen=True)
+class Coordinate:
+    """A named scalar coordinate.
+
+    kind: physical dimension ("length" or "angle").
+    family: joints of the same kind share limits (s1, s2, s3 -> "s").
+    """
+
+    name: str
+    kind: str
+    description: str = ""
+    family: str = ""
+
+    @property
+    def group(self) -> str:
+        return self.family or self.name
+
+
+def _names(coords: Sequence[Coordinate]) -> list[str]:
+    return [c.name for c in coords]
+
+
+class LoopClosure:
+    """Symbolic description of one mechanism type.
+
+    Parameters
+    ----------
+    name:
+        mechanism type, e.g. "prs3".
+    x, q:
+        coordinates of the pose (nx) and of the actuators (nq).
+    parameters:
+        names of the geometry parameters p (np), in order.
+    phi:
+        ``ca.Function("phi", [x, q, p], [phi], ["x", "q", "p"], ["phi"])``,
+        nx residuals, each in ``residual_unit``.
+    task:
+        names (in x) of the nq independent output coordinates.
+    ik:
+        optional closed form, ``("ik", [t, p], [x, q, reach])``; ``reach < 0``
+        when the pose cannot be assembled.
+    passive:
+        optional ``("passive", [x, q, p], [j])`` with one entry per
+        ``passive_coords``.
+    branch:
+        optional ``("branch", [x, q, p], [g])``: all g > 0 on the assembly
+        branch the model designates.
+    home:
+        ``p -> (x_home, q_home)`` (numpy), the reference configuration and the
+        default initial guess.
+    bounds:
+        ``p -> (x_lower, x_upper)`` (numpy) used by IPOPT to stay on the branch.
+    offsets:
+        input/output names for coordinates measured from the home pose,
+        e.g. ``{"dz": "pz"}`` (dz = pz - pz_home).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        *,
+        x: Sequence[Coordinate],
+        q: Sequence[Coordinate],
+        parameters: Sequence[str],
+        phi: ca.Function,
+        task: Sequence[str],
+        home: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+        bounds: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+        ik: ca.Function | None = None,
+        passive: ca.Function | None = None,
+        passive_coords: Sequence[Coordinate] = (),
+        branch: ca.Function | None = None,
+        offsets: Mapping[str, str] | None = None,
+        residual_unit: str = "m",
+    ) -> None:
+        self.name = name
+        self.x = tuple(x)
+        self.q = tuple(q)
+        self.parameters = tuple(parameters)
+        self.task = tuple(task)
+        self.phi = phi
+        self.ik = ik
+        self.passive = passive
+        self.passive_coords = tuple(passive_coords)
+        self.branch = branch
+        self.home = home
+        self.bounds = bounds
+        self.residual_unit = residual_unit
+        self.offsets = dict(offsets or {})
+        self.nx, self.nq, self.np = len(self.x), len(self.q), len(self.parameters)
+        x_names = _names(self.x)
+        missing = [t for t in self.task if t not in x_names]
+        if missing or len(self.task) != self.nq:
+            raise ValueError(f"{name}: task coordinates {self.task} must be {self.nq} names of x")
+        self.task_index = np.array([x_names.index(t) for t in self.task], dtype=int)
+        self.dep_index = np.array([i for i in range(self.nx) if i not in set(self.task_index)], dtype=int)
+        if phi.size1_out(0) != self.nx:
+            raise ValueError(f"{name}: phi has {phi.size1_out(0)} rows, expected nx = {self.nx}")
+        self._derive()
+        self.solvers = SolverCache()
+
+    # -- AD-derived functions ------------------------------------------------
+    def _derive(self) -> None:
+        x = ca.SX.sym("x", self.nx)
+        q = ca.SX.sym("q", self.nq)
+        p = ca.SX.sym("p", self.np)
+        phi = self.phi(x, q, p)
+        phi_x = ca.jacobian(phi, x)
+        phi_q = ca.jacobian(phi, q)
+        # forward Jacobian by the implicit function theorem: dx/dq = -Φ_x⁻¹ Φ_q
+        jac = -ca.solve(phi_x, phi_q)
+        # inverse: unknowns y = (x_dep, q) given the task coordinates t
+        phi_t = phi_x[:, list(self.task_index)]
+        phi_y = ca.horzcat(phi_x[:, list(self.dep_index)], phi_q)
+        dy_dt = -ca.solve(phi_y, phi_t)
+        jac_inv = dy_dt[len(self.dep_index) :, :]
+        io = (["x", "q", "p"],)
+        self.phi_x = ca.Function("phi_x", [x, q, p], [phi_x], *io, ["phi_x"])
+        self.phi_q = ca.Function("phi_q", [x, q, p], [phi_q], *io, ["phi_q"])
+        self.phi_y = ca.Function("phi_y", [x, q, p], [phi_y], *io, ["phi_y"])
+        self.jacobian = ca.Function("jacobian", [x, q, p], [jac], *io, ["J"])
+        self.inverse_jacobian = ca.Function("inverse_jacobian", [x, q, p], [jac_inv], *io, ["J_inv"])
+        # residuals in the solver layout: FK unknown x, known (q, p); IK unknown (x_dep, q), known (t, p)
+        w_fk = ca.SX.sym("w", self.nq + self.np)
+        self.fk_residual = ca.Function(
+            "fk_residual", [x, w_fk], [self.phi(x, w_fk[: self.nq], w_fk[self.nq :])], ["x", "w"], ["phi"]
+        )
+        nd = len(self.dep_index)
+        y = ca.SX.sym("y", nd + self.nq)
+        w_ik = ca.SX.sym("w", self.nq + self.np)
+        x_full = self.assemble_x(w_ik[: self.nq], y[:nd])
+        self.ik_residual = ca.Function(
+            "ik_residual", [y, w_ik], [self.phi(x_full, y[nd:], w_ik[self.nq :])], ["y", "w"], ["phi"]
+        )
+
+    def assemble_x(self, t: Any, d: Any) -> Any:
+        """x from its task part t and dependent part d (symbolic or numeric)."""
+        parts: list[Any] = [None] * self.nx
+        for k, i in enumerate(self.task_index):
+            parts[i] = t[k]
+        for k, i in enumerate(self.dep_index):
+            parts[i] = d[k]
+        if isinstance(t, (ca.SX, ca.MX)) or isinstance(d, (ca.SX, ca.MX)):
+            return ca.vertcat(*parts)
+        return np.array([float(v) for v in parts])
+
+    # -- solvers (built once per configuration) -----------------------------------
+    def fk_solver(self, config: SolverConfig) -> SquareSolver:
+        return self.solvers.get(
+            "fk", config, lambda: SquareSolver(f"{self.name}_fk", self.fk_residual, self.nx, self.nq + self.np, config)
+        )
+
+    def ik_solver(self, config: SolverConfig) -> SquareSolver:
+        ny = len(self.dep_index) + self.nq
+        return self.solvers.get(
+            "ik", config, lambda: SquareSolver(f"{self.name}_ik", self.ik_residual, ny, self.nq + self.np, config)
+        )
+
+    @property
+    def x_names(self) -> list[str]:
+        return _names(self.x)
+
+    @property
+    def q_names(self) -> list[str]:
+        return _names(self.q)
+
+    @property
+    def passive_names(self) -> list[str]:
+        return _names(self.passive_coords)
+
+
+@dataclass
+class Model:
+    """A mechanism with numbers.
+
+    closure: the symbolic mechanism type.
+    parameters: geometry, SI, in the order of ``closure.parameters``.
+    limits: joint limits ``name -> (low, high)`` (SI) for actuators and
+        passive joints; a family name ("s", "alpha") applies to all its members.
+    derived: quantities that follow from the parameters (e.g. the 3-PRS
+        actuator circle radius a), reported with results.
+    """
+
+    closure: LoopClosure
+    parameters: Mapping[str, float]
+    limits: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    derived: Mapping[str, float] = field(default_factory=dict)
+    dimensions: Mapping[str, str] = field(default_factory=dict)  # of parameters and derived values
+    #: length that converts angle rates to length rates in conditioning measures
+    characteristic_length: float = 1.0
+
+    def __post_init__(self) -> None:
+        missing = [n for n in self.closure.parameters if n not in self.parameters]
+        if missing:
+            raise ValueError(f"{self.closure.name}: missing parameters {missing}")
+        self.p = np.array([float(self.parameters[n]) for n in self.closure.parameters])
+        self.x_home, self.q_home = (np.asarray(v, dtype=float) for v in self.closure.home(self.p))
+        self.x_lower, self.x_upper = (np.asarray(v, dtype=float) for v in self.closure.bounds(self.p))
+
+    @property
+    def name(self) -> str:
+        return self.closure.name
+
+    def limit_of(self, coord: Coordinate) -> tuple[float, float] | None:
+        """Declared limits of a coordinate (its own, else its family's)."""
+        if coord.name in self.limits:
+            return self.limits[coord.name]
+        return self.limits.get(coord.family) if coord.family else None
+
+    def task_of(self, x: np.ndarray) -> np.ndarray:
+        return np.asarray(x, dtype=float)[self.closure.task_index]

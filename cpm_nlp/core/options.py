@@ -1,0 +1,212 @@
+"""Declared options: name, kind (a physical dimension or a plain type), bounds,
+default and description -- validated the same way wherever they appear
+(mechanism parameters, joint limits, problem inputs, solver settings).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from .errors import InputError, suggest, unknown_key_error
+from .units import DIMENSIONS, article, format_quantity, parse_quantity
+
+
+class _Required:
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+REQUIRED: Any = _Required()
+
+#: Largest number of points a grid may have (keeps a typo from exhausting memory).
+MAX_GRID_POINTS = 1_000_000
+
+
+@dataclass(frozen=True)
+class Option:
+    """One declared option.
+
+    kind:
+        a dimension of :mod:`cpm_nlp.core.units` ("length", "angle", ...), or one of
+        "int", "bool", "str", "choice".
+    shape:
+        "scalar"; "list" (a non-empty list of scalars); "grid" (a list, or a
+        mapping ``{from, to, count}``); "range" (a pair ``[low, high]``).
+    lower, upper:
+        bounds on the SI value; ``strict`` makes them exclusive.
+    """
+
+    name: str
+    kind: str
+    description: str
+    default: Any = REQUIRED
+    lower: float | None = None
+    upper: float | None = None
+    strict: bool = False
+    choices: tuple[str, ...] = ()
+    shape: str = "scalar"
+    max_len: int | None = None
+
+    @property
+    def required(self) -> bool:
+        return self.default is REQUIRED
+
+    def expectation(self) -> str:
+        """Human text of what the option accepts."""
+        if self.kind == "choice":
+            return "one of " + ", ".join(f"'{c}'" for c in self.choices)
+        if self.kind in ("int", "bool", "str"):
+            base = {"int": "an integer", "bool": "true or false", "str": "a string"}[self.kind]
+        else:
+            dim = DIMENSIONS[self.kind]
+            base = "a number" if self.kind == "dimensionless" else article(self.kind.replace("_", " "))
+            if self.kind != "dimensionless":
+                base += f" such as '{dim.example}'"
+        bounds = self._bounds_text()
+        return base + (f" {bounds}" if bounds else "")
+
+    def format_value(self, v: float) -> str:
+        if self.kind in DIMENSIONS and self.kind != "dimensionless":
+            return format_quantity(v, self.kind)
+        return f"{v:g}"
+
+    def _bounds_text(self) -> str:
+        lo, hi = self.lower, self.upper
+        if lo is None and hi is None:
+            return ""
+        left = "(" if self.strict else "["
+        right = ")" if self.strict else "]"
+        if lo is not None and hi is not None:
+            return f"in {left}{self.format_value(lo)}, {self.format_value(hi)}{right}"
+        if lo is not None:
+            return f"{'>' if self.strict else '>='} {self.format_value(lo)}"
+        return f"{'<' if self.strict else '<='} {self.format_value(hi)}"
+
+    # -- validation -------------------------------------------------------
+    def parse(self, value: Any, path: tuple) -> Any:
+        """Validate ``value`` found at ``path``; return it in SI."""
+        if self.shape == "scalar":
+            return self._scalar(value, path)
+        if self.shape == "list":
+            return self._list(value, path)
+        if self.shape == "range":
+            values = self._list(value, path)
+            if len(values) != 2:
+                raise InputError(f"expected a pair [low, high] of {self.expectation()}, got {value!r}", path=path)
+            if not values[0] < values[1]:
+                raise InputError(
+                    f"expected low < high, got [{self.format_value(values[0])}, {self.format_value(values[1])}]",
+                    path=path,
+                )
+            return tuple(values)
+        if self.shape == "grid":
+            return self._grid(value, path)
+        raise ValueError(f"unknown option shape {self.shape!r}")  # pragma: no cover - programming error
+
+    def _list(self, value: Any, path: tuple) -> list:
+        if not isinstance(value, (list, tuple)) or not value:
+            raise InputError(f"expected a non-empty list of {self.expectation()}, got {value!r}", path=path)
+        if self.max_len is not None and len(value) > self.max_len:
+            raise InputError(f"expected at most {self.max_len} values, got {len(value)}", path=path)
+        return [self._scalar(v, path + (i,)) for i, v in enumerate(value)]
+
+    def _grid(self, value: Any, path: tuple) -> list:
+        if isinstance(value, Mapping):
+            spec = {
+                "from": Option("from", self.kind, "first value", lower=self.lower, upper=self.upper),
+                "to": Option("to", self.kind, "last value", lower=self.lower, upper=self.upper),
+                "count": Option("count", "int", "number of values", lower=1, upper=MAX_GRID_POINTS),
+            }
+            parsed = validate_mapping(value, spec.values(), path, what="grid key")
+            n = parsed["count"]
+            if n == 1:
+                return [parsed["from"]]
+            step = (parsed["to"] - parsed["from"]) / (n - 1)
+            return [parsed["from"] + i * step for i in range(n)]
+        if isinstance(value, (list, tuple)):
+            return self._list(value, path)
+        return self._scalar(value, path)
+
+    def _scalar(self, value: Any, path: tuple) -> Any:
+        kind = self.kind
+        if kind == "bool":
+            if not isinstance(value, bool):
+                raise InputError(f"expected true or false, got {value!r}", path=path)
+            return value
+        if kind == "str":
+            if not isinstance(value, str) or not value.strip():
+                raise InputError(f"expected a non-empty string, got {value!r}", path=path)
+            return value
+        if kind == "choice":
+            if not isinstance(value, str) or value not in self.choices:
+                raise InputError(
+                    f"expected {self.expectation()}, got {value!r}",
+                    path=path,
+                    suggestions=suggest(str(value), self.choices),
+                )
+            return value
+        if kind == "int":
+            if isinstance(value, bool) or not isinstance(value, int):
+                if isinstance(value, float) and value.is_integer() and math.isfinite(value):
+                    value = int(value)
+                else:
+                    raise InputError(f"expected {self.expectation()}, got {value!r}", path=path)
+            self._check_bounds(float(value), value, path)
+            return int(value)
+        number = parse_quantity(value, kind, path)
+        self._check_bounds(number, value, path)
+        return number
+
+    def _check_bounds(self, number: float, raw: Any, path: tuple) -> None:
+        lo, hi = self.lower, self.upper
+        bad = (lo is not None and (number < lo or (self.strict and number == lo))) or (
+            hi is not None and (number > hi or (self.strict and number == hi))
+        )
+        if not bad:
+            return
+        hint = None
+        if isinstance(raw, (int, float)) and self.kind in DIMENSIONS and self.kind != "dimensionless":
+            dim = DIMENSIONS[self.kind]
+            hint = f"a bare number is read in SI ({dim.si}); did you mean '{raw:g} {dim.display}'?"
+        raise InputError(f"expected {self.expectation()}, got {raw!r}", path=path, hint=hint)
+
+
+def validate_mapping(
+    data: Any,
+    options: Sequence[Option] | Any,
+    path: tuple,
+    *,
+    what: str = "key",
+    allow_extra: bool = False,
+) -> dict[str, Any]:
+    """Validate a mapping against declared options; return SI values.
+
+    Unknown keys are rejected with a "did you mean" (unless ``allow_extra``),
+    missing required keys are named with their description, defaults filled in.
+    """
+    options = list(options)
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        raise InputError(f"expected a mapping of {what}s, got {type(data).__name__} {data!r}", path=path)
+    by_name = {o.name: o for o in options}
+    out: dict[str, Any] = {}
+    for key in data:
+        if not isinstance(key, str):
+            raise InputError(f"expected {what} names to be strings, got {key!r}", path=path)
+        if key not in by_name and not allow_extra:
+            raise unknown_key_error(key, by_name, path, what)
+    for opt in options:
+        if opt.name in data and data[opt.name] is not None:
+            out[opt.name] = opt.parse(data[opt.name], path + (opt.name,))
+        elif opt.required:
+            raise InputError(
+                f"missing required {what} '{opt.name}' ({opt.description}; expected {opt.expectation()})",
+                path=path,
+            )
+        else:
+            out[opt.name] = opt.default
+    return out

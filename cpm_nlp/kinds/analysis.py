@@ -1,0 +1,241 @@
+"""Problem kinds beyond pose solving: amplifier, workspace and dynamics.
+
+* ``amplifier`` -- the ratios of a lever amplifier (A1, A2) and its output
+  d = A2 q for given inputs (prc3-li-2018.md eq 1-2);
+* ``workspace`` -- the reachable workspace under the actuator strokes
+  (:mod:`cpm_nlp.analysis.workspace`);
+* ``dynamics`` -- M, K, G of Lagrange's equations and the natural
+  frequencies (:mod:`cpm_nlp.analysis.dynamics`), for mechanisms with a dynamic model.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from ..analysis import dynamics as dyn
+from ..analysis.flexure import material as parse_material
+from ..analysis.workspace import joint_box, reachable_workspace
+from ..core.errors import InputError, unknown_key_error
+from ..core.kind import ProblemKind, actuator_options, broadcast, check_actuator_limits, given
+from ..core.model import Model
+from ..core.options import Option, validate_mapping
+from ..core.result import Result, SolverInfo, Status
+from ..core.solver import SolverConfig
+from ..core.units import DIMENSIONS
+from ..mechanisms.registry import MODULES
+from .kinematic import _model_info, _si
+
+
+def _result(kind: str, model: Model, values: dict, dims: dict, status=Status.SOLVED, message="", solver=None):
+    units = {k: (_si(d) if d in DIMENSIONS else d) for k, d in dims.items()}
+    return Result(
+        kind, status, values, units, dims, solver or SolverInfo("closed_form"), message, None, _model_info(model)
+    )
+
+
+# -- amplifier ------------------------------------------------------------------------------------
+
+
+class Amplifier(ProblemKind):
+    name = "amplifier"
+    description = "lever amplifier ratios A1, A2 (prc3 eq 1) and the output d = A2 q for given inputs (eq 2)"
+
+    def supports(self, model: Model) -> str | None:
+        return None if "A2" in model.derived else "it has no lever amplifier (no ratio A2)"
+
+    def input_options(self, model: Model) -> list[Option]:
+        return actuator_options(model, "grid")
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        check_actuator_limits(model, inputs, path)
+        names = given(inputs, model.closure.q_names)
+        broadcast([inputs[n] for n in names], names, path)
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        A2 = model.derived["A2"]
+        values: dict[str, Any] = {"A1": model.derived["A1"], "A2": A2}
+        dims = {"A1": "dimensionless", "A2": "dimensionless"}
+        for k, name in enumerate(model.closure.q_names):
+            q = inputs.get(name)
+            if q is None:
+                continue
+            values[name] = q
+            values[f"d{k + 1}"] = [A2 * v for v in q] if isinstance(q, list) else A2 * q  # eq 2
+            dims[name] = dims[f"d{k + 1}"] = "length"
+        return _result(self.name, model, values, dims, message="A1 = L2/L1, A2 = L2 L4/(L1 L3) (eq 1); d = A2 q")
+
+    def output_names(self, model: Model) -> list[str]:
+        n = len(model.closure.q_names)
+        return ["A1", "A2"] + model.closure.q_names + [f"d{k + 1}" for k in range(n)]
+
+
+# -- workspace ------------------------------------------------------------------------------------
+
+
+class ActuatorWorkspace(ProblemKind):
+    name = "actuator_workspace"
+    description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
+
+    def input_options(self, model: Model) -> list[Option]:
+        return [
+            Option("samples", "int", "grid points per actuator over its stroke (ends included)", 11, 2, 101),
+            Option("quadrature", "int", "Gauss-Legendre points per actuator for the volume", 4, 1, 20),
+            Option("points", "bool", "also return every sampled point (a large list)", False),
+        ]
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        joint_box(model)
+        n = model.closure.nq
+        if inputs["samples"] ** n > 200_000:
+            raise InputError(
+                f"samples^{n} = {inputs['samples'] ** n} grid points; expected at most 200000",
+                path=path + ("samples",),
+            )
+
+    def _dims(self, model: Model) -> dict[str, str]:
+        c = model.closure
+        dims: dict[str, str] = {}
+        for i in c.task_index:
+            coord = c.x[i]
+            dims.update({f"{coord.name}_min": coord.kind, f"{coord.name}_max": coord.kind})
+        kinds = [c.x[i].kind for i in c.task_index]
+        vol = "volume" if c.nq == 3 and all(k == "length" for k in kinds) else "*".join(_si(k) for k in kinds)
+        dims.update({"volume": vol, "linear_volume": vol, "box_volume": vol, "volume_ratio": "dimensionless"})
+        dims["vertices"] = "matrix"
+        dims["jacobian_deviation"] = "dimensionless"
+        for i in c.task_index:
+            dims[f"{c.x[i].name}_linear_error"] = c.x[i].kind
+        dims["n_points"] = "dimensionless"
+        return dims
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        c = model.closure
+        rep = reachable_workspace(model, inputs["samples"], inputs["quadrature"], solver)
+        dims = self._dims(model)
+        info = SolverInfo(
+            "+".join(sorted({s.solver for s in rep.solutions if s.solver})) or solver.name,
+            sum(s.iterations for s in rep.solutions),
+            rep.seconds,
+        )
+        if not rep.status.ok:
+            return _result(self.name, model, {}, dims, rep.status, rep.message, info)
+        names = [c.x[i].name for i in c.task_index]
+        values: dict[str, Any] = {}
+        for k, n in enumerate(names):
+            values[f"{n}_min"], values[f"{n}_max"] = float(rep.lower[k]), float(rep.upper[k])
+        box = float(np.prod(rep.upper - rep.lower))
+        values.update(
+            volume=rep.volume,
+            linear_volume=rep.linear_volume,
+            box_volume=box,
+            volume_ratio=rep.volume / box if box > 0 else None,
+            vertices=rep.vertices.tolist(),
+            jacobian_deviation=rep.jacobian_deviation,
+        )
+        for k, n in enumerate(names):
+            values[f"{n}_linear_error"] = float(rep.linear_error[k])
+        values["n_points"] = len(rep.q)
+        res = _result(self.name, model, values, dims, rep.status, rep.message, info)
+        res.units["vertices"] = "rows: box corners; columns " + ", ".join(
+            f"{n} [{_si(dims[n + '_min'])}]" for n in names
+        )
+        if inputs["points"]:
+            res.values["points"] = rep.t.tolist()
+            res.dimensions["points"] = "matrix"
+            res.units["points"] = res.units["vertices"].replace("box corners", "grid points")
+        return res
+
+    def output_names(self, model: Model) -> list[str]:
+        return list(self._dims(model)) + ["points"]
+
+
+# -- dynamics -------------------------------------------------------------------------------------
+
+
+def _module(model: Model):
+    return importlib.import_module(MODULES[model.name])
+
+
+class Dynamics(ProblemKind):
+    name = "dynamics"
+    description = "Lagrange dynamics at home: M, K, G (AD of the energies) and the natural frequencies"
+
+    def supports(self, model: Model) -> str | None:
+        return None if hasattr(_module(model), "lagrangian") else "it has no dynamic model (no energies)"
+
+    def input_options(self, model: Model) -> list[Option]:
+        masses = [
+            Option(m, "mass", f"{d}; a mass or a block {{length, width, height}}") for m, d in _module(model).MASSES
+        ]
+        return [
+            Option("material", "str", "the hinge material: a name (Al 7075-T6, ...) or inline {E, nu, density}"),
+            *masses,
+            Option("g", "acceleration", "gravitational acceleration", default=9.81, lower=0.0),
+        ]
+
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        if raw is None:
+            raw = {}
+        if not isinstance(raw, Mapping):
+            raise InputError(f"expected a mapping of inputs, got {type(raw).__name__} {raw!r}", path=path)
+        options = self.input_options(model)
+        known = [o.name for o in options]
+        for key in raw:
+            if key not in known:
+                raise unknown_key_error(str(key), known, path, "input")
+        for o in options:
+            if o.required and raw.get(o.name) is None:
+                raise InputError(f"missing required input '{o.name}' ({o.description})", path=path)
+        mat = parse_material(raw["material"], path + ("material",))
+        inputs: dict[str, Any] = {"material": mat}
+        for m, _ in _module(model).MASSES:
+            inputs[m] = dyn.parse_mass(raw[m], mat.density, mat.name, path + (m,))
+        inputs.update(validate_mapping({"g": raw.get("g")}, [options[-1]], path, what="input"))
+        inputs["E"] = mat.require("E", path + ("material",), "the hinge stiffness needs it")
+        missing = [n for n in _module(model).DYNAMIC_PARAMETERS if n not in inputs and n not in model.parameters]
+        if missing:
+            raise InputError(
+                f"missing parameter(s) {', '.join(missing)}, needed by the dynamics "
+                f"(see cpm-nlp describe {model.name})",
+                path=("mechanism", "parameters"),
+            )
+        return inputs
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        mod = _module(model)
+        w = np.array([inputs[n] if n in inputs else model.parameters[n] for n in mod.DYNAMIC_PARAMETERS], dtype=float)
+        M, K, G = dyn.matrices(mod.lagrangian(), model.q_home, model.p, w)
+        f = dyn.natural_frequencies(M, K)
+        n = model.closure.nq
+        values: dict[str, Any] = {m: inputs[m] for m, _ in mod.MASSES}
+        dims = {m: "mass" for m, _ in mod.MASSES}
+        for k in range(n):
+            values[f"f{k + 1}"] = float(f[k])
+            dims[f"f{k + 1}"] = "frequency"
+        values.update(M=M.tolist(), K=K.tolist(), G=G.tolist(), q_static=(-np.linalg.solve(K, G)).tolist())
+        dims.update(M="matrix", K="matrix", G="vector", q_static="vector")
+        if hasattr(mod, "dynamics_values"):
+            values.update(mod.dynamics_values(model, w, M, K, G))
+            dims.update(mod.DYNAMICS_DIMENSIONS)
+        res = _result(
+            self.name,
+            model,
+            values,
+            dims,
+            message=f"material {inputs['material'].name}; frequencies from |K - (2 pi f)^2 M| = 0",
+        )
+        qs = ", ".join(model.closure.q_names)
+        res.units.update(
+            M=f"kg (generalized coordinates {qs})", K="N/m", G="N", q_static="m (static deflection under G)"
+        )
+        return res
+
+    def output_names(self, model: Model) -> list[str]:
+        mod = _module(model)
+        names = [m for m, _ in mod.MASSES] + [f"f{k + 1}" for k in range(model.closure.nq)]
+        names += ["M", "K", "G", "q_static"] + list(getattr(mod, "DYNAMICS_DIMENSIONS", {}))
+        return names

@@ -1,0 +1,346 @@
+"""The kinematic problem kinds: forward_kinematics, inverse_kinematics,
+jacobian and joint_requirements.
+
+Inputs take a scalar per coordinate, or a list (a batch: one solve per
+entry, values come back as lists with ``null`` for points that failed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..analysis.requirements import joint_requirements
+from ..core.batch import batch_forward_kinematics, batch_inverse_kinematics
+from ..core.errors import InputError
+from ..core.kernels import batch_newton_supported
+from ..core.kind import (
+    ProblemKind,
+    actuator_options,
+    broadcast,
+    check_actuator_limits,
+    coordinate_dims,
+    given,
+    task_options,
+    task_values,
+)
+from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
+from ..core.model import Model
+from ..core.options import Option, validate_mapping
+from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
+from ..core.solver import SolverConfig
+from ..core.units import DIMENSIONS
+
+
+def _pose_names(model: Model) -> tuple[list[str], dict[str, str]]:
+    c = model.closure
+    dims = coordinate_dims(c.x)
+    for off, target in c.offsets.items():
+        dims[off] = dims[target]
+    dims.update(coordinate_dims(c.q))
+    dims.update(coordinate_dims(c.passive_coords))
+    dims["residual"] = "length" if c.residual_unit == "m" else "dimensionless"
+    return list(dims), dims
+
+
+def _pose_values(model: Model, sols: Sequence[PoseSolution], batch: bool) -> dict[str, Any]:
+    """Values of solved poses under the papers' names; None for failed points."""
+    c = model.closure
+    cols: dict[str, list] = {n: [] for n in _pose_names(model)[0]}
+    for s in sols:
+        ok = s.ok
+        for i, name in enumerate(c.x_names):
+            cols[name].append(float(s.x[i]) if ok else None)
+        for off, target in c.offsets.items():
+            i = c.x_names.index(target)
+            cols[off].append(float(s.x[i] - model.x_home[i]) if ok else None)
+        for j, name in enumerate(c.q_names):
+            cols[name].append(float(s.q[j]) if ok else None)
+        for j, name in enumerate(c.passive_names):
+            cols[name].append(float(s.passive[j]) if ok and s.passive is not None else None)
+        cols["residual"].append(float(s.residual) if ok else None)
+    return {k: (v if batch else v[0]) for k, v in cols.items()}
+
+
+def _summary(sols: Sequence[PoseSolution], batch: bool) -> tuple[Status, str, list[Status] | None]:
+    statuses = [s.status for s in sols]
+    status = worst_status(statuses)
+    if not batch:
+        s = sols[0]
+        msg = STATUS_TEXT[s.status] + (f": {s.message}" if s.message else "")
+        return status, msg, None
+    failed = [(k, s) for k, s in enumerate(sols) if not s.ok]
+    if not failed:
+        return status, f"all {len(sols)} points solved", statuses
+    k, s = failed[0]
+    msg = f"{len(failed)} of {len(sols)} points not solved; first, point {k}: {s.status.value}" + (
+        f" ({s.message})" if s.message else ""
+    )
+    return status, msg, statuses
+
+
+def _solver_info(sols: Sequence[PoseSolution], fallback: str) -> SolverInfo:
+    names = sorted({s.solver for s in sols if s.solver}) or [fallback]
+    return SolverInfo("+".join(names), sum(s.iterations for s in sols), sum(s.seconds for s in sols))
+
+
+def _result(
+    kind: str,
+    model: Model,
+    sols: Sequence[PoseSolution],
+    batch: bool,
+    solver: SolverConfig,
+    extra: Mapping[str, Any] | None = None,
+) -> Result:
+    names, dims = _pose_names(model)
+    status, message, statuses = _summary(sols, batch)
+    values = _pose_values(model, sols, batch)
+    if extra:
+        values.update(extra)
+    return Result(
+        kind,
+        status,
+        values,
+        {n: _si(dims[n]) for n in names},
+        dims,
+        _solver_info(sols, solver.name),
+        message,
+        statuses,
+        _model_info(model),
+    )
+
+
+def _si(dimension: str) -> str:
+    return DIMENSIONS[dimension].si if dimension in DIMENSIONS else dimension
+
+
+def _model_info(model: Model) -> dict[str, Any]:
+    return {"type": model.name, **dict(model.parameters), **dict(model.derived)}
+
+
+class ForwardKinematics(ProblemKind):
+    name = "forward_kinematics"
+    description = "platform pose from the actuator displacements (FK), checked against IK"
+
+    def input_options(self, model: Model) -> list[Option]:
+        return actuator_options(model, "grid")
+
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        raw = dict(raw) if isinstance(raw, Mapping) else raw
+        guess = raw.pop("guess", None) if isinstance(raw, dict) else None
+        inputs = super().parse_inputs(raw, model, path)
+        if guess is not None:
+            c = model.closure
+            opts = [Option(x.name, x.kind, x.description, default=None) for x in c.x]
+            g = validate_mapping(guess, opts, path + ("guess",), what="pose coordinate")
+            inputs["guess"] = np.array([model.x_home[i] if g[n] is None else g[n] for i, n in enumerate(c.x_names)])
+        return inputs
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        names = model.closure.q_names
+        missing = [n for n in names if inputs.get(n) is None]
+        if missing:
+            raise InputError(
+                f"missing actuator input(s) {', '.join(missing)}; give every one of {', '.join(names)}", path=path
+            )
+        check_actuator_limits(model, inputs, path)
+        broadcast([inputs[n] for n in names], names, path)
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        names = model.closure.q_names
+        qs, batch = broadcast([inputs[n] for n in names], names, ("inputs",))
+        guess = inputs.get("guess")
+        if batch and batch_newton_supported(solver):  # one vectorized Newton over every point
+            sols = batch_forward_kinematics(model, qs, solver, guess).solutions()
+        else:
+            sols = [forward_kinematics(model, q, solver, guess) for q in qs]
+        return _result(self.name, model, sols, batch, solver)
+
+    def output_names(self, model: Model) -> list[str]:
+        return _pose_names(model)[0]
+
+
+class InverseKinematics(ProblemKind):
+    name = "inverse_kinematics"
+    description = "actuator displacements and passive joints for a platform pose (IK)"
+
+    def input_options(self, model: Model) -> list[Option]:
+        return task_options(model, "grid") + [
+            Option(
+                "method",
+                "choice",
+                "closed form (the paper's) or solved from the loop closures",
+                default="auto",
+                choices=("auto", "closed_form", "solve"),
+            )
+        ]
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        cols = task_values(inputs, model, path)
+        broadcast(cols, list(model.closure.task), path)
+        if inputs["method"] == "closed_form" and model.closure.ik is None:
+            raise InputError(
+                f"mechanism {model.name} has no closed-form IK; use 'solve' or 'auto'", path=path + ("method",)
+            )
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        ts, batch = broadcast(task_values(inputs, model, ("inputs",)), list(model.closure.task), ("inputs",))
+        if batch and model.closure.ik is not None and inputs["method"] != "solve":  # closed form, vectorized
+            sols = batch_inverse_kinematics(model, ts, solver).solutions()
+        else:
+            sols = [inverse_kinematics(model, t, solver, inputs["method"]) for t in ts]
+        return _result(self.name, model, sols, batch, solver)
+
+    def output_names(self, model: Model) -> list[str]:
+        return _pose_names(model)[0]
+
+
+class Jacobian(ProblemKind):
+    name = "jacobian"
+    description = "forward/inverse Jacobians (AD) and singularity measures at one pose"
+
+    def input_options(self, model: Model) -> list[Option]:
+        return (
+            task_options(model, "scalar")
+            + actuator_options(model, "scalar")
+            + [
+                Option(
+                    "characteristic_length",
+                    "length",
+                    "length that turns angle rates into length rates for cond and manipulability "
+                    "(default: the mechanism's)",
+                    default=None,
+                    lower=0.0,
+                    strict=True,
+                )
+            ]
+        )
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        c = model.closure
+        pose_keys = given(inputs, [o.name for o in task_options(model, "scalar")])
+        act_keys = given(inputs, c.q_names)
+        if pose_keys and act_keys:
+            raise InputError(
+                "give either the pose ("
+                + ", ".join(pose_keys)
+                + ") or the actuators ("
+                + ", ".join(act_keys)
+                + "), not both",
+                path=path,
+            )
+        if act_keys:
+            if len(act_keys) != c.nq:
+                raise InputError(f"give every actuator: {', '.join(c.q_names)}", path=path)
+            check_actuator_limits(model, inputs, path)
+        else:
+            task_values(inputs, model, path)
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        c = model.closure
+        if given(inputs, c.q_names):
+            sol = forward_kinematics(model, [inputs[n] for n in c.q_names], solver)
+        else:
+            sol = inverse_kinematics(model, task_values(inputs, model, ("inputs",)), solver)
+        extra: dict[str, Any] = {}
+        units: dict[str, str] = {}
+        if sol.ok:
+            rep = jacobians(model, sol.x, sol.q, inputs.get("characteristic_length"))
+            extra = {
+                "J": rep.J.tolist(),
+                "J_task": rep.J_task.tolist(),
+                "J_inv": rep.J_inv.tolist(),
+                "Phi_x": rep.phi_x.tolist(),
+                "Phi_q": rep.phi_q.tolist(),
+                "det_Phi_x": rep.det_phi_x,
+                "det_Phi_y": rep.det_phi_y,
+                "cond": rep.cond,
+                "manipulability": rep.manipulability,
+                "characteristic_length": rep.characteristic_length,
+            }
+            rows = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
+            task_rows = ", ".join(f"{c.x[i].name} [{_si(c.x[i].kind)}]" for i in c.task_index)
+            cols = ", ".join(f"{q.name} [{_si(q.kind)}]" for q in c.q)
+            units = {
+                "J": f"rows {rows} per columns {cols}",
+                "J_task": f"rows {task_rows} per columns {cols}",
+                "J_inv": f"rows {cols} per columns {task_rows}",
+                "Phi_x": f"d(phi) [{c.residual_unit}] / d({', '.join(c.x_names)})",
+                "Phi_q": f"d(phi) [{c.residual_unit}] / d({', '.join(c.q_names)})",
+                "det_Phi_x": "",
+                "det_Phi_y": "",
+                "cond": "",
+                "manipulability": "",
+                "characteristic_length": "m",
+            }
+        res = _result(self.name, model, [sol], False, solver, extra)
+        res.units.update(units)
+        res.dimensions.update(
+            {
+                k: (
+                    "length"
+                    if k == "characteristic_length"
+                    else "matrix"
+                    if k.startswith(("J", "Phi"))
+                    else "dimensionless"
+                )
+                for k in extra
+            }
+        )
+        return res
+
+    def output_names(self, model: Model) -> list[str]:
+        return _pose_names(model)[0] + [
+            "J",
+            "J_task",
+            "J_inv",
+            "Phi_x",
+            "Phi_q",
+            "det_Phi_x",
+            "det_Phi_y",
+            "cond",
+            "manipulability",
+            "characteristic_length",
+        ]
+
+
+class JointRequirements(ProblemKind):
+    name = "joint_requirements"
+    description = "actuator strokes and passive-joint rotations over every combination of task values"
+
+    def input_options(self, model: Model) -> list[Option]:
+        return task_options(model, "grid")
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        cols = task_values(inputs, model, path)
+        n = int(np.prod([len(v) if isinstance(v, list) else 1 for v in cols]))
+        if n > 200_000:
+            raise InputError(
+                f"the grid has {n} poses; expected at most 200000 (use fewer values per coordinate)", path=path
+            )
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        c = model.closure
+        grid = [v if isinstance(v, list) else [v] for v in task_values(inputs, model, ("inputs",))]
+        rep = joint_requirements(model, grid, solver)
+        sols = rep.solutions
+        res = _result(self.name, model, sols, True, solver)
+        res.values.update(rep.ranges)
+        res.dimensions.update(rep.range_dimensions)
+        res.units.update({k: _si(d) for k, d in rep.range_dimensions.items()})
+        if rep.status.ok:
+            res.message = (
+                f"{len(sols)} poses ({' x '.join(str(len(g)) for g in grid)} over {', '.join(c.task)}) solved by IK"
+            )
+        return res
+
+    def output_names(self, model: Model) -> list[str]:
+        c = model.closure
+        fams = sorted(
+            {q.group for q in c.q} | {c.x[i].group for i in c.dep_index} | {p.group for p in c.passive_coords}
+        )
+        ranges = [f"{f}_{e}" for f in fams for e in ("min", "max")]
+        ranges += [f"d{f}_{e}" for f in fams for e in ("min", "max")]
+        return _pose_names(model)[0] + ranges

@@ -1,0 +1,299 @@
+"""Workspace problem kinds: ``inscribed_cuboid`` and ``workspace``.
+
+Both work for any mechanism from its loop closures and joint limits (see
+:mod:`cpm_nlp.analysis.workspace`).  A mechanism module may add to them:
+
+* ``CUBOID_OPTIONS`` (Options), ``CUBOID_VALUE_NAMES`` and
+  ``cuboid_values(model, lower, upper, inputs, solver) -> (values,
+  dimensions)``: extra inputs and values of the cuboid found, e.g. the
+  paper's names for it and the paper's own formulation;
+* ``paper_membership(model, points) -> (inside, margins)``: a closed-form
+  membership test from the paper, reported beside the general one.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from ..analysis.workspace import (
+    ADDED_PER_ROUND,
+    CHECK_OPTION,
+    EXTRA_SLOTS,
+    inscribed_cuboid,
+    membership,
+    sample_workspace,
+)
+from ..core.errors import InputError
+from ..core.kind import ProblemKind, broadcast, require_ipopt
+from ..core.model import Model
+from ..core.multistart import start_options
+from ..core.options import Option
+from ..core.result import Result, SolverInfo, Status
+from ..core.solver import SolverConfig
+from ..core.units import DIMENSIONS
+from ..mechanisms.registry import MODULES
+from .kinematic import _model_info
+
+
+def _module(model: Model):
+    return importlib.import_module(MODULES[model.name])
+
+
+def _unit(dim: str) -> str:
+    if dim in DIMENSIONS:
+        return DIMENSIONS[dim].si
+    return {"si": "SI unit of the binding quantity"}.get(dim, "")
+
+
+def _region_options(model: Model) -> list[Option]:
+    c = model.closure
+    return [
+        Option(
+            f"{c.x[i].name}_range",
+            c.x[i].kind,
+            f"search region of {c.x[i].name} [low, high] (default: probed around the home pose)",
+            default=None,
+            shape="range",
+        )
+        for i in c.task_index
+    ]
+
+
+def _region(inputs: Mapping[str, Any], model: Model, path: tuple) -> tuple[np.ndarray, np.ndarray] | None:
+    names = [f"{t}_range" for t in model.closure.task]
+    given = [n for n in names if inputs.get(n) is not None]
+    if not given:
+        return None
+    if len(given) != len(names):
+        missing = [n for n in names if n not in given]
+        raise InputError(f"give a search range for every task coordinate; missing {', '.join(missing)}", path=path)
+    return np.array([inputs[n][0] for n in names]), np.array([inputs[n][1] for n in names])
+
+
+def _volume_dimension(model: Model) -> tuple[str, str]:
+    """Dimension and SI unit of a box volume in the task coordinates."""
+    kinds = [model.closure.x[i].kind for i in model.closure.task_index]
+    if all(k == "length" for k in kinds):
+        return "volume", "m^3"
+    unit = "*".join(DIMENSIONS[k].si for k in kinds)
+    return "task volume", unit
+
+
+class InscribedCuboid(ProblemKind):
+    name = "inscribed_cuboid"
+    description = "largest axis-aligned box of task coordinates inside the reachable workspace (IPOPT, multi-start)"
+
+    def input_options(self, model: Model) -> list[Option]:
+        rounds = EXTRA_SLOTS // ADDED_PER_ROUND
+        opts = start_options() + [
+            Option(
+                "samples_per_edge",
+                "int",
+                "sample points per box edge in the NLP (odd keeps face centres)",
+                default=5,
+                lower=2,
+                upper=9,
+            ),
+            CHECK_OPTION,
+            Option(
+                "refinements",
+                "int",
+                "exchange rounds that add outside points of the check to the NLP",
+                default=rounds,
+                lower=0,
+                upper=rounds,
+            ),
+            Option(
+                "installation_volume",
+                "volume",
+                "installation volume of the mechanism; gives ratio = volume / installation_volume",
+                default=None,
+                lower=0.0,
+                strict=True,
+            ),
+        ]
+        opts += _region_options(model)
+        opts += list(getattr(_module(model), "CUBOID_OPTIONS", ()))
+        return opts
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        _region(inputs, model, path)
+
+    def check_solver(self, solver: SolverConfig) -> None:
+        require_ipopt(solver, self.name)
+
+    def output_names(self, model: Model) -> list[str]:
+        names = []
+        for t in model.closure.task:
+            names += [f"{t}_min", f"{t}_max"]
+        names += [
+            "volume",
+            "ratio",
+            "starts",
+            "starts_converged",
+            "starts_agreed",
+            "refinements",
+            "shrink",
+            "check_points",
+            "check_outside",
+            "check_margin",
+            "check_binding",
+        ]
+        return names + list(getattr(_module(model), "CUBOID_VALUE_NAMES", ()))
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        require_ipopt(solver, self.name)
+        c = model.closure
+        res = inscribed_cuboid(
+            model,
+            solver,
+            starts=inputs["starts"],
+            seed=inputs["seed"],
+            samples_per_edge=inputs["samples_per_edge"],
+            check_per_edge=inputs["check_per_edge"],
+            refinements=inputs["refinements"],
+            region=_region(inputs, model, ("inputs",)),
+        )
+        vdim, vunit = _volume_dimension(model)
+        values: dict[str, Any] = {}
+        dims: dict[str, str] = {}
+        for k, t in enumerate(c.task):
+            kind = c.x[c.task_index[k]].kind
+            values[f"{t}_min"] = float(res.lower[k]) if res.found else None
+            values[f"{t}_max"] = float(res.upper[k]) if res.found else None
+            dims[f"{t}_min"] = dims[f"{t}_max"] = kind
+        values["volume"] = res.volume
+        dims["volume"] = vdim
+        vol_inst = inputs.get("installation_volume")
+        if vol_inst is not None:
+            values["ratio"] = res.volume / vol_inst if res.found and vdim == "volume" else None
+            dims["ratio"] = "dimensionless"
+        values.update(
+            starts=res.starts,
+            starts_converged=res.converged,
+            starts_agreed=res.agreed,
+            refinements=res.refinements,
+            shrink=res.shrink if res.found else None,
+        )
+        dims.update(
+            {k: "dimensionless" for k in ("starts", "starts_converged", "starts_agreed", "refinements", "shrink")}
+        )
+        chk = res.check
+        values.update(
+            check_points=chk.points if chk else None,
+            check_outside=chk.outside if chk else None,
+            check_margin=chk.margin if chk else None,
+            check_binding=chk.binding if chk else None,
+        )
+        dims.update(
+            check_points="dimensionless", check_outside="dimensionless", check_margin="si", check_binding="text"
+        )
+        hook = getattr(_module(model), "cuboid_values", None)
+        if hook is not None and res.found:
+            extra, extra_dims = hook(model, res.lower, res.upper, dict(inputs), solver)
+            values.update(extra)
+            dims.update(extra_dims)
+        if not res.found:  # no numbers that look like an answer
+            keep = ("starts", "starts_converged")
+            values = {k: (v if k in keep else None) for k, v in values.items()}
+            values.update({k: None for k in getattr(_module(model), "CUBOID_VALUE_NAMES", ())})
+        status = Status.SOLVED if res.found else (Status.INFEASIBLE if res.infeasible else Status.NOT_CONVERGED)
+        message = res.message
+        if res.found:
+            message += (
+                f"; membership check: {chk.points} points of its faces, edges and interior, "
+                f"all inside (worst margin {chk.margin:.3g}, {chk.binding})"
+            )
+        units = {k: (vunit if d == "task volume" else _unit(d)) for k, d in dims.items()}
+        return Result(
+            self.name,
+            status,
+            values,
+            units,
+            dims,
+            SolverInfo("ipopt", res.iterations, res.seconds),
+            message,
+            None,
+            _model_info(model),
+        )
+
+
+class Workspace(ProblemKind):
+    name = "workspace"
+    description = "membership of given points and a seeded point cloud of the reachable workspace"
+
+    def input_options(self, model: Model) -> list[Option]:
+        c = model.closure
+        opts = [
+            Option(c.x[i].name, c.x[i].kind, f"points to test: {c.x[i].description}", default=None, shape="grid")
+            for i in c.task_index
+        ]
+        opts += [
+            Option("samples", "int", "points drawn for the point cloud (0: none)", default=0, lower=0, upper=200_000),
+            Option("seed", "int", "seed of the point cloud", default=0, lower=0, upper=2**32 - 1),
+        ]
+        return opts + _region_options(model)
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        _region(inputs, model, path)
+        task = list(model.closure.task)
+        have = [t for t in task if inputs.get(t) is not None]
+        if have and len(have) != len(task):
+            raise InputError(f"give every task coordinate of the points to test: {', '.join(task)}", path=path)
+        if not have and not inputs["samples"]:
+            raise InputError(f"give points to test ({', '.join(task)}) or samples > 0 for a point cloud", path=path)
+        if have:
+            broadcast([inputs[t] for t in task], task, path)
+
+    def output_names(self, model: Model) -> list[str]:
+        task = list(model.closure.task)
+        return (
+            ["inside", "margin", "binding", "inside_paper", "count_inside"]
+            + [f"cloud_{t}" for t in task]
+            + ["cloud_count", "volume_estimate"]
+            + [f"{t}_range" for t in task]
+        )
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        c = model.closure
+        task = list(c.task)
+        values: dict[str, Any] = {}
+        dims: dict[str, str] = {}
+        if inputs.get(task[0]) is not None:
+            T, _batch = broadcast([inputs[t] for t in task], task, ("inputs",))
+            mem = membership(model, T, solver)
+            values["inside"] = mem.inside.tolist()
+            values["margin"] = [float(m) if np.isfinite(m) else None for m in mem.margin]
+            values["binding"] = mem.binding
+            values["count_inside"] = int(np.count_nonzero(mem.inside))
+            dims.update(inside="text", margin="si", binding="text", count_inside="dimensionless")
+            paper = getattr(_module(model), "paper_membership", None)
+            if paper is not None:
+                values["inside_paper"] = paper(model, T)[0].tolist()
+                dims["inside_paper"] = "text"
+        status, message = Status.SOLVED, ""
+        if inputs["samples"]:
+            pts, region, vol = sample_workspace(
+                model, inputs["samples"], inputs["seed"], _region(inputs, model, ()), solver
+            )
+            if region is None:
+                status = Status.INFEASIBLE
+                message = "the home configuration is outside the workspace; give a search region (<task>_range)"
+            else:
+                for k, t in enumerate(task):
+                    values[f"cloud_{t}"] = pts[:, k].tolist()
+                    values[f"{t}_range"] = [float(region[0][k]), float(region[1][k])]
+                    dims[f"cloud_{t}"] = dims[f"{t}_range"] = c.x[c.task_index[k]].kind
+                values["cloud_count"] = len(pts)
+                values["volume_estimate"] = vol
+                dims["cloud_count"] = "dimensionless"
+                dims["volume_estimate"] = _volume_dimension(model)[0]
+                message = f"{len(pts)} of {inputs['samples']} points of the search region inside"
+        units = {k: _unit(d) for k, d in dims.items()}
+        return Result(
+            self.name, status, values, units, dims, SolverInfo(solver.name), message, None, _model_info(model)
+        )

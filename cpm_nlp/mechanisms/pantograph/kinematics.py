@@ -1,0 +1,577 @@
+"""3D compliant pantograph (Elgammal, Fanni, Mohamed 2016;
+``../shared/papers/pantograph-3d-elgammal-2016.md``).
+
+Symbols follow the paper:
+
+* a = AC = BC = DF, b = CD = BF = FE (section 3),
+* q = (dx, dy, dz) -- actuators: dy, dz move point A, dx moves point B;
+  OA = (0, dy, dz), OB = (dx, 0, 0) (Fig. 2, eq 1-8),
+* x = (px, py, pz, theta1, theta2, phi) -- the end-effector E and the three
+  passive coordinates of the loops: theta1 is the angle of the links AD and
+  BF (CD ∥ BF), theta2 that of DE and BC (DF ∥ CB), both measured in the
+  plane of the pantograph, which turns by phi about the y axis.  With
+  u(θ) = (cos θ cos φ, sin θ, -cos θ sin φ) the loops read
+  OE = OA + (a + b)(u1 + u2) (eq 1, 3-5) and OE = OB + b (u1 + u2) (eq 2, 6-8).
+* psi -- the hinge angle ACB at C (eq 17).  Subtracting the loops gives
+  AB = a (u1 + u2), so |AB|² = 2a²(1 + cos(θ1 - θ2)) = 2a²(1 - cos ψ) with
+  **ψ = π - (θ1 - θ2)** on the designated branch (θ1 > θ2).
+
+Readings of the paper chosen here (documented, not tuned):
+
+* **Home configuration**: the flexures are undeflected at ψ = π/2, φ = 0
+  (eq 31 puts ψ_min, ψ_max symmetric about π/2; section 8: "the
+  configuration corresponding to the middle of the input displacement
+  ranges has zero deflection"): θ1 = π/4, θ2 = -π/4, dx0 = √2 a, dy = dz = 0
+  (the prototype's dx range 28.234 ... 28.334 mm is centred on √2 · 20 mm).
+* **Branch**: the elbow with θ1 > θ2 (point C on the +y side of AB at home;
+  the mirror elbow has the mirrored, identical workspace).  The singularity
+  of section 5 (eq 25-29, θ_i = ±π/2, "main pantograph links aligned with
+  the guiding mechanism") belongs to the guiding parallelograms, which eq
+  1-8 do not contain (Φ_x is regular there: det Φ_x ∝ (cos θ1 + cos θ2)
+  sin(θ2 - θ1)).  It enters as the branch condition cos θ_i > 0; with it,
+  sin(θ1 - θ2) > 0 and cos φ > 0 the indicator is positive exactly inside
+  the region bounded by eq 24-29 (proof in :func:`paper_membership`).
+* **Magnification factors** Mx, My, Mz are read off the AD Jacobian of the
+  loops at the home configuration (Model.derived), not typed in; the
+  closed form Mx = 1 + b/a, My = Mz = b/a (eq 9-10) is used only by the
+  closed-form IK and in tests, which check the two against each other.
+* **Joint limits** are those of the paper: ψ ∈ [ψ_min, ψ_max] for the hinges
+  with horizontal axes and |φ| <= φ_max for those with vertical axes
+  (section 5.2), given directly or from the hinge by eq 31:
+  ψ = π/2 ∓ δ_max, φ_max = δ_max with δ_max of the flexure (eq 30 or 38).
+  The hinges at A and B also turn, by θ1 - π/4 and θ2 + π/4 (at the edges of
+  the paper's cuboid by more than three times φ_max); the paper puts no
+  limit on them (an optional ``theta`` limit on these rotations adds one).
+* **Eq 31 discrepancy**: with l = 5 mm, t = 0.1 mm, E = 2 GPa, σ_all = 23.5
+  MPa eq 30-31 give δ_max = 0.148·5·23.5e6/(2e9·0.1) = 0.0870 rad, while the
+  paper prints φ_max = 0.0795 rad and ψ = 1.49/1.65 rad (= π/2 ∓ 0.08).  The
+  printed limits are the ones its cuboid (V = 1.78e-6 m³) is computed with;
+  problems/pantograph_cuboid_hinge.yaml shows both.
+* **Eq 34c** as printed, ẑ <= a Mz x̂ tan φ_max / Mx, is not a length (a·x̂) and
+  bounds ẑ at the far face x̂; the cuboid's corners on its near face px = k
+  then leave the φ planes (eq 18: |pz| <= (Mz/Mx) px tan φ_max).  The paper's
+  own optimum (ẑ = 0.0054 m) satisfies the bound at the near face,
+  ẑ <= (Mz/Mx) k tan φ_max, which is also what membership requires.  See
+  :func:`paper_cuboid` (``reading``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from ...analysis import flexure
+from ...core.errors import InputError
+from ...core.model import Coordinate, LoopClosure, Model
+from ...core.options import Option
+from ...core.solver import SolverConfig
+
+TITLE = "3D compliant pantograph, decoupled XYZ (Elgammal et al.)"
+PAPER = "pantograph-3d-elgammal-2016.md"
+#: the synthesis problem kind dispatches here (see cpm_nlp.kinds.synthesis)
+SYNTHESIS = "cpm_nlp.mechanisms.pantograph.synthesis:PantographSynthesis"
+
+HALF_PI = math.pi / 2
+SQRT2 = math.sqrt(2.0)
+
+PARAMETERS = (
+    Option("a", "length", "link length AC = BC = DF (section 3)", lower=0.0, upper=10.0, strict=True),
+    Option("b", "length", "link length CD = BF = FE (section 3)", lower=0.0, upper=10.0, strict=True),
+)
+
+LIMITS = (
+    Option("psi_min", "angle", "lowest hinge angle ACB (eq 17, 24)", default=None, lower=0.0, upper=math.pi),
+    Option("psi_max", "angle", "highest hinge angle ACB (eq 17, 23)", default=None, lower=0.0, upper=math.pi),
+    Option(
+        "phi_max",
+        "angle",
+        "largest rotation |phi| of the vertical-axis hinges (eq 18)",
+        default=None,
+        lower=0.0,
+        upper=HALF_PI,
+        strict=True,
+    ),
+    Option(
+        "theta",
+        "angle",
+        "range [low, high] of the rotations theta1 - pi/4 and theta2 + pi/4 of the hinges at A and B from home "
+        "(not limited in the paper)",
+        default=None,
+        shape="range",
+    ),
+    Option(
+        "stroke",
+        "length",
+        "actuator range [low, high] about the home configuration (dx0 = sqrt(2) a, dy0 = dz0 = 0), for each actuator",
+        default=None,
+        shape="range",
+    ),
+) + flexure.HINGE_LIMIT_OPTIONS
+
+X = (
+    Coordinate("px", "length", "end-effector E, x (eq 3, 6)"),
+    Coordinate("py", "length", "end-effector E, y (eq 4, 7)"),
+    Coordinate("pz", "length", "end-effector E, z (eq 5, 8)"),
+    Coordinate("theta1", "angle", "angle of links AD and BF in the pantograph plane (eq 3-8)", "theta"),
+    Coordinate("theta2", "angle", "angle of links DE and BC in the pantograph plane (eq 3-8)", "theta"),
+    Coordinate("phi", "angle", "rotation of the pantograph plane about y (eq 18)"),
+)
+Q = (
+    Coordinate("dx", "length", "actuator at B along x (eq 6)", "stroke"),
+    Coordinate("dy", "length", "actuator at A along y (eq 4)", "stroke"),
+    Coordinate("dz", "length", "actuator at A along z (eq 5)", "stroke"),
+)
+TASK = ("px", "py", "pz")
+PASSIVE = (Coordinate("psi", "angle", "hinge angle ACB at C, psi = pi - (theta1 - theta2) (eq 17)"),)
+
+
+def _u(theta, phi):
+    """Unit vector of a pantograph link at angle theta in the plane turned by phi."""
+    return ca.vertcat(ca.cos(theta) * ca.cos(phi), ca.sin(theta), -ca.cos(theta) * ca.sin(phi))
+
+
+def loop_closure() -> ca.Function:
+    """Φ(x, q; p): eq 3-5 (loop 1, OE = OA + AD + DE) and eq 6-8 (loop 2, OE = OB + BF + FE)."""
+    x = ca.SX.sym("x", 6)
+    q = ca.SX.sym("q", 3)
+    p = ca.SX.sym("p", 2)
+    a, b = p[0], p[1]
+    P = x[0:3]
+    w = _u(x[3], x[5]) + _u(x[4], x[5])  # (cos θ1 + cos θ2) cos φ, sin θ1 + sin θ2, -(...) sin φ
+    OA = ca.vertcat(0, q[1], q[2])
+    OB = ca.vertcat(q[0], 0, 0)
+    loop1 = OA + (a + b) * w - P  # eq 3-5
+    loop2 = OB + b * w - P  # eq 6-8
+    return ca.Function("phi", [x, q, p], [ca.vertcat(loop1, loop2)], ["x", "q", "p"], ["phi"])
+
+
+def magnification(a, b):
+    """Closed form Mx = 1 + b/a, My = Mz = b/a (eq 9-10)."""
+    return 1 + b / a, b / a, b / a
+
+
+def inverse_kinematics() -> ca.Function:
+    """Closed-form IK: q by eq 9-10, then φ by eq 18, θ1, θ2 from AB = a(u1 + u2).
+
+    With AB = (dx, -dy, -dz): the mean angle m = (θ1 + θ2)/2 = atan2(-dy, sqrt(dx² + dz²)),
+    the half difference h = (θ1 - θ2)/2 = acos(|AB| / 2a) (eq 17 with ψ = π - 2h);
+    reach = 2a - |AB| < 0 when A and B are further apart than the links allow.
+    """
+    t = ca.SX.sym("t", 3)
+    p = ca.SX.sym("p", 2)
+    a, b = p[0], p[1]
+    Mx, My, Mz = magnification(a, b)
+    dx, dy, dz = t[0] / Mx, -t[1] / My, -t[2] / Mz  # eq 9-10
+    phi = ca.atan2(dz, dx)  # eq 18
+    rho = ca.sqrt(dx**2 + dz**2)
+    n = ca.sqrt(dx**2 + dy**2 + dz**2)
+    m = ca.atan2(-dy, rho)
+    h = ca.acos(ca.fmin(n / (2 * a), 1))
+    x = ca.vertcat(t[0], t[1], t[2], m + h, m - h, phi)
+    return ca.Function("ik", [t, p], [x, ca.vertcat(dx, dy, dz), 2 * a - n], ["t", "p"], ["x", "q", "reach"])
+
+
+def passive_joints() -> ca.Function:
+    """ψ = π - (θ1 - θ2), the hinge angle ACB (eq 17) on the designated branch."""
+    x = ca.SX.sym("x", 6)
+    q = ca.SX.sym("q", 3)
+    p = ca.SX.sym("p", 2)
+    return ca.Function("passive", [x, q, p], [math.pi - (x[3] - x[4])], ["x", "q", "p"], ["j"])
+
+
+def branch_indicator() -> ca.Function:
+    """g > 0 on the designated branch: cos θ1, cos θ2 (away from the guiding-mechanism
+    singularity, eq 25-29), sin(θ1 - θ2) (the elbow, 0 < ψ < π), cos φ."""
+    x = ca.SX.sym("x", 6)
+    q = ca.SX.sym("q", 3)
+    p = ca.SX.sym("p", 2)
+    g = ca.vertcat(ca.cos(x[3]), ca.cos(x[4]), ca.sin(x[3] - x[4]), ca.cos(x[5]))
+    return ca.Function("branch", [x, q, p], [g], ["x", "q", "p"], ["g"])
+
+
+def home_pose(a, b):
+    """Home: ψ = π/2, φ = 0 (θ1 = π/4, θ2 = -π/4); dx0 = √2 a; E at ((a + b)√2, 0, 0).
+    Works on floats and CasADi symbols."""
+    x0 = [(a + b) * SQRT2, 0.0, 0.0, math.pi / 4, -math.pi / 4, 0.0]
+    q0 = [SQRT2 * a, 0.0, 0.0]
+    return x0, q0
+
+
+def home(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    x0, q0 = home_pose(float(p[0]), float(p[1]))
+    return np.array(x0), np.array(q0)
+
+
+def bounds(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Box that keeps IPOPT on the working branch: |θ_i|, |φ| <= π/2, E within 2(a + b)."""
+    a, b = float(p[0]), float(p[1])
+    r = 2 * (a + b)
+    return (
+        np.array([-r, -r, -r, -HALF_PI, -HALF_PI, -HALF_PI]),
+        np.array([r, r, r, HALF_PI, HALF_PI, HALF_PI]),
+    )
+
+
+def closure() -> LoopClosure:
+    """The symbolic pantograph (built fresh; the registry caches one per process)."""
+    return LoopClosure(
+        "pantograph",
+        x=X,
+        q=Q,
+        parameters=("a", "b"),
+        phi=loop_closure(),
+        task=TASK,
+        ik=inverse_kinematics(),
+        passive=passive_joints(),
+        passive_coords=PASSIVE,
+        branch=branch_indicator(),
+        home=home,
+        bounds=bounds,
+    )
+
+
+# -- limits -------------------------------------------------------------------------------------
+
+_DIRECT = ("psi_min", "psi_max", "phi_max")
+
+
+def check_limits(limits: dict, path: tuple) -> None:
+    """Either the joint-angle limits or the hinge that sets them (eq 31), not both."""
+    direct = [k for k in _DIRECT if limits.get(k) is not None]
+    hinge = [k for k in flexure.HINGE_KEYS if limits.get(k) is not None]
+    if direct and hinge:
+        raise InputError(
+            f"give either the joint-angle limits ({', '.join(direct)}) or the hinge that sets them by eq 31 "
+            f"({', '.join(hinge)}), not both",
+            path=path,
+        )
+    lo, hi = limits.get("psi_min"), limits.get("psi_max")
+    if lo is not None and hi is not None and not lo < hi:
+        raise InputError(
+            f"expected psi_min < psi_max, got psi_min = {lo:.6g} rad, psi_max = {hi:.6g} rad", path=path + ("psi_min",)
+        )
+    flexure.hinge_rotation(limits, path)  # validates the hinge
+
+
+def joint_limits(limits: dict) -> dict:
+    """psi_min, psi_max, phi_max (rad; None where unlimited) and delta_max, the hinge
+    rotation of eq 30/38 (None unless a hinge is given), from validated limits."""
+    delta = flexure.hinge_rotation(limits)
+    if delta is not None:  # eq 31; a hinge that turns further than the geometry allows does not limit
+        return {
+            "psi_min": max(HALF_PI - delta, 0.0),
+            "psi_max": min(HALF_PI + delta, math.pi),
+            "phi_max": delta if delta < HALF_PI else None,
+            "delta_max": delta,
+        }
+    out = {k: limits.get(k) for k in _DIRECT}
+    out["delta_max"] = None
+    return out
+
+
+def build(closure_: LoopClosure, parameters: dict, limits: dict) -> Model:
+    """A pantograph model from validated parameters (SI) and limits."""
+    a, b = parameters["a"], parameters["b"]
+    angles = joint_limits(limits)
+    lim: dict[str, tuple[float, float]] = {}
+    if angles["psi_min"] is not None or angles["psi_max"] is not None:
+        lim["psi"] = (
+            angles["psi_min"] if angles["psi_min"] is not None else 0.0,
+            angles["psi_max"] if angles["psi_max"] is not None else math.pi,
+        )
+    if angles["phi_max"] is not None:
+        lim["phi"] = (-angles["phi_max"], angles["phi_max"])
+    x0, q0 = home_pose(a, b)
+    if limits.get("theta") is not None:
+        lo, hi = limits["theta"]
+        lim["theta1"] = (x0[3] + lo, x0[3] + hi)
+        lim["theta2"] = (x0[4] + lo, x0[4] + hi)
+    if limits.get("stroke") is not None:
+        lo, hi = limits["stroke"]
+        for name, centre in zip(("dx", "dy", "dz"), q0):
+            lim[name] = (centre + lo, centre + hi)
+    # magnification factors from the AD Jacobian of the loops at home (eq 9-13)
+    J = np.asarray(closure_.jacobian(x0, q0, [a, b]))
+    Mx, My, Mz = float(J[0, 0]), float(-J[1, 1]), float(-J[2, 2])
+    derived = {
+        "Mx": Mx,
+        "My": My,
+        "Mz": Mz,
+        "omega": abs(float(np.linalg.det(J[:3, :]))),  # eq 15-16
+        "dx0": q0[0],
+        "psi_min": angles["psi_min"],
+        "psi_max": angles["psi_max"],
+        "phi_max": angles["phi_max"],
+    }
+    if angles["delta_max"] is not None:
+        derived["delta_max"] = angles["delta_max"]
+        derived.update({k: limits[k] for k in ("l", "t", "r") if limits.get(k) is not None})  # the hinge
+    dims = {
+        "a": "length",
+        "b": "length",
+        "dx0": "length",
+        "delta_max": "angle",
+        "l": "length",
+        "t": "length",
+        "r": "length",
+    }
+    dims.update({k: "dimensionless" for k in ("Mx", "My", "Mz", "omega")})
+    dims.update({k: "angle" for k in _DIRECT})
+    return Model(
+        closure_,
+        parameters={"a": a, "b": b},
+        limits=lim,
+        derived=derived,
+        dimensions=dims,
+    )
+
+
+# -- workspace in closed form (section 5) ----------------------------------------------------------
+
+
+def _radius2(a, psi):
+    """|AB|² = 2a²(1 - cos ψ) (eq 17)."""
+    return 2 * a**2 * (1 - np.cos(psi))
+
+
+def paper_membership(model: Model, points) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The paper's reachable workspace (section 5) as a membership test.
+
+    points: (N, 3) end-effector positions.  Returns (inside, margins), every
+    margin >= 0 inside: ``outer`` and ``inner`` (eq 23-24), ``phi`` (the
+    planes of eq 18), ``singular`` (outside both ellipsoids of eq 29, in units
+    of their normalised radius), ``px`` (px >= 0).  The magnification factors
+    are the model's (AD); missing limits are the rigid-body ones (section 5.1).
+
+    Equivalence with the loop model: with AB = (dx, -dy, -dz), θ1,2 = m ± h,
+    m = atan2(-dy, sqrt(dx² + dz²)), h = (π - ψ)/2, the condition cos θ_i > 0
+    is |m| < ψ/2, i.e. |dy| < 2a sin²(ψ/2) = |AB|²/(2a), which is exactly
+    "outside both spheres dx² + (dy ± a)² + dz² = a²", eq 29 in actuator space.
+    """
+    P = np.atleast_2d(np.asarray(points, dtype=float))
+    a = model.parameters["a"]
+    d = model.derived
+    Mx, My, Mz = d["Mx"], d["My"], d["Mz"]
+    psi_min = d["psi_min"] if d["psi_min"] is not None else 0.0
+    psi_max = d["psi_max"] if d["psi_max"] is not None else math.pi
+    px, py, pz = P[:, 0], P[:, 1], P[:, 2]
+    s = (px / Mx) ** 2 + (py / My) ** 2 + (pz / Mz) ** 2  # eq 23-24, left side
+    margins = {
+        "outer": _radius2(a, psi_max) - s,  # eq 23
+        "inner": s - _radius2(a, psi_min),  # eq 24
+        "px": px,
+    }
+    if d["phi_max"] is not None:  # eq 18: |tan φ| = |Mx pz / (Mz px)| <= tan φ_max
+        margins["phi"] = math.tan(d["phi_max"]) * px - np.abs(Mx * pz / Mz)
+    sing = [(px / (a * Mx)) ** 2 + ((py + sgn * a * My) / (a * My)) ** 2 + (pz / (a * Mz)) ** 2 - 1 for sgn in (1, -1)]
+    margins["singular"] = np.minimum(*sing)  # eq 29
+    inside = np.all(np.vstack([m >= 0 for m in margins.values()]), axis=0)
+    return inside, margins
+
+
+def actuator_ranges(model: Model) -> dict[str, float]:
+    """Actuator ranges of eq 20-22 (from psi_max and phi_max)."""
+    a = model.parameters["a"]
+    psi_max = model.derived["psi_max"] if model.derived["psi_max"] is not None else math.pi
+    r = math.sqrt(_radius2(a, psi_max))
+    phi_max = model.derived["phi_max"]
+    dz = r if phi_max is None else math.sqrt(r**2 / (1 + 1 / math.tan(phi_max) ** 2))
+    return {"dx_max": r, "dx_min": 0.0, "dy_max": r, "dy_min": -r, "dz_max": dz, "dz_min": -dz}
+
+
+# -- the paper's cuboid (eq 32-34) ---------------------------------------------------------------
+
+#: readings of eq 34c (see the module docstring)
+READINGS = ("near_face", "printed")
+
+
+def inner_extent(a, Mx, psi_min):
+    """k = max(a Mx, a sqrt(2 Mx² (1 - cos ψ_min))): the largest px semi-axis of the
+    inner ellipsoids, eq 24 and 29 (text after eq 32).  Floats or CasADi."""
+    if isinstance(a, (ca.SX, ca.MX)) or isinstance(psi_min, (ca.SX, ca.MX)):
+        return ca.fmax(a * Mx, a * Mx * ca.sqrt(2 * (1 - ca.cos(psi_min))))
+    return max(a * Mx, a * Mx * math.sqrt(2 * (1 - math.cos(psi_min))))
+
+
+def cuboid_constraints(a, Mx, My, Mz, psi_max, phi_max, k, x_hat, y_hat, z_hat, reading: str):
+    """Constraints g >= 0 of the paper's cuboid [k, x̂] × [-ŷ, ŷ] × [-ẑ, ẑ]:
+    eq 33a (corner in the outer ellipsoid; 33b follows from it as x̂ >= k),
+    34a, 34c (both readings, see the module docstring) and x̂ >= k.
+    Floats or CasADi symbols; every entry is a length (eq 33a as a distance
+    in actuator space)."""
+    R2 = 2 * a**2 * (1 - ca.cos(psi_max))  # eq 23, right side
+    R = R2**0.5
+    corner = (x_hat / Mx) ** 2 + (y_hat / My) ** 2 + (z_hat / Mz) ** 2
+    face = k if reading == "near_face" else x_hat
+    return [
+        (R2 - corner) / (2 * R),  # eq 33a
+        x_hat - k,  # eq 34a, lower
+        Mx * R - x_hat,  # eq 34a, upper
+        My * R - y_hat,  # eq 34b
+        Mz * R - z_hat,  # eq 34c, second term
+        Mz * face * ca.tan(phi_max) / Mx - z_hat,  # eq 34c, first term (reading)
+    ]
+
+
+class _PaperCuboidNLP:
+    """Eq 32-34 by IPOPT (built once per reading): maximise v = 4 (x̂ - k) ŷ ẑ (eq 32)
+    as -log(x̂ - k) - log ŷ - log ẑ (same maximiser; the problem is then convex:
+    a convex objective over an ellipsoid cut by half-spaces, so one start suffices)."""
+
+    def __init__(self, reading: str, with_phi: bool, config: SolverConfig):
+        v = ca.SX.sym("v", 3)  # (x̂ - k, ŷ, ẑ) / L
+        P = ca.SX.sym("P", 7)  # a, Mx, My, Mz, psi_max, phi_max, k
+        a, Mx, My, Mz, psi_max, phi_max, k = (P[i] for i in range(7))
+        L = a * Mx
+        x_hat, y_hat, z_hat = k + L * v[0], L * v[1], L * v[2]
+        g = cuboid_constraints(a, Mx, My, Mz, psi_max, phi_max, k, x_hat, y_hat, z_hat, reading)
+        if not with_phi:
+            g = g[:-1]
+        nlp = {"x": v, "p": P, "f": -ca.sum1(ca.log(v)), "g": ca.vertcat(*g[:1], *g[2:]) / L}
+        opts = {**config.casadi_options(), "ipopt.tol": 1e-12, "ipopt.bound_relax_factor": 0.0, **dict(config.options)}
+        self.solver = ca.nlpsol(f"pantograph_paper_cuboid_{reading}", "ipopt", nlp, opts)
+
+
+def paper_cuboid(model: Model, reading: str = "near_face", solver: SolverConfig | None = None) -> dict:
+    """The paper's maximal cuboid, eq 32-34: [k, x̂] × [-ŷ, ŷ] × [-ẑ, ẑ].
+
+    reading: "near_face" bounds ẑ by the φ planes at the cuboid's near face px = k,
+    "printed" at its far face x̂, as eq 34c is printed (without its stray
+    factor a, which would make the bound a·length).  Returns ``status``
+    ("solved", "infeasible" or "not_converged"), ``message`` and, when solved,
+    x_hat, y_hat, z_hat, k, volume (SI).
+    """
+    if reading not in READINGS:
+        raise InputError(f"expected one of {', '.join(READINGS)}, got {reading!r}", path=("inputs", "paper_reading"))
+    config = solver or SolverConfig()
+    a = model.parameters["a"]
+    d = model.derived
+    Mx, My, Mz = d["Mx"], d["My"], d["Mz"]
+    psi_min = d["psi_min"] if d["psi_min"] is not None else 0.0
+    psi_max = d["psi_max"] if d["psi_max"] is not None else math.pi
+    with_phi = d["phi_max"] is not None
+    k = inner_extent(a, Mx, psi_min)
+    room = Mx * math.sqrt(_radius2(a, psi_max)) - k  # eq 34a: x̂ can exceed k at all
+    if not room > 0:
+        return {"status": "infeasible", "message": f"eq 34a: k = {k:.6g} m is not below the outer ellipsoid"}
+    built = model.closure.solvers.get(
+        f"paper_cuboid:{reading}:{with_phi}", config, lambda: _PaperCuboidNLP(reading, with_phi, config)
+    )
+    L = a * Mx
+    P = [a, Mx, My, Mz, psi_max, d["phi_max"] if with_phi else 0.0, k]
+    v0 = [0.5 * room / L, 1e-4 * room / L, 1e-6 * room / L]
+    try:
+        out = built.solver(x0=v0, p=P, lbx=1e-14, ubx=np.inf, lbg=0, ubg=np.inf)
+    except RuntimeError as exc:
+        return {"status": "not_converged", "message": f"IPOPT: {exc}".splitlines()[0]}
+    stats = built.solver.stats()
+    if not stats.get("success", False):
+        status = "infeasible" if "Infeasible" in str(stats.get("return_status")) else "not_converged"
+        return {"status": status, "message": f"IPOPT: {stats.get('return_status')}"}
+    v = np.asarray(out["x"]).ravel()
+    x_hat, y_hat, z_hat = k + L * v[0], L * v[1], L * v[2]
+    return {
+        "status": "solved",
+        "message": "",
+        "x_hat": x_hat,
+        "y_hat": y_hat,
+        "z_hat": z_hat,
+        "k": k,
+        "volume": 4 * (x_hat - k) * y_hat * z_hat,  # eq 32
+    }
+
+
+# -- hooks of the inscribed_cuboid problem kind --------------------------------------------------
+
+CUBOID_OPTIONS = (
+    Option(
+        "paper_reading",
+        "choice",
+        "reading of eq 34c for the paper's formulation reported beside the general one: ẑ bounded by the "
+        "phi planes at the near face px = k (near_face) or at x_hat as printed (printed)",
+        default="near_face",
+        choices=READINGS,
+    ),
+)
+
+
+CUBOID_VALUE_NAMES = (
+    "x_hat",
+    "y_hat",
+    "z_hat",
+    "x_near",
+    "a",
+    "b",
+    "Mx",
+    "My",
+    "Mz",
+    "omega",
+    "psi_min",
+    "psi_max",
+    "phi_max",
+    "delta_max",
+    "l",
+    "t",
+    "r",
+    "paper_x_hat",
+    "paper_y_hat",
+    "paper_z_hat",
+    "paper_k",
+    "paper_volume",
+    "paper_status",
+    "paper_check_outside",
+    "paper_check_margin",
+    "paper_check_binding",
+)
+
+
+def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig) -> tuple[dict, dict]:
+    """The cuboid under the paper's names, and the paper's own formulation (eq 32-34)
+    solved and checked against the membership test beside it."""
+    from ...analysis.workspace import check_box
+
+    d = model.derived
+    values = {
+        "x_hat": None,
+        "y_hat": None,
+        "z_hat": None,
+        "x_near": None,
+        "a": model.parameters["a"],
+        "b": model.parameters["b"],
+        "Mx": d["Mx"],
+        "My": d["My"],
+        "Mz": d["Mz"],
+        "omega": d["omega"],
+        "psi_min": d["psi_min"],
+        "psi_max": d["psi_max"],
+        "phi_max": d["phi_max"],
+    }
+    values.update({k: d[k] for k in ("delta_max", "l", "t", "r") if k in d})
+    if lower is not None:
+        values.update(
+            x_hat=float(upper[0]),
+            y_hat=float(upper[1] - lower[1]) / 2,
+            z_hat=float(upper[2] - lower[2]) / 2,
+            x_near=float(lower[0]),
+        )
+    paper = paper_cuboid(model, inputs.get("paper_reading", "near_face"), solver)
+    for name in ("x_hat", "y_hat", "z_hat", "k", "volume"):
+        values[f"paper_{name}"] = paper.get(name)
+    values["paper_status"] = paper["status"]
+    values["paper_check_outside"] = None
+    if paper["status"] == "solved":
+        box_lo = [paper["k"], -paper["y_hat"], -paper["z_hat"]]
+        box_hi = [paper["x_hat"], paper["y_hat"], paper["z_hat"]]
+        check = check_box(model, box_lo, box_hi, inputs.get("check_per_edge", 17), solver)[0]
+        values["paper_check_outside"] = check.outside
+        values["paper_check_margin"] = check.margin
+        values["paper_check_binding"] = check.binding
+    dims = {k: "length" for k in values if k.endswith(("_hat", "_k", "x_near")) or k in ("a", "b", "l", "t", "r")}
+    dims["paper_check_margin"] = "si"
+    dims.update({k: "angle" for k in ("psi_min", "psi_max", "phi_max", "delta_max")})
+    dims.update({"paper_volume": "volume"})
+    dims.update({k: "dimensionless" for k in ("Mx", "My", "Mz", "omega", "paper_check_outside")})
+    dims.update({k: "text" for k in ("paper_status", "paper_check_binding")})
+    return values, dims

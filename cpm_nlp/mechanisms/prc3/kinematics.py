@@ -1,0 +1,426 @@
+"""3-PRC compliant parallel micromanipulator with secondary lever amplifiers
+(Li, Li, Ding, Xu, Adv. Mech. Eng. 2018; ``../shared/papers/prc3-li-2018.md``).
+
+Symbols follow the paper:
+
+* L1 ... L8, r (Table 1's R), t, b, h -- Table 1; L1..L4 are the lever arms of
+  the amplifier, A1 = L2/L1 and A2 = L2 L4 / (L1 L3) (eq 1),
+* q = (q1, q2, q3) -- piezo inputs (eq 2, 10, 27), the **actuated
+  coordinates of the model**: the paper's joint limits (0 <= q_i <= 15 um,
+  eq 27), its inverse kinematics (eq 10) and its generalized coordinates of
+  the dynamics (section "Dynamics model") are all in q.  The slider
+  displacements d_i = A2 q_i (eq 2) are reported with every pose as the
+  passive coordinates d1..d3,
+* x = p = (x, y, z) -- the platform centre P; the platform does not turn
+  (R_p = I, eq 5),
+* l = L7 -- the length of the R-C legs (eq 27).
+
+Limb i (axis e_i = x, y, z for i = 1, 2, 3) closes the loop of eq 5,
+l l_io = D_i - d_i d_io, with d_io = -e_i and D_i = p + l e_i, so that
+
+    |p + (l + d_i) e_i|^2 = l^2                      (eq 6, with eq 9's terms)
+
+whose root with d_i = 0 at p = 0 is eq 8-9: d_1 = -x - l + sqrt(l^2 - y^2 - z^2),
+and cyclically.  Positive inputs move the platform towards -e_i (eq 26:
+p = -A2 q).
+
+Readings of the paper chosen here (documented, not tuned):
+
+* **Both transverse coordinates under the root (eq 9).**  With the axes of the
+  R joint and of the C joint parallel, the C joint's slide s_i (eq 11-12)
+  would absorb the platform's motion along that axis and leave one transverse
+  coordinate under the root.  The paper's eq 9 has both; so do its workspace
+  (eq 10, 27) and its dynamics (eq 31-32: every leg turns by two angles,
+  beta_i and gamma_i).  The model follows eq 9: each leg is a link of length l
+  whose ends turn about two axes.  Over the workspace the other reading would
+  change d_i by at most (A2 q_max)^2 / (2 l) = 0.118 um (0.09 % of the stroke).
+* **Positive root.**  Eq 7 has two roots; eq 8 takes the positive one (d = 0
+  at p = 0).  On it the leg points along +e_i from slider to platform:
+  (p + (l + d_i) e_i) . e_i > 0 is the branch indicator.
+* **The expanded Jacobian.**  Eq 21, J = J_d^-1 J_p with rows
+  l_io^T / (l_io^T d_io), evaluated on eq 8's root gives
+  J = -[[1, y/(x + l + d1), z/(x + l + d1)], ...]: the denominator is
+  sqrt(l^2 - y^2 - z^2) = x + l + d1.  The printed expansion has x + l - d1
+  (and eq 18 prints the other root's sign); the two differ by 2 d1 / l
+  (0.36 %) in entries that are themselves below 2e-3.  :func:`jacobian_eq21`
+  and :func:`jacobian_printed` give both; the model's own Jacobian comes from
+  AD of the loop closures (dq/dx = J / A2).
+* **Leg angles** beta_i, gamma_i are the exact angles of leg i towards the
+  next and the previous axis (cyclic x -> y -> z -> x; for limb 2 the paper's
+  beta_2 ~ z/L8 and gamma_2 ~ x/L7, eq 31), asin(component / l).
+* Residuals are scaled to lengths, (|leg|^2 - l^2) / (2 l), so one tolerance
+  in metres applies.
+
+The Lagrange model (eq 28-41) is :func:`lagrangian`; its readings are in its
+docstring.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import casadi as ca
+import numpy as np
+
+from ...analysis import flexure
+from ...core.model import Coordinate, LoopClosure, Model
+from ...core.options import Option
+
+TITLE = "3-PRC micromanipulator with secondary lever amplifiers (Li et al. 2018)"
+PAPER = "prc3-li-2018.md"
+
+
+def _length(name: str, description: str, required: bool = True) -> Option:
+    extra = {} if required else {"default": None}
+    return Option(name, "length", description, lower=0.0, upper=1.0, strict=True, **extra)
+
+
+PARAMETERS = (
+    _length("L1", "first lever O1AB, input arm (Table 1, Fig. 2b; A1 = L2/L1, eq 1)"),
+    _length("L2", "first lever O1AB, output arm (Table 1; eq 1, 28-29: theta_1 = A1 q/L2)"),
+    _length("L3", "second lever O2CD, input arm (Table 1; A2 = L2 L4/(L1 L3), eq 1)"),
+    _length("L4", "second lever O2CD, output arm (Table 1; eq 1, 28-29: theta_2 = A2 q/L4)"),
+    _length("L7", "length l of the R-C legs (Table 1; eq 27: l = L7)"),
+    _length("L5", "coupler link of the first lever (Table 1; I_G3, eq 29) -- used by the dynamics", False),
+    _length("L6", "output link of the second lever (Table 1; I_G5, eq 29) -- used by the dynamics", False),
+    _length("L8", "second bending length of the R-C legs (Table 1; beta_i, I_G6, eq 31-32) -- dynamics", False),
+    _length("r", "notch radius of the circular flexure hinges (Table 1's R; eq 28)", False),
+    _length("t", "notch thickness of the circular flexure hinges (Table 1; eq 28)", False),
+    _length("b", "width of the circular flexure hinges (Table 1; eq 28)", False),
+    _length("h", "h of Table 1 (the paper does not say what it is; no equation uses it)", False),
+)
+#: parameters of the loop closures, in the order of the CasADi vector p
+KINEMATIC = ("L1", "L2", "L3", "L4", "L7")
+
+LIMITS = (
+    Option(
+        "q", "length", "piezo input range [low, high] of every q_i (eq 27: [0, 15 um])", default=None, shape="range"
+    ),
+    Option("d", "length", "slider displacement range of every d_i = A2 q_i (eq 2)", default=None, shape="range"),
+    Option("beta", "angle", "bending range of every leg towards the next axis", default=None, shape="range"),
+    Option("gamma", "angle", "bending range of every leg towards the previous axis", default=None, shape="range"),
+)
+
+AXES = ("x", "y", "z")
+X = tuple(Coordinate(a, "length", f"platform centre P, {a} (eq 5; R_p = I)") for a in AXES)
+Q = tuple(Coordinate(f"q{i}", "length", f"piezo input of limb {i} (eq 2, 10, 27)", "q") for i in (1, 2, 3))
+PASSIVE = (
+    tuple(Coordinate(f"d{i}", "length", f"slider displacement of limb {i}, d = A2 q (eq 2)", "d") for i in (1, 2, 3))
+    + tuple(Coordinate(f"beta{i}", "angle", f"leg {i} bending towards axis {AXES[i % 3]}", "beta") for i in (1, 2, 3))
+    + tuple(
+        Coordinate(f"gamma{i}", "angle", f"leg {i} bending towards axis {AXES[(i + 1) % 3]}", "gamma")
+        for i in (1, 2, 3)
+    )
+)
+
+
+def lever_ratios(L1, L2, L3, L4):
+    """First-lever and total amplification of the secondary lever amplifier,
+    A1 = L2/L1 and A2 = L2 L4 / (L1 L3) (eq 1); floats or CasADi symbols."""
+    return L2 / L1, L2 * L4 / (L1 * L3)
+
+
+def _e(i: int) -> ca.DM:
+    v = [0.0, 0.0, 0.0]
+    v[i % 3] = 1.0
+    return ca.DM(v)
+
+
+def leg_vector(i: int, P, d_i, l):
+    """l_i l_io = D_i - d_i d_io with D_i = P + l e_i and d_io = -e_i (eq 5, 8-9)."""
+    return P + (l + d_i) * _e(i)
+
+
+def _unpack(p):
+    L1, L2, L3, L4, l = (p[k] for k in range(5))
+    return lever_ratios(L1, L2, L3, L4), l
+
+
+def loop_closure() -> ca.Function:
+    """Φ(x, q; p): one leg-length equation per limb (eq 5-6), scaled to a length."""
+    x, q, p = ca.SX.sym("x", 3), ca.SX.sym("q", 3), ca.SX.sym("p", len(KINEMATIC))
+    (_A1, A2), l = _unpack(p)
+    phi = []
+    for i in range(3):
+        v = leg_vector(i, x, A2 * q[i], l)  # d_i = A2 q_i, eq 2
+        phi.append((ca.dot(v, v) - l**2) / (2 * l))
+    return ca.Function("phi", [x, q, p], [ca.vertcat(*phi)], ["x", "q", "p"], ["phi"])
+
+
+def inverse_kinematics() -> ca.Function:
+    """Closed-form IK, eq 8-10 (positive root): t = (x, y, z) -> x, q = d/A2, reach."""
+    t, p = ca.SX.sym("t", 3), ca.SX.sym("p", len(KINEMATIC))
+    (_A1, A2), l = _unpack(p)
+    d, margin = [], []
+    for i in range(3):
+        rad = l**2 - t[(i + 1) % 3] ** 2 - t[(i + 2) % 3] ** 2
+        margin.append(rad / (2 * l))
+        d.append(-t[i] - l + ca.sqrt(ca.fmax(rad, 0)))  # eq 9
+    q = ca.vertcat(*d) / A2  # eq 10
+    return ca.Function("ik", [t, p], [t, q, ca.mmin(ca.vertcat(*margin))], ["t", "p"], ["x", "q", "reach"])
+
+
+def passive_joints() -> ca.Function:
+    """Slider displacements d_i = A2 q_i (eq 2) and the leg angles beta_i, gamma_i."""
+    x, q, p = ca.SX.sym("x", 3), ca.SX.sym("q", 3), ca.SX.sym("p", len(KINEMATIC))
+    (_A1, A2), l = _unpack(p)
+    d = A2 * q
+    beta, gamma = [], []
+    for i in range(3):
+        v = leg_vector(i, x, d[i], l)
+        for out, k in ((beta, (i + 1) % 3), (gamma, (i + 2) % 3)):
+            out.append(ca.atan2(v[k], ca.sqrt(ca.dot(v, v) - v[k] ** 2)))  # asin(v_k / |v|)
+    j = ca.vertcat(d, *beta, *gamma)
+    return ca.Function("passive", [x, q, p], [j], ["x", "q", "p"], ["j"])
+
+
+def branch_indicator() -> ca.Function:
+    """g_i > 0 on eq 8's root: leg i points along +e_i from slider to platform."""
+    x, q, p = ca.SX.sym("x", 3), ca.SX.sym("q", 3), ca.SX.sym("p", len(KINEMATIC))
+    (_A1, A2), l = _unpack(p)
+    g = [leg_vector(i, x, A2 * q[i], l)[i] / l for i in range(3)]
+    return ca.Function("branch", [x, q, p], [ca.vertcat(*g)], ["x", "q", "p"], ["g"])
+
+
+def home(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Home pose: platform at the origin, q = 0 (eq 9: d = 0 at p = 0)."""
+    return np.zeros(3), np.zeros(3)
+
+
+def bounds(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """|x|, |y|, |z| <= l/2 keeps IPOPT on eq 8's root (leg along +e_i) for
+    any slider displacement above -l/2; the workspace is micrometres wide."""
+    half = 0.5 * float(p[KINEMATIC.index("L7")])
+    return np.full(3, -half), np.full(3, half)
+
+
+def closure() -> LoopClosure:
+    """The symbolic 3-PRC (built fresh; the registry caches one per process)."""
+    return LoopClosure(
+        "prc3",
+        x=X,
+        q=Q,
+        parameters=KINEMATIC,
+        phi=loop_closure(),
+        task=AXES,
+        ik=inverse_kinematics(),
+        passive=passive_joints(),
+        passive_coords=PASSIVE,
+        branch=branch_indicator(),
+        home=home,
+        bounds=bounds,
+    )
+
+
+def check_parameters(params: dict, path: tuple) -> None:
+    """The hinge must be one the circular-notch formula of eq 28 describes."""
+    if params.get("t") is not None and params.get("r") is not None:
+        flexure.check_circular_notch(params["t"], params["r"], path + ("t",))
+
+
+def build(closure_: LoopClosure, parameters: dict, limits: dict) -> Model:
+    """A 3-PRC model from validated parameters (SI) and limits."""
+    given = {k: v for k, v in parameters.items() if v is not None}
+    A1, A2 = lever_ratios(*(given[k] for k in ("L1", "L2", "L3", "L4")))
+    dims = {k: "length" for k in given}
+    dims.update(A1="dimensionless", A2="dimensionless")
+    return Model(
+        closure_,
+        parameters=given,
+        limits={k: v for k, v in limits.items() if v is not None},
+        derived={"A1": A1, "A2": A2},
+        dimensions=dims,
+    )
+
+
+# -- the paper's Jacobian (eq 19-21), for comparison with the AD Jacobian ------------------------
+
+
+def _legs(x, d, l) -> np.ndarray:
+    x, d = np.asarray(x, dtype=float), np.asarray(d, dtype=float)
+    return np.array([x + (l + d[i]) * np.eye(3)[i] for i in range(3)])
+
+
+def jacobian_eq21(x, d, l) -> np.ndarray:
+    """J = J_d^-1 J_p (eq 19-21), d(d)/dp, with the unit vectors l_io of the
+    leg on eq 8's root (eq 5) and d_io = -e_i: rows l_io^T / (l_io^T d_io)."""
+    legs = _legs(x, d, l) / l
+    return np.array([legs[i] / (-legs[i][i]) for i in range(3)])
+
+
+def jacobian_printed(x, d, l) -> np.ndarray:
+    """The expansion of eq 21 as printed: J = -[[1, y/(x+l-d1), z/(x+l-d1)], ...]
+    (its x + l - d1 is x + l + d1 on eq 8's root; see the module docstring)."""
+    x, d = np.asarray(x, dtype=float), np.asarray(d, dtype=float)
+    J = np.empty((3, 3))
+    for i in range(3):
+        den = x[i] + l - d[i]
+        J[i] = -x / den
+        J[i, i] = -1.0
+    return J
+
+
+# -- Lagrange dynamics (eq 28-41) -------------------------------------------------------------------
+
+MASSES = (
+    ("m0", "mobile platform (eq 34)"),
+    ("m1", "input block of the amplifier, moving with q (eq 29)"),
+    ("m2", "first lever, length L2, turning about O1 (eq 29: I_G2 = m2 L2^2/3)"),
+    ("m3", "coupler, length L5, moving with A1 q and turning with the first lever (I_G3 = m3 L5^2/12)"),
+    ("m4", "second lever, length L4, turning about O2 (I_G4 = m4 L4^2/3)"),
+    ("m5", "output link, length L6, moving with A2 q and turning with the second lever (I_G5)"),
+    ("m6", "output block E of the amplifier, moving with A2 q (eq 29)"),
+    ("m7", "each of the two bars of an R-C leg (eq 32: I_G6 = m7 L8^2/12, I_G7 = m7 L7^2/12)"),
+)
+#: parameters of the dynamics, in the order of the CasADi vector w: the hinge
+#: material's E, the gravity g, the masses, and mechanism parameters by name
+DYNAMIC_PARAMETERS = ("E", "g", "b", "t", "r", "L5", "L6", "L8") + tuple(m for m, _ in MASSES)
+
+
+def _dynamic_symbols():
+    q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
+    p, w = ca.SX.sym("p", len(KINEMATIC)), ca.SX.sym("w", len(DYNAMIC_PARAMETERS))
+    named = {n: w[k] for k, n in enumerate(DYNAMIC_PARAMETERS)}
+    named.update({n: p[k] for k, n in enumerate(KINEMATIC)})
+    return q, qd, p, w, named
+
+
+def _gravity_coefficient(v: dict, A1, A2):
+    """G_e as printed (eq 35, 38)."""
+    return (
+        v["m0"] * A2 + 6 * (v["m1"] + v["m2"] + v["m3"]) * A1 + 6 * (v["m4"] + v["m5"] + v["m6"] + v["m7"]) * A2
+    ) * v["g"]
+
+
+@functools.lru_cache(maxsize=1)
+def lagrangian() -> ca.Function:
+    """Kinetic energy T(q, qd) and potential energy U(q) of the 3-PRC
+    (eq 28-36), symbolic in the kinematic parameters p and the dynamic ones w
+    (:data:`DYNAMIC_PARAMETERS`).  :mod:`cpm_nlp.analysis.dynamics` derives
+    M = d2T/dqd2, K = d2U/dq2 and G = dU/dq at q = 0 (eq 37-38).
+
+    Each energy is typed in as the first line of its equation (the sum over
+    bodies and hinges); the collected second lines and eq 38 are
+    :func:`printed_coefficients`.  Readings (documented, not tuned):
+
+    * Hinges: k = 2 E b t^2.5 / (9 pi r^0.5) for every hinge (after eq 28).
+      Per limb, 2 x (4 hinges turning theta_1 = A1 q/L2 and 3 turning
+      theta_2 = A2 q/L4) (eq 28), and 4 leg hinges bending by beta and gamma
+      (eq 31).
+    * The leg angles are platform displacement over length (eq 31:
+      beta_2 = z/L8, gamma_2 = x/L7), cyclic for the other limbs (limb i
+      bends by beta_i towards axis i+1 over L8, gamma_i towards axis i+2 over
+      L7).  With x = -A2 q1 (eq 26) this gives the leg term
+      4 k A2^2 (1/L7^2 + 1/L8^2) in K; eq 38 prints it without A2^2 (as does
+      the last line of eq 31, where A stands for A2 but is dropped in eq 38).
+      The model keeps the A2^2 of eq 31's first line.
+    * Platform velocity: pdot = J qdot with J the AD Jacobian of the loop
+      closures at home, which equals -A2 I (eq 26).
+    * m1 is the input block and moves with q: 1/2 m1 qdot^2 (eq 29, first
+      line).  The collected line multiplies m1 by A1^2; the model does not.
+    * I_G5: eq 29 lists I_G5 = m5 L6^2/3, its collected line and eq 38 use
+      m5 L6^2/12.  m5 translates with A2 q *and* turns (like m3, whose I_G3 =
+      m3 L5^2/12): its inertia about its own centre, m5 L6^2/12, is the
+      consistent one and is used.
+    * Gravity: U_G = G_e q2 with G_e as printed (eq 35).  It only shifts the
+      static equilibrium (q = -K^-1 G) and does not enter the frequencies;
+      the mass distribution behind it (Fig. 6) is not in the text.
+    """
+    q, qd, p, w, v = _dynamic_symbols()
+    A1, A2 = lever_ratios(v["L1"], v["L2"], v["L3"], v["L4"])
+    k = flexure.circular_notch_stiffness(v["E"], v["b"], v["t"], v["r"])  # after eq 28
+    m = [v[f"m{j}"] for j in range(8)]
+    L2, L4, L5, L6, L7, L8 = (v[n] for n in ("L2", "L4", "L5", "L6", "L7", "L8"))
+    IG2, IG3, IG4, IG5 = m[2] * L2**2 / 3, m[3] * L5**2 / 12, m[4] * L4**2 / 3, m[5] * L6**2 / 12  # eq 29
+    IG6, IG7 = m[7] * L8**2 / 12, m[7] * L7**2 / 12  # eq 32
+    # platform displacement and velocity from the AD Jacobian at home (= -A2 I, eq 26)
+    xs, qs = ca.SX.sym("xs", 3), ca.SX.sym("qs", 3)
+    phi = loop_closure()(xs, qs, p)
+    J = -ca.solve(ca.jacobian(phi, xs), ca.jacobian(phi, qs))
+    J0 = ca.substitute(J, ca.vertcat(xs, qs), ca.SX.zeros(6))
+    P, Pd = J0 @ q, J0 @ qd
+    T, U = 0, 0
+    for i in range(3):
+        th1, th2 = A1 * q[i] / L2, A2 * q[i] / L4
+        th1d, th2d = A1 * qd[i] / L2, A2 * qd[i] / L4
+        U += 2 * (4 * 0.5 * k * th1**2 + 3 * 0.5 * k * th2**2)  # eq 28
+        T += 2 * (  # eq 29, first line
+            0.5 * m[1] * qd[i] ** 2
+            + 0.5 * IG2 * th1d**2
+            + 0.5 * m[3] * (A1 * qd[i]) ** 2
+            + 0.5 * IG3 * th1d**2
+            + 0.5 * IG4 * th2d**2
+            + 0.5 * (m[5] + m[6]) * (A2 * qd[i]) ** 2
+            + 0.5 * IG5 * th2d**2
+        )
+        nxt, prv = (i + 1) % 3, (i + 2) % 3
+        beta, gamma = P[nxt] / L8, P[prv] / L7
+        betad, gammad = Pd[nxt] / L8, Pd[prv] / L7
+        U += 4 * 0.5 * k * (beta**2 + gamma**2)  # eq 31
+        T += 2 * (  # eq 32, first line; the slider moves with d_i = A2 q_i (eq 2)
+            0.5 * m[7] * ((A2 * qd[i]) ** 2 + (Pd[nxt] / 2) ** 2 + (Pd[prv] / 2) ** 2)
+            + 0.5 * (IG6 * betad**2 + IG7 * gammad**2)
+        )
+    T += 0.5 * m[0] * ca.dot(Pd, Pd)  # eq 34
+    U_G = _gravity_coefficient(v, A1, A2) * q[1]  # eq 35
+    return ca.Function("lagrangian", [q, qd, p, w], [T, U + U_G, k], ["q", "qd", "p", "w"], ["T", "U", "k"])
+
+
+@functools.lru_cache(maxsize=1)
+def printed_coefficients() -> ca.Function:
+    """M_e, K_e, G_e exactly as printed in eq 38 (and eq 41's f from them)."""
+    _q, _qd, p, w, v = _dynamic_symbols()
+    A1, A2 = lever_ratios(v["L1"], v["L2"], v["L3"], v["L4"])
+    m = [v[f"m{j}"] for j in range(8)]
+    L2, L4, L5, L6, L7, L8 = (v[n] for n in ("L2", "L4", "L5", "L6", "L7", "L8"))
+    M_e = (
+        2 * (m[1] + m[2] / 3 + (1 + L5**2 / (12 * L2**2)) * m[3]) * A1**2
+        + (2 * m[4] / 3 + 2 * (1 + L6**2 / (12 * L4**2)) * m[5] + 2 * m[6] + 10 * m[7] / 3 + m[0]) * A2**2
+    )
+    K_e = (
+        8
+        * v["E"]
+        * v["b"]
+        * v["t"] ** 2.5
+        / (9 * math.pi * v["r"] ** 0.5)
+        * (2 * A1**2 / L2**2 + 3 * A2**2 / (2 * L4**2) + (1 / L7**2 + 1 / L8**2))
+    )
+    G_e = _gravity_coefficient(v, A1, A2)
+    f = ca.sqrt(K_e / M_e) / (2 * math.pi)  # eq 41
+    return ca.Function("eq38", [p, w], [M_e, K_e, G_e, f], ["p", "w"], ["M_e", "K_e", "G_e", "f"])
+
+
+def dynamics_values(model: Model, w: np.ndarray, M: np.ndarray, K: np.ndarray, G: np.ndarray) -> dict:
+    """The paper's named quantities: k (after eq 28), M_e, K_e, G_e (eq 38) of
+    the model and as printed, and f (eq 41) both ways."""
+    _T, _U, k = (float(v) for v in lagrangian()(np.zeros(3), np.zeros(3), model.p, w))
+    v = dict(zip(DYNAMIC_PARAMETERS, w))
+    M_p, K_p, G_p, f_p = (float(x) for x in printed_coefficients()(model.p, w))
+    return {
+        "k": k,
+        "k_exact": float(flexure.circular_notch_stiffness_exact(v["E"], v["b"], v["t"], v["r"])),
+        "M_e": float(M[0, 0]),
+        "K_e": float(K[0, 0]),
+        "G_e": float(G[1]),
+        "f": math.sqrt(K[0, 0] / M[0, 0]) / (2 * math.pi),  # eq 41
+        "M_e_printed": M_p,
+        "K_e_printed": K_p,
+        "G_e_printed": G_p,
+        "f_printed": f_p,
+    }
+
+
+#: dimension of each value of :func:`dynamics_values`
+DYNAMICS_DIMENSIONS = {
+    "k": "rotational_stiffness",
+    "k_exact": "rotational_stiffness",
+    "M_e": "mass",
+    "K_e": "stiffness",
+    "G_e": "force",
+    "f": "frequency",
+    "M_e_printed": "mass",
+    "K_e_printed": "stiffness",
+    "G_e_printed": "force",
+    "f_printed": "frequency",
+}

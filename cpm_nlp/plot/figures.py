@@ -1,0 +1,565 @@
+"""Which figure a result makes, and the data it takes from it.
+
+A result is the JSON of ``cpm-nlp solve -o`` (or a :class:`~cpm_nlp.core.result.Result`)
+or a sweep results file; :func:`load` reads either into :class:`ResultData`.
+The figure is chosen from the result's problem kind (:data:`DEFAULTS`: the
+first plot type that applies to the values wins) or named (``--type``).
+
+Extending: a plot type is one entry in :data:`PLOTS` (name ->
+"module:function"), the function taking ``(data, options)`` and returning a
+Matplotlib figure made by :mod:`cpm_nlp.plot.draw` from arrays, or raising
+:class:`NotApplicable`; a problem kind lists its plot types in
+:data:`DEFAULTS`.  A kind needs no plotting code of its own when its values
+use the names read here (SI values, units in the result):
+
+* ``workspace`` -- a point cloud: ``cloud_<t>`` for each task coordinate t
+  (the ``workspace`` kind), or ``points`` (N x 3); a cuboid: ``<t>_min`` and
+  ``<t>_max`` (the ``inscribed_cuboid`` kind), or ``cuboid_lower`` and
+  ``cuboid_upper``; a batch of poses (FK, IK) gives its task coordinates.  A
+  cuboid without a cloud (``inscribed_cuboid``) is drawn in a cloud sampled
+  from the model when the model is at hand (``cpm-nlp solve FILE --plot``);
+* ``map`` -- :data:`MAP_AXES` names (x, y, value) of the kind: x and y
+  lists and the value either a list of the same length or a matrix
+  (rows y, columns x; ``null`` outside the design space); optional
+  ``in_region`` (same shape: outlined), ``<x>_best``/``<y>_best`` and
+  ``<x>_design``/``<y>_design`` (marked), ``domain`` (vertices, outlined).
+  A sweep maps a value over its two swept parameters.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import InputError, suggest
+from ..core.units import DIMENSIONS
+from .draw import as_floats
+
+SWEEP = "sweep"  # the "kind" of a sweep results file in DEFAULTS
+
+#: plot type -> "module:function(data, options) -> Figure"
+PLOTS = {
+    "workspace": "cpm_nlp.plot.figures:workspace_plot",
+    "map": "cpm_nlp.plot.figures:map_plot",
+    "requirements": "cpm_nlp.plot.figures:requirements_plot",
+    "io": "cpm_nlp.plot.figures:io_plot",
+    "lines": "cpm_nlp.plot.figures:lines_plot",
+}
+
+#: problem kind (or "sweep") -> plot types that may apply, the default first
+DEFAULTS = {
+    "forward_kinematics": ("io", "workspace"),
+    "inverse_kinematics": ("io", "workspace"),
+    "joint_requirements": ("requirements", "workspace"),
+    "workspace": ("workspace",),
+    "inscribed_cuboid": ("workspace",),
+    "actuator_workspace": ("workspace",),  # its points (inputs.points: true): the images of the stroke grid
+    "rpr_transmission_map": ("map",),
+    SWEEP: ("map", "lines", "workspace"),
+}
+
+#: problem kind -> (x, y, value) names of the values a design map of its result shows
+MAP_AXES: dict[str, tuple[str, str, str]] = {
+    "rpr_transmission_map": ("s", "t", "eta"),  # rpr-2rpu-upr-zhang-2022.md, Fig. 4
+}
+
+#: sweep statuses of points outside the design space (drawn apart from points that did not solve)
+OUTSIDE = ("infeasible", "invalid_input")
+
+_BY_SI = {d.si: name for name, d in DIMENSIONS.items() if name != "dimensionless"}
+
+
+class NotApplicable(InputError):
+    """This plot type does not fit the result (the message says why)."""
+
+
+class NothingSolved(InputError):
+    """The result has no solved point: there is nothing to draw."""
+
+
+@dataclass
+class PlotOptions:
+    """value: the quantity of a map or curves; x, y: the map's axes (names of
+    swept keys or values); best: mark the "max" or "min" of a map."""
+
+    value: str | None = None
+    x: str | None = None
+    y: str | None = None
+    best: str | None = None
+
+
+@dataclass
+class ResultData:
+    """A result to plot.
+
+    problem: the problem kind; sweep: True for a sweep results file, whose
+    ``values`` are its columns (lists, one entry per point) and ``parameters``
+    its swept keys; dimensions: of every value ("length", "angle" ...).
+    """
+
+    source: str
+    problem: str
+    values: dict[str, Any]
+    dimensions: dict[str, str]
+    statuses: list[str] | None = None
+    model: dict[str, Any] = field(default_factory=dict)
+    sweep: bool = False
+    status: str = "solved"  # of the whole result
+    live: Any = None  # the Model solved, when at hand (solve --plot): lets a plot sample its workspace
+    parameters: list[dict[str, Any]] = field(default_factory=list)
+    recorded: list[str] = field(default_factory=list)  # value columns of a sweep
+
+    @property
+    def kind(self) -> str:
+        return SWEEP if self.sweep else self.problem
+
+    @property
+    def ok(self) -> np.ndarray | None:
+        return None if self.statuses is None else np.array([s == "solved" for s in self.statuses])
+
+
+def _dimension_of_unit(unit: Any) -> str | None:
+    if unit == "":
+        return "dimensionless"
+    return _BY_SI.get(unit) if isinstance(unit, str) else None
+
+
+def from_result(result: Any, source: str = "") -> ResultData:
+    """A :class:`~cpm_nlp.core.result.Result` or its JSON dict."""
+    d = result if isinstance(result, Mapping) else result.to_dict()
+    if not isinstance(d.get("values"), Mapping) or not isinstance(d.get("problem"), str):
+        raise InputError("expected a cpm-nlp result (JSON with problem, status, values, units)", file=source or None)
+    dims = {k: dim for k, u in (d.get("units") or {}).items() if (dim := _dimension_of_unit(u))}
+    return ResultData(
+        source,
+        d["problem"],
+        dict(d["values"]),
+        dims,
+        d.get("statuses"),
+        dict(d.get("model") or {}),
+        status=str(d.get("status")),
+    )
+
+
+def from_table(table: Any) -> ResultData:
+    """A sweep results file read by :func:`cpm_nlp.io.results.read_results`."""
+    meta = table.meta
+    names = ["point", *(p["key"] for p in table.parameters), "status", "message", "seconds", *table.values]
+    values = {n: table.column(n) for n in names}
+    dims = {p["key"]: p["dimension"] for p in table.parameters if p.get("dimension")}
+    dims.update(meta.get("dimensions") or {})
+    for n, u in (meta.get("units") or {}).items():
+        if n not in dims and (dim := _dimension_of_unit(u)):
+            dims[n] = dim
+    model = {"type": meta.get("mechanism")}
+    return ResultData(
+        table.path,
+        str(meta.get("problem")),
+        values,
+        dims,
+        statuses=[str(s) for s in table.column("status")],
+        model=model,
+        sweep=True,
+        parameters=table.parameters,
+        recorded=table.values,
+    )
+
+
+def load(path: str | os.PathLike) -> ResultData:
+    """Read a JSON result (``cpm-nlp solve -o``) or a sweep results file."""
+    from ..io.results import FORMATS, read_results
+
+    p = Path(path)
+    if p.suffix.lower() in FORMATS:
+        return from_table(read_results(p))
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError("file not found", file=str(path)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read the file ({exc.__class__.__name__})", file=str(path)) from None
+    try:
+        data = json.loads(text)
+    except ValueError:
+        raise InputError(
+            "expected a JSON result written by 'cpm-nlp solve -o' or a sweep results file (.parquet, .csv)",
+            file=str(path),
+        ) from None
+    return from_result(data, str(path))
+
+
+def figure(data: ResultData, plot_type: str | None = None, options: PlotOptions | None = None) -> tuple[Any, str]:
+    """The figure of a result: ``(figure, plot type)``.  Raises
+    :class:`NothingSolved` for a result without a solved point."""
+    options = options or PlotOptions()
+    ok = data.ok
+    if (ok is not None and not ok.any()) or (ok is None and data.status != "solved"):
+        raise NothingSolved(f"no point of {data.source or 'the result'} is solved; there is nothing to plot")
+    if plot_type is not None:
+        if plot_type not in PLOTS:
+            raise InputError(
+                f"unknown plot type {plot_type!r}; expected one of: {', '.join(sorted(PLOTS))}",
+                path=("--type",),
+                suggestions=suggest(plot_type, PLOTS),
+            )
+        return _plot_function(plot_type)(data, options), plot_type
+    candidates = DEFAULTS.get(data.kind)
+    if not candidates:
+        raise NotApplicable(f"no plot is known for a {data.kind} result; known: {', '.join(sorted(DEFAULTS))}")
+    reasons = []
+    for name in candidates:
+        try:
+            return _plot_function(name)(data, options), name
+        except NotApplicable as exc:
+            reasons.append(f"{name}: {exc.message}")
+    raise NotApplicable("no plot fits this result (" + "; ".join(reasons) + ")")
+
+
+def _plot_function(name: str) -> Any:
+    module, func = PLOTS[name].split(":")
+    return getattr(importlib.import_module(module), func)
+
+
+# -- helpers ------------------------------------------------------------------------------------
+
+
+def _closure(data: ResultData) -> Any:
+    """The symbolic mechanism of the result (names of its coordinates)."""
+    from ..mechanisms.registry import closure_of, mechanism_type
+
+    name = data.model.get("type")
+    if not name:
+        raise NotApplicable("the result does not name its mechanism (model.type)")
+    return closure_of(mechanism_type(name, path=("model", "type")))
+
+
+def _list(data: ResultData, name: str) -> list | None:
+    v = data.values.get(name)
+    return v if isinstance(v, list) else None
+
+
+def _pose_name(data: ResultData, closure: Any, coord: str) -> str:
+    """A coordinate, by its offset from home where the result has it (dz for pz)."""
+    for off, target in closure.offsets.items():
+        if target == coord and off in data.values:
+            return off
+    return coord
+
+
+def _require_lists(data: ResultData, names: list[str], what: str) -> None:
+    missing = [n for n in names if _list(data, n) is None]
+    if missing:
+        raise NotApplicable(
+            f"{what} needs per-point lists of {', '.join(missing)} (solve a batch, without an outputs selection)"
+        )
+
+
+def _dims(data: ResultData, name: str) -> str | None:
+    return data.dimensions.get(name)
+
+
+# -- workspace ------------------------------------------------------------------------------------
+
+
+def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
+    """A point cloud with its cuboid (see the module's naming conventions)."""
+    from .draw import workspace_figure
+
+    v = data.values
+    title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
+    if v.get("points") is not None:
+        pts = np.asarray(v["points"], dtype=float)
+        if pts.ndim != 2 or pts.shape[1] != 3:
+            raise NotApplicable(f"'points' must be a list of [x, y, z], got shape {pts.shape}")
+        lower, upper = v.get("cuboid_lower"), v.get("cuboid_upper")
+        cuboid = (lower, upper) if lower is not None and upper is not None else None
+        dim = _dims(data, "points") or "length"
+        names = v.get("point_names") or ("x", "y", "z")
+        return workspace_figure(pts, cuboid=cuboid, names=names, dimensions=(dim,) * 3, title=title)
+    closure = _closure(data)
+    task = list(closure.task)
+    if len(task) != 3:
+        raise NotApplicable(f"a workspace cloud needs 3 task coordinates; {closure.name} has {len(task)}")
+    kinds = [closure.x[i].kind for i in closure.task_index]
+    box_label = "maximal inscribed cuboid" if data.problem == "inscribed_cuboid" else "box <t>_min ... <t>_max"
+    cuboid = None
+    if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
+        cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
+    if all(_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
+        pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
+        label = "reachable points (seeded sample)"
+    elif cuboid is not None:  # inscribed_cuboid: the cloud from the model, if at hand
+        pts, label = np.zeros((0, 3)), ""
+        if data.live is not None:
+            pts = _cloud_around(data.live, cuboid)
+            label = "reachable points (sample of 20000, seed 0)"
+        else:
+            title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
+        return workspace_figure(
+            pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label, cuboid_label=box_label
+        )
+    else:  # a batch of poses, one sweep point per pose
+        names = [_pose_name(data, closure, t) for t in task]
+        _require_lists(data, names, "a workspace cloud")
+        pts = np.array([as_floats(v[n]) for n in names]).T
+        if data.ok is not None:
+            pts = pts[data.ok]
+        kinds = [_dims(data, n) or k for n, k in zip(names, kinds)]
+        task, label = names, "solved poses"
+    return workspace_figure(
+        pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label, cuboid_label=box_label
+    )
+
+
+def _cloud_around(model: Any, cuboid: tuple) -> np.ndarray:
+    """Reachable points in a box holding the region probed from home and the
+    cuboid, a quarter wider each way: the workspace's boundary near the cuboid
+    shows even where the probe from home stops short of it."""
+    from ..analysis.workspace import probe_region, sample_workspace
+
+    lo, hi = (np.asarray(c, dtype=float) for c in cuboid)
+    probed = probe_region(model)
+    if probed is not None:
+        lo, hi = np.minimum(lo, probed[0]), np.maximum(hi, probed[1])
+    margin = 0.25 * (hi - lo)
+    return sample_workspace(model, 20000, 0, (lo - margin, hi + margin))[0]
+
+
+# -- map ---------------------------------------------------------------------------------------------
+
+
+def _sweep_key(data: ResultData, name: str | None, option: str) -> str:
+    """A swept key or value column of a sweep, named in full or by its last part."""
+    keys = [p["key"] for p in data.parameters] + list(data.recorded)
+    if name in keys:
+        return name
+    short = [k for k in keys if k.rsplit(".", 1)[-1] == name]
+    if len(short) == 1:
+        return short[0]
+    raise InputError(
+        f"unknown column {name!r}; expected one of: {', '.join(keys)}",
+        path=(option,),
+        suggestions=suggest(str(name), keys),
+    )
+
+
+def _numeric_columns(data: ResultData, names: list[str]) -> list[str]:
+    out = []
+    for n in names:
+        col = data.values.get(n) or []
+        if any(v is not None for v in col) and all(
+            v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in col
+        ):
+            out.append(n)
+    return out
+
+
+def _value_column(data: ResultData, options: PlotOptions) -> str:
+    if options.value:
+        return _sweep_key(data, options.value, "--value")
+    numeric = _numeric_columns(data, data.recorded)
+    if not numeric:
+        raise NotApplicable("the sweep recorded no numeric value (select scalar values with outputs.values)")
+    return numeric[0]
+
+
+def map_plot(data: ResultData, options: PlotOptions) -> Any:
+    """A design map: a value over two swept parameters, or over the two grids
+    of a kind in :data:`MAP_AXES` (see the module's naming conventions)."""
+    from .draw import design_map_figure, pretty
+
+    if data.sweep:
+        return _sweep_map(data, options)
+    v = data.values
+    axes = MAP_AXES.get(data.problem) or (None, None, None)
+    xk, yk, zk = options.x or axes[0], options.y or axes[1], options.value or axes[2]
+    if not (xk and yk and zk):
+        raise NotApplicable("a map of a single result needs --x, --y and --value naming three of its lists")
+    for n, opt in ((xk, "--x"), (yk, "--y"), (zk, "--value")):
+        if _list(data, n) is None:
+            raise InputError(
+                f"expected the name of a list of the result, got {n!r}",
+                path=(opt,),
+                suggestions=suggest(n, [k for k in v if _list(data, k) is not None]),
+            )
+    x, y, z = v[xk], v[yk], v[zk]
+    region = v.get("in_region")
+    if z and isinstance(z[0], list):  # a matrix over the grids: rows y, columns x
+        if len(z) != len(y) or any(len(row) != len(x) for row in z):
+            raise NotApplicable(f"{zk} is not a {len(y)} x {len(x)} matrix over {yk} and {xk}")
+        x, y = [xi for _ in y for xi in x], [yi for yi in y for _ in x]
+        z = [zij for row in z for zij in row]
+        if isinstance(region, list) and region and isinstance(region[0], list):
+            region = [rij for row in region for rij in row]
+        outside = [zij is None for zij in z]  # null: outside the design space
+    else:
+        outside = None
+    marks = []
+    for suffix, label in (("_design", "design (the file)"), ("_best", f"best {pretty(zk)} (the result)")):
+        mx, my = v.get(xk + suffix), v.get(yk + suffix)
+        if isinstance(mx, (int, float)) and isinstance(my, (int, float)):
+            marks.append((mx, my, label))
+    return design_map_figure(
+        x,
+        y,
+        z,
+        names=(xk, yk, zk),
+        dimensions=(_dims(data, xk), _dims(data, yk), _dims(data, zk) if _dims(data, zk) != "matrix" else None),
+        outside=outside,
+        region=region if isinstance(region, list) and len(region) == len(z) else None,
+        domain=v.get("domain"),
+        best=options.best,
+        marks=marks,
+        title=f"{data.problem}, {data.model.get('type') or ''}",
+    )
+
+
+def _sweep_map(data: ResultData, options: PlotOptions) -> Any:
+    from .draw import design_map_figure
+
+    params = _numeric_columns(data, [p["key"] for p in data.parameters])
+    if options.x or options.y:
+        xk = _sweep_key(data, options.x or params[0], "--x")
+        yk = _sweep_key(data, options.y or next(p for p in params if p != xk), "--y")
+    elif len(params) >= 2:
+        xk, yk = params[0], params[1]
+    else:
+        raise NotApplicable(f"a map needs two swept numeric parameters; this sweep has {len(params)}")
+    others = [p["key"] for p in data.parameters if p["key"] not in (xk, yk)]
+    if others:
+        raise NotApplicable(f"a map shows two parameters; this sweep also varies {', '.join(others)}")
+    zk = _value_column(data, options)
+    bases = {p["key"]: p.get("base") for p in data.parameters}
+    return design_map_figure(
+        data.values[xk],
+        data.values[yk],
+        data.values[zk],
+        names=(xk, yk, zk),
+        dimensions=(_dims(data, xk), _dims(data, yk), _dims(data, zk)),
+        ok=data.ok,
+        outside=[s in OUTSIDE for s in data.statuses or []] or None,
+        best=options.best,
+        marks=[(bases.get(xk), bases.get(yk), "base design (the file)")],
+        title=f"sweep of {data.problem}, {data.model.get('type') or ''}",
+    )
+
+
+# -- curves ----------------------------------------------------------------------------------------
+
+
+def lines_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Values of a one-parameter sweep against the parameter, one panel each."""
+    from .draw import Panel, panels_figure
+
+    if not data.sweep:
+        raise NotApplicable("'lines' plots a sweep results file")
+    params = _numeric_columns(data, [p["key"] for p in data.parameters])
+    if len(data.parameters) != 1 or not params:
+        raise NotApplicable(f"'lines' needs a sweep of one numeric parameter; this one has {len(data.parameters)}")
+    x = params[0]
+    names = [_value_column(data, options)] if options.value else _numeric_columns(data, data.recorded)
+    if not names:
+        raise NotApplicable("the sweep recorded no numeric value")
+    order = np.argsort(np.asarray(data.values[x], dtype=float))
+    ok = data.ok if data.ok is not None else np.ones(len(order), bool)
+    panels = [Panel(n, _dims(data, n), {n: [data.values[n][i] if ok[i] else None for i in order]}) for n in names]
+    xs = [data.values[x][i] for i in order]
+    return panels_figure(xs, panels, xname=x, xdimension=_dims(data, x), title=f"{data.problem}: sweep of {x}")
+
+
+def _families(coords: Any) -> dict[str, list[Any]]:
+    out: dict[str, list[Any]] = {}
+    for c in coords:
+        out.setdefault(c.group, []).append(c)
+    return out
+
+
+def requirements_plot(data: ResultData, options: PlotOptions) -> Any:
+    """The joint requirements over the studied poses: platform motions and
+    actuator displacements (first row, 3-PRS paper Fig. 6), passive joint
+    rotations, relative to home where home is not zero (Fig. 7)."""
+    from ..core.kinematics import passive_joints
+    from ..mechanisms.registry import build_model
+    from .draw import Panel, panels_figure
+
+    if data.sweep:
+        raise NotApplicable("'requirements' plots one joint_requirements result, not a sweep")
+    c = _closure(data)
+    task = [_pose_name(data, c, t) for t in c.task]
+    names = task + c.q_names + c.passive_names
+    _require_lists(data, names, "the requirements plot")
+    n = len(data.values[task[0]])
+    panels = [
+        Panel(t, _dims(data, t) or c.x[c.x_names.index(x)].kind, {t: data.values[t]}) for t, x in zip(task, c.task)
+    ]
+    for fam, coords in _families(c.q).items():
+        panels.append(Panel(fam, coords[0].kind, {q.name: data.values[q.name] for q in coords}, annotate_range=True))
+    home: dict[str, float] = {}
+    if c.passive is not None:
+        try:
+            model = build_model(data.model["type"], {p: data.model[p] for p in c.parameters})
+            home = passive_joints(model, model.x_home, model.q_home)
+        except (InputError, KeyError):
+            home = {}
+    for fam, coords in _families(c.passive_coords).items():
+        shift = {j.name: home.get(j.name, 0.0) for j in coords}
+        relative = any(abs(v) > 1e-12 for v in shift.values())
+        series = {
+            ("d" if relative else "") + j.name: [None if v is None else v - shift[j.name] for v in data.values[j.name]]
+            for j in coords
+        }
+        panels.append(Panel(("d" if relative else "") + fam, coords[0].kind, series, annotate_range=True))
+    return panels_figure(
+        list(range(1, n + 1)),
+        panels,
+        xname="studied pose",
+        title=f"Joint requirements of {data.model.get('type')} over {n} poses",
+        ncols=len(task) + len(_families(c.q)),
+    )
+
+
+def io_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Outputs against the input that varies, one panel per output (pantograph
+    paper, Fig. 20-22): pose coordinates against an actuator for FK, actuators
+    and dependent coordinates against a task coordinate for IK."""
+    from .draw import Panel, panels_figure
+
+    if data.sweep:
+        raise NotApplicable("'io' plots one batch result; for a sweep use 'lines'")
+    c = _closure(data)
+    if data.problem == "inverse_kinematics":
+        inputs = [_pose_name(data, c, t) for t in c.task]
+        outputs = c.q_names + [_pose_name(data, c, c.x_names[i]) for i in c.dep_index]
+    else:
+        inputs = c.q_names
+        outputs = [_pose_name(data, c, x) for x in c.x_names]
+    if options.value:
+        if options.value not in data.values:
+            raise InputError(
+                f"unknown value {options.value!r}", path=("--value",), suggestions=suggest(options.value, data.values)
+            )
+        outputs = [options.value]
+    _require_lists(data, inputs + outputs, "an output/input plot")
+    cols = {n: np.array([np.nan if v is None else v for v in data.values[n]], dtype=float) for n in inputs}
+    spread = {n: np.nanmax(v) - np.nanmin(v) if np.isfinite(v).any() else 0.0 for n, v in cols.items()}
+    x = max(inputs, key=lambda n: spread[n])
+    if spread[x] <= 0:
+        raise NotApplicable("no input varies over the batch")
+    same = [n for n in inputs if np.allclose(cols[n], cols[x], equal_nan=True)]
+    xname = " = ".join(same)
+    order = np.argsort(cols[x])
+    panels = [Panel(o, _dims(data, o), {o: [data.values[o][i] for i in order]}) for o in outputs if o not in same]
+    return panels_figure(
+        cols[x][order],
+        panels,
+        xname=xname,
+        xdimension=_dims(data, x),
+        title=f"Outputs against {xname} ({data.model.get('type')}, {data.problem})",
+    )

@@ -1,0 +1,729 @@
+"""Design sweeps: the ``sweep`` section of a problem file.
+
+A sweep solves the base problem of the file once per point, each point being
+the base problem with some values overridden, exactly as
+``cpm-nlp solve FILE --set KEY=VALUE ...`` would solve it::
+
+    sweep:
+      parameters:                      # dotted keys of the problem file
+        mechanism.parameters.L: {from: 90 mm, to: 130 mm, count: 9}     # a grid
+        mechanism.parameters.alpha0: [35 deg, 45 deg, 55 deg]            # a list
+        mechanism.parameters.b: {random: uniform, from: 40 mm, to: 60 mm}  # a seeded sample
+      samples: 200                     # draws of the random parameters
+      seed: 1                          # default 0
+
+The grid and list parameters form a full factorial (the first parameter
+varies slowest); the random parameters are drawn together ``samples`` times
+and crossed with it.  Point ``k`` is ``(sample k // n_grid, grid point
+k % n_grid)`` and sample ``s`` is drawn from its own stream ``(seed, s)``, so
+raising ``samples`` adds points at the end and keeps the ones already
+solved (a sweep resumed with more samples solves only the new ones).
+
+Keys name a value of the file: ``mechanism.parameters.<name>``,
+``mechanism.limits.<name>`` (a list of [low, high] pairs), ``inputs.<name>``
+(a point's value may itself be a list, a batch), ``solver`` or
+``solver.<key>`` and ``solver.options.<CasADi option>``.  Every value is
+validated here, against the declaration of what it overrides, so a typo is
+reported before anything is solved.  Rules that involve several values (a
+mechanism's ``check_parameters``) are checked per point: a point that breaks
+one is recorded with status ``invalid_input`` and the message, like a
+point that does not solve.
+
+Running a sweep (:func:`run_sweep`, Dask) and its results files
+(:mod:`cpm_nlp.io.results`) build on this module; parsing needs neither
+Dask nor pyarrow.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import logging
+import math
+import os
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import InputError, suggest, unknown_key_error
+from ..core.options import MAX_GRID_POINTS, Option, validate_mapping
+from ..core.units import DIMENSIONS
+
+log = logging.getLogger(__name__)
+
+SECTION_KEYS = {
+    "parameters": "the swept values: dotted key -> grid, list or {random: ...}",
+    "samples": "number of draws of the random parameters",
+    "seed": "seed of the random draws (default 0)",
+}
+DISTRIBUTIONS = ("uniform", "loguniform")
+#: top-level sections a sweep may override
+SWEEPABLE = ("mechanism", "inputs", "solver")
+
+#: statuses a sweep records besides those of :class:`~cpm_nlp.core.result.Status`
+INVALID_INPUT = "invalid_input"  # the point's values break a rule of the problem (message says which)
+ERROR = "error"  # the point raised an internal error or killed its worker repeatedly (message says what)
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept value.
+
+    key: dotted key of the problem file; mode: "grid", "list" or "random";
+    values: the SI values of a grid or list; low, high, distribution: the
+    range of a random parameter; dimension: of a numeric value ("length",
+    "angle", ...), None for other values.
+    """
+
+    key: str
+    mode: str
+    values: tuple = ()
+    low: float | None = None
+    high: float | None = None
+    distribution: str = "uniform"
+    dimension: str | None = None
+    base: float | None = None  # the value (SI) of the base problem at this key, if a number
+
+    @property
+    def name(self) -> str:
+        """The last part of the key (``L`` for ``mechanism.parameters.L``)."""
+        return self.key.rsplit(".", 1)[-1]
+
+    def describe(self) -> dict[str, Any]:
+        """JSON-able description (stored with the results)."""
+        out: dict[str, Any] = {"key": self.key, "name": self.name, "mode": self.mode, "dimension": self.dimension}
+        if self.mode == "random":
+            out.update({"distribution": self.distribution, "from": self.low, "to": self.high})
+        else:
+            out["count"] = len(self.values)
+        out["base"] = self.base
+        return out
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated ``sweep`` section: which points to solve."""
+
+    axes: tuple[Axis, ...]
+    samples: int | None
+    seed: int
+    raw: Any  # the section as written (for the fingerprint)
+
+    @property
+    def grid_axes(self) -> tuple[Axis, ...]:
+        return tuple(a for a in self.axes if a.mode != "random")
+
+    @property
+    def random_axes(self) -> tuple[Axis, ...]:
+        return tuple(a for a in self.axes if a.mode == "random")
+
+    @property
+    def n_grid(self) -> int:
+        return math.prod(len(a.values) for a in self.grid_axes)
+
+    @property
+    def size(self) -> int:
+        return self.n_grid * (self.samples or 1)
+
+    def point(self, k: int) -> dict[str, Any]:
+        """The values of point ``k`` (0 <= k < size), key -> SI value."""
+        if not 0 <= k < self.size:
+            raise IndexError(f"point {k} is outside the sweep (0 .. {self.size - 1})")
+        sample, g = divmod(k, self.n_grid)
+        out: dict[str, Any] = {}
+        for axis in reversed(self.grid_axes):  # the first axis varies slowest
+            g, i = divmod(g, len(axis.values))
+            out[axis.key] = axis.values[i]
+        if self.random_axes:
+            rng = np.random.default_rng([self.seed, sample])
+            for axis in self.random_axes:
+                u = float(rng.random())
+                if axis.distribution == "loguniform":
+                    out[axis.key] = math.exp(math.log(axis.low) + u * (math.log(axis.high) - math.log(axis.low)))
+                else:
+                    out[axis.key] = axis.low + u * (axis.high - axis.low)
+        return {a.key: out[a.key] for a in self.axes}
+
+    def points(self) -> Iterator[tuple[int, dict[str, Any]]]:
+        for k in range(self.size):
+            yield k, self.point(k)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, tuple):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, list):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+# -- parsing ------------------------------------------------------------------------------
+
+
+def parse_sweep(raw: Any, data: Mapping[str, Any], kind: Any, model: Any, base_dir: Path | None) -> SweepSpec:
+    """Validate the ``sweep`` section of a problem file.
+
+    ``data`` is the whole (parsed) file, ``kind`` and ``model`` the validated
+    base problem: every swept key is resolved against what it overrides.
+    """
+    path = ("sweep",)
+    if not isinstance(raw, Mapping):
+        raise InputError(
+            f"expected a mapping with keys {', '.join(SECTION_KEYS)}; got {type(raw).__name__} {raw!r}"[:200],
+            path=path,
+        )
+    for key in raw:
+        if key not in SECTION_KEYS:
+            raise unknown_key_error(str(key), SECTION_KEYS, path, "sweep key")
+    settings = validate_mapping(
+        {k: v for k, v in raw.items() if k != "parameters"},
+        (
+            Option("samples", "int", SECTION_KEYS["samples"], default=None, lower=1, upper=MAX_GRID_POINTS),
+            Option("seed", "int", SECTION_KEYS["seed"], default=0, lower=0, upper=2**63 - 1),
+        ),
+        path,
+        what="sweep key",
+    )
+    params = raw.get("parameters")
+    if not isinstance(params, Mapping) or not params:
+        raise InputError(
+            "expected a non-empty mapping of dotted keys (e.g. mechanism.parameters.L) to a grid "
+            "{from, to, count}, a list, or {random: uniform, from, to}"
+            + ("" if params is not None else " (the key is missing)"),
+            path=path + ("parameters",),
+        )
+    axes = []
+    for key, spec in params.items():
+        if not isinstance(key, str):
+            raise InputError(f"expected dotted keys as strings, got {key!r}", path=path + ("parameters",))
+        axes.append(_parse_axis(key, spec, data, kind, model, base_dir, path + ("parameters", key)))
+    randoms = [a.key for a in axes if a.mode == "random"]
+    samples = settings["samples"]
+    if randoms and samples is None:
+        raise InputError(
+            f"missing 'samples' (how many draws of the random parameter(s) {', '.join(randoms)})", path=path
+        )
+    if samples is not None and not randoms:
+        raise InputError(
+            "'samples' applies to random parameters ({random: uniform, from: ..., to: ...}), and none is given",
+            path=path + ("samples",),
+        )
+    spec = SweepSpec(tuple(axes), samples, settings["seed"], _jsonable_raw(raw))
+    if spec.size > MAX_GRID_POINTS:
+        raise InputError(f"the sweep has {spec.size} points; expected at most {MAX_GRID_POINTS}", path=path)
+    return spec
+
+
+def _jsonable_raw(raw: Any) -> Any:
+    return json.loads(json.dumps(raw, default=str))
+
+
+def _parse_axis(
+    key: str, spec: Any, data: Mapping[str, Any], kind: Any, model: Any, base_dir: Path | None, path: tuple
+) -> Axis:
+    axis = _axis(key, spec, data, kind, model, base_dir, path)
+    option = _resolve(key, kind, model, path)[0]
+    return dataclasses.replace(axis, base=_base_value(data, key, option))
+
+
+def _base_value(data: Mapping[str, Any], key: str, option: Option | None) -> float | None:
+    """The base problem's value at ``key`` in SI, if it is one number (else None)."""
+    node: Any = data
+    for part in key.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            return None
+        node = node[part]
+    if isinstance(node, list) and len(node) == 1:
+        node = node[0]
+    if option is None or option.kind not in DIMENSIONS:
+        return float(node) if _is_number(node) else None
+    try:
+        value = dataclasses.replace(option, shape="scalar").parse(node, ())
+    except InputError:  # a list, a pair, a mapping: no single base value
+        return None
+    return float(value) if _is_number(value) else None
+
+
+def _axis(
+    key: str, spec: Any, data: Mapping[str, Any], kind: Any, model: Any, base_dir: Path | None, path: tuple
+) -> Axis:
+    option, solver_key = _resolve(key, kind, model, path)
+    dimension = option.kind if option is not None and option.kind in DIMENSIONS else None
+    if isinstance(spec, Mapping) and "random" in spec:
+        return _random_axis(key, spec, option, dimension, path)
+    if isinstance(spec, Mapping) and solver_key is None and option is not None and option.shape != "range":
+        scalar = dataclasses.replace(option, shape="scalar")
+        for end in ("from", "to"):  # the ends as written, with the bounds of the value they override
+            if spec.get(end) is not None:
+                scalar.parse(spec[end], path + (end,))
+        values = dataclasses.replace(option, shape="grid").parse(spec, path)  # {from, to, count}
+        return Axis(key, "grid", tuple(_check_each(option, values, path)), dimension=dimension)
+    if isinstance(spec, Mapping) and not solver_key:
+        raise InputError(f"expected a list of values for {key} (a grid needs a numeric value)", path=path)
+    values = list(spec) if isinstance(spec, list) else [spec]
+    if not values:
+        raise InputError("expected a non-empty list of values", path=path)
+    where = [path + (i,) if isinstance(spec, list) else path for i in range(len(values))]
+    if solver_key:
+        parsed = [_check_solver_value(key, v, data, base_dir, w) for v, w in zip(values, where)]
+        dimension = "dimensionless" if all(_is_number(v) for v in parsed) else None
+        return Axis(key, "list", tuple(parsed), dimension=dimension)
+    parsed = [_jsonable(option.parse(v, w)) for v, w in zip(values, where)]
+    return Axis(key, "list", tuple(parsed), dimension=dimension)
+
+
+def _check_each(option: Option, values: list, path: tuple) -> list:
+    """Values of a grid, each checked like a single value (integers, bounds)."""
+    scalar = dataclasses.replace(option, shape="scalar")
+    return [scalar.parse(v, path) for v in values]
+
+
+def _random_axis(key: str, spec: Mapping, option: Option | None, dimension: str | None, path: tuple) -> Axis:
+    kind = option.kind if option is not None else "dimensionless"
+    if kind not in DIMENSIONS or (option is not None and option.shape == "range"):
+        raise InputError(f"expected a list of values for {key} (a random sample needs a numeric value)", path=path)
+    bound = {"lower": option.lower, "upper": option.upper, "strict": option.strict} if option is not None else {}
+    opts = (
+        Option("random", "choice", "the distribution", choices=DISTRIBUTIONS),
+        Option("from", kind, "lowest value", **bound),
+        Option("to", kind, "highest value", **bound),
+    )
+    parsed = validate_mapping(spec, opts, path, what="random key")
+    low, high = parsed["from"], parsed["to"]
+    if not low < high:
+        raise InputError(f"expected from < to, got from {spec.get('from')!r}, to {spec.get('to')!r}", path=path)
+    if parsed["random"] == "loguniform" and low <= 0:
+        raise InputError(f"a loguniform sample needs from > 0, got {spec.get('from')!r}", path=path + ("from",))
+    return Axis(key, "random", low=low, high=high, distribution=parsed["random"], dimension=dimension or kind)
+
+
+def _resolve(key: str, kind: Any, model: Any, path: tuple) -> tuple[Option | None, str | None]:
+    """The declaration a dotted key overrides: (option, None), or (None,
+    solver-key) for the solver section (validated through the solver parser)."""
+    from ..mechanisms.registry import mechanism_type
+
+    parts = key.split(".")
+    if any(not p for p in parts):
+        raise InputError(f"expected a dotted key such as mechanism.parameters.L, got {key!r}", path=path)
+    top = parts[0]
+    if top not in SWEEPABLE:
+        raise InputError(
+            f"cannot sweep {top!r}; expected a key under {', '.join(SWEEPABLE)} "
+            "(e.g. mechanism.parameters.L, inputs.dz, solver.method)",
+            path=path,
+            suggestions=suggest(top, SWEEPABLE),
+        )
+    if top == "solver":
+        return None, key
+    if top == "mechanism":
+        section = parts[1] if len(parts) > 1 else ""
+        if section not in ("parameters", "limits") or len(parts) != 3:
+            hint = suggest(section, ("parameters", "limits")) if section else ()
+            raise InputError(
+                f"expected mechanism.parameters.<name> or mechanism.limits.<name>, got {key!r}",
+                path=path,
+                suggestions=[f"mechanism.{h}.{parts[-1]}" for h in hint] if len(parts) == 3 else (),
+            )
+        mtype = mechanism_type(model.name)
+        options = mtype.parameters if section == "parameters" else mtype.limits
+        what = "parameter" if section == "parameters" else "limit"
+    else:
+        if len(parts) != 2:
+            raise InputError(f"expected inputs.<name>, got {key!r}", path=path)
+        options = kind.input_options(model)
+        what = f"input of {kind.name}"
+    by_name = {o.name: o for o in options}
+    if parts[-1] not in by_name:
+        raise unknown_key_error(parts[-1], by_name, path, what)
+    return by_name[parts[-1]], None
+
+
+def _check_solver_value(key: str, value: Any, data: Mapping[str, Any], base_dir: Path | None, path: tuple) -> Any:
+    """A swept solver value: the base solver section with the override must parse."""
+    from ..problems.file import apply_overrides, parse_solver
+
+    try:
+        section = apply_overrides({"solver": data.get("solver")}, [override(key, value)]).get("solver")
+        parse_solver(section, base_dir)
+    except InputError as exc:
+        raise InputError(
+            f"value {value!r}: {exc.message}", path=path, suggestions=exc.suggestions, hint=exc.hint
+        ) from None
+    return value
+
+
+def override(key: str, value: Any) -> str:
+    """``--set`` text for one swept value (JSON is YAML: the value round-trips exactly)."""
+    return f"{key}={json.dumps(value)}"
+
+
+# -- the work of one point -------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Job:
+    """What a worker needs to solve points of a sweep (small; pickled per task).
+
+    data: the problem file without its ``sweep`` and ``reproduce`` sections
+    (solving them is what ``cpm-nlp solve`` does with the file); values: the
+    result values recorded for each point.
+    """
+
+    data: dict
+    file: str | None
+    base_dir: str | None
+    spec: SweepSpec
+    values: tuple[str, ...]
+
+
+def solve_point(job: Job, k: int) -> tuple[dict[str, Any], dict[str, str], dict[str, str]]:
+    """Solve point ``k`` as ``cpm-nlp solve`` would; never raises for a point.
+
+    Returns (record, units, dimensions): the record holds ``point``, the swept
+    values, ``status``, ``message``, ``seconds`` and every recorded value
+    (None where the point did not solve).
+    """
+    from ..problems.file import apply_overrides, problem_from_dict, solve
+
+    params = job.spec.point(k)
+    t0 = time.perf_counter()
+    units: dict[str, str] = {}
+    dims: dict[str, str] = {}
+    values: dict[str, Any] = {}
+    try:
+        data = apply_overrides(job.data, [override(key, v) for key, v in params.items()])
+        problem = problem_from_dict(data, file=job.file, base_dir=Path(job.base_dir) if job.base_dir else None)
+        result = solve(problem)
+        status, message = result.status.value, result.message
+        values = result.to_dict()["values"]
+        units, dims = dict(result.units), dict(result.dimensions)
+    except InputError as exc:
+        status, message = INVALID_INPUT, exc.render()
+    except Exception as exc:  # a bug in one point must not lose the sweep: recorded, with status "error"
+        log.exception("point %d of the sweep raised", k)
+        status, message = ERROR, f"internal error: {exc.__class__.__name__}: {exc}"
+    record: dict[str, Any] = {"point": k, **params}
+    record.update(status=status, message=" ".join(str(message).split()), seconds=round(time.perf_counter() - t0, 6))
+    for name in job.values:
+        record[name] = values.get(name)
+    return record, {n: units[n] for n in job.values if n in units}, {n: dims[n] for n in job.values if n in dims}
+
+
+def solve_points(job: Job, ids: Sequence[int]) -> dict[str, Any]:
+    """A worker task: solve some points; records plus the units learned."""
+    records, units, dims = [], {}, {}
+    for k in ids:
+        rec, u, d = solve_point(job, k)
+        records.append(rec)
+        units.update(u)
+        dims.update(d)
+    return {"records": records, "units": units, "dimensions": dims}
+
+
+# -- planning ---------------------------------------------------------------------------------
+
+
+def job_of(problem: Any) -> Job:
+    """The :class:`Job` of a validated problem that has a sweep section."""
+    if problem.sweep is None:
+        raise InputError(
+            "the file has no 'sweep' section; add one naming the values to sweep, e.g. "
+            "sweep: {parameters: {mechanism.parameters.L: {from: 90 mm, to: 130 mm, count: 5}}}",
+            file=problem.file,
+        )
+    data = {k: v for k, v in problem.data.items() if k not in ("sweep", "reproduce")}
+    values = tuple(problem.outputs or problem.kind.output_names(problem.model))
+    base_dir = str(Path(problem.file).resolve().parent) if problem.file else None
+    return Job(data, problem.file, base_dir, problem.sweep, values)
+
+
+def fingerprint(job: Job) -> str:
+    """Identity of a sweep's points: the problem solved at each point and the
+    swept values (not ``samples``, so a sample can grow)."""
+    data = {k: v for k, v in job.data.items() if k != "description"}
+    raw = job.spec.raw if isinstance(job.spec.raw, Mapping) else {}
+    ident = {
+        "data": data,
+        "parameters": raw.get("parameters"),
+        "seed": job.spec.seed,
+        "values": list(job.values),
+    }
+    text = json.dumps(ident, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def metadata(problem: Any, job: Job) -> dict[str, Any]:
+    """What a results file says about itself (besides its rows); a parameter's
+    ``base`` is its value in the base problem (the design of the file)."""
+    return {
+        "format": "cpm_nlp.sweep.run/1",
+        "problem": job.data.get("problem"),
+        "mechanism": problem.model.name,
+        "file": job.file,
+        "fingerprint": fingerprint(job),
+        "points": job.spec.size,
+        "parameters": [a.describe() for a in job.spec.axes],
+        "values": list(job.values),
+        "units": {},
+        "dimensions": {},
+    }
+
+
+def columns(job: Job) -> list[str]:
+    """Columns of a results file, in order."""
+    return ["point", *(a.key for a in job.spec.axes), "status", "message", "seconds", *job.values]
+
+
+# -- running on Dask --------------------------------------------------------------------------
+
+
+@dataclass
+class SweepSummary:
+    """Outcome of :func:`run_sweep`.
+
+    total: points of the sweep; statuses: status -> number of points in the
+    results file; solved_now: points solved in this run; seconds: wall time
+    of this run; workers: worker threads used (0 if nothing was left to do).
+    """
+
+    output: str
+    total: int
+    statuses: dict[str, int]
+    solved_now: int
+    seconds: float
+    workers: int
+
+    @property
+    def ok(self) -> bool:
+        return set(self.statuses) <= {"solved"} and sum(self.statuses.values()) == self.total
+
+
+def default_workers() -> int:
+    """Worker processes of the local default: one per core this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def require(module: str, extra: str, purpose: str) -> Any:
+    """Import an optional dependency, or say how to install it."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise InputError(
+            f"{purpose} needs the Python package '{module.split('.')[0]}', which is not installed",
+            hint=f"pip install 'cpm_nlp[{extra}]'",
+        ) from None
+
+
+#: Dask settings of the local cluster a sweep starts (benchmarks/bench_sweep.py):
+#: * the worker's statistical profiler samples every thread's stack every
+#:   10 ms; on points that are short CasADi calls wrapped in Python it cost
+#:   about half the solve time: off;
+#: * the nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536 (for large
+#:   dataframes); on many small CasADi allocations it costs about 13 % more
+#:   CPU: left to glibc's default;
+#: * the event-loop, system and memory monitors wake every 20-500 ms (about
+#:   3 % of a core while idle); every 0.5-2 s is plenty for tasks of half a
+#:   second.
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    "distributed.admin.tick.interval": "500ms",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+
+
+def dask_config() -> Any:
+    """The settings under which a sweep starts its local cluster (a context)."""
+    import dask
+
+    return dask.config.set(LOCAL_CLUSTER_CONFIG)
+
+
+class _Connection:
+    """A Dask client: to an existing scheduler, or to a local cluster it starts
+    (and stops) itself, one single-threaded worker process per core (CasADi
+    holds the GIL, so processes, not threads, run points in parallel)."""
+
+    def __init__(self, scheduler: str | None, workers: int | None, client: Any) -> None:
+        self.scheduler, self.workers, self.given = scheduler, workers, client
+        self.client: Any = client
+        self.cluster: Any = None
+
+    def __enter__(self) -> Any:
+        if self.client is not None:
+            return self.client
+        distributed = require("distributed", "sweep", "running a sweep")
+        if self.scheduler:
+            try:
+                self.client = distributed.Client(self.scheduler)  # waits distributed.comm.timeouts.connect
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise InputError(
+                    f"cannot connect to the Dask scheduler {self.scheduler}: {exc}", path=("--scheduler",)
+                ) from None
+            return self.client
+        with dask_config():
+            self.cluster = distributed.LocalCluster(
+                n_workers=self.workers or default_workers(),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # a free port: never "8787 is in use" when two sweeps run
+            )
+        self.client = distributed.Client(self.cluster)
+        log.info("local Dask cluster, dashboard at %s", self.client.dashboard_link)
+        return self.client
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.given is None and self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def run_sweep(
+    problem: Any,
+    output: str | os.PathLike,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    client: Any = None,
+    chunk_size: int | None = None,
+    overwrite: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> SweepSummary:
+    """Solve every point of ``problem.sweep`` on Dask, streaming records to ``output``.
+
+    output: ``.parquet`` or ``.csv``.  If it already holds points of this
+    sweep, only the missing ones are solved (resume); a file of another sweep
+    is an :class:`InputError` unless ``overwrite``.
+    scheduler: address of an existing Dask scheduler (``tcp://host:port``);
+    client: an existing ``distributed.Client``; neither: a local cluster of
+    ``workers`` processes (default: one per core).
+    chunk_size: points per Dask task (default: adapted so a task takes about
+    half a second).
+    progress: called with (points done, total) as points finish.
+    """
+    from ..io.results import open_store
+
+    t0 = time.perf_counter()
+    job = job_of(problem)
+    store = open_store(output, metadata(problem, job), columns(job), overwrite=overwrite)
+    n_workers = 0
+    try:
+        pending = [k for k in range(job.spec.size) if k not in store.done]
+        if progress is not None:
+            progress(job.spec.size - len(pending), job.spec.size)
+        if pending:
+            with _Connection(scheduler, workers, client) as dask_client:
+                n_workers = _execute(dask_client, job, pending, store, chunk_size, progress)
+    finally:
+        store.close()
+    return SweepSummary(
+        str(output), job.spec.size, store.status_counts(), store.added, time.perf_counter() - t0, n_workers
+    )
+
+
+#: a task aims at this many seconds of work (per-task overhead of Dask is a few ms)
+TASK_SECONDS = 0.5
+#: tasks kept in flight per worker thread, so that no worker waits for the client
+IN_FLIGHT = 2
+
+
+def _threads(client: Any) -> int:
+    return max(1, sum(client.nthreads().values()))
+
+
+def _execute(
+    client: Any,
+    job: Job,
+    pending: list[int],
+    store: Any,
+    chunk_size: int | None,
+    progress: Callable[[int, int], None] | None,
+) -> int:
+    """Feed chunks of points to the cluster, write records as they come back.
+
+    A chunk whose task fails (its worker died more often than Dask retries,
+    or it raised) is split into single points; a single point that fails is
+    recorded with status ``error``.  Returns the number of worker threads."""
+    distributed = require("distributed", "sweep", "running a sweep")
+    queue = list(reversed(pending))  # pop() from the end = lowest point first
+    threads = _threads(client)
+    per_point = None  # seconds, measured
+    futures: dict[Any, list[int]] = {}
+    done = len(store.done)
+    total = job.spec.size
+    retry: list[list[int]] = []
+
+    def next_chunk() -> list[int]:
+        if retry:
+            return retry.pop()
+        if chunk_size:
+            n = chunk_size
+        elif per_point is None:
+            n = 1  # measure first
+        else:
+            n = int(TASK_SECONDS / max(per_point, 1e-6))
+            n = min(n, math.ceil(len(queue) / (2 * threads)))  # keep the end balanced
+        n = max(1, min(n, len(queue)))
+        return [queue.pop() for _ in range(n)]
+
+    def submit(seq: Any) -> None:
+        while (queue or retry) and len(futures) < IN_FLIGHT * threads:
+            ids = next_chunk()
+            fut = client.submit(solve_points, job, ids, pure=False)
+            futures[fut] = ids
+            seq.add(fut)
+
+    seq = distributed.as_completed([])
+    try:
+        submit(seq)
+        last_threads = time.monotonic()
+        for fut in seq:
+            ids = futures.pop(fut)
+            if fut.status == "finished":
+                out = fut.result()
+                store.append(out["records"], out["units"], out["dimensions"])
+                secs = [r["seconds"] for r in out["records"]]
+                mean = sum(secs) / len(secs)
+                per_point = mean if per_point is None else 0.7 * per_point + 0.3 * mean
+                done += len(ids)
+            else:
+                exc = fut.exception() if fut.status == "error" else None
+                if len(ids) > 1:
+                    log.warning("a task of %d points failed (%s); solving them one by one", len(ids), exc)
+                    retry.extend([i] for i in reversed(ids))
+                else:
+                    store.append([_error_record(job, ids[0], exc)], {}, {})
+                    done += 1
+            if progress is not None:
+                progress(done, total)
+            if time.monotonic() - last_threads > 2.0:  # clusters grow and shrink
+                threads, last_threads = _threads(client), time.monotonic()
+            submit(seq)
+    finally:
+        if futures:
+            client.cancel(list(futures))
+    return threads
+
+
+def _error_record(job: Job, k: int, exc: BaseException | None) -> dict[str, Any]:
+    record: dict[str, Any] = {"point": k, **job.spec.point(k)}
+    text = f"{exc.__class__.__name__}: {exc}" if exc is not None else "the task failed"
+    record.update(status=ERROR, message=" ".join(f"the task failed: {text}".split()), seconds=None)
+    record.update({name: None for name in job.values})
+    return record
