@@ -45,7 +45,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import cpm_nlp as cn  # noqa: E402
-from cpm_nlp.problems.file import apply_overrides, problem_from_dict, solve  # noqa: E402
+from cpm_nlp.problems.file import problem_from_dict, solve  # noqa: E402
+from cpm_nlp.problems.overrides import apply_overrides  # noqa: E402
 from cpm_nlp.sweep.run import dask_config, default_workers, job_of, override, run_sweep, solve_point  # noqa: E402
 
 TARGET = 1.10

@@ -10,104 +10,20 @@ Quick start::
 or, from a problem file::
 
     result = cn.solve(cn.load_problem("problems/prs3_forward_kinematics.yaml"))
+
+The public names are those of :mod:`cpm_nlp.api` (listed once, there).  The
+package's layers: ``core`` (model, kernels, solvers, units), ``analysis``
+(workspace, cuboid, flexures, dynamics), ``io`` (atomic files, export,
+results files), ``kinds`` (the generic problem kinds), ``mechanisms`` (the
+registry and the built-in mechanisms), ``problems`` (problem files, kinds
+registry, reproduce), ``sweep``, ``plot`` and ``cli``.
 """
 
 import logging
 
-from .api import (
-    BatchJacobians,
-    BatchResult,
-    Comparison,
-    Coordinate,
-    CpmError,
-    CuboidResult,
-    InputError,
-    JacobianReport,
-    LoopClosure,
-    Membership,
-    Model,
-    ModelFunctions,
-    PoseSolution,
-    Problem,
-    RequirementsReport,
-    Result,
-    SolverConfig,
-    SolverInfo,
-    Status,
-    apply_overrides,
-    assess,
-    batch_forward_kinematics,
-    batch_inverse_kinematics,
-    batch_jacobians,
-    build_model,
-    check_box,
-    export_kinematics,
-    forward_kinematics,
-    functions,
-    inscribed_cuboid,
-    inverse_kinematics,
-    jacobians,
-    joint_requirements,
-    load_exported,
-    load_problem,
-    mechanism_type,
-    membership,
-    passive_joints,
-    problem_from_dict,
-    reproduce,
-    residual,
-    sample_workspace,
-    solve,
-    status_of,
-)
+from . import _legacy
+from .api import *  # noqa: F403 - the public API, listed once in api.__all__
+from .api import __all__, __version__  # noqa: F401
 
-__all__ = [
-    "status_of",
-    "ModelFunctions",
-    "export_kinematics",
-    "functions",
-    "load_exported",
-    "BatchJacobians",
-    "BatchResult",
-    "batch_forward_kinematics",
-    "batch_inverse_kinematics",
-    "batch_jacobians",
-    "Comparison",
-    "Coordinate",
-    "CuboidResult",
-    "CpmError",
-    "InputError",
-    "JacobianReport",
-    "LoopClosure",
-    "Membership",
-    "Model",
-    "PoseSolution",
-    "Problem",
-    "RequirementsReport",
-    "Result",
-    "SolverConfig",
-    "SolverInfo",
-    "Status",
-    "apply_overrides",
-    "assess",
-    "build_model",
-    "check_box",
-    "forward_kinematics",
-    "inscribed_cuboid",
-    "inverse_kinematics",
-    "jacobians",
-    "joint_requirements",
-    "load_problem",
-    "mechanism_type",
-    "membership",
-    "passive_joints",
-    "problem_from_dict",
-    "reproduce",
-    "residual",
-    "sample_workspace",
-    "solve",
-]
-
-__version__ = "0.1.0"
-
+_legacy.install()
 logging.getLogger(__name__).addHandler(logging.NullHandler())

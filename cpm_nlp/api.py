@@ -1,4 +1,4 @@
-"""The public API of cpm_nlp (re-exported by the package).
+"""The public API of cpm_nlp: every name ``import cpm_nlp as cn`` gives (``cn.__all__``).
 
 Load a problem file or build a mechanism in code, then call the algorithms
 with numpy arrays, or take the CasADi Functions of the model (``model.closure``:
@@ -7,11 +7,14 @@ with numpy arrays, or take the CasADi Functions of the model (``model.closure``:
 to the ``cpm_nlp`` logger.
 """
 
+import os
+
 from .analysis.requirements import RequirementsReport, joint_requirements
 from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
 from .core.errors import CpmError, InputError
 from .core.kernels import status_of
+from .core.kind import ProblemKind
 from .core.kinematics import (
     JacobianReport,
     PoseSolution,
@@ -22,58 +25,95 @@ from .core.kinematics import (
     passive_joints,
     residual,
 )
+from .core.mechanism import CuboidExtras, DynamicsModel, Mechanism, declare
 from .core.model import Coordinate, LoopClosure, Model
 from .core.result import Result, SolverInfo, Status
 from .core.solver import SolverConfig
-from .io.embed import ModelFunctions, functions
+from .core.version import __version__
+from .io.embed import ModelFunctions, model_functions
 from .io.export import export_kinematics, load_exported
-from .mechanisms.registry import build_model, mechanism_type
-from .problems.file import Problem, apply_overrides, load_problem, problem_from_dict, solve
+from .mechanisms.registry import build_model, mechanism_names, mechanism_type, register, unregister
+from .problems.file import Problem, load_problem, problem_from_dict, solve
+from .problems.overrides import apply_overrides
+from .problems.registry import kind_names, problem_kind
 from .problems.reproduce import Comparison, reproduce
 
+
+def functions(source: Model | str | os.PathLike, solver: SolverConfig | None = None) -> ModelFunctions:
+    """The CasADi Functions of a model, or of the mechanism of a problem file.
+
+    source: a :class:`Model` (e.g. from :func:`cpm_nlp.build_model`) or the
+    path of a problem file (its mechanism, and its solver unless ``solver`` is given).
+    solver: tolerance and Newton options (abstol, abstolStep, max_iter) built
+    into fk and ik (default: ``SolverConfig("newton")``).
+    """
+    if isinstance(source, (str, os.PathLike)):
+        problem = load_problem(source)
+        return model_functions(problem.model, solver or problem.solver)
+    return model_functions(source, solver)
+
+
+#: a mechanism declared in code, with "did you mean" for a misspelt part
+declare_mechanism = declare
+#: add a mechanism declared in code to the registry
+register_mechanism = register
+#: remove a mechanism registered in code
+unregister_mechanism = unregister
+
 __all__ = [
-    "status_of",
-    "ModelFunctions",
-    "export_kinematics",
-    "functions",
-    "load_exported",
     "BatchJacobians",
     "BatchResult",
-    "batch_forward_kinematics",
-    "batch_inverse_kinematics",
-    "batch_jacobians",
     "Comparison",
     "Coordinate",
-    "CuboidResult",
     "CpmError",
+    "CuboidExtras",
+    "CuboidResult",
+    "DynamicsModel",
     "InputError",
     "JacobianReport",
     "LoopClosure",
+    "Mechanism",
     "Membership",
     "Model",
+    "ModelFunctions",
     "PoseSolution",
     "Problem",
+    "ProblemKind",
     "RequirementsReport",
     "Result",
     "SolverConfig",
     "SolverInfo",
     "Status",
+    "__version__",
     "apply_overrides",
     "assess",
+    "batch_forward_kinematics",
+    "batch_inverse_kinematics",
+    "batch_jacobians",
     "build_model",
     "check_box",
+    "declare_mechanism",
+    "export_kinematics",
     "forward_kinematics",
+    "functions",
     "inscribed_cuboid",
     "inverse_kinematics",
     "jacobians",
     "joint_requirements",
+    "kind_names",
+    "load_exported",
     "load_problem",
+    "mechanism_names",
     "mechanism_type",
     "membership",
     "passive_joints",
     "problem_from_dict",
+    "problem_kind",
+    "register_mechanism",
     "reproduce",
     "residual",
     "sample_workspace",
     "solve",
+    "status_of",
+    "unregister_mechanism",
 ]

@@ -3,8 +3,8 @@ expected; exit status 2; no traceback; no output file."""
 
 import pytest
 
-from cpm_nlp.core.kind import KINDS
-from cpm_nlp.mechanisms.registry import MODULES
+from cpm_nlp.mechanisms.registry import mechanism_names
+from cpm_nlp.problems.registry import kind_names
 
 from .conftest import PROBLEMS
 
@@ -85,7 +85,7 @@ def test_unknown_problem_kind(cli, tmp_path):
         tmp_path,
         GOOD.replace("forward_kinematics", "forward_kinematic"),
         "problem: unknown problem kind 'forward_kinematic'; expected one of: "
-        + ", ".join(sorted(KINDS))  # every registered kind, e.g. forward_kinematics, inverse_kinematics ...
+        + ", ".join(kind_names())  # every registered kind, e.g. forward_kinematics, inverse_kinematics ...
         + "; did you mean 'forward_kinematics' or 'inverse_kinematics'?",
     )
 
@@ -96,7 +96,7 @@ def test_unknown_mechanism_type(cli, tmp_path):
         tmp_path,
         GOOD.replace("type: prs3", "type: 3prs"),
         "mechanism.type: unknown mechanism type '3prs'; expected one of: "
-        + ", ".join(sorted(MODULES))  # every registered mechanism: prc3, prs3 ...
+        + ", ".join(mechanism_names())  # every registered mechanism: prc3, prs3 ...
         + "; did you mean 'prs3'?",
     )
 

@@ -150,5 +150,5 @@ def test_synthesis_needs_a_formulation(cli, tmp_path):
     assert run.code == 2
     assert run.err == (
         f"error: {path}: problem: problem kind 'synthesis' does not apply to mechanism 'prs3': "
-        "the mechanism module of 'prs3' defines no SYNTHESIS formulation\n"
+        "the mechanism 'prs3' declares no synthesis formulation (Mechanism.synthesis)\n"
     )

@@ -108,8 +108,8 @@ def test_rpr_kinds_need_the_rpr_mechanism(cli, tmp_path):
         SYNTHESIS.replace("type: rpr", "type: prs3").replace(
             "{r1: 40 mm, r2: 80 mm, P0: 40 mm}", "{b: 47.91 mm, L: 109.215 mm}"
         ),
-        "problem: problem kind 'synthesis' does not apply to mechanism 'prs3': the mechanism module of 'prs3' "
-        "defines no SYNTHESIS formulation",
+        "problem: problem kind 'synthesis' does not apply to mechanism 'prs3': the mechanism 'prs3' "
+        "declares no synthesis formulation (Mechanism.synthesis)",
     )
 
 

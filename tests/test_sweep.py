@@ -11,7 +11,8 @@ import sys
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.sweep.run import ERROR, INVALID_INPUT, fingerprint, job_of, override, require, solve_point
+from cpm_nlp.core.extras import require
+from cpm_nlp.sweep.run import ERROR, INVALID_INPUT, fingerprint, job_of, override, solve_point
 
 from .conftest import PROBLEMS, ROOT
 

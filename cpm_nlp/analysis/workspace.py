@@ -54,6 +54,7 @@ import numpy as np
 
 from ..core.batch import evaluate_points
 from ..core.errors import InputError, suggest
+from ..core.kernels import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
 from ..core.kinematics import PoseSolution, forward_kinematics
 from ..core.model import LoopClosure, Model
 from ..core.multistart import AGREEMENT, best_and_agreement
@@ -70,8 +71,6 @@ CHECK_TOLERANCE = 1e-9
 #: the NLP keeps its limits this much (SI) inside the declared ones, so that IPOPT's
 #: relaxed bounds still pass the check
 NLP_MARGIN = 5e-9
-#: cond(Φ_x) above this counts as singular (outside) in the membership test
-SINGULAR_CONDITION = 1e10
 #: defaults for the cuboid NLP under the user's solver options
 CUBOID_IPOPT = {
     "ipopt.tol": 1e-10,
@@ -326,7 +325,7 @@ PROBE_BISECTIONS = 40
 PROBE_LEVELS = 4
 
 
-def probe_region(
+def probe_region(  # noqa: C901 - one loop of probe rounds with its stop rules
     model: Model, solver: SolverConfig | None = None, centre=None, factor: float = 2.0
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """A box around ``centre`` (default: the home pose) in the task coordinates:
@@ -663,7 +662,7 @@ def _start_box(model: Model, t_c: np.ndarray, S: np.ndarray, centre, size, confi
 FORMULATIONS = ("auto", "closed_form", "poses")
 
 
-def inscribed_cuboid(
+def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
     model: Model,
     solver: SolverConfig | None = None,
     *,

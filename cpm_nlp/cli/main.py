@@ -10,9 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import os
 import sys
-import tempfile
 import time
 import traceback
 from collections.abc import Callable, Sequence
@@ -22,49 +20,12 @@ from typing import Any, TextIO
 from ..core.errors import CpmError, InputError
 from ..core.result import STATUS_TEXT, Result
 from ..core.units import DIMENSIONS, format_quantity
+from ..io.atomic import check_output_path, write_atomic
 
 EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
 
 # -- output helpers -------------------------------------------------------------------------------
-
-
-def replace_atomically(path: str | os.PathLike, write: Callable[[str], Any], suffix: str = ".tmp") -> None:
-    """Create ``path`` all at once: ``write(temporary path)``, then rename.  The
-    file gets the permissions of any new file (the umask), not mkstemp's 0600."""
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=directory)
-    os.close(fd)
-    try:
-        write(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
-def write_atomic(path: str, text: str) -> None:
-    """Write ``text`` to ``path`` all at once (temp file + rename)."""
-    replace_atomically(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-
-
-def check_output_path(path: str | None) -> None:
-    """Fail early (exit 2) if ``-o`` cannot be written, before solving."""
-    if path is None:
-        return
-    target = Path(path)
-    parent = target.parent if str(target.parent) else Path(".")
-    if target.is_dir():
-        raise InputError(f"output path {path} is a directory; expected a file name", path=("-o",))
-    if not parent.is_dir():
-        raise InputError(f"output directory {parent} does not exist", path=("-o",))
-    if not os.access(parent, os.W_OK):
-        raise InputError(f"output directory {parent} is not writable", path=("-o",))
 
 
 def _fmt_scalar(value: Any, dim: str | None) -> tuple[str, str]:
@@ -178,8 +139,8 @@ def _plot_options(args: argparse.Namespace) -> Any:
 def _check_plot_args(args: argparse.Namespace) -> None:
     """Before solving: the figure can be written, and Matplotlib is there."""
     if getattr(args, "plot", None):
+        from ..core.extras import require
         from ..plot.draw import check_figure_path
-        from ..sweep.run import require
 
         check_figure_path(args.plot, "--plot")
         require("matplotlib", "plot", "plotting")
@@ -210,9 +171,9 @@ def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: T
 
 
 def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
+    from ..core.extras import require
     from ..plot.draw import check_figure_path, save
     from ..plot.figures import figure, load
-    from ..sweep.run import require
 
     check_figure_path(args.output)
     require("matplotlib", "plot", "plotting")
@@ -377,30 +338,36 @@ def cmd_export(args: argparse.Namespace, out: TextIO) -> int:
 
 
 def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
-    from ..core.kind import KINDS, problem_kind
-    from ..mechanisms.registry import MODULES, mechanism_type
+    from ..mechanisms.registry import mechanism_names, mechanism_type
+    from ..problems.registry import kind_names, kind_origin, problem_kind
 
     if not args.name:
         out.write("mechanisms:\n")
-        for name in sorted(MODULES):
+        for name in mechanism_names():
             mt = mechanism_type(name)
-            out.write(f"  {name:<12} {mt.title} [{mt.paper}]\n")
+            origin = "" if mt.origin == "built-in" else f"  ({mt.origin})"
+            out.write(f"  {name:<12} {mt.title}{origin}\n")
         out.write("problem kinds:\n")
-        for name in sorted(KINDS):
+        for name in kind_names():
             out.write(f"  {name:<20} {problem_kind(name).description}\n")
         return EXIT_OK
-    if args.name in KINDS:
+    if args.name in kind_names():
         kind = problem_kind(args.name)
-        out.write(f"{kind.name}: {kind.description}\n(inputs depend on the mechanism; see problems/*.yaml)\n")
+        out.write(f"{kind.name}: {kind.description}\n[{kind_origin(kind.name)}]\n")
+        out.write("(inputs depend on the mechanism; see problems/*.yaml)\n")
         return EXIT_OK
     mt = mechanism_type(args.name, path=("describe",))
-    out.write(f"{mt.name}: {mt.title} [{mt.paper}]\n\nparameters:\n")
+    out.write(f"{mt.name}: {mt.title}\n{mt.paper}\n[{mt.origin}]\n\nparameters:\n")
     for o in mt.parameters:
         default = "" if o.required or o.default is None else f" (default {o.format_value(o.default)})"
         out.write(f"  {o.name:<8} {o.expectation()}{default}\n           {o.description}\n")
     out.write("limits (optional, [low, high]):\n")
     for o in mt.limits:
         out.write(f"  {o.name:<8} {o.description}\n")
+    caps = mt.capabilities()
+    out.write("capabilities: " + (", ".join(caps) if caps else "none beyond the required parts") + "\n")
+    if mt.kinds:
+        out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
     return EXIT_OK
 
 

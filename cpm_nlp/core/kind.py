@@ -6,43 +6,23 @@ a :class:`~cpm_nlp.core.model.Model` with a :class:`~cpm_nlp.core.solver.SolverC
 returning a :class:`~cpm_nlp.core.result.Result`.  Problem, method (the algorithm
 modules) and solver stay separate.
 
-Kinds are registered in :data:`KINDS` (name -> "module:Class"); later
-mechanisms add theirs there.
+The generic kinds live in :mod:`cpm_nlp.kinds`; a mechanism declares its own
+kinds (``Mechanism.kinds``); :mod:`cpm_nlp.problems.registry` finds them all.
 """
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from .errors import InputError, suggest
+from .errors import InputError
 from .model import Coordinate, Model
 from .options import Option, validate_mapping
 from .result import Result
 from .solver import SolverConfig
 from .units import format_quantity
-
-#: problem kind -> "module:Class"
-KINDS = {
-    "forward_kinematics": "cpm_nlp.kinds.kinematic:ForwardKinematics",
-    "inverse_kinematics": "cpm_nlp.kinds.kinematic:InverseKinematics",
-    "jacobian": "cpm_nlp.kinds.kinematic:Jacobian",
-    "joint_requirements": "cpm_nlp.kinds.kinematic:JointRequirements",
-    "amplifier": "cpm_nlp.kinds.analysis:Amplifier",
-    "actuator_workspace": "cpm_nlp.kinds.analysis:ActuatorWorkspace",
-    "dynamics": "cpm_nlp.kinds.analysis:Dynamics",
-    "rpr_screw_jacobian": "cpm_nlp.mechanisms.rpr.kinds:ScrewJacobian",
-    "rpr_twists": "cpm_nlp.mechanisms.rpr.kinds:Twists",
-    "rpr_transmission_map": "cpm_nlp.mechanisms.rpr.kinds:TransmissionMap",
-    "rpr_joint_design": "cpm_nlp.mechanisms.rpr.kinds:JointDesign",
-    "rpr_compliance": "cpm_nlp.mechanisms.rpr.kinds:Compliance",
-    "inscribed_cuboid": "cpm_nlp.kinds.workspace:InscribedCuboid",
-    "workspace": "cpm_nlp.kinds.workspace:Workspace",
-    "synthesis": "cpm_nlp.kinds.synthesis:Synthesis",
-}
 
 
 class ProblemKind:
@@ -55,6 +35,10 @@ class ProblemKind:
 
     name = ""
     description = ""
+    #: plot types that may draw a result of this kind, the default first (see :mod:`cpm_nlp.plot.figures`)
+    plots: tuple[str, ...] = ()
+    #: (x, y, value) names of the values a design map of a result shows (plot type "map")
+    map_axes: tuple[str, str, str] | None = None
 
     def input_options(self, model: Model) -> list[Option]:
         raise NotImplementedError
@@ -80,18 +64,6 @@ class ProblemKind:
     def check_solver(self, solver: SolverConfig) -> None:
         """Raise :class:`InputError` if the kind cannot use this solver
         configuration (e.g. an optimisation needs IPOPT)."""
-
-
-def problem_kind(name: Any, path: tuple = ("problem",)) -> ProblemKind:
-    """Look up a problem kind by name (with a "did you mean" if unknown)."""
-    if not isinstance(name, str) or name not in KINDS:
-        raise InputError(
-            f"unknown problem kind {name!r}; expected one of: {', '.join(sorted(KINDS))}",
-            path=path,
-            suggestions=suggest(str(name), KINDS),
-        )
-    module, cls = KINDS[name].split(":")
-    return getattr(importlib.import_module(module), cls)()
 
 
 # -- helpers shared by the kinematic kinds ------------------------------------------

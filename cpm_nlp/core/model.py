@@ -129,6 +129,9 @@ class LoopClosure:
             raise ValueError(f"{name}: phi has {phi.size1_out(0)} rows, expected nx = {self.nx}")
         self._derive()
         self.solvers = SolverCache()
+        #: the :class:`~cpm_nlp.core.mechanism.Mechanism` declaration this closure was built for
+        #: (set by the registry; None for a closure built by hand)
+        self.mechanism: Any = None
 
     # -- AD-derived functions ------------------------------------------------
     def _derive(self) -> None:
@@ -231,6 +234,11 @@ class Model:
     @property
     def name(self) -> str:
         return self.closure.name
+
+    @property
+    def mechanism(self) -> Any:
+        """The mechanism's declaration (its capabilities), or None for a closure built by hand."""
+        return self.closure.mechanism
 
     def limit_of(self, coord: Coordinate) -> tuple[float, float] | None:
         """Declared limits of a coordinate (its own, else its family's)."""

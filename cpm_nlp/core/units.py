@@ -90,7 +90,7 @@ def _describe(dim: Dimension) -> str:
     return "a dimensionless number" if dim.name == "dimensionless" else article(dim.name.replace("_", " "))
 
 
-def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:
+def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # noqa: C901 - one branch per accepted form of a quantity
     """Return the SI value of ``value``, a quantity of the given ``dimension``.
 
     ``value`` is a bare number (already SI) or a string ``"<number> <unit>"``.

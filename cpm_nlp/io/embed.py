@@ -22,7 +22,6 @@ state; the Functions may be called from several threads.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 import casadi as ca
@@ -67,24 +66,14 @@ def _with_parameters(fn: ca.Function, model: Model, name: str) -> ca.Function:
     return ca.Function(name, [x, q], outs, ["x", "q"], fn.name_out())
 
 
-def functions(source: Model | str | os.PathLike, solver: SolverConfig | None = None) -> ModelFunctions:
-    """The CasADi Functions of a model, or of the mechanism of a problem file.
+def model_functions(model: Model, solver: SolverConfig | None = None) -> ModelFunctions:
+    """The CasADi Functions of a model (``cpm_nlp.functions`` also takes a problem file).
 
-    source: a :class:`Model` (e.g. from :func:`cpm_nlp.build_model`) or the
-    path of a problem file (its mechanism, and its solver unless ``solver`` is given).
     solver: tolerance and Newton options (abstol, abstolStep, max_iter) built
     into fk and ik (default: ``SolverConfig("newton")``).
     """
-    if isinstance(source, Model):
-        model = source
-    elif isinstance(source, (str, os.PathLike)):
-        from ..problems.file import load_problem
-
-        problem = load_problem(source)
-        model = problem.model
-        solver = solver or problem.solver
-    else:
-        raise InputError(f"expected a Model or the path of a problem file, got {type(source).__name__}")
+    if not isinstance(model, Model):
+        raise InputError(f"expected a Model or the path of a problem file, got {type(model).__name__}")
     config = solver or SolverConfig("newton")
     c = model.closure
     name = c.name

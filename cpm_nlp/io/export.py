@@ -53,6 +53,7 @@ from ..core.model import Coordinate, Model
 from ..core.result import STATUS_TEXT
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
+from ..core.version import __version__
 
 WHAT = ("fk", "ik", "jacobian")
 FORMATS = ("casadi", "c")
@@ -259,11 +260,8 @@ def manifest(
     source: str | None = None,
 ) -> dict[str, Any]:
     """What the exported files contain and how to call them."""
-    from .. import __version__
-    from ..mechanisms.registry import MODULES, mechanism_type
-
     c = model.closure
-    mt = mechanism_type(model.name) if model.name in MODULES else None
+    mt = model.mechanism
     lower, upper = limit_vectors(model)
     joints = list(limited_coordinates(c))
 

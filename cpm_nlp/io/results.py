@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..cli.main import check_output_path, replace_atomically
 from ..core.errors import InputError
+from .atomic import check_output_path, replace_atomically
 
 META_PREFIX = "# cpm_nlp sweep "
 FORMATS = (".parquet", ".csv")
@@ -328,12 +328,12 @@ def read_csv(path: Path) -> SweepTable:
 
 
 def require_pyarrow() -> Any:
-    from ..sweep.run import require
+    from ..core.extras import require
 
     require("pyarrow.parquet", "sweep", "a Parquet results file")
 
 
-def read_parquet(path: Path) -> SweepTable:
+def read_parquet(path: Path) -> SweepTable:  # noqa: C901 - one message per way a results file can be broken
     """Rows of the Parquet file and of its journal (a sweep still running or interrupted)."""
     require_pyarrow()
     import pyarrow.parquet as pq

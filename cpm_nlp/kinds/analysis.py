@@ -1,8 +1,6 @@
-"""Problem kinds beyond pose solving: amplifier, workspace and dynamics.
+"""Problem kinds beyond pose solving: actuator workspace and dynamics.
 
-* ``amplifier`` -- the ratios of a lever amplifier (A1, A2) and its output
-  d = A2 q for given inputs (prc3-li-2018.md eq 1-2);
-* ``workspace`` -- the reachable workspace under the actuator strokes
+* ``actuator_workspace`` -- the reachable workspace under the actuator strokes
   (:mod:`cpm_nlp.analysis.workspace`);
 * ``dynamics`` -- M, K, G of Lagrange's equations and the natural
   frequencies (:mod:`cpm_nlp.analysis.dynamics`), for mechanisms with a dynamic model.
@@ -10,7 +8,6 @@
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Mapping
 from typing import Any
 
@@ -20,57 +17,23 @@ from ..analysis import dynamics as dyn
 from ..analysis.flexure import material as parse_material
 from ..analysis.workspace import joint_box, reachable_workspace
 from ..core.errors import InputError, unknown_key_error
-from ..core.kind import ProblemKind, actuator_options, broadcast, check_actuator_limits, given
+from ..core.kind import ProblemKind
+from ..core.mechanism import DynamicsModel
 from ..core.model import Model
 from ..core.options import Option, validate_mapping
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
-from ..mechanisms.registry import MODULES
 from .kinematic import _model_info, _si
 
 
-def _result(kind: str, model: Model, values: dict, dims: dict, status=Status.SOLVED, message="", solver=None):
+def closed_form_result(
+    kind: str, model: Model, values: dict, dims: dict, status=Status.SOLVED, message="", solver=None
+):
     units = {k: (_si(d) if d in DIMENSIONS else d) for k, d in dims.items()}
     return Result(
         kind, status, values, units, dims, solver or SolverInfo("closed_form"), message, None, _model_info(model)
     )
-
-
-# -- amplifier ------------------------------------------------------------------------------------
-
-
-class Amplifier(ProblemKind):
-    name = "amplifier"
-    description = "lever amplifier ratios A1, A2 (prc3 eq 1) and the output d = A2 q for given inputs (eq 2)"
-
-    def supports(self, model: Model) -> str | None:
-        return None if "A2" in model.derived else "it has no lever amplifier (no ratio A2)"
-
-    def input_options(self, model: Model) -> list[Option]:
-        return actuator_options(model, "grid")
-
-    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
-        check_actuator_limits(model, inputs, path)
-        names = given(inputs, model.closure.q_names)
-        broadcast([inputs[n] for n in names], names, path)
-
-    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
-        A2 = model.derived["A2"]
-        values: dict[str, Any] = {"A1": model.derived["A1"], "A2": A2}
-        dims = {"A1": "dimensionless", "A2": "dimensionless"}
-        for k, name in enumerate(model.closure.q_names):
-            q = inputs.get(name)
-            if q is None:
-                continue
-            values[name] = q
-            values[f"d{k + 1}"] = [A2 * v for v in q] if isinstance(q, list) else A2 * q  # eq 2
-            dims[name] = dims[f"d{k + 1}"] = "length"
-        return _result(self.name, model, values, dims, message="A1 = L2/L1, A2 = L2 L4/(L1 L3) (eq 1); d = A2 q")
-
-    def output_names(self, model: Model) -> list[str]:
-        n = len(model.closure.q_names)
-        return ["A1", "A2"] + model.closure.q_names + [f"d{k + 1}" for k in range(n)]
 
 
 # -- workspace ------------------------------------------------------------------------------------
@@ -79,6 +42,7 @@ class Amplifier(ProblemKind):
 class ActuatorWorkspace(ProblemKind):
     name = "actuator_workspace"
     description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
+    plots = ("workspace",)  # its points (inputs.points: true): the images of the stroke grid
 
     def input_options(self, model: Model) -> list[Option]:
         return [
@@ -122,7 +86,7 @@ class ActuatorWorkspace(ProblemKind):
             rep.seconds,
         )
         if not rep.status.ok:
-            return _result(self.name, model, {}, dims, rep.status, rep.message, info)
+            return closed_form_result(self.name, model, {}, dims, rep.status, rep.message, info)
         names = [c.x[i].name for i in c.task_index]
         values: dict[str, Any] = {}
         for k, n in enumerate(names):
@@ -139,7 +103,7 @@ class ActuatorWorkspace(ProblemKind):
         for k, n in enumerate(names):
             values[f"{n}_linear_error"] = float(rep.linear_error[k])
         values["n_points"] = len(rep.q)
-        res = _result(self.name, model, values, dims, rep.status, rep.message, info)
+        res = closed_form_result(self.name, model, values, dims, rep.status, rep.message, info)
         res.units["vertices"] = "rows: box corners; columns " + ", ".join(
             f"{n} [{_si(dims[n + '_min'])}]" for n in names
         )
@@ -156,8 +120,9 @@ class ActuatorWorkspace(ProblemKind):
 # -- dynamics -------------------------------------------------------------------------------------
 
 
-def _module(model: Model):
-    return importlib.import_module(MODULES[model.name])
+def _dynamics(model: Model) -> DynamicsModel:
+    """The mechanism's declared Lagrange model (``Mechanism.dynamics``)."""
+    return model.mechanism.dynamics
 
 
 class Dynamics(ProblemKind):
@@ -165,11 +130,13 @@ class Dynamics(ProblemKind):
     description = "Lagrange dynamics at home: M, K, G (AD of the energies) and the natural frequencies"
 
     def supports(self, model: Model) -> str | None:
-        return None if hasattr(_module(model), "lagrangian") else "it has no dynamic model (no energies)"
+        if model.mechanism is None or model.mechanism.dynamics is None:
+            return "it has no dynamic model (no energies)"
+        return None
 
     def input_options(self, model: Model) -> list[Option]:
         masses = [
-            Option(m, "mass", f"{d}; a mass or a block {{length, width, height}}") for m, d in _module(model).MASSES
+            Option(m, "mass", f"{d}; a mass or a block {{length, width, height}}") for m, d in _dynamics(model).masses
         ]
         return [
             Option("material", "str", "the hinge material: a name (Al 7075-T6, ...) or inline {E, nu, density}"),
@@ -192,11 +159,11 @@ class Dynamics(ProblemKind):
                 raise InputError(f"missing required input '{o.name}' ({o.description})", path=path)
         mat = parse_material(raw["material"], path + ("material",))
         inputs: dict[str, Any] = {"material": mat}
-        for m, _ in _module(model).MASSES:
+        for m, _ in _dynamics(model).masses:
             inputs[m] = dyn.parse_mass(raw[m], mat.density, mat.name, path + (m,))
         inputs.update(validate_mapping({"g": raw.get("g")}, [options[-1]], path, what="input"))
         inputs["E"] = mat.require("E", path + ("material",), "the hinge stiffness needs it")
-        missing = [n for n in _module(model).DYNAMIC_PARAMETERS if n not in inputs and n not in model.parameters]
+        missing = [n for n in _dynamics(model).parameters if n not in inputs and n not in model.parameters]
         if missing:
             raise InputError(
                 f"missing parameter(s) {', '.join(missing)}, needed by the dynamics "
@@ -206,22 +173,22 @@ class Dynamics(ProblemKind):
         return inputs
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
-        mod = _module(model)
-        w = np.array([inputs[n] if n in inputs else model.parameters[n] for n in mod.DYNAMIC_PARAMETERS], dtype=float)
-        M, K, G = dyn.matrices(mod.lagrangian(), model.q_home, model.p, w)
+        dm = _dynamics(model)
+        w = np.array([inputs[n] if n in inputs else model.parameters[n] for n in dm.parameters], dtype=float)
+        M, K, G = dyn.matrices(dm.lagrangian(), model.q_home, model.p, w)
         f = dyn.natural_frequencies(M, K)
         n = model.closure.nq
-        values: dict[str, Any] = {m: inputs[m] for m, _ in mod.MASSES}
-        dims = {m: "mass" for m, _ in mod.MASSES}
+        values: dict[str, Any] = {m: inputs[m] for m, _ in dm.masses}
+        dims = {m: "mass" for m, _ in dm.masses}
         for k in range(n):
             values[f"f{k + 1}"] = float(f[k])
             dims[f"f{k + 1}"] = "frequency"
         values.update(M=M.tolist(), K=K.tolist(), G=G.tolist(), q_static=(-np.linalg.solve(K, G)).tolist())
         dims.update(M="matrix", K="matrix", G="vector", q_static="vector")
-        if hasattr(mod, "dynamics_values"):
-            values.update(mod.dynamics_values(model, w, M, K, G))
-            dims.update(mod.DYNAMICS_DIMENSIONS)
-        res = _result(
+        if dm.values is not None:
+            values.update(dm.values(model, w, M, K, G))
+            dims.update(dm.dimensions)
+        res = closed_form_result(
             self.name,
             model,
             values,
@@ -235,7 +202,7 @@ class Dynamics(ProblemKind):
         return res
 
     def output_names(self, model: Model) -> list[str]:
-        mod = _module(model)
-        names = [m for m, _ in mod.MASSES] + [f"f{k + 1}" for k in range(model.closure.nq)]
-        names += ["M", "K", "G", "q_static"] + list(getattr(mod, "DYNAMICS_DIMENSIONS", {}))
+        dm = _dynamics(model)
+        names = [m for m, _ in dm.masses] + [f"f{k + 1}" for k in range(model.closure.nq)]
+        names += ["M", "K", "G", "q_static"] + list(dm.dimensions)
         return names

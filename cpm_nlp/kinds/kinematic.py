@@ -123,6 +123,7 @@ def _model_info(model: Model) -> dict[str, Any]:
 class ForwardKinematics(ProblemKind):
     name = "forward_kinematics"
     description = "platform pose from the actuator displacements (FK), checked against IK"
+    plots = ("io", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
         return actuator_options(model, "grid")
@@ -165,6 +166,7 @@ class ForwardKinematics(ProblemKind):
 class InverseKinematics(ProblemKind):
     name = "inverse_kinematics"
     description = "actuator displacements and passive joints for a platform pose (IK)"
+    plots = ("io", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
         return task_options(model, "grid") + [
@@ -309,6 +311,7 @@ class Jacobian(ProblemKind):
 class JointRequirements(ProblemKind):
     name = "joint_requirements"
     description = "actuator strokes and passive-joint rotations over every combination of task values"
+    plots = ("requirements", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
         return task_options(model, "grid")

@@ -1,15 +1,14 @@
 """The ``synthesis`` problem kind: dimensional synthesis of a mechanism.
 
 Every paper states its own synthesis (design variables, objective,
-constraints), so the kind dispatches to the mechanism: a mechanism module
-that supports it names its formulation in ``SYNTHESIS = "module:Class"``, a
-:class:`SynthesisFormulation`.  The kind itself only looks the formulation
+constraints), so the kind dispatches to the mechanism: a mechanism that
+supports it declares its formulation, a :class:`SynthesisFormulation`
+subclass, as the capability ``Mechanism.synthesis``.  The kind itself only looks the formulation
 up and hands it the validated model, inputs and solver.
 """
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Mapping
 from typing import Any
 
@@ -18,7 +17,6 @@ from ..core.model import Model
 from ..core.options import Option
 from ..core.result import Result
 from ..core.solver import SolverConfig
-from ..mechanisms.registry import MODULES
 
 
 class SynthesisFormulation(ProblemKind):
@@ -31,11 +29,10 @@ class SynthesisFormulation(ProblemKind):
 
 def formulation(model: Model) -> SynthesisFormulation | None:
     """The synthesis formulation of a model's mechanism, or None."""
-    spec = getattr(importlib.import_module(MODULES[model.name]), "SYNTHESIS", None)
-    if spec is None:
+    mech = model.mechanism
+    if mech is None or mech.synthesis is None:
         return None
-    module, cls = spec.split(":")
-    return getattr(importlib.import_module(module), cls)()
+    return mech.synthesis()
 
 
 class Synthesis(ProblemKind):
@@ -44,7 +41,7 @@ class Synthesis(ProblemKind):
 
     def supports(self, model: Model) -> str | None:
         if formulation(model) is None:
-            return f"the mechanism module of '{model.name}' defines no SYNTHESIS formulation"
+            return f"the mechanism '{model.name}' declares no synthesis formulation (Mechanism.synthesis)"
         return None
 
     def input_options(self, model: Model) -> list[Option]:

@@ -1,19 +1,18 @@
 """Workspace problem kinds: ``inscribed_cuboid`` and ``workspace``.
 
 Both work for any mechanism from its loop closures and joint limits (see
-:mod:`cpm_nlp.analysis.workspace`).  A mechanism module may add to them:
+:mod:`cpm_nlp.analysis.workspace`).  A mechanism may add to them through
+two declared capabilities (:class:`~cpm_nlp.core.mechanism.Mechanism`):
 
-* ``CUBOID_OPTIONS`` (Options), ``CUBOID_VALUE_NAMES`` and
-  ``cuboid_values(model, lower, upper, inputs, solver) -> (values,
-  dimensions)``: extra inputs and values of the cuboid found, e.g. the
-  paper's names for it and the paper's own formulation;
+* ``cuboid`` (:class:`~cpm_nlp.core.mechanism.CuboidExtras`): extra inputs
+  and values of the cuboid found, e.g. the paper's names for it and the
+  paper's own formulation;
 * ``paper_membership(model, points) -> (inside, margins)``: a closed-form
   membership test from the paper, reported beside the general one.
 """
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Mapping
 from typing import Any
 
@@ -29,18 +28,22 @@ from ..analysis.workspace import (
 )
 from ..core.errors import InputError
 from ..core.kind import ProblemKind, broadcast, require_ipopt
+from ..core.mechanism import CuboidExtras
 from ..core.model import Model
 from ..core.multistart import start_options
 from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
-from ..mechanisms.registry import MODULES
 from .kinematic import _model_info
 
 
-def _module(model: Model):
-    return importlib.import_module(MODULES[model.name])
+def _cuboid_extras(model: Model) -> CuboidExtras | None:
+    return model.mechanism.cuboid if model.mechanism is not None else None
+
+
+def _paper_membership(model: Model) -> Any:
+    return model.mechanism.paper_membership if model.mechanism is not None else None
 
 
 def _unit(dim: str) -> str:
@@ -86,6 +89,7 @@ def _volume_dimension(model: Model) -> tuple[str, str]:
 class InscribedCuboid(ProblemKind):
     name = "inscribed_cuboid"
     description = "largest axis-aligned box of task coordinates inside the reachable workspace (IPOPT, multi-start)"
+    plots = ("workspace",)
 
     def input_options(self, model: Model) -> list[Option]:
         rounds = EXTRA_SLOTS // ADDED_PER_ROUND
@@ -117,7 +121,8 @@ class InscribedCuboid(ProblemKind):
             ),
         ]
         opts += _region_options(model)
-        opts += list(getattr(_module(model), "CUBOID_OPTIONS", ()))
+        extras = _cuboid_extras(model)
+        opts += list(extras.options) if extras else []
         return opts
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
@@ -143,7 +148,8 @@ class InscribedCuboid(ProblemKind):
             "check_margin",
             "check_binding",
         ]
-        return names + list(getattr(_module(model), "CUBOID_VALUE_NAMES", ()))
+        extras = _cuboid_extras(model)
+        return names + (list(extras.value_names) if extras else [])
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         require_ipopt(solver, self.name)
@@ -192,15 +198,15 @@ class InscribedCuboid(ProblemKind):
         dims.update(
             check_points="dimensionless", check_outside="dimensionless", check_margin="si", check_binding="text"
         )
-        hook = getattr(_module(model), "cuboid_values", None)
-        if hook is not None and res.found:
-            extra, extra_dims = hook(model, res.lower, res.upper, dict(inputs), solver)
+        extras = _cuboid_extras(model)
+        if extras is not None and res.found:
+            extra, extra_dims = extras.values(model, res.lower, res.upper, dict(inputs), solver)
             values.update(extra)
             dims.update(extra_dims)
         if not res.found:  # no numbers that look like an answer
             keep = ("starts", "starts_converged")
             values = {k: (v if k in keep else None) for k, v in values.items()}
-            values.update({k: None for k in getattr(_module(model), "CUBOID_VALUE_NAMES", ())})
+            values.update({k: None for k in (extras.value_names if extras else ())})
         status = Status.SOLVED if res.found else (Status.INFEASIBLE if res.infeasible else Status.NOT_CONVERGED)
         message = res.message
         if res.found:
@@ -225,6 +231,7 @@ class InscribedCuboid(ProblemKind):
 class Workspace(ProblemKind):
     name = "workspace"
     description = "membership of given points and a seeded point cloud of the reachable workspace"
+    plots = ("workspace",)
 
     def input_options(self, model: Model) -> list[Option]:
         c = model.closure
@@ -271,7 +278,7 @@ class Workspace(ProblemKind):
             values["binding"] = mem.binding
             values["count_inside"] = int(np.count_nonzero(mem.inside))
             dims.update(inside="text", margin="si", binding="text", count_inside="dimensionless")
-            paper = getattr(_module(model), "paper_membership", None)
+            paper = _paper_membership(model)
             if paper is not None:
                 values["inside_paper"] = paper(model, T)[0].tolist()
                 dims["inside_paper"] = "text"

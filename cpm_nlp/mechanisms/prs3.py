@@ -38,6 +38,7 @@ import math
 import casadi as ca
 import numpy as np
 
+from ..core.mechanism import Mechanism
 from ..core.model import Coordinate, LoopClosure, Model
 from ..core.options import Option
 
@@ -45,8 +46,6 @@ SQRT3 = math.sqrt(3.0)
 #: angular positions of the legs, eq 2-3
 GAMMA = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
 
-TITLE = "3-PRS compliant stage (Ruiz et al.)"
-PAPER = "prs3-ruiz.md"
 
 PARAMETERS = (
     Option(
@@ -310,3 +309,24 @@ def build(closure_: LoopClosure, parameters: dict, limits: dict) -> Model:
         dimensions={"b": "length", "L": "length", "alpha0": "angle", "a": "length", "pz0": "length"},
         characteristic_length=parameters["b"],  # a tilt dθ moves the joints B_i by about b dθ
     )
+
+
+MECHANISM = Mechanism(
+    name="prs3",
+    title="3-PRS compliant stage (Ruiz et al.)",
+    paper=(
+        "A. Ruiz, F. J. Campa, C. Roldan-Paraponiaris, O. Altuzarra, C. Pinto, Experimental validation of the "
+        "kinematic design of 3PRS compliant parallel mechanisms, University of the Basque Country UPV/EHU"
+    ),
+    parameters=PARAMETERS,
+    limits=LIMITS,
+    closure=closure,
+    build=build,
+    problem_files=(
+        "prs3_forward_kinematics.yaml",
+        "prs3_inverse_kinematics.yaml",
+        "prs3_jacobian.yaml",
+        "prs3_joint_requirements.yaml",
+        "prs3_fem_table2.yaml",
+    ),
+)

@@ -1,13 +1,17 @@
-"""Registry of mechanism types.
+"""The registry of mechanism types: built-in, and added by plugins.
 
-Each mechanism is one module of the package that provides
+A mechanism type is a :class:`~cpm_nlp.core.mechanism.Mechanism` declaration.
+The built-in ones are listed in :data:`BUILTIN`; a third-party package adds
+its own through the entry-point group ``cpm_nlp.mechanisms``, without editing
+cpm_nlp::
 
-* ``TITLE``, ``PAPER`` -- what it is and where it comes from,
-* ``PARAMETERS``, ``LIMITS`` -- declared :class:`~cpm_nlp.core.options.Option` s,
-* ``closure()`` -- its symbolic :class:`~cpm_nlp.core.model.LoopClosure`,
-* ``build(closure, parameters, limits)`` -- a :class:`~cpm_nlp.core.model.Model`,
-* optionally ``check_parameters(params, path)`` and ``check_limits(limits,
-  path)`` for rules that involve several values.
+    # the plugin's pyproject.toml
+    [project.entry-points."cpm_nlp.mechanisms"]
+    delta = "my_package.delta:MECHANISM"
+
+The entry point names a :class:`Mechanism` (or a function without arguments
+returning one).  Registering validates it: a misspelt or mistyped capability
+is an error that names the plugin, never a silently missing feature.
 
 The symbolic closure is built once per process and shared by every model of
 that type (it holds code, not problem data), so solvers built for one model
@@ -16,71 +20,188 @@ serve all of them.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
+import logging
+import re
 import threading
 from collections.abc import Mapping
-from dataclasses import dataclass
-from types import ModuleType
+from importlib import metadata
 from typing import Any
 
-from ..core.errors import InputError, suggest
+from ..core.errors import CpmError, InputError, suggest
+from ..core.mechanism import PARTS, Mechanism, MechanismDeclarationError, validate
 from ..core.model import LoopClosure, Model
-from ..core.options import Option, validate_mapping
 
-#: mechanism type -> module implementing it
-MODULES = {
-    "prc3": "cpm_nlp.mechanisms.prc3.kinematics",
-    "prs3": "cpm_nlp.mechanisms.prs3",
-    "rpr": "cpm_nlp.mechanisms.rpr.kinematics",
-    "pantograph": "cpm_nlp.mechanisms.pantograph.kinematics",
+log = logging.getLogger(__name__)
+
+#: entry-point group of mechanism plugins
+ENTRY_POINT_GROUP = "cpm_nlp.mechanisms"
+
+#: built-in mechanism type -> "module:attribute" of its declaration
+BUILTIN = {
+    "prc3": "cpm_nlp.mechanisms.prc3:MECHANISM",
+    "prs3": "cpm_nlp.mechanisms.prs3:MECHANISM",
+    "rpr": "cpm_nlp.mechanisms.rpr:MECHANISM",
+    "pantograph": "cpm_nlp.mechanisms.pantograph:MECHANISM",
 }
 
 
-@dataclass(frozen=True)
-class MechanismType:
-    name: str
-    module: ModuleType
-
-    @property
-    def title(self) -> str:
-        return self.module.TITLE
-
-    @property
-    def paper(self) -> str:
-        return self.module.PAPER
-
-    @property
-    def parameters(self) -> tuple[Option, ...]:
-        return tuple(self.module.PARAMETERS)
-
-    @property
-    def limits(self) -> tuple[Option, ...]:
-        return tuple(self.module.LIMITS)
+class PluginError(InputError):
+    """A mechanism plugin that cannot be loaded or breaks the interface (the message names the plugin)."""
 
 
-_lock = threading.Lock()
-_closures: dict[str, LoopClosure] = {}
+class _Registry:
+    """Mechanism declarations by name, loaded on first use (thread-safe)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.RLock()
+        self._specs: dict[str, tuple[str, str]] | None = None  # name -> (target, origin)
+        self._loaded: dict[str, Mechanism] = {}
+        self._closures: dict[str, LoopClosure] = {}
+        #: bumped by every register/unregister, so that tables derived from the registry refresh
+        self.version = 0
+
+    def _discover(self) -> dict[str, tuple[str, str]]:
+        if self._specs is None:
+            specs = {name: (target, "built-in") for name, target in BUILTIN.items()}
+            for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
+                origin = f"plugin {ep.name!r} ({ep.value}" + (f", package {ep.dist.name})" if ep.dist else ")")
+                if ep.name in specs:
+                    log.warning(
+                        "mechanism plugin %s ignored: the name %r is taken (%s)", origin, ep.name, specs[ep.name][1]
+                    )
+                    continue
+                specs[ep.name] = (ep.value, origin)
+            self._specs = specs
+        return self._specs
+
+    def names(self) -> list[str]:
+        with self._lock:
+            return sorted(self._discover())
+
+    def register(self, mech: Mechanism, *, replace: bool = False) -> Mechanism:
+        """Add a mechanism declared in code (validated)."""
+        if not isinstance(mech, Mechanism):
+            raise MechanismDeclarationError(f"expected a Mechanism declaration, got {type(mech).__name__}")
+        validate(mech)
+        with self._lock:
+            specs = self._discover()
+            if mech.name in specs and not replace:
+                raise MechanismDeclarationError(
+                    f"mechanism {mech.name!r} ({mech.origin}) is already registered ({specs[mech.name][1]})"
+                )
+            specs[mech.name] = ("", mech.origin)
+            self._loaded[mech.name] = mech
+            self._closures.pop(mech.name, None)
+            self.version += 1
+        return mech
+
+    def unregister(self, name: str) -> None:
+        with self._lock:
+            self._discover().pop(name, None)
+            self._loaded.pop(name, None)
+            self._closures.pop(name, None)
+            self.version += 1
+
+    def get(self, name: str) -> Mechanism:
+        with self._lock:
+            mech = self._loaded.get(name)
+            if mech is None:
+                target, origin = self._discover()[name]
+                mech = _load(name, target, origin)
+                self._loaded[name] = mech
+            return mech
+
+    def closure(self, mech: Mechanism) -> LoopClosure:
+        with self._lock:
+            c = self._closures.get(mech.name)
+            if c is None:
+                try:
+                    c = mech.closure()
+                except CpmError:
+                    raise
+                except Exception as exc:
+                    raise PluginError(
+                        f"mechanism {mech.name!r} ({mech.origin}): building its closure failed: {exc}"
+                    ) from exc
+                if not isinstance(c, LoopClosure):
+                    raise PluginError(
+                        f"mechanism {mech.name!r} ({mech.origin}): closure() must return a LoopClosure, "
+                        f"got {type(c).__name__}"
+                    )
+                c.mechanism = mech
+                self._closures[mech.name] = c
+            return c
 
 
-def mechanism_type(name: Any, path: tuple = ("mechanism", "type")) -> MechanismType:
-    """Look up a mechanism type by name (with a "did you mean" if unknown)."""
-    if not isinstance(name, str) or name not in MODULES:
+_UNEXPECTED = re.compile(r"unexpected keyword argument '(\w+)'")
+
+
+def _load(name: str, target: str, origin: str) -> Mechanism:
+    """Import and validate one declaration; every failure names its origin."""
+    module, _, attr = target.partition(":")
+    try:
+        obj: Any = importlib.import_module(module)
+        for part in attr.split(".") if attr else ():
+            obj = getattr(obj, part)
+        if not isinstance(obj, Mechanism) and callable(obj):
+            obj = obj()
+    except TypeError as exc:
+        hint = ""
+        m = _UNEXPECTED.search(str(exc))
+        if m:
+            close = suggest(m.group(1), PARTS)
+            hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+        raise PluginError(f"mechanism {name!r} ({origin}) failed to load: {exc}{hint}") from exc
+    except Exception as exc:
+        raise PluginError(f"mechanism {name!r} ({origin}) failed to load: {type(exc).__name__}: {exc}") from exc
+    if not isinstance(obj, Mechanism):
+        raise PluginError(f"mechanism {name!r} ({origin}) must name a Mechanism declaration, got {type(obj).__name__}")
+    if obj.name != name:
+        raise PluginError(f"mechanism {name!r} ({origin}) declares the name {obj.name!r}; the two must agree")
+    if origin != "built-in" and obj.origin == "built-in":
+        obj = _with_origin(obj, origin)
+    return obj
+
+
+def _with_origin(mech: Mechanism, origin: str) -> Mechanism:
+    return dataclasses.replace(mech, origin=origin)
+
+
+REGISTRY = _Registry()
+
+
+def mechanism_names() -> list[str]:
+    """Names of every registered mechanism type (built-in and plugins)."""
+    return REGISTRY.names()
+
+
+def register(mech: Mechanism, *, replace: bool = False) -> Mechanism:
+    """Register a mechanism declared in code, e.g. in a script or a test."""
+    return REGISTRY.register(mech, replace=replace)
+
+
+def unregister(name: str) -> None:
+    """Remove a mechanism registered in code."""
+    REGISTRY.unregister(name)
+
+
+def mechanism_type(name: Any, path: tuple = ("mechanism", "type")) -> Mechanism:
+    """The declaration of a mechanism type (with a "did you mean" if unknown)."""
+    names = REGISTRY.names()
+    if not isinstance(name, str) or name not in names:
         raise InputError(
-            f"unknown mechanism type {name!r}; expected one of: {', '.join(sorted(MODULES))}",
+            f"unknown mechanism type {name!r}; expected one of: {', '.join(names)}",
             path=path,
-            suggestions=suggest(str(name), MODULES),
+            suggestions=suggest(str(name), names),
         )
-    return MechanismType(name, importlib.import_module(MODULES[name]))
+    return REGISTRY.get(name)
 
 
-def closure_of(mtype: MechanismType) -> LoopClosure:
+def closure_of(mech: Mechanism) -> LoopClosure:
     """The shared symbolic closure of a mechanism type."""
-    with _lock:
-        c = _closures.get(mtype.name)
-        if c is None:
-            c = mtype.module.closure()
-            _closures[mtype.name] = c
-        return c
+    return REGISTRY.closure(mech)
 
 
 def build_model(
@@ -96,13 +217,15 @@ def build_model(
     exactly as in a problem file, e.g.
     ``build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm"})``.
     """
-    mtype = mechanism_type(type_name, path + ("type",))
-    params = validate_mapping(parameters or {}, mtype.parameters, path + ("parameters",), what="parameter")
-    lims = validate_mapping(limits or {}, mtype.limits, path + ("limits",), what="limit")
-    check = getattr(mtype.module, "check_parameters", None)
-    if check is not None:
-        check(params, path + ("parameters",))
-    check_limits = getattr(mtype.module, "check_limits", None)
-    if check_limits is not None:
-        check_limits(lims, path + ("limits",))
-    return mtype.module.build(closure_of(mtype), params, lims)
+    mech = mechanism_type(type_name, path + ("type",))
+    closure = closure_of(mech)
+    if mech.origin == "built-in":
+        return mech.model(closure, parameters, limits, path)
+    try:
+        return mech.model(closure, parameters, limits, path)
+    except CpmError:
+        raise
+    except Exception as exc:
+        raise PluginError(
+            f"mechanism {mech.name!r} ({mech.origin}): build failed: {type(exc).__name__}: {exc}"
+        ) from exc

@@ -33,9 +33,9 @@ from typing import Any
 
 import numpy as np
 
-from ..cli.main import check_output_path, replace_atomically
 from ..core.errors import InputError
 from ..core.units import DIMENSIONS, to_display
+from ..io.atomic import check_output_path, replace_atomically
 
 #: file types :func:`save` writes
 FIGURE_FORMATS = (".png", ".svg", ".pdf")
@@ -65,7 +65,7 @@ _GREEK = (
 
 
 def _figure_class() -> Any:
-    from ..sweep.run import require
+    from ..core.extras import require
 
     require("matplotlib", "plot", "plotting")
     from matplotlib.figure import Figure
@@ -253,7 +253,7 @@ def _edges(u: np.ndarray) -> np.ndarray:
     return np.r_[u[0] - (mid[0] - u[0]), mid, u[-1] + (u[-1] - mid[-1])]
 
 
-def design_map_figure(
+def design_map_figure(  # noqa: C901 - one branch per optional layer of the map
     x: Any,
     y: Any,
     z: Any,

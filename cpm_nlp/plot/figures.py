@@ -2,14 +2,15 @@
 
 A result is the JSON of ``cpm-nlp solve -o`` (or a :class:`~cpm_nlp.core.result.Result`)
 or a sweep results file; :func:`load` reads either into :class:`ResultData`.
-The figure is chosen from the result's problem kind (:data:`DEFAULTS`: the
-first plot type that applies to the values wins) or named (``--type``).
+The figure is chosen from the result's problem kind (its ``plots``, see
+:class:`~cpm_nlp.core.kind.ProblemKind`: the first plot type that applies to
+the values wins) or named (``--type``).
 
-Extending: a plot type is one entry in :data:`PLOTS` (name ->
-"module:function"), the function taking ``(data, options)`` and returning a
-Matplotlib figure made by :mod:`cpm_nlp.plot.draw` from arrays, or raising
-:class:`NotApplicable`; a problem kind lists its plot types in
-:data:`DEFAULTS`.  A kind needs no plotting code of its own when its values
+Extending: a plot type is one entry in :data:`PLOTS` (name -> function),
+the function taking ``(data, options)`` and returning a Matplotlib figure
+made by :mod:`cpm_nlp.plot.draw` from arrays, or raising
+:class:`NotApplicable`; a problem kind lists its plot types in its
+``plots`` attribute.  A kind needs no plotting code of its own when its values
 use the names read here (SI values, units in the result):
 
 * ``workspace`` -- a point cloud: ``cloud_<t>`` for each task coordinate t
@@ -18,7 +19,7 @@ use the names read here (SI values, units in the result):
   ``cuboid_upper``; a batch of poses (FK, IK) gives its task coordinates.  A
   cuboid without a cloud (``inscribed_cuboid``) is drawn in a cloud sampled
   from the model when the model is at hand (``cpm-nlp solve FILE --plot``);
-* ``map`` -- :data:`MAP_AXES` names (x, y, value) of the kind: x and y
+* ``map`` -- the kind's ``map_axes`` name (x, y, value): x and y: x and y
   lists and the value either a list of the same length or a matrix
   (rows y, columns x; ``null`` outside the design space); optional
   ``in_region`` (same shape: outlined), ``<x>_best``/``<y>_best`` and
@@ -28,7 +29,6 @@ use the names read here (SI values, units in the result):
 
 from __future__ import annotations
 
-import importlib
 import json
 import os
 from collections.abc import Mapping
@@ -38,37 +38,19 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.workspace import probe_region, sample_workspace
 from ..core.errors import InputError, suggest
+from ..core.kinematics import passive_joints
 from ..core.units import DIMENSIONS
-from .draw import as_floats
+from ..io.results import FORMATS, read_results
+from ..mechanisms.registry import build_model, closure_of, mechanism_type
+from ..problems.registry import kind_names, problem_kind
+from .draw import Panel, as_floats, design_map_figure, panels_figure, pretty, workspace_figure
 
 SWEEP = "sweep"  # the "kind" of a sweep results file in DEFAULTS
 
-#: plot type -> "module:function(data, options) -> Figure"
-PLOTS = {
-    "workspace": "cpm_nlp.plot.figures:workspace_plot",
-    "map": "cpm_nlp.plot.figures:map_plot",
-    "requirements": "cpm_nlp.plot.figures:requirements_plot",
-    "io": "cpm_nlp.plot.figures:io_plot",
-    "lines": "cpm_nlp.plot.figures:lines_plot",
-}
-
-#: problem kind (or "sweep") -> plot types that may apply, the default first
-DEFAULTS = {
-    "forward_kinematics": ("io", "workspace"),
-    "inverse_kinematics": ("io", "workspace"),
-    "joint_requirements": ("requirements", "workspace"),
-    "workspace": ("workspace",),
-    "inscribed_cuboid": ("workspace",),
-    "actuator_workspace": ("workspace",),  # its points (inputs.points: true): the images of the stroke grid
-    "rpr_transmission_map": ("map",),
-    SWEEP: ("map", "lines", "workspace"),
-}
-
-#: problem kind -> (x, y, value) names of the values a design map of its result shows
-MAP_AXES: dict[str, tuple[str, str, str]] = {
-    "rpr_transmission_map": ("s", "t", "eta"),  # rpr-2rpu-upr-zhang-2022.md, Fig. 4
-}
+#: plot types that may draw a sweep results file, the default first
+SWEEP_PLOTS = ("map", "lines", "workspace")
 
 #: sweep statuses of points outside the design space (drawn apart from points that did not solve)
 OUTSIDE = ("infeasible", "invalid_input")
@@ -118,7 +100,7 @@ class ResultData:
 
     @property
     def kind(self) -> str:
-        return SWEEP if self.sweep else self.problem
+        return "sweep" if self.sweep else self.problem
 
     @property
     def ok(self) -> np.ndarray | None:
@@ -174,8 +156,6 @@ def from_table(table: Any) -> ResultData:
 
 def load(path: str | os.PathLike) -> ResultData:
     """Read a JSON result (``cpm-nlp solve -o``) or a sweep results file."""
-    from ..io.results import FORMATS, read_results
-
     p = Path(path)
     if p.suffix.lower() in FORMATS:
         return from_table(read_results(p))
@@ -210,9 +190,10 @@ def figure(data: ResultData, plot_type: str | None = None, options: PlotOptions 
                 suggestions=suggest(plot_type, PLOTS),
             )
         return _plot_function(plot_type)(data, options), plot_type
-    candidates = DEFAULTS.get(data.kind)
+    candidates = SWEEP_PLOTS if data.sweep else _kind_plots(data.problem)
     if not candidates:
-        raise NotApplicable(f"no plot is known for a {data.kind} result; known: {', '.join(sorted(DEFAULTS))}")
+        known = [n for n in kind_names() if problem_kind(n).plots]
+        raise NotApplicable(f"no plot is known for a {data.kind} result; known: {', '.join(known + ['sweep'])}")
     reasons = []
     for name in candidates:
         try:
@@ -223,8 +204,17 @@ def figure(data: ResultData, plot_type: str | None = None, options: PlotOptions 
 
 
 def _plot_function(name: str) -> Any:
-    module, func = PLOTS[name].split(":")
-    return getattr(importlib.import_module(module), func)
+    return PLOTS[name]
+
+
+def _kind_plots(name: str) -> tuple[str, ...]:
+    """The plot types of a problem kind (none for a kind unknown here)."""
+    return problem_kind(name).plots if name in kind_names() else ()
+
+
+def _map_axes(name: str) -> tuple[str | None, str | None, str | None]:
+    axes = problem_kind(name).map_axes if name in kind_names() else None
+    return axes or (None, None, None)
 
 
 # -- helpers ------------------------------------------------------------------------------------
@@ -232,8 +222,6 @@ def _plot_function(name: str) -> Any:
 
 def _closure(data: ResultData) -> Any:
     """The symbolic mechanism of the result (names of its coordinates)."""
-    from ..mechanisms.registry import closure_of, mechanism_type
-
     name = data.model.get("type")
     if not name:
         raise NotApplicable("the result does not name its mechanism (model.type)")
@@ -268,10 +256,8 @@ def _dims(data: ResultData, name: str) -> str | None:
 # -- workspace ------------------------------------------------------------------------------------
 
 
-def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
+def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG001 - signature of every plot function
     """A point cloud with its cuboid (see the module's naming conventions)."""
-    from .draw import workspace_figure
-
     v = data.values
     title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
     if v.get("points") is not None:
@@ -322,8 +308,6 @@ def _cloud_around(model: Any, cuboid: tuple) -> np.ndarray:
     """Reachable points in a box holding the region probed from home and the
     cuboid, a quarter wider each way: the workspace's boundary near the cuboid
     shows even where the probe from home stops short of it."""
-    from ..analysis.workspace import probe_region, sample_workspace
-
     lo, hi = (np.asarray(c, dtype=float) for c in cuboid)
     probed = probe_region(model)
     if probed is not None:
@@ -372,13 +356,11 @@ def _value_column(data: ResultData, options: PlotOptions) -> str:
 
 def map_plot(data: ResultData, options: PlotOptions) -> Any:
     """A design map: a value over two swept parameters, or over the two grids
-    of a kind in :data:`MAP_AXES` (see the module's naming conventions)."""
-    from .draw import design_map_figure, pretty
-
+    of a kind's ``map_axes`` (see the module's naming conventions)."""
     if data.sweep:
         return _sweep_map(data, options)
     v = data.values
-    axes = MAP_AXES.get(data.problem) or (None, None, None)
+    axes = _map_axes(data.problem)
     xk, yk, zk = options.x or axes[0], options.y or axes[1], options.value or axes[2]
     if not (xk and yk and zk):
         raise NotApplicable("a map of a single result needs --x, --y and --value naming three of its lists")
@@ -422,8 +404,6 @@ def map_plot(data: ResultData, options: PlotOptions) -> Any:
 
 
 def _sweep_map(data: ResultData, options: PlotOptions) -> Any:
-    from .draw import design_map_figure
-
     params = _numeric_columns(data, [p["key"] for p in data.parameters])
     if options.x or options.y:
         xk = _sweep_key(data, options.x or params[0], "--x")
@@ -456,8 +436,6 @@ def _sweep_map(data: ResultData, options: PlotOptions) -> Any:
 
 def lines_plot(data: ResultData, options: PlotOptions) -> Any:
     """Values of a one-parameter sweep against the parameter, one panel each."""
-    from .draw import Panel, panels_figure
-
     if not data.sweep:
         raise NotApplicable("'lines' plots a sweep results file")
     params = _numeric_columns(data, [p["key"] for p in data.parameters])
@@ -481,14 +459,10 @@ def _families(coords: Any) -> dict[str, list[Any]]:
     return out
 
 
-def requirements_plot(data: ResultData, options: PlotOptions) -> Any:
+def requirements_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG001 - signature of every plot function
     """The joint requirements over the studied poses: platform motions and
     actuator displacements (first row, 3-PRS paper Fig. 6), passive joint
     rotations, relative to home where home is not zero (Fig. 7)."""
-    from ..core.kinematics import passive_joints
-    from ..mechanisms.registry import build_model
-    from .draw import Panel, panels_figure
-
     if data.sweep:
         raise NotApplicable("'requirements' plots one joint_requirements result, not a sweep")
     c = _closure(data)
@@ -529,8 +503,6 @@ def io_plot(data: ResultData, options: PlotOptions) -> Any:
     """Outputs against the input that varies, one panel per output (pantograph
     paper, Fig. 20-22): pose coordinates against an actuator for FK, actuators
     and dependent coordinates against a task coordinate for IK."""
-    from .draw import Panel, panels_figure
-
     if data.sweep:
         raise NotApplicable("'io' plots one batch result; for a sweep use 'lines'")
     c = _closure(data)
@@ -563,3 +535,13 @@ def io_plot(data: ResultData, options: PlotOptions) -> Any:
         xdimension=_dims(data, x),
         title=f"Outputs against {xname} ({data.model.get('type')}, {data.problem})",
     )
+
+
+#: plot type -> function(data, options) -> Figure
+PLOTS = {
+    "workspace": workspace_plot,
+    "map": map_plot,
+    "requirements": requirements_plot,
+    "io": io_plot,
+    "lines": lines_plot,
+}

@@ -2,10 +2,10 @@
 
 One schema family for every problem kind::
 
-    problem: forward_kinematics        # the question (see cpm_nlp.core.kind.KINDS)
+    problem: forward_kinematics        # the question (cpm-nlp describe lists the kinds)
     description: free text
     mechanism:
-      type: prs3                       # see cpm_nlp.mechanisms.registry.MODULES
+      type: prs3                       # cpm-nlp describe lists the types
       parameters: {b: 47.91 mm, L: 109.215 mm, alpha0: 45 deg}
       limits: {s: [-3 mm, 3 mm]}       # optional joint limits
     inputs: {s1: 1 mm, s2: 0.5 mm, s3: -0.3 mm}
@@ -21,21 +21,23 @@ Every error names the file and the key path and says what was expected.
 from __future__ import annotations
 
 import os
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from ..core.errors import InputError, format_key_path, suggest, unknown_key_error
-from ..core.kind import ProblemKind, problem_kind
+from ..core.errors import InputError, suggest, unknown_key_error
+from ..core.kind import ProblemKind
 from ..core.model import Model
-from ..core.options import Option, validate_mapping
 from ..core.result import Result
-from ..core.solver import METHODS, SolverConfig
+from ..core.solver import SolverConfig
 from ..mechanisms.registry import build_model
+from .overrides import apply_overrides
+from .published import parse_reproduce
+from .reader import read_yaml
+from .registry import problem_kind
+from .solver_section import parse_solver
+from .sweep_section import parse_sweep
 
 TOP_LEVEL = {
     "problem": "the problem kind",
@@ -47,21 +49,6 @@ TOP_LEVEL = {
     "reproduce": "published figures the file reproduces",
     "sweep": "values to sweep (cpm-nlp sweep)",
 }
-
-SOLVER_OPTIONS = (
-    Option("preset", "str", "name of a preset under configs/", default=None),
-    Option("method", "choice", "ipopt (NLP with bounds) or newton (rootfinder)", default=None, choices=METHODS),
-    Option("options", "str", "CasADi/IPOPT options, passed unchanged", default=None),  # checked below
-    Option(
-        "tolerance",
-        "dimensionless",
-        "largest accepted loop-closure residual (SI)",
-        default=None,
-        lower=0.0,
-        strict=True,
-    ),
-    Option("description", "str", "what the preset is for", default=None),
-)
 
 
 @dataclass
@@ -80,242 +67,6 @@ class Problem:
     sweep: Any = None  # a cpm_nlp.sweep.run.SweepSpec when the file has a sweep section
 
 
-# -- reading ------------------------------------------------------------------------------------
-
-
-class _Loader(yaml.SafeLoader):
-    """YAML with two YAML 1.2 readings that users expect:
-
-    * ``1e-10`` is a float (PyYAML's YAML 1.1 wants ``1.0e-10`` and would hand
-      the solver the string "1e-10"),
-    * only true/false are booleans (``ipopt.sb: yes`` stays the string IPOPT wants).
-    """
-
-
-_Loader.yaml_implicit_resolvers = {
-    first: [(tag, rx) for tag, rx in resolvers if tag != "tag:yaml.org,2002:bool"]
-    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
-}
-_Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
-)
-_Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
-    list("-+0123456789"),
-)
-
-
-def load_yaml_text(text: str) -> Any:
-    """Parse YAML text with the problem-file rules (see :class:`_Loader`)."""
-    return yaml.load(text, Loader=_Loader)  # noqa: S506 - a SafeLoader subclass
-
-
-def read_yaml(path: str | os.PathLike) -> Any:
-    """Parse a YAML file; errors name the file and the line."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError("file not found", file=str(path)) from None
-    except IsADirectoryError:
-        raise InputError("expected a YAML file, got a directory", file=str(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read the file ({exc.__class__.__name__}: {exc})", file=str(path)) from None
-    try:
-        return load_yaml_text(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise InputError(f"malformed YAML: {where}{problem}", file=str(path)) from None
-    except (ValueError, OverflowError, RecursionError) as exc:  # e.g. timestamps out of range
-        raise InputError(f"malformed YAML: {exc}", file=str(path)) from None
-
-
-# -- overrides (--set dotted.key=VALUE) -------------------------------------------------------
-
-
-def parse_override(text: str) -> tuple[list[str | int], Any]:
-    """``"mechanism.parameters.b=50 mm"`` -> (["mechanism", "parameters", "b"], "50 mm")."""
-    if not isinstance(text, str) or "=" not in text:
-        raise InputError(f"expected dotted.key=VALUE, got {text!r}", path=("--set",))
-    key, _, raw = text.partition("=")
-    key = key.strip()
-    if not key or any(not part for part in key.replace("]", "").split(".")):
-        raise InputError(f"expected dotted.key=VALUE with a non-empty key, got {text!r}", path=("--set",))
-    parts: list[str | int] = []
-    for part in key.split("."):
-        while "[" in part and part.endswith("]"):
-            head, _, idx = part.partition("[")
-            if head:
-                parts.append(head)
-            try:
-                parts.append(int(idx[:-1]))
-            except ValueError:
-                raise InputError(f"expected an integer list index in {text!r}", path=("--set",)) from None
-            part = ""
-        if part:
-            parts.append(int(part) if part.isdigit() else part)
-    try:
-        value = load_yaml_text(raw) if raw.strip() else None
-    except yaml.YAMLError:
-        value = raw
-    return parts, value
-
-
-def apply_overrides(data: Any, overrides: Sequence[str]) -> dict[str, Any]:
-    """Apply ``--set`` overrides (like Hydra) to a parsed problem file.
-
-    Keys are dotted paths; integers or ``[i]`` index lists; under
-    ``solver.options`` the rest of the path is one option name
-    (``solver.options.ipopt.tol=1e-8``).  Missing mappings are created.
-    """
-    if not overrides:
-        return data
-    if not isinstance(data, dict):
-        raise InputError("--set needs the problem file to be a mapping of keys (problem, mechanism, inputs ...)")
-    data = _deep_copy(data)
-    for text in overrides:
-        parts, value = parse_override(text)
-        if len(parts) > 2 and parts[:2] == ["solver", "options"]:
-            parts = parts[:2] + [".".join(str(p) for p in parts[2:])]
-        if len(parts) > 1 and parts[0] == "solver" and isinstance(data.get("solver"), str):
-            data["solver"] = {"preset": data["solver"]}  # a preset name, now refined
-        node: Any = data
-        for depth, part in enumerate(parts[:-1]):
-            where = tuple(parts[: depth + 1])
-            if isinstance(node, list):
-                if not isinstance(part, int) or not -len(node) <= part < len(node):
-                    raise InputError(
-                        f"--set {text}: no list element {part!r} at {format_key_path(where[:-1])}", path=("--set",)
-                    )
-                node = node[part]
-                continue
-            if not isinstance(node, dict):
-                raise InputError(f"--set {text}: {format_key_path(where[:-1])} is not a mapping", path=("--set",))
-            if part not in node or node[part] is None:
-                node[part] = {}
-            node = node[part]
-        last = parts[-1]
-        if isinstance(node, list):
-            if not isinstance(last, int) or not -len(node) <= last < len(node):
-                raise InputError(f"--set {text}: no list element {last!r}", path=("--set",))
-            node[last] = value
-        elif isinstance(node, dict):
-            node[last] = value
-        else:
-            raise InputError(f"--set {text}: {format_key_path(parts[:-1])} is not a mapping", path=("--set",))
-    return data
-
-
-def _deep_copy(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _deep_copy(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_deep_copy(v) for v in value]
-    return value
-
-
-# -- presets ----------------------------------------------------------------------------------
-
-
-def config_dirs(base_dir: Path | None) -> list[Path]:
-    """Where solver presets are looked up, in order."""
-    dirs = []
-    env = os.environ.get("CPM_NLP_CONFIGS")
-    if env:
-        dirs.append(Path(env))
-    if base_dir is not None:
-        dirs += [base_dir / "configs", base_dir.parent / "configs"]
-    dirs += [Path.cwd() / "configs", Path(__file__).resolve().parent.parent / "configs"]
-    seen, out = set(), []
-    for d in dirs:
-        r = d.resolve()
-        if r not in seen:
-            seen.add(r)
-            out.append(r)
-    return out
-
-
-def available_presets(base_dir: Path | None) -> dict[str, Path]:
-    found: dict[str, Path] = {}
-    for d in config_dirs(base_dir):
-        if d.is_dir():
-            for f in sorted(d.glob("*.yaml")):
-                found.setdefault(f.stem, f)
-    return found
-
-
-def load_preset(name: str, base_dir: Path | None, path: tuple) -> dict[str, Any]:
-    presets = available_presets(base_dir)
-    if name not in presets:
-        where = ", ".join(str(d) for d in config_dirs(base_dir))
-        raise InputError(
-            f"unknown solver preset '{name}'; expected one of: {', '.join(sorted(presets)) or '(none found)'}",
-            path=path,
-            suggestions=suggest(name, presets),
-            hint=f"presets are looked up in {where}",
-        )
-    data = read_yaml(presets[name])
-    try:
-        raw = _solver_mapping(data, ())
-    except InputError as exc:
-        raise exc.at(file=str(presets[name])) from None
-    if raw.get("preset"):
-        raise InputError("a preset cannot name another preset", path=("preset",), file=str(presets[name]))
-    return raw
-
-
-def _solver_mapping(raw: Any, path: tuple) -> dict[str, Any]:
-    if not isinstance(raw, Mapping):
-        raise InputError(
-            f"expected a preset name or a mapping with keys preset, method, options, tolerance; got {raw!r}", path=path
-        )
-    opts = raw.get("options")
-    if opts is not None:
-        if not isinstance(opts, Mapping) or not all(isinstance(k, str) for k in opts):
-            raise InputError(
-                f"expected a mapping of CasADi option names to values, got {opts!r}", path=path + ("options",)
-            )
-    cleaned = {k: v for k, v in raw.items() if k != "options"}
-    out = validate_mapping(cleaned, SOLVER_OPTIONS, path, what="solver key")
-    out["options"] = dict(opts) if opts else {}
-    return out
-
-
-def parse_solver(raw: Any, base_dir: Path | None, path: tuple = ("solver",)) -> SolverConfig:
-    """A SolverConfig from the ``solver`` section (preset name or mapping)."""
-    if raw is None:
-        return SolverConfig()
-    if isinstance(raw, str):
-        raw = {"preset": raw}
-    section = _solver_mapping(raw, path)
-    merged: dict[str, Any] = {"method": None, "options": {}, "tolerance": None}
-    if section.get("preset"):
-        preset = load_preset(section["preset"], base_dir, path + ("preset",))
-        merged.update({k: v for k, v in preset.items() if k in ("method", "tolerance") and v is not None})
-        merged["options"] = dict(preset["options"])
-    for k in ("method", "tolerance"):
-        if section.get(k) is not None:
-            merged[k] = section[k]
-    merged["options"].update(section["options"])
-    kwargs: dict[str, Any] = {"options": merged["options"], "preset": section.get("preset")}
-    if merged["method"] is not None:
-        kwargs["method"] = merged["method"]
-    if merged["tolerance"] is not None:
-        kwargs["tolerance"] = float(merged["tolerance"])
-    try:
-        config = SolverConfig(**kwargs)
-        config.validate()
-    except InputError as exc:
-        raise InputError(exc.message, path=path + exc.path[1:], suggestions=exc.suggestions, hint=exc.hint) from None
-    return config
-
-
-# -- the whole file -----------------------------------------------------------------------------
-
-
 def problem_from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Problem:
     """Validate a parsed problem mapping into a :class:`Problem`."""
     try:
@@ -324,7 +75,7 @@ def problem_from_dict(data: Any, *, file: str | None = None, base_dir: Path | No
         raise exc.at(file=file) from None
 
 
-def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Problem:
+def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Problem:  # noqa: C901 - one step per section of the file
     if not isinstance(data, dict):
         kind = "an empty file" if data is None else f"{type(data).__name__} {data!r}"[:80]
         raise InputError(f"expected a mapping with keys {', '.join(TOP_LEVEL)}; got {kind}")
@@ -361,13 +112,9 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
         raise InputError(f"expected free text, got {description!r}", path=("description",))
     reproduce = None
     if data.get("reproduce") is not None:
-        from .reproduce import parse_reproduce
-
         reproduce = parse_reproduce(data["reproduce"], ("reproduce",))
     sweep = None
     if data.get("sweep") is not None:
-        from ..sweep.run import parse_sweep
-
         sweep = parse_sweep(data["sweep"], data, kind, model, base_dir)
     return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data, sweep)
 

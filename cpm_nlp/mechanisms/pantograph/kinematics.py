@@ -63,15 +63,11 @@ import casadi as ca
 import numpy as np
 
 from ...analysis import flexure
+from ...analysis.workspace import check_box
 from ...core.errors import InputError
 from ...core.model import Coordinate, LoopClosure, Model
 from ...core.options import Option
 from ...core.solver import SolverConfig
-
-TITLE = "3D compliant pantograph, decoupled XYZ (Elgammal et al.)"
-PAPER = "pantograph-3d-elgammal-2016.md"
-#: the synthesis problem kind dispatches here (see cpm_nlp.kinds.synthesis)
-SYNTHESIS = "cpm_nlp.mechanisms.pantograph.synthesis:PantographSynthesis"
 
 HALF_PI = math.pi / 2
 SQRT2 = math.sqrt(2.0)
@@ -530,8 +526,6 @@ CUBOID_VALUE_NAMES = (
 def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig) -> tuple[dict, dict]:
     """The cuboid under the paper's names, and the paper's own formulation (eq 32-34)
     solved and checked against the membership test beside it."""
-    from ...analysis.workspace import check_box
-
     d = model.derived
     values = {
         "x_hat": None,

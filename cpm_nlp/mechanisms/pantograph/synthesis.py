@@ -53,7 +53,6 @@ from ...core.result import Result, SolverInfo, Status
 from ...core.solver import SolverConfig
 from ...core.units import DIMENSIONS
 from ...kinds.synthesis import SynthesisFormulation
-from ..registry import build_model
 from . import kinematics as P
 
 DESIGN = ("a", "b", "l", "t")
@@ -298,7 +297,7 @@ class PantographSynthesis(SynthesisFormulation):
                     k_ref,
                 ]
                 for x in starts:
-                    v0, lbx, ubx = _start(x, noms, bounds, d_ref, k_ref, E, sigma, phase)
+                    v0, lbx, ubx = _start(x, noms, bounds, k_ref, E, sigma, phase)
                     z, status, iters = built.solve(v0, par, lbx, ubx)
                     iterations += iters
                     if phase == "scale":
@@ -348,7 +347,7 @@ class PantographSynthesis(SynthesisFormulation):
             starts_agreed=agreed,
         )
         # the optimum's cuboid against the membership test of the loop model
-        built_model = _design_model(values)
+        built_model = _design_model(model, values)
         lo = [values["k"], -values["y_hat"], -values["z_hat"]]
         hi = [values["x_hat"], values["y_hat"], values["z_hat"]]
         check = check_box(built_model, lo, hi, inputs["check_per_edge"])[0]
@@ -398,7 +397,7 @@ def _material(inputs: Mapping[str, Any], path: tuple) -> tuple[float, float]:
     return flexure.elastic_limits(inputs, path, "the synthesis")
 
 
-def _start(x, noms, bounds, d_ref, k_ref, E, sigma, phase):
+def _start(x, noms, bounds, k_ref, E, sigma, phase):
     """A start for one design (a, b, l, t): the inner-ellipsoid k of that design,
     a small cuboid in front of it; scaled variables and their bounds."""
     a, b, l, t = x
@@ -415,11 +414,13 @@ def _start(x, noms, bounds, d_ref, k_ref, E, sigma, phase):
     return np.array(v0), np.array(lbx), np.array(ubx)
 
 
-def _design_model(values: Mapping[str, float]) -> Model:
-    return build_model(
-        "pantograph",
+def _design_model(model: Model, values: Mapping[str, float]) -> Model:
+    """The synthesized design as a model of the same mechanism (validated like a problem file's)."""
+    return model.mechanism.model(
+        model.closure,
         {"a": values["a"], "b": values["b"]},
         {"psi_min": values["psi_min"], "psi_max": values["psi_max"], "phi_max": values["phi_max"]},
+        ("mechanism",),
     )
 
 

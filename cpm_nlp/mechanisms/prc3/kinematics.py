@@ -67,9 +67,6 @@ from ...analysis import flexure
 from ...core.model import Coordinate, LoopClosure, Model
 from ...core.options import Option
 
-TITLE = "3-PRC micromanipulator with secondary lever amplifiers (Li et al. 2018)"
-PAPER = "prc3-li-2018.md"
-
 
 def _length(name: str, description: str, required: bool = True) -> Option:
     extra = {} if required else {"default": None}
@@ -183,7 +180,7 @@ def branch_indicator() -> ca.Function:
     return ca.Function("branch", [x, q, p], [ca.vertcat(*g)], ["x", "q", "p"], ["g"])
 
 
-def home(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def home(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # noqa: ARG001 - signature of LoopClosure.home
     """Home pose: platform at the origin, q = 0 (eq 9: d = 0 at p = 0)."""
     return np.zeros(3), np.zeros(3)
 

@@ -94,7 +94,7 @@ def joint_compliance(joint: str, E, G, dims) -> Any:
     return fc.u_joint_compliance(E, G, w, t, r)
 
 
-def working_compliance(joint: str, E, G, dims) -> Any:
+def working_compliance(joint: str, E, G, dims) -> Any:  # noqa: ARG001 - one signature for every joint type
     """Compliance of the joint's working rotation [rad/(N m)] (the notch's rz)."""
     r, t, w = dims
     return fc.circular_notch_compliances(E, G, w, t, r)["rz"]

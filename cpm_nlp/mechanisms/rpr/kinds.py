@@ -292,6 +292,8 @@ def _design_values(model: Model, eta_max: str) -> tuple[dict, dict]:
 class TransmissionMap(RprKind):
     name = "rpr_transmission_map"
     description = "output transmission index eta over a grid of the (s, t) design triangle (eq 19-23, Fig. 4)"
+    plots = ("map",)
+    map_axes = ("s", "t", "eta")  # rpr-2rpu-upr-zhang-2022.md, Fig. 4
 
     def input_options(self, model: Model) -> list[Option]:
         return [
@@ -733,7 +735,7 @@ class Compliance(RprKind):
             ),
         ]
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:  # noqa: C901 - one rule per input of the compliance model
         raw, material = _pop_mapping(raw, "material")
         raw, amplifier = _pop_mapping(raw, "amplifier")
         raw, joints = _pop_mapping(raw, "joints")

@@ -54,11 +54,6 @@ from ...core.errors import InputError
 from ...core.model import Coordinate, LoopClosure, Model
 from ...core.options import Option
 
-TITLE = "RPR compliant mechanism from a 2-RPU-UPR (Zhang, Liu, Ding)"
-#: the synthesis formulation of the shared ``synthesis`` kind (eq 19-26)
-SYNTHESIS = "cpm_nlp.mechanisms.rpr.kinds:Synthesis"
-PAPER = "rpr-2rpu-upr-zhang-2022.md"
-
 PARAMETERS = (
     Option(
         "r1",
@@ -274,7 +269,7 @@ def build(closure_: LoopClosure, parameters: dict, limits: dict) -> Model:
 # -- screw theory, eq 7-13 and the appendix -------------------------------------------------------
 
 
-def motion_screws(x, p, reference=None, convention: str = "velocity"):
+def motion_screws(x, p, reference=None, convention: str = "velocity"):  # noqa: ARG001 - same (x, p) signature as the other screw functions
     """S_t (6 x 3): the platform twist is S_t (θ̇, α̇, Ṗ) (eq 7).
 
     reference: point (fixed frame) the linear rows refer to; default o'.
@@ -395,7 +390,7 @@ def twist_function() -> ca.Function:
     return ca.Function("rpr_twist_basis", [x, p, c, k], [S], ["x", "p", "c", "k"], ["S_t"])
 
 
-def reference_point(model: Model, x: Sequence[float], reference: str, point: Sequence[float] | None) -> np.ndarray:
+def reference_point(model: Model, x: Sequence[float], reference: str, point: Sequence[float] | None) -> np.ndarray:  # noqa: ARG001 - same (model, x) signature as twist_basis
     """The reference point (fixed frame) named by ``reference``: o' of the
     pose, the fixed origin o, or the given ``point``."""
     if reference == "o_prime":

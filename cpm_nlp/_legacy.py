@@ -1,0 +1,89 @@
+"""Aliases for the module paths of cpm_nlp 0.1, before the package had layers.
+
+``import cpm_nlp.prs3`` (or ``from cpm_nlp import workspace``) still works and
+gives the module at its new place, with a DeprecationWarning that names it.
+Three old modules became packages of the same name and are not aliased:
+``cpm_nlp.problems`` (its ``ProblemKind`` is in :mod:`cpm_nlp.core.kind`, its
+``problem_kind`` in :mod:`cpm_nlp.problems.registry`), ``cpm_nlp.mechanisms``
+(now :mod:`cpm_nlp.mechanisms.registry`) and ``cpm_nlp.sweep`` (now
+:mod:`cpm_nlp.sweep.run`).  See docs/changelog.md.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import warnings
+
+#: old module name (under cpm_nlp) -> its module now
+MOVED = {
+    "errors": "core.errors",
+    "units": "core.units",
+    "options": "core.options",
+    "result": "core.result",
+    "solver": "core.solver",
+    "model": "core.model",
+    "kernels": "core.kernels",
+    "kinematics": "core.kinematics",
+    "batch": "core.batch",
+    "compiled": "core.compiled",
+    "multistart": "core.multistart",
+    "screws": "core.screws",
+    "workspace": "analysis.workspace",
+    "cuboid_ik": "analysis.cuboid_ik",
+    "requirements": "analysis.requirements",
+    "flexure": "analysis.flexure",
+    "flexure_compliance": "analysis.flexure_compliance",
+    "dynamics": "analysis.dynamics",
+    "export": "io.export",
+    "embed": "io.embed",
+    "sweep_files": "io.results",
+    "kinematic_problems": "kinds.kinematic",
+    "workspace_problems": "kinds.workspace",
+    "analysis_problems": "kinds.analysis",
+    "synthesis": "kinds.synthesis",
+    "prs3": "mechanisms.prs3",
+    "prc3": "mechanisms.prc3.kinematics",
+    "rpr": "mechanisms.rpr.kinematics",
+    "rpr_design": "mechanisms.rpr.design",
+    "rpr_compliance": "mechanisms.rpr.compliance",
+    "rpr_problems": "mechanisms.rpr.kinds",
+    "pantograph": "mechanisms.pantograph.kinematics",
+    "pantograph_synthesis": "mechanisms.pantograph.synthesis",
+    "problem_file": "problems.file",
+    "reproduce": "problems.reproduce",
+    "plots": "plot.draw",
+    "figures": "plot.figures",
+}
+
+
+class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Finds ``cpm_nlp.<old>`` and loads it as the module at its new place."""
+
+    def __init__(self) -> None:
+        self._specs: dict = {}
+
+    def find_spec(self, fullname, path=None, target=None):  # noqa: ARG002 - the finder protocol
+        package, _, leaf = fullname.rpartition(".")
+        if package != "cpm_nlp" or leaf not in MOVED:
+            return None
+        return importlib.util.spec_from_loader(fullname, self)
+
+    def create_module(self, spec):
+        new = f"cpm_nlp.{MOVED[spec.name.rpartition('.')[2]]}"
+        warnings.warn(f"{spec.name} moved to {new}; the old name will be removed", DeprecationWarning, stacklevel=2)
+        module = importlib.import_module(new)
+        self._specs[spec.name] = module.__spec__
+        return module
+
+    def exec_module(self, module):
+        """The module is already executed at its new place; keep its own spec (the import
+        system set the alias's)."""
+        module.__spec__ = self._specs.get(module.__spec__.name, module.__spec__)
+
+
+def install() -> None:
+    if not any(isinstance(f, _Alias) for f in sys.meta_path):
+        sys.meta_path.append(_Alias())

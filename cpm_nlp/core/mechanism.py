@@ -1,0 +1,227 @@
+"""The declared interface between a mechanism and the rest of cpm_nlp.
+
+A mechanism type is one :class:`Mechanism` value.  Its required parts say
+what the mechanism *is*; its optional capabilities say what else it can do,
+and every feature of the toolkit that needs a capability asks for it by its
+field here, never by probing a module for an attribute.  A misspelt
+capability is therefore an error when the mechanism is declared
+(:func:`declare`) or registered, not a silently missing feature.
+
+Required parts
+--------------
+``name``, ``title``
+    the type name used in problem files (``mechanism.type``) and a one-line title.
+``parameters``, ``limits``
+    declared :class:`~cpm_nlp.core.options.Option` s of the geometry (SI, with
+    dimension, default, bounds, description) and of the joint limits.
+``closure``
+    ``() -> LoopClosure``: the symbolic closure Φ(x, q; p).  Built once per
+    process by the registry and shared by every model of the type.  Three
+    capabilities live on the closure itself, as optional arguments of
+    :class:`~cpm_nlp.core.model.LoopClosure`: the closed-form IK (``ik``), the
+    passive joint angles (``passive``, ``passive_coords``) and the
+    assembly-branch indicator (``branch``).
+``build``
+    ``(closure, parameters, limits) -> Model``: a model from validated values (SI).
+
+Optional capabilities
+---------------------
+See the fields of :class:`Mechanism`: cross-value checks, a synthesis
+formulation, extra inscribed-cuboid inputs and values, a closed-form
+workspace membership from the paper, a dynamics model, problem kinds of its
+own, and the problem files that reproduce its paper's figures.
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+from .errors import suggest
+from .options import Option, validate_mapping
+
+
+class MechanismDeclarationError(TypeError):
+    """A mechanism declaration that breaks the interface (raised at declaration
+    or registration, with the mechanism's name and the field at fault)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class CuboidExtras:
+    """What a mechanism adds to the ``inscribed_cuboid`` kind.
+
+    options: extra inputs of the kind for this mechanism.
+    value_names: the names of the extra values, all of them (set to null when
+        no cuboid was found).
+    values: ``(model, lower, upper, inputs, solver) -> (values, dimensions)``
+        for a found box ``lower <= t <= upper`` (SI, task coordinates).
+    """
+
+    options: tuple[Option, ...] = ()
+    value_names: tuple[str, ...] = ()
+    values: Callable[..., tuple[dict, dict]]
+
+
+@dataclass(frozen=True, kw_only=True)
+class DynamicsModel:
+    """A Lagrange model of the mechanism, used by the ``dynamics`` kind.
+
+    masses: ``(name, description)`` of each mass input (kg, or a block of the
+        hinge material given by its dimensions).
+    parameters: names, in order, of the vector w the energies take: ``E``,
+        ``g``, the masses and any mechanism parameters by name.
+    lagrangian: ``() -> ca.Function("...", [q, qd, p, w], [T, U, ...])``: the
+        kinetic and potential energies in the actuator coordinates q (nq).
+    values: optional ``(model, w, M, K, G) -> dict`` of named quantities of the
+        paper, with their dimensions in ``dimensions``.
+    """
+
+    masses: tuple[tuple[str, str], ...]
+    parameters: tuple[str, ...]
+    lagrangian: Callable[[], Any]
+    values: Callable[..., dict] | None = None
+    dimensions: Mapping[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Mechanism:
+    """A mechanism type: required parts and optional capabilities.
+
+    Sizes in model terms: nx pose coordinates x, nq actuators q, np
+    parameters p (see :class:`~cpm_nlp.core.model.LoopClosure`).
+    """
+
+    #: type name in problem files (``mechanism.type``)
+    name: str
+    #: one-line title
+    title: str
+    #: geometry parameters (declared options, SI)
+    parameters: tuple[Option, ...]
+    #: joint limits (declared options, each a [low, high] range)
+    limits: tuple[Option, ...]
+    #: ``() -> LoopClosure``: the symbolic closure (with optional ik, passive, branch)
+    closure: Callable[[], Any]
+    #: ``(closure, parameters, limits) -> Model``
+    build: Callable[[Any, dict, dict], Any]
+    #: the paper the mechanism comes from: a citation, with its DOI where the paper gives one
+    paper: str = ""
+    #: ``(parameters, path) -> None``: rules over several parameters; raises InputError
+    check_parameters: Callable[[dict, tuple], None] | None = None
+    #: ``(limits, path) -> None``: rules over several limits; raises InputError
+    check_limits: Callable[[dict, tuple], None] | None = None
+    #: ``() -> ProblemKind``: the paper's dimensional synthesis, run by the ``synthesis`` kind
+    synthesis: Callable[[], Any] | None = None
+    #: extra inputs and values of the ``inscribed_cuboid`` kind
+    cuboid: CuboidExtras | None = None
+    #: ``(model, points (N, nq)) -> (inside (N,), margins)``: the paper's closed-form
+    #: workspace membership, reported by the ``workspace`` kind beside the general test
+    paper_membership: Callable[[Any, Any], tuple[Any, dict]] | None = None
+    #: a Lagrange model for the ``dynamics`` kind
+    dynamics: DynamicsModel | None = None
+    #: problem kinds of its own: kind name -> ProblemKind subclass
+    kinds: Mapping[str, type] = field(default_factory=dict)
+    #: its shipped problem files: examples of its kinds, and (those with a ``reproduce:``
+    #: section) its paper's figures; names under the shipped ``problems/`` directory, or
+    #: absolute paths for a plugin's own files
+    problem_files: tuple[str, ...] = ()
+    #: where the declaration came from ("built-in", a plugin's entry point, a file)
+    origin: str = "built-in"
+
+    def __post_init__(self) -> None:
+        validate(self)
+
+    def model(
+        self, closure: Any, parameters: Mapping[str, Any] | None, limits: Mapping[str, Any] | None, path: tuple
+    ) -> Any:
+        """A model on ``closure`` from values given as in a problem file (numbers in SI
+        or strings with units), validated against the declared options and checks."""
+        params = validate_mapping(parameters or {}, self.parameters, path + ("parameters",), what="parameter")
+        lims = validate_mapping(limits or {}, self.limits, path + ("limits",), what="limit")
+        if self.check_parameters is not None:
+            self.check_parameters(params, path + ("parameters",))
+        if self.check_limits is not None:
+            self.check_limits(lims, path + ("limits",))
+        return self.build(closure, params, lims)
+
+    def capabilities(self) -> list[str]:
+        """Names of the optional capabilities this mechanism declares."""
+        return [f.name for f in fields(self) if f.name in CAPABILITIES and getattr(self, f.name)]
+
+
+#: required parts of a mechanism
+REQUIRED = ("name", "title", "parameters", "limits", "closure", "build")
+#: optional capabilities (fields) of a mechanism
+CAPABILITIES = (
+    "check_parameters",
+    "check_limits",
+    "synthesis",
+    "cuboid",
+    "paper_membership",
+    "dynamics",
+    "kinds",
+    "problem_files",
+)
+#: every part a declaration may name
+PARTS = REQUIRED + CAPABILITIES + ("paper", "origin")
+
+
+def _fail(mech: Any, name: str, expected: str) -> None:
+    value = getattr(mech, name)
+    raise MechanismDeclarationError(
+        f"mechanism {mech.name!r} ({mech.origin}): {name} must be {expected}, got {type(value).__name__} {value!r:.60}"
+    )
+
+
+def validate(mech: Mechanism) -> None:  # noqa: C901 - one flat check per declared part
+    """Check the types of every part of a declaration (registration calls it too)."""
+    if not isinstance(mech.name, str) or not mech.name.isidentifier():
+        raise MechanismDeclarationError(f"a mechanism name must be an identifier, got {mech.name!r} ({mech.origin})")
+    if not isinstance(mech.title, str):
+        _fail(mech, "title", "a string")
+    for group in ("parameters", "limits"):
+        value = getattr(mech, group)
+        if not isinstance(value, tuple) or not all(isinstance(o, Option) for o in value):
+            _fail(mech, group, "a tuple of Option")
+        names = [o.name for o in value]
+        if len(set(names)) != len(names):
+            _fail(mech, group, "a tuple of Options with distinct names")
+    for name in ("closure", "build"):
+        if not callable(getattr(mech, name)):
+            _fail(mech, name, "callable")
+    for name in ("check_parameters", "check_limits", "synthesis", "paper_membership"):
+        if getattr(mech, name) is not None and not callable(getattr(mech, name)):
+            _fail(mech, name, "callable or None")
+    if mech.cuboid is not None and not isinstance(mech.cuboid, CuboidExtras):
+        _fail(mech, "cuboid", "a CuboidExtras or None")
+    if mech.dynamics is not None and not isinstance(mech.dynamics, DynamicsModel):
+        _fail(mech, "dynamics", "a DynamicsModel or None")
+    if not isinstance(mech.kinds, Mapping):
+        _fail(mech, "kinds", "a mapping of kind name -> ProblemKind subclass")
+    for kname, cls in mech.kinds.items():
+        if not isinstance(kname, str) or not inspect.isclass(cls) or not hasattr(cls, "run"):
+            _fail(mech, "kinds", f"a mapping of kind name -> ProblemKind subclass (entry {kname!r})")
+        if getattr(cls, "name", kname) != kname:
+            _fail(mech, "kinds", f"keyed by each kind's own name ({cls.__name__}.name is {cls.name!r}, key {kname!r})")
+    if not isinstance(mech.problem_files, tuple) or not all(isinstance(f, str) for f in mech.problem_files):
+        _fail(mech, "problem_files", "a tuple of file names")
+
+
+def declare(**parts: Any) -> Mechanism:
+    """A :class:`Mechanism` from keyword parts, with a "did you mean" for a
+    misspelt part (``Mechanism(...)`` itself only says "unexpected keyword")."""
+    unknown = [k for k in parts if k not in PARTS]
+    if unknown:
+        hints = [f"{k!r} (did you mean {', '.join(repr(s) for s in suggest(k, PARTS))}?)" for k in unknown]
+        name = parts.get("name", "?")
+        raise MechanismDeclarationError(
+            f"mechanism {name!r}: unknown part(s) {', '.join(hints)}; "
+            f"required: {', '.join(REQUIRED)}; optional: {', '.join(CAPABILITIES)}, paper, origin"
+        )
+    missing = [k for k in REQUIRED if k not in parts]
+    if missing:
+        raise MechanismDeclarationError(
+            f"mechanism {parts.get('name', '?')!r}: missing required part(s) {', '.join(missing)}"
+        )
+    return Mechanism(**parts)

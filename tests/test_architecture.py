@@ -1,0 +1,185 @@
+"""The package's layers: no import cycle (imports inside functions included),
+dependencies that flow one way, library code that never imports the CLI, and
+generic modules that name no mechanism."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+PKG = Path(__file__).resolve().parent.parent / "cpm_nlp"
+
+#: rank of each layer: a module may import its own package or a lower rank only
+#: (cli -> problems/sweep/plot/api -> mechanisms -> kinds -> analysis/io -> core)
+LAYERS = {
+    "core": 0,
+    "analysis": 1,
+    "io": 1,
+    "kinds": 2,
+    "mechanisms": 3,
+    "problems": 4,
+    "sweep": 5,
+    "plot": 5,
+    "api": 5,
+    "cli": 6,
+}
+#: modules that must not name a mechanism or a paper-specific kind (code, not docstrings)
+GENERIC = ("plot", "sweep", "cli", "kinds", "problems", "io", "analysis", "core")
+MECHANISM_WORDS = ("prs3", "prc3", "rpr", "pantograph")
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for f in PKG.rglob("*.py"):
+        rel = f.relative_to(PKG.parent).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = f
+    return out
+
+
+def _imports(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
+    """Modules of cpm_nlp that ``name`` imports anywhere in its code."""
+    tree = ast.parse(path.read_text())
+    is_pkg = path.name == "__init__.py"
+    package = name if is_pkg else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - (node.level - 1)]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if not target.startswith("cpm_nlp"):
+                continue
+            for alias in node.names:
+                sub = f"{target}.{alias.name}"
+                found.add(sub if sub in modules else target)
+        elif isinstance(node, ast.Import):
+            found |= {a.name for a in node.names if a.name.startswith("cpm_nlp")}
+    return {m for m in found if m in modules and m != name}
+
+
+@pytest.fixture(scope="module")
+def graph():
+    modules = _modules()
+    return {name: _imports(name, path, modules) for name, path in modules.items()}
+
+
+def _layer(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else None
+
+
+def test_no_import_cycle(graph):
+    """Depth-first search over every import, those inside functions included."""
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(m: str) -> None:
+        state[m] = 1
+        stack.append(m)
+        for n in sorted(graph[m]):
+            if state.get(n) == 1:
+                cycle = stack[stack.index(n) :] + [n]
+                pytest.fail("import cycle: " + " -> ".join(cycle))
+            if n not in state:
+                visit(n)
+        stack.pop()
+        state[m] = 2
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m)
+
+
+def test_dependencies_flow_one_way(graph):
+    bad = []
+    for m, targets in graph.items():
+        lm = _layer(m)
+        if lm not in LAYERS:
+            continue
+        for t in targets:
+            lt = _layer(t)
+            if lt is None or lt not in LAYERS or lt == lm:
+                continue
+            if LAYERS[lt] >= LAYERS[lm]:
+                bad.append(f"{m} ({lm}) imports {t} ({lt})")
+    assert not bad, "imports against the layers:\n" + "\n".join(bad)
+
+
+def test_library_never_imports_the_cli(graph):
+    entry = ("cpm_nlp.__main__",)  # ``python -m cpm_nlp`` is the command itself
+    bad = [
+        m for m, ts in graph.items() if _layer(m) != "cli" and m not in entry and any(_layer(t) == "cli" for t in ts)
+    ]
+    assert not bad
+
+
+def _code_words(path: Path) -> set[str]:
+    """Identifiers and string constants of a module, docstrings left out."""
+    tree = ast.parse(path.read_text())
+    docstrings = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            body = getattr(node, "body", [])
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                docstrings.add(id(body[0].value))
+    words = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:
+            words |= set(node.value.replace(".", " ").replace("_", " ").replace(":", " ").split())
+        elif isinstance(node, ast.Name):
+            words.add(node.id)
+        elif isinstance(node, ast.Attribute):
+            words.add(node.attr)
+        elif isinstance(node, ast.alias):
+            words |= set(node.name.split("."))
+    return words
+
+
+def test_generic_modules_name_no_mechanism():
+    bad = []
+    for name, path in _modules().items():
+        if _layer(name) in GENERIC:
+            hits = sorted(w for w in _code_words(path) if w.lower() in MECHANISM_WORDS)
+            if hits:
+                bad.append(f"{name}: {', '.join(hits)}")
+    assert not bad, "generic modules that name a mechanism:\n" + "\n".join(bad)
+
+
+def test_every_module_imports_in_a_fresh_interpreter():
+    """Every module of the package imports, in a new interpreter, in reverse order of
+    the layers (the CLI first), so no module depends on another having been loaded."""
+    names = sorted((n for n in _modules() if not n.endswith("__main__")), key=lambda n: -LAYERS.get(_layer(n), 9))
+    code = f"import importlib\nfor n in {names!r}:\n    importlib.import_module(n)\n"
+    run = subprocess.run(
+        [sys.executable, "-W", "error::DeprecationWarning", "-c", code], capture_output=True, text=True
+    )
+    assert run.returncode == 0, run.stderr
+
+
+def test_public_names_listed_once():
+    import cpm_nlp as cn
+    import cpm_nlp.api as api
+
+    assert cn.__all__ is api.__all__
+    assert len(set(cn.__all__)) == len(cn.__all__)
+    for name in cn.__all__:
+        assert getattr(cn, name) is getattr(api, name)
+
+
+def test_legacy_module_names_still_import_with_a_warning():
+    import importlib
+
+    with pytest.warns(DeprecationWarning, match="cpm_nlp.prs3 moved to cpm_nlp.mechanisms.prs3"):
+        old = importlib.import_module("cpm_nlp.prs3")
+    assert old is importlib.import_module("cpm_nlp.mechanisms.prs3")
+    assert old.__spec__.name == "cpm_nlp.mechanisms.prs3"
