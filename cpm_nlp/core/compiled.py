@@ -27,7 +27,7 @@ from pathlib import Path
 
 import casadi as ca
 
-from .errors import CpmError
+from .errors import CpmError, InputError, suggest
 from .kernels import Kernel
 from .model import LoopClosure
 
@@ -128,6 +128,26 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
             os.unlink(tmp_lib)
     log.info("compiled %s into %s", name, lib)
     return lib
+
+
+BACKENDS = ("map", "compiled", "auto")
+
+
+def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[ca.Function, str]:
+    """The kernel's Function for a backend ("map": CasADi's virtual machine;
+    "compiled": C; "auto": compiled when a C compiler is available) and the
+    backend used."""
+    if backend not in BACKENDS:
+        raise InputError(
+            f"unknown backend {backend!r}; expected one of: {', '.join(BACKENDS)}",
+            path=("backend",),
+            suggestions=suggest(str(backend), BACKENDS),
+        )
+    if backend in ("compiled", "auto"):
+        if backend == "compiled" or compiler_available():
+            return compiled_function(closure, kern), "compiled"
+        log.info("no C compiler: backend 'auto' uses 'map'")
+    return kern.function, "map"
 
 
 def compiled_function(closure: LoopClosure, kern: Kernel) -> ca.Function:
