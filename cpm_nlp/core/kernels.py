@@ -177,8 +177,8 @@ def check_expressions(
     return out
 
 
-#: the preconditioned residual ‖I - B Φ_x‖₁ must stay below this for :func:`cond1_bound` to certify
-CERTIFY_DELTA = 0.5
+#: the preconditioned residual ‖I - Φ_x B‖₁ must stay below this for :func:`cond1_bound` to certify
+CERTIFY_DELTA = 0.9
 
 
 def _induced_norm_1(m: ca.SX) -> ca.SX:
