@@ -348,7 +348,8 @@ def table(results: dict) -> str:
     rows = [("measurement", "value", "unit", "target", "verdict", "load")]
     flat = {**results["batch"], **results["single"], **results["reproduce"], **results["memory"]}
     for name, value in flat.items():
-        if not isinstance(value, (int, float)) or name == "threads" or name.endswith(("_exit", "_mb", "_poses", "difference")):
+        skipped = name == "threads" or name.endswith(("_exit", "_mb", "_poses", "difference"))
+        if not isinstance(value, (int, float)) or skipped:
             continue
         unit = UNITS.get(name, "x" if name.startswith("ratio") else "")
         target = ""
