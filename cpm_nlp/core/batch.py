@@ -40,7 +40,7 @@ import casadi as ca
 import numpy as np
 
 from .compiled import BACKENDS as BACKENDS  # noqa: F401 - re-exported
-from .compiled import backend_function
+from .compiled import NativeLoop, backend_function, native_loop
 from .errors import InputError
 from .kernels import (
     NUMPY,
@@ -269,47 +269,59 @@ def _broadcast_rows(values, n: int, n_cols: int, name: str) -> np.ndarray:
     return arr
 
 
-def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Function, str]:
-    return backend_function(model.closure, kern, backend)
+def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Function | NativeLoop, str]:
+    """The kernel's CasADi Function ("map") or the compiled library's loop over poses ("compiled")."""
+    fn, used = backend_function(model.closure, kern, backend)
+    return (native_loop(model.closure, kern), used) if used == "compiled" else (fn, used)
 
 
 def evaluate(
-    function: ca.Function,
+    function: ca.Function | NativeLoop,
     args: Sequence[np.ndarray],
     threads: int | None = None,
     chunk: int = CHUNK,
 ) -> list[np.ndarray]:
-    """Evaluate a Function over N poses.
+    """Evaluate a Function (or a compiled kernel's :class:`NativeLoop`) over N poses.
 
     args: one array per input of ``function``: (N, nnz_in(k)) C-contiguous
     for a per-pose input, 1-D for a value shared by every pose.  Returns
     (N, nnz_out(k)) arrays (dense, column-major per pose).  Chunks of
     ``chunk`` poses go through ``function.map(chunk)`` (one FunctionBuffer
-    each), spread over ``threads`` threads.
+    each; a NativeLoop runs them in C directly), spread over ``threads``
+    threads of the persistent pool.
     """
+    native = isinstance(function, NativeLoop)
     per_pose = [a for a in args if a.ndim == 2]
     n = per_pose[0].shape[0] if per_pose else 1
-    outs = [np.empty((n, function.nnz_out(k))) for k in range(function.n_out())]
+    nnz_out = function.nnz_out if native else [function.nnz_out(k) for k in range(function.n_out())]
+    outs = [np.empty((n, m)) for m in nnz_out]
     if n == 0:
         return outs
     threads = default_threads() if threads is None else max(1, int(threads))
     chunk = max(1, min(int(chunk), -(-n // threads)))
     starts = list(range(0, n, chunk))
-    maps: dict[int, tuple[ca.Function, list[np.ndarray | None]]] = {}
-    for size in {min(chunk, n - a) for a in starts}:  # built before the threads start
-        tiled = [None if a.ndim == 2 else np.ascontiguousarray(np.broadcast_to(a, (size, a.size))) for a in args]
-        maps[size] = (mapped(function, size), tiled)
+    if native:
+        args = [np.ascontiguousarray(a, dtype=float) for a in args]
 
-    def run(start: int) -> int:
-        stop = min(start + chunk, n)
-        mapped, tiled = maps[stop - start]
-        buf, call = mapped.buffer()
-        for k, (arr, rep) in enumerate(zip(args, tiled)):
-            buf.set_arg(k, memoryview((arr[start:stop] if rep is None else rep).reshape(-1)))
-        for k, arr in enumerate(outs):
-            buf.set_res(k, memoryview(arr[start:stop].reshape(-1)))
-        call()
-        return buf.ret()
+        def run(start: int) -> int:
+            return function.run(start, min(start + chunk, n), args, outs)
+
+    else:
+        maps: dict[int, tuple[ca.Function, list[np.ndarray | None]]] = {}
+        for size in {min(chunk, n - a) for a in starts}:  # built before the threads start
+            tiled = [None if a.ndim == 2 else np.ascontiguousarray(np.broadcast_to(a, (size, a.size))) for a in args]
+            maps[size] = (mapped(function, size), tiled)
+
+        def run(start: int) -> int:
+            stop = min(start + chunk, n)
+            fn, tiled = maps[stop - start]
+            buf, call = fn.buffer()
+            for k, (arr, rep) in enumerate(zip(args, tiled)):
+                buf.set_arg(k, memoryview((arr[start:stop] if rep is None else rep).reshape(-1)))
+            for k, arr in enumerate(outs):
+                buf.set_res(k, memoryview(arr[start:stop].reshape(-1)))
+            call()
+            return buf.ret()
 
     if threads == 1 or len(starts) == 1:
         codes = [run(a) for a in starts]
@@ -318,7 +330,8 @@ def evaluate(
         rest = [thread_pool(threads).submit(run, a) for a in starts[1:]]
         codes = [run(starts[0])] + [f.result() for f in rest]
     if any(codes):
-        raise RuntimeError(f"evaluation of {function.name()} failed")
+        name = function.function.name() if native else function.name()
+        raise RuntimeError(f"evaluation of {name} failed")
     return outs
 
 

@@ -688,14 +688,14 @@ class BoundCall:
     linearization) and every input and output array are bound to a
     FunctionBuffer once per thread; a call copies the pose inputs in,
     evaluates, and returns the (per-thread, reused) output arrays -- copy
-    what you keep.
+    what you keep.  ``defaults``: a value per pose input (or None), used
+    where a call passes None (e.g. the home pose as x0).
     """
 
-    def __init__(self, function: ca.Function, shared: Sequence[np.ndarray], n_pose: int) -> None:
+    def __init__(self, function: ca.Function, shared: Sequence[np.ndarray], defaults: Sequence[Any]) -> None:
         self.function = function
-        self.names_out = tuple(function.name_out())
         self._shared = [np.ascontiguousarray(v, dtype=float).reshape(-1) for v in shared]
-        self._n_pose = n_pose
+        self._defaults = [None if d is None else np.asarray(d, dtype=float).reshape(-1) for d in defaults]
         self._local = threading.local()
 
     def _state(self):
@@ -703,23 +703,34 @@ class BoundCall:
         if state is None:
             fn = self.function
             buf, evaluate = fn.buffer()
-            pose = [np.zeros(fn.nnz_in(i)) for i in range(self._n_pose)]
+            pose = [np.zeros(fn.nnz_in(i)) for i in range(len(self._defaults))]
             for i, arr in enumerate(pose + self._shared):
                 buf.set_arg(i, memoryview(arr))
             outs = [np.empty(fn.nnz_out(i)) for i in range(fn.n_out())]
             for i, arr in enumerate(outs):
                 buf.set_res(i, memoryview(arr))
-            state = self._local.state = (buf, evaluate, pose, outs)
+            state = self._local.state = [buf, evaluate, pose, outs, [False] * len(pose)]
         return state
 
-    def __call__(self, *pose: np.ndarray) -> list[np.ndarray]:
-        buf, evaluate, arrays, outs = self._state()
-        for arr, value in zip(arrays, pose):
-            arr[:] = value
-        evaluate()
+    def _fill(self, state: list, pose: Sequence[Any]) -> None:
+        arrays, is_default = state[2], state[4]
+        for k, value in enumerate(pose):
+            if value is None:
+                if not is_default[k]:
+                    arrays[k][:] = self._defaults[k]
+                    is_default[k] = True
+            else:
+                arrays[k][:] = value
+                is_default[k] = False
+
+    def __call__(self, *pose: Any) -> list[np.ndarray]:
+        state = self._state()
+        self._fill(state, pose)
+        buf = state[0]
+        state[1]()
         if buf.ret() != 0:
             raise RuntimeError(f"evaluation of {self.function.name()} failed (code {buf.ret()})")
-        return outs
+        return state[3]
 
 
 def fast(closure: LoopClosure, key: tuple, function: Callable[[], ca.Function]) -> FastFunction:

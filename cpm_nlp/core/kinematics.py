@@ -14,13 +14,14 @@ Sizes: nx = pose coordinates, nq = actuated joints (= task coordinates).
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .compiled import backend_function
+from .compiled import BoundNative, backend_function, native_loop
 from .errors import InputError
 from .kernels import (
     PATHS,
@@ -79,7 +80,7 @@ def _vector(values, n: int, name: str) -> np.ndarray:
     arr = np.asarray(values, dtype=float).ravel()
     if arr.size != n:
         raise InputError(f"expected {n} values, got {arr.size}", path=(name,))
-    if not np.isfinite(arr).all():
+    if not all(map(math.isfinite, arr.tolist())):
         raise InputError(f"expected finite numbers, got {arr.tolist()}", path=(name,))
     return arr
 
@@ -193,7 +194,7 @@ def _checked(model: Model, x, q, tolerance: float, iterations: int, seconds: flo
 _CHECK_NAMES = ("residual", "branch_margin", "round_trip_error", "cond1", "limit_margin")
 
 
-def _bound_fk(model: Model, config: SolverConfig, backend: str) -> tuple[BoundCall, dict[str, int]]:
+def _bound_fk(model: Model, config: SolverConfig, backend: str) -> tuple[BoundCall | BoundNative, tuple[int, ...]]:
     """The FK kernel bound to this model (built once per model, configuration
     and backend) and the positions of its outputs."""
     key = ("fk", config.key(), float(config.tolerance), backend)
@@ -201,47 +202,62 @@ def _bound_fk(model: Model, config: SolverConfig, backend: str) -> tuple[BoundCa
     hit = cache.get(key)
     if hit is None:
         kern = fk_kernel(model.closure, config)
-        fn, _used = backend_function(model.closure, kern, backend)
+        fn, used = backend_function(model.closure, kern, backend)
         shared = shared_values(kern, model, config.tolerance)
-        hit = cache[key] = (BoundCall(fn, shared, len(kern.pose_inputs)), {n: k for k, n in enumerate(kern.outputs)})
+        defaults = [None, model.x_home]  # x0: the home pose unless a guess is given
+        if used == "compiled":  # straight into the library's loop, through ctypes
+            bound: BoundCall | BoundNative = BoundNative(native_loop(model.closure, kern), shared, defaults)
+        else:
+            bound = BoundCall(fn, shared, defaults)
+        hit = cache[key] = (bound, _fk_index(kern.outputs))
     return hit
+
+
+#: outputs of the FK kernel that make a PoseSolution, in this order (path: absent for mechanisms without an IK)
+_FK_FIELDS = (
+    "x",
+    "passive",
+    "residual",
+    "branch_margin",
+    "round_trip_error",
+    "limit_margin",
+    "cond1",
+    "path",
+    "status",
+)
+
+
+def _fk_index(outputs: Sequence[str]) -> tuple[int, ...]:
+    return tuple(outputs.index(n) if n in outputs else -1 for n in _FK_FIELDS)
 
 
 def pose_from_kernel(
     model: Model,
     outs: Sequence[np.ndarray],
-    index: dict[str, int],
+    index: tuple[int, ...],
     q: np.ndarray,
     tolerance: float,
     seconds: float,
     solver: str,
 ) -> PoseSolution:
     """A :class:`PoseSolution` from the outputs of the FK kernel for one pose
-    (``index``: output name -> position), exactly as
+    (``index``: positions of :data:`_FK_FIELDS` among them), exactly as
     :class:`cpm_nlp.core.batch.BatchResult` turns a batch row into one (the
     1-norm singularity screen refined by the 2-norm condition number)."""
     c = model.closure
-    code = int(outs[index["status"]][0])
-    details = {k: float(outs[index[k]][0]) for k in _CHECK_NAMES}
-    details["cond1_phi_x"] = details.pop("cond1")
-    path = PATHS[int(outs[index["path"]][0])] if "path" in index else ""
-    residual = details["residual"]
-    x = outs[index["x"]].copy()
-    passive = outs[index["passive"]].copy()
-    if code == 0:  # solved: the fast path
-        return PoseSolution(
-            Status.SOLVED,
-            x,
-            q,
-            passive if c.passive is not None else None,
-            residual,
-            0,
-            seconds,
-            solver,
-            "",
-            details,
-            path,
-        )
+    i_x, i_passive, i_res, i_branch, i_trip, i_limit, i_cond, i_path, i_status = index
+    code = int(outs[i_status][0])
+    residual = float(outs[i_res][0])
+    details = {
+        "residual": residual,
+        "branch_margin": float(outs[i_branch][0]),
+        "round_trip_error": float(outs[i_trip][0]),
+        "limit_margin": float(outs[i_limit][0]),
+        "cond1_phi_x": float(outs[i_cond][0]),
+    }
+    path = PATHS[int(outs[i_path][0])] if i_path >= 0 else ""
+    x = outs[i_x].copy()
+    passive = outs[i_passive].copy()
     if code == code_of(Status.SINGULAR):
         a = fast(c, ("phi_x",), lambda: c.phi_x)(x, q, model.p)[0].reshape(c.nx, c.nx)
         sv = np.linalg.svd(a, compute_uv=False)
@@ -250,20 +266,9 @@ def pose_from_kernel(
         rows["finite"] = True
         code = int(status_code(status_rules(rows, tolerance, is_singular(cond, SCALAR), SCALAR), SCALAR))
         details["cond_phi_x"] = cond
-        if code == 0:
-            return PoseSolution(
-                Status.SOLVED,
-                x,
-                q,
-                passive if c.passive is not None else None,
-                residual,
-                0,
-                seconds,
-                solver,
-                "",
-                details,
-                path,
-            )
+    if code == 0:
+        passive_out = passive if c.passive is not None else None
+        return PoseSolution(Status.SOLVED, x, q, passive_out, residual, 0, seconds, solver, "", details, path)
     status = STATUSES[code]
     message = failure_message(model, status, details, x, q, passive, tolerance)
     return PoseSolution(
@@ -271,7 +276,9 @@ def pose_from_kernel(
     )
 
 
-def _kernel_forward(model: Model, q: np.ndarray, x0: np.ndarray, config: SolverConfig, backend: str) -> PoseSolution:
+def _kernel_forward(
+    model: Model, q: np.ndarray, x0: np.ndarray | None, config: SolverConfig, backend: str
+) -> PoseSolution:
     t0 = time.perf_counter()
     call, index = _bound_fk(model, config, backend)
     outs = call(q, x0)
@@ -306,9 +313,10 @@ def forward_kinematics(
     config = solver or SolverConfig()
     c = model.closure
     qv = _vector(q, c.nq, "q")
-    x0 = model.x_home if guess is None else _vector(guess, c.nx, "guess")
+    x0 = None if guess is None else _vector(guess, c.nx, "guess")
     if config.method == "newton" and batch_newton_supported(config):
         return _kernel_forward(model, qv, x0, config, backend)
+    x0 = model.x_home if x0 is None else x0
     built = c.fk_solver(config)
     x, ok, iters, msg, sec = built.solve(x0, np.concatenate([qv, model.p]), model.x_lower, model.x_upper)
     if not ok:
