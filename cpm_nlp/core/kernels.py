@@ -483,13 +483,14 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         ins = [ca.MX.sym(n, s.sparsity()) for n, s in zip(["q", "x0", *SHARED_INPUTS], [q, x0, *shared[:4]])]
         r_in = [ca.MX.sym(f"reduced_{n}", reduced.sparsity_out(k)) for k, n in enumerate(names)]
         # outputs: (x, passive, checks..., path, status): status stays last
-        keep = ca.Function(f"{c.name}_fk_keep", ins + r_in, r_in[:-1] + [ca.MX(0), r_in[-1]])
+        out_names = [*names[:-1], "path", "status"]
+        io = ([n.name() for n in ins + r_in], out_names)
+        keep = ca.Function(f"{c.name}_fk_keep", ins + r_in, r_in[:-1] + [ca.MX(0), r_in[-1]], *io)
         f = list(full(*ins))
-        fallback = ca.Function(f"{c.name}_fk_fallback", ins + r_in, f[:-1] + [ca.MX(1), f[-1]])
+        fallback = ca.Function(f"{c.name}_fk_fallback", ins + r_in, f[:-1] + [ca.MX(1), f[-1]], *io)
         switch = ca.Function.if_else(f"{c.name}_fk_switch", keep, fallback)
         settled = r[-1] == code_of(Status.SOLVED)
         outs = switch(settled, q, x0, *shared[:4], *r)
-        out_names = [*names[:-1], "path", "status"]
         fn = ca.Function(f"{c.name}_fk", [q, x0, *shared], list(outs), ["q", "x0", *REDUCED_SHARED_INPUTS], out_names)
         return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS)
 
