@@ -261,3 +261,16 @@ def test_the_thread_pool_is_kept_between_batches():
     two = cn.batch_forward_kinematics(model, q, threads=2)
     assert thread_pool(2) is pool
     np.testing.assert_array_equal(one.x, two.x)
+
+
+def test_auto_backend_falls_back_to_the_virtual_machine_when_compiling_fails(tmp_path, monkeypatch, caplog):
+    """A single Newton solve never fails for want of a working C compiler."""
+    monkeypatch.setenv("CPM_NLP_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("CC", "false")  # a "compiler" that always fails
+    model = build("prs3")
+    with caplog.at_level("WARNING", logger="cpm_nlp"):
+        sol = cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3], NEWTON)
+    assert sol.ok and sol.path == "reduced"
+    assert "backend 'auto' uses 'map'" in caplog.text
+    ref = cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3], NEWTON, backend="map")
+    np.testing.assert_array_equal(sol.x, ref.x)

@@ -239,10 +239,23 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
             path=("backend",),
             suggestions=suggest(str(backend), BACKENDS),
         )
-    if backend in ("compiled", "auto"):
-        if backend == "compiled" or compiler_available():
+    if backend == "compiled":
+        return compiled_function(closure, kern), "compiled"
+    if backend == "auto":
+
+        def decide() -> str:
+            if not compiler_available():
+                log.info("no C compiler: backend 'auto' uses 'map'")
+                return "map"
+            try:
+                compiled_function(closure, kern)
+            except CompilerError as exc:  # "auto" means the best available: the virtual machine then
+                log.warning("backend 'auto' uses 'map': %s", exc)
+                return "map"
+            return "compiled"
+
+        if closure.solvers.memo(("auto_backend", str(cache_dir())) + kern.key, decide) == "compiled":
             return compiled_function(closure, kern), "compiled"
-        log.info("no C compiler: backend 'auto' uses 'map'")
     return kern.function, "map"
 
 
