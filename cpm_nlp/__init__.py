@@ -12,54 +12,8 @@ or, from a problem file::
     result = cn.solve(cn.load_problem("problems/prs3_forward_kinematics.yaml"))
 """
 
+import importlib
 import logging
-
-from .api import (
-    BatchJacobians,
-    BatchResult,
-    Comparison,
-    Coordinate,
-    CpmError,
-    CuboidResult,
-    InputError,
-    JacobianReport,
-    LoopClosure,
-    Membership,
-    Model,
-    ModelFunctions,
-    PoseSolution,
-    Problem,
-    RequirementsReport,
-    Result,
-    SolverConfig,
-    SolverInfo,
-    Status,
-    apply_overrides,
-    assess,
-    batch_forward_kinematics,
-    batch_inverse_kinematics,
-    batch_jacobians,
-    build_model,
-    check_box,
-    export_kinematics,
-    forward_kinematics,
-    functions,
-    inscribed_cuboid,
-    inverse_kinematics,
-    jacobians,
-    joint_requirements,
-    load_exported,
-    load_problem,
-    mechanism_type,
-    membership,
-    passive_joints,
-    problem_from_dict,
-    reproduce,
-    residual,
-    sample_workspace,
-    solve,
-    status_of,
-)
 
 __all__ = [
     "status_of",
@@ -111,3 +65,18 @@ __all__ = [
 __version__ = "0.1.0"
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())
+
+
+def __getattr__(name: str) -> object:
+    """The public API, imported on first use (PEP 562): ``import cpm_nlp`` and the
+    ``cpm-nlp`` command line start without loading numpy, CasADi and the solvers
+    until a name of :mod:`cpm_nlp.api` is used."""
+    if name in __all__:
+        value = getattr(importlib.import_module(".api", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
