@@ -16,6 +16,8 @@ import importlib
 import logging
 
 __all__ = [
+    "Certificate",
+    "certify_box",
     "status_of",
     "ModelFunctions",
     "export_kinematics",

@@ -7,6 +7,7 @@ with numpy arrays, or take the CasADi Functions of the model (``model.closure``:
 to the ``cpm_nlp`` logger.
 """
 
+from .analysis.certify import Certificate, certify_box
 from .analysis.requirements import RequirementsReport, joint_requirements
 from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
@@ -32,6 +33,8 @@ from .problems.file import Problem, apply_overrides, load_problem, problem_from_
 from .problems.reproduce import Comparison, reproduce
 
 __all__ = [
+    "Certificate",
+    "certify_box",
     "status_of",
     "ModelFunctions",
     "export_kinematics",
