@@ -133,3 +133,31 @@ def test_plain_units_do_not_build_the_registry():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
+
+
+def test_published_quantities_find_the_same_dimension_either_way(monkeypatch):
+    """reproduce's parse_any_quantity tries the fast unit's dimension first: the same
+    value and dimension as trying every dimension in order through pint, for every
+    `published` figure of the shipped problem files and some bad ones."""
+    import yaml
+
+    from cpm_nlp.core import units as U
+    from cpm_nlp.problems.reproduce import parse_any_quantity
+
+    from .conftest import PROBLEMS
+
+    published = ["1.78e-6 m^3", "2 N/um", "5 %", "93.8 Hz", "3 rad", "1,5 mm", "2 furlong", "mm", 0.5]
+    for f in sorted(PROBLEMS.glob("*.yaml")):
+        rows = (yaml.safe_load(f.read_text()).get("reproduce") or {}).get("rows") or []
+        published += [r["published"] for r in rows if "published" in r]
+    assert len(published) > 100
+
+    def outcome(v):
+        try:
+            return parse_any_quantity(v, ("published",))
+        except InputError as exc:
+            return str(exc)
+
+    fast = [outcome(v) for v in published]
+    monkeypatch.setattr(U, "FAST_UNITS", {})
+    assert fast == [outcome(v) for v in published]

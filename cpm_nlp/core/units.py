@@ -108,6 +108,17 @@ FAST_UNITS: dict[str, tuple[float, str]] = {
 }
 
 
+def fast_dimension(value: Any) -> str | None:
+    """The dimension of a ``"<number> <unit>"`` string whose unit is in
+    :data:`FAST_UNITS` (else None): where a caller tries dimensions in turn, the
+    one to try first."""
+    if not isinstance(value, str):
+        return None
+    match = _NUMBER.match(value)
+    unit = FAST_UNITS.get(match.group(2)) if match else None
+    return unit[1] if unit else None
+
+
 _registry_lock = threading.Lock()
 _registry: Any = None
 
