@@ -29,6 +29,13 @@ of the working set across starts), and each start runs from its own initial
 box.  An exchange round adds sample points and continues from the current
 optimum the same way.
 
+The starts after the first are solved together (:meth:`ClosedFormCuboid.start_all`):
+J copies of the working-set NLP, one per start with its own box and rows, as one
+block-separable NLP (no constraint couples two blocks, the objective is the sum),
+whose KKT points are exactly the tuples of the starts' KKT points; IPOPT's fixed
+cost per iteration, which dominates for so few unknowns, is then paid once.  If
+that joint solve fails the starts run one by one, as the first.
+
 The working-set NLP has K row slots (K = 16, 32, 64, ...; one IPOPT solver
 per K, built once per mechanism type and configuration); a slot holds a
 sample point s_k and a one-hot selector e_k of the quantity it bounds, both
@@ -343,19 +350,19 @@ class ClosedFormCuboid:
             self.memory |= active
         return ok, (z if ok else None), status, iters
 
-    def start_all(self, boxes: list[tuple[np.ndarray, np.ndarray]]) -> tuple[list[tuple], int] | None:
+    def start_all(self, boxes: list[tuple[np.ndarray, np.ndarray]]) -> tuple[list[tuple] | None, int]:
         """Several starts from the boxes (u0, w0) at once, as one block-separable NLP,
         each from the rows of the optima found before (the first start's, run by
-        :meth:`start`): ([(converged, z, status, 0) per start], iterations).  None if
-        the joint solve did not converge: the caller then runs the starts one by one
-        (which also retries a start with the corners' rows)."""
+        :meth:`start`): ([(converged, z, status, 0) per start], IPOPT iterations).  The
+        runs are None if the joint solve did not converge: the caller then runs the
+        starts one by one (which also retries a start with the corners' rows)."""
         if not self.memory or len(boxes) < 2:
-            return None
+            return None, 0
         z0s = [np.r_[u0, w0] for u0, w0 in boxes]
         Z, ok, status, iters, actives = self.settle_blocks(z0s, [self.memory] * len(boxes))
         if not ok:
             log.debug("joint start of %d boxes did not converge (%s); one by one", len(boxes), status)
-            return None
+            return None, iters
         for active in actives:
             self.memory |= active
         return [(True, z, status, 0) for z in Z], iters

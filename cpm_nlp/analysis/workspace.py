@@ -787,11 +787,11 @@ def inscribed_cuboid(
         k0 = pending.pop(0)
         runs[k0] = engine.start(*boxes[k0])
         iterations += runs[k0][3]
-        joint = engine.start_all([boxes[k][:2] for k in pending])
+        joint, iters = engine.start_all([boxes[k][:2] for k in pending])
+        iterations += iters
     if joint is not None:
-        for k, run in zip(pending, joint[0]):
+        for k, run in zip(pending, joint):
             runs[k] = run
-        iterations += joint[1]
     else:
         for k in pending:
             runs[k] = engine.start(*boxes[k])
