@@ -300,7 +300,7 @@ def bench_cases(quick: bool) -> list[dict]:
             entry["note"] = f"skipped: {case['file']} is not in this checkout (yet)"
             out.append(entry)
             continue
-        problem = cn.load_problem(path)
+        problem = cn.load_problem(path, case.get("set", []))
         result = cn.solve(problem)
         repeats = 2 if quick else int(case.get("repeats", 5))
         entry["seconds"] = median_call(lambda problem=problem: cn.solve(problem), repeats)

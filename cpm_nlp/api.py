@@ -10,6 +10,7 @@ to the ``cpm_nlp`` logger.
 import os
 
 from .analysis.assembly import AssemblyMode, AssemblyModes, assembly_modes
+from .analysis.certify import Certificate, certify_box
 from .analysis.requirements import RequirementsReport, joint_requirements
 from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
@@ -65,6 +66,8 @@ __all__ = [
     "AssemblyMode",
     "AssemblyModes",
     "assembly_modes",
+    "Certificate",
+    "certify_box",
     "BatchJacobians",
     "BatchResult",
     "Comparison",
