@@ -22,13 +22,13 @@ import numpy as np
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import Coordinate, LoopClosure, Model
-from ...io.yamlfile import read_yaml
+from ...io.yamlfile import load_yaml_text, read_yaml
 from .generate import closure_parts, parameter_options
 from .spec import Description, description_from_dict
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Description", "load_file", "from_dict", "mechanism", "shipped_files"]
+__all__ = ["Description", "load_file", "from_dict", "mechanism", "shipped_files", "read_yaml", "load_yaml_text"]
 
 #: the shipped mechanism files
 SHIPPED_DIR = Path(__file__).resolve().parents[3] / "problems" / "mechanisms"
@@ -103,6 +103,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         passive=fns["passive"],
         passive_coords=[r.coord for r in gen.reported],
         branch=fns["branch"],
+        offsets=d.platform.offsets,
     )
     params = parameter_options(d)
     limits = gen.limit_options()
@@ -129,7 +130,9 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     return mech
 
 
-def _build(closure: LoopClosure, parameters: dict, limits: dict, fns: dict, derived_names: list, d: Description) -> Model:
+def _build(
+    closure: LoopClosure, parameters: dict, limits: dict, fns: dict, derived_names: list, d: Description
+) -> Model:
     p = np.array([float(parameters[n]) for n in closure.parameters])
     values = fns["extras"](p)
     length = float(values[2])
@@ -144,6 +147,11 @@ def _build(closure: LoopClosure, parameters: dict, limits: dict, fns: dict, deri
         dimensions=dims,
         characteristic_length=length if length > 0 else 1.0,
     )
+    for (what, path), value in zip(fns["requirements"], np.asarray(values[4], dtype=float).ravel()):
+        if not abs(value) < 1e-9:
+            raise InputError(
+                f"the reference configuration does not assemble: {what} (deviation {value:.3e})", path=path
+            )
     check_reference(model, fns["row_names"])
     return model
 

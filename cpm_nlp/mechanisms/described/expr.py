@@ -85,7 +85,9 @@ def _same(name: str, args: list[Value], col: int) -> Dim:
     dims = [a.dim for a in args if a.dim is not None]
     for d in dims[1:]:
         if not compatible(dims[0], d):
-            raise ExpressionError(f"{name}() needs arguments of one dimension, got {describe(dims[0])} and {describe(d)}", col)
+            raise ExpressionError(
+                f"{name}() needs arguments of one dimension, got {describe(dims[0])} and {describe(d)}", col
+            )
     return dims[0] if dims else None
 
 

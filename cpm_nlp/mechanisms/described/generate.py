@@ -37,7 +37,7 @@ import numpy as np
 
 from ...analysis import flexure
 from ...core.errors import InputError, format_key_path
-from ...core.model import Coordinate, LoopClosure
+from ...core.model import Coordinate
 from ...core.options import REQUIRED, Option, validate_mapping
 from ...core.units import parse_quantity
 from . import expr as ex
@@ -111,18 +111,20 @@ class Generator:
         self.q_home: list[ca.SX] = []
         self.q_limits: dict[str, tuple] = {}
         self.platform_radius: list[ca.SX] = []
+        #: (quantity that must vanish at the reference configuration, what it means, key path)
+        self.requirements: list[tuple[ca.SX, str, tuple]] = []
 
     # -- expressions -----------------------------------------------------------------------
     def value(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ex.Value:
         try:
             v = ex.parse(text, env)
         except ex.ExpressionError as exc:
-            shown = text if isinstance(text, str) else repr(text)
+            shown = "[" + ", ".join(str(t) for t in text) + "]" if isinstance(text, list) else str(text)
             raise InputError(f"in {shown!r}: column {exc.column}: {exc.message}", path=path) from None
         if dimension is not None and not ex.compatible(v.dim, ex.DIMENSION_OF[dimension]):
-            raise InputError(f"expected {ex.describe(ex.DIMENSION_OF[dimension])}, got {ex.describe(v.dim)} in {text!r}", path=path)
-        if dimension == "angle" and v.dim is not None and v.dim[1] == 0 and v.dim[0] == 0 and not v.sx.is_constant():
-            pass  # a plain number where an angle is expected is radians
+            raise InputError(
+                f"expected {ex.describe(ex.DIMENSION_OF[dimension])}, got {ex.describe(v.dim)} in {text!r}", path=path
+            )
         return v
 
     def scalar(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ca.SX:
@@ -154,7 +156,12 @@ class Generator:
         self.x = ca.SX.sym("x", len(self.x_names))
         self.xenv = dict(self.env)
         for k, name in enumerate(self.x_names):
-            self._bind(self.xenv, name, ex.Value(self.x[k], ex.DIMENSION_OF[pf.coordinates[name]]), ("platform", "coordinates", name))
+            self._bind(
+                self.xenv,
+                name,
+                ex.Value(self.x[k], ex.DIMENSION_OF[pf.coordinates[name]]),
+                ("platform", "coordinates", name),
+            )
         for name, text in pf.fixed.items():
             v = self.value(text, ("platform", "fixed", name), self.env, pf.coordinates[name])
             self._bind(self.xenv, name, v, ("platform", "fixed", name))
@@ -185,7 +192,9 @@ class Generator:
             raise InputError(f"actuator {name!r} drives two joints", path=j.path + ("actuated",))
         dim = JOINT_DIMS.get(j.type)
         if j.type not in ("P", "R", "planar_P", "planar_R"):
-            raise InputError(f"a {j.type} joint cannot be actuated (P, R, planar_P, planar_R can)", path=j.path + ("actuated",))
+            raise InputError(
+                f"a {j.type} joint cannot be actuated (P, R, planar_P, planar_R can)", path=j.path + ("actuated",)
+            )
         fam = j.limit or (re.sub(r"\d+$", "", name) or name)
         self.q_coords.append(Coordinate(name, dim, f"actuator of the {j.type} joint at {_where(j.path)}", fam))
         sym = ca.SX.sym(name)
@@ -237,7 +246,9 @@ class Generator:
             raise InputError("a U joint needs its two 'axes'", path=j.path)
         dof = {"P": 1, "R": 1, "planar_R": 1, "planar_P": 1, "C": 2, "U": 2, "S": 3, "distance": 0}[j.type]
         if j.coordinates and len(j.coordinates) != dof:
-            raise InputError(f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}", path=j.path + ("coordinates",))
+            raise InputError(
+                f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}", path=j.path + ("coordinates",)
+            )
         if j.actuated is not None:
             out.value = self.actuator(j, env)
         elif j.home:
@@ -293,7 +304,16 @@ class Generator:
         Rb = Rm
         if slide is not None:
             if slide.value is None:
-                raise InputError(f"leg {leg.name}: a passive P between two point joints constrains nothing", path=slide.spec.path)
+                raise InputError(
+                    f"leg {leg.name}: a passive P between two point joints constrains nothing", path=slide.spec.path
+                )
+            self.requirements.append(
+                (
+                    ca.norm_2(ca.cross(slide.axis, u0)) / r,
+                    "the P joint's axis is not along the leg (c -> B)",
+                    slide.spec.path,
+                )
+            )
             self.rows.append((ca.norm_2(v) - (r + slide.value), f"leg {leg.name}: length"))
             self.branch.append((r + slide.value) / r)
             self.branch.append(ca.dot(u, v) / (r * ca.norm_2(v)))
@@ -344,7 +364,9 @@ class Generator:
             dim = "length" if (j.type == "C" and k == 1) or j.type in ("P", "planar_P") else "angle"
             fam = j.spec.limit or re.sub(r"\d+$", "", name) or name
             desc = f"{j.type} joint of leg {leg}" + (f", axis {k + 1}" if len(names) > 1 else "")
-            self.reported.append(_Reported(Coordinate(name, dim, desc, fam), home + val, self._limit(j, dim), j.spec.path))
+            self.reported.append(
+                _Reported(Coordinate(name, dim, desc, fam), home + val, self._limit(j, dim), j.spec.path)
+            )
 
     def report_sphere(self, elim: _Joint, Rm: ca.SX, u0: ca.SX, v: ca.SX, leg: Leg) -> ca.SX | None:
         """The angles of a U (or planar R) whose link is eliminated, and the link's rotation (None: not determined)."""
@@ -356,6 +378,14 @@ class Generator:
         if elim.type == "U":
             a1, a2 = elim.axes
             F = ca.horzcat(a1, a2, ca.cross(a1, a2))
+            self.requirements.append((ca.dot(a1, a2), "the U joint's axes are not perpendicular", elim.spec.path))
+            self.requirements.append(
+                (
+                    ca.norm_2(ca.cross(F[:, 2], u0)) / ca.norm_2(u0),
+                    "the U joint's link is not normal to both axes",
+                    elim.spec.path,
+                )
+            )
             w = F.T @ Rm.T @ v
             theta2 = ca.atan2(w[0], ca.sqrt(w[1] ** 2 + w[2] ** 2))
             theta1 = ca.atan2(-w[1], w[2])
@@ -419,11 +449,15 @@ class Generator:
             self._bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("actuators", c.name))
         for k, text in enumerate(d.closures):
             self.rows.append((self.scalar(text, ("closures", k), full), f"closures[{k}]"))
+        families = list(dict.fromkeys(r.coord.group for r in self.reported))
+        self.reported.sort(key=lambda r: families.index(r.coord.group))  # alpha1..3, beta1..3, as the papers list them
         for qty in d.passive:
             v = self.value(qty.value, ("passive", qty.name), full, qty.dimension)
             dim = qty.dimension or _dim_name(v.dim)
             fam = qty.family or re.sub(r"\d+$", "", qty.name) or qty.name
-            self.reported.append(_Reported(Coordinate(qty.name, dim, qty.description, fam), v.sx, None, ("passive", qty.name)))
+            self.reported.append(
+                _Reported(Coordinate(qty.name, dim, qty.description, fam), v.sx, None, ("passive", qty.name))
+            )
         nx, nrows = len(self.x_names), len(self.rows)
         if nrows != nx:
             what = "over" if nrows > nx else "under"
@@ -454,12 +488,13 @@ class Generator:
         if self.d.characteristic_length is not None:
             radius = self.scalar(self.d.characteristic_length, ("characteristic_length",), self.env, "length")
         lo, hi = self.bounds(radius)
+        req = ca.vertcat(*[r[0] for r in self.requirements]) if self.requirements else ca.SX(0, 1)
         extras = ca.Function(
             "described_values",
             [p],
-            [lo, hi, radius, ca.vertcat(*[dv[1] for dv in self.derived]) if self.derived else ca.SX(0, 1)],
+            [lo, hi, radius, ca.vertcat(*[dv[1] for dv in self.derived]) if self.derived else ca.SX(0, 1), req],
             ["p"],
-            ["lower", "upper", "length", "derived"],
+            ["lower", "upper", "length", "derived", "requirements"],
         )
         return {
             "phi": phi,
@@ -469,6 +504,7 @@ class Generator:
             "extras": extras,
             "ik": self.closed_form_ik(),
             "row_names": [r[1] for r in self.rows],
+            "requirements": [(r[1], r[2]) for r in self.requirements],
         }
 
     def bounds(self, radius: ca.SX) -> tuple[ca.SX, ca.SX]:
@@ -498,7 +534,7 @@ class Generator:
         env = dict(self.env)
         for k, name in enumerate(pf.task):
             env[name] = ex.Value(t[k], ex.DIMENSION_OF[pf.coordinates[name]])
-        for name, text in pf.fixed.items():
+        for name in pf.fixed:
             env[name] = self.xenv[name]
         for name, text in ik.let.items():
             self._bind(env, name, self.value(text, ("ik", "let", name), env), ("ik", "let", name))
@@ -509,7 +545,10 @@ class Generator:
             elif name in ik.pose:
                 xs.append(self.scalar(ik.pose[name], ("ik", "pose", name), env, pf.coordinates[name]))
             else:
-                raise InputError(f"missing the dependent coordinate {name!r} (an expression of the task coordinates)", path=("ik", "pose"))
+                raise InputError(
+                    f"missing the dependent coordinate {name!r} (an expression of the task coordinates)",
+                    path=("ik", "pose"),
+                )
         qs = []
         for c in self.q_coords:
             if c.name not in ik.actuators:
@@ -518,7 +557,9 @@ class Generator:
         if ik.reach is None:
             raise InputError("missing 'reach': an expression < 0 where the pose cannot be assembled", path=("ik",))
         reach = self.scalar(ik.reach, ("ik", "reach"), env)
-        return ca.Function("ik", [t, self.p], [ca.vertcat(*xs), ca.vertcat(*qs), reach], ["t", "p"], ["x", "q", "reach"])
+        return ca.Function(
+            "ik", [t, self.p], [ca.vertcat(*xs), ca.vertcat(*qs), reach], ["t", "p"], ["x", "q", "reach"]
+        )
 
     # -- declared options -----------------------------------------------------------------------
     def limit_options(self) -> tuple[Option, ...]:
@@ -528,11 +569,19 @@ class Generator:
             seen[fam] = Option(fam, dim, f"range [low, high] of every actuator {fam}*", default=lim, shape="range")
         for c in self.q_coords:
             if c.group not in seen:
-                seen[c.group] = Option(c.group, c.kind, f"range [low, high] of every actuator {c.group}*", default=None, shape="range")
+                seen[c.group] = Option(
+                    c.group, c.kind, f"range [low, high] of every actuator {c.group}*", default=None, shape="range"
+                )
         for r in self.reported:
             fam = r.coord.group
             if fam not in seen:
-                seen[fam] = Option(fam, r.coord.kind, f"range [low, high] of every {fam}* ({r.coord.description})", default=r.limit, shape="range")
+                seen[fam] = Option(
+                    fam,
+                    r.coord.kind,
+                    f"range [low, high] of every {fam}* ({r.coord.description})",
+                    default=r.limit,
+                    shape="range",
+                )
         return tuple(seen.values())
 
 
@@ -554,12 +603,25 @@ def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
 def parameter_options(d: Description) -> tuple[Option, ...]:
     out = []
     for par in d.parameters:
-        out.append(Option(par.name, par.dimension, par.description or par.name, default=par.default, lower=par.lower, upper=par.upper))
+        out.append(
+            Option(
+                par.name,
+                par.dimension,
+                par.description or par.name,
+                default=par.default,
+                lower=par.lower,
+                upper=par.upper,
+            )
+        )
     return out and tuple(out) or ()
 
 
 def numeric(fn: ca.Function, *args: Any) -> list[np.ndarray]:
-    return [np.asarray(v, dtype=float).ravel() for v in fn(*args)] if fn.n_out() > 1 else [np.asarray(fn(*args), dtype=float).ravel()]
+    return (
+        [np.asarray(v, dtype=float).ravel() for v in fn(*args)]
+        if fn.n_out() > 1
+        else [np.asarray(fn(*args), dtype=float).ravel()]
+    )
 
 
 __all__ = ["Generator", "closure_parts", "parameter_options", "numeric", "REQUIRED"]

@@ -146,6 +146,7 @@ class Platform:
     bounds: dict[str, tuple[Expr, Expr]] = field(default_factory=dict)
     descriptions: dict[str, str] = field(default_factory=dict)
     planar: bool = False
+    offsets: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -280,6 +281,7 @@ PLATFORM_KEYS = {
     "home": "the reference pose: name -> value",
     "bounds": "name -> [low, high]: the box IPOPT keeps the pose in",
     "planar": "true for a planar mechanism (P in the plane, R about z)",
+    "offsets": "name -> coordinate: inputs/outputs measured from the home pose (dz: pz)",
 }
 
 
@@ -328,7 +330,12 @@ def _platform(raw: Any, path: tuple) -> Platform:  # noqa: C901 - one check per 
     planar = raw.get("planar", False)
     if not isinstance(planar, bool):
         raise InputError(f"expected true or false, got {planar!r}", path=path + ("planar",))
-    return Platform(coords, raw["position"], rotation, tuple(task), fixed, home, bounds, descs, planar)
+    offsets = _mapping(raw.get("offsets") or {}, path + ("offsets",), "name -> coordinate")
+    for name, target in offsets.items():
+        _name(name, path + ("offsets", name), "an offset name")
+        if target not in coords or target in fixed:
+            raise InputError(f"expected a pose coordinate, got {target!r}", path=path + ("offsets", name))
+    return Platform(coords, raw["position"], rotation, tuple(task), fixed, home, bounds, descs, planar, offsets)
 
 
 JOINT_KEYS = {
@@ -447,9 +454,7 @@ def _legs(raw: Any, path: tuple) -> list[Leg]:
         for template, index, rotate, axis in variants:
             suffix = "" if index is None else str(template[index])
             joints = [_joint(j, p + ("joints", n), template) for n, j in enumerate(joints_raw)]
-            legs.append(
-                Leg(name + suffix, joints, index, tuple(template.values()), rotate, axis, p)
-            )
+            legs.append(Leg(name + suffix, joints, index, tuple(template.values()), rotate, axis, p))
     return legs
 
 
