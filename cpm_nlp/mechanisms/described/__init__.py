@@ -21,7 +21,7 @@ import numpy as np
 
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
-from ...core.model import Coordinate, LoopClosure, Model
+from ...core.model import LoopClosure, Model
 from ...io.yamlfile import load_yaml_text, read_yaml
 from .generate import closure_parts, parameter_options
 from .spec import Description, description_from_dict
@@ -89,10 +89,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     gen, fns = closure_parts(d)
     closure = LoopClosure(
         d.name,
-        x=[
-            Coordinate(n, d.platform.coordinates[n], d.platform.descriptions.get(n, "platform coordinate"))
-            for n in gen.x_names
-        ],
+        x=gen.x_coords,
         q=gen.q_coords,
         parameters=[p.name for p in d.parameters],
         phi=fns["phi"],

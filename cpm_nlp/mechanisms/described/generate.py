@@ -73,6 +73,8 @@ class _Joint:
     axes: list = field(default_factory=list)
     value: ca.SX | None = None  # displacement from the reference configuration, when known
     home: list = field(default_factory=list)
+    #: elementary motions ("P" | "R", axis, displacement) of a joint in the proximal chain
+    motions: list = field(default_factory=list)
 
     @property
     def type(self) -> str:
@@ -113,6 +115,9 @@ class Generator:
         self.platform_radius: list[ca.SX] = []
         #: (quantity that must vanish at the reference configuration, what it means, key path)
         self.requirements: list[tuple[ca.SX, str, tuple]] = []
+        #: passive joints of the proximal chains: (coordinate, symbol, home value, limit, key path)
+        self.extra: list[tuple] = []
+        self.extra_limits: dict[str, tuple] = {}
 
     # -- expressions -----------------------------------------------------------------------
     def value(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ex.Value:
@@ -153,6 +158,9 @@ class Generator:
             if t in pf.fixed:
                 raise InputError(f"{t!r} is both a task coordinate and fixed", path=("platform", "task"))
         self.x_names = [c for c in pf.coordinates if c not in pf.fixed]
+        self.x_coords = [
+            Coordinate(n, pf.coordinates[n], pf.descriptions.get(n, "platform coordinate")) for n in self.x_names
+        ]
         self.x = ca.SX.sym("x", len(self.x_names))
         self.xenv = dict(self.env)
         for k, name in enumerate(self.x_names):
@@ -276,16 +284,11 @@ class Generator:
             )
         slide = None
         if elim is None and before and before[-1].type in ("P", "planar_P") and len(before) >= 2:
-            if before[-2].value is None and before[-2].type in SPHERE_JOINTS:
+            if before[-2].value is None and before[-2].type in SPHERE_JOINTS | {"R"}:
                 slide, elim = before.pop(), before.pop()
-        for j in before:
+        for k, j in enumerate(before):
             if j.value is None:
-                raise InputError(
-                    f"leg {leg.name}: the passive {j.type} joint here is not next to the platform's point joint; "
-                    "passive joints are supported in the last two places of a leg (R-S, U-S, C-S, S-S, U-P-S, "
-                    "R-R planar) and actuated ones before them",
-                    path=j.spec.path,
-                )
+                self.unknowns(j, leg, k)
         Rm, tm = self.chain(before)
         B = self.platform_point(tip)
         R_rel = self.R @ self.R_home.T
@@ -317,7 +320,14 @@ class Generator:
             self.rows.append((ca.norm_2(v) - (r + slide.value), f"leg {leg.name}: length"))
             self.branch.append((r + slide.value) / r)
             self.branch.append(ca.dot(u, v) / (r * ca.norm_2(v)))
-            Rb = self.report_sphere(elim, Rm, u0, v, leg)
+            if elim.type == "R":  # R-P-S: the leg also stays in the plane normal to the R axis
+                w = Rm @ elim.axis
+                self.rows.append((ca.dot(v, w) - ca.dot(u0, elim.axis), f"leg {leg.name}: plane of the R joint"))
+                theta = ca.atan2(ca.dot(w, ca.cross(u, v)), ca.dot(u, v))
+                self.report(elim, [theta], leg.name)
+                Rb = _rot(w, theta) @ Rm
+            else:
+                Rb = self.report_sphere(elim, Rm, u0, v, leg)
         elif elim.type == "R":
             w = Rm @ elim.axis
             h = ca.dot(u0, elim.axis)
@@ -347,13 +357,39 @@ class Generator:
         """The motion y -> Rm y + tm of the proximal chain's last body (product of exponentials)."""
         Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
         for j in joints:
-            if j.type in ("P", "planar_P"):
-                Rk, tk = ca.SX.eye(3), j.value * j.axis
-            else:  # R, planar_R about the axis through j.at
-                Rk = _rot(j.axis, j.value)
-                tk = j.at - Rk @ j.at
-            Rm, tm = Rm @ Rk, Rm @ tk + tm
+            motions = j.motions or [("P" if j.type in ("P", "planar_P") else "R", j.axis, j.value)]
+            for kind, axis, value in motions:
+                if kind == "P":
+                    Rk, tk = ca.SX.eye(3), value * axis
+                else:  # a rotation about the axis through j.at
+                    Rk = _rot(axis, value)
+                    tk = j.at - Rk @ j.at
+                Rm, tm = Rm @ Rk, Rm @ tk + tm
         return Rm, tm
+
+    def unknowns(self, j: _Joint, leg: Leg, k: int) -> None:
+        """A passive joint of the proximal chain: its values become pose unknowns (dependent coordinates)."""
+        if j.type == "distance":
+            raise InputError(f"leg {leg.name}: a distance joint must be the last of its leg", path=j.spec.path)
+        e = [ca.DM([1.0, 0, 0]), ca.DM([0, 1.0, 0]), ca.DM([0, 0, 1.0])]
+        elementary = {
+            "P": [("P", j.axis)],
+            "planar_P": [("P", j.axis)],
+            "R": [("R", j.axis)],
+            "planar_R": [("R", j.axis)],
+            "C": [("R", j.axis), ("P", j.axis)],
+            "U": [("R", a) for a in j.axes],
+            "S": [("R", a) for a in (j.axes or e)],
+        }[j.type]
+        names = j.spec.coordinates or tuple(f"{leg.name}_j{k + 1}_{n + 1}" for n in range(len(elementary)))
+        for n, ((kind, axis), name) in enumerate(zip(elementary, names)):
+            dim = "length" if kind == "P" else "angle"
+            sym = ca.SX.sym(name)
+            home = j.home[n] if n < len(j.home) else ca.SX(0)
+            fam = j.spec.limit or re.sub(r"\d+$", "", name) or name
+            coord = Coordinate(name, dim, f"passive {j.type} joint of leg {leg.name} (an unknown of the loops)", fam)
+            self.extra.append((coord, sym, home, self._limit(j, dim), j.spec.path))
+            j.motions.append((kind, axis, sym - home))
 
     def report(self, j: _Joint, values: list, leg: str) -> None:
         names = j.spec.coordinates
@@ -458,6 +494,7 @@ class Generator:
             self.reported.append(
                 _Reported(Coordinate(qty.name, dim, qty.description, fam), v.sx, None, ("passive", qty.name))
             )
+        self.add_unknowns()
         nx, nrows = len(self.x_names), len(self.rows)
         if nrows != nx:
             what = "over" if nrows > nx else "under"
@@ -474,6 +511,18 @@ class Generator:
                 path=("platform", "task"),
             )
         return self.functions(q)
+
+    def add_unknowns(self) -> None:
+        if not self.extra:
+            return
+        self.x = ca.vertcat(self.x, *[e[1] for e in self.extra])
+        self.x_home = ca.vertcat(self.x_home, *[e[2] for e in self.extra])
+        for coord, _sym, _home, limit, path in self.extra:
+            if coord.name in self.x_names or coord.name in [c.name for c in self.q_coords]:
+                raise InputError(f"the coordinate name {coord.name!r} is used twice", path=path + ("coordinates",))
+            self.x_names.append(coord.name)
+            self.x_coords.append(coord)
+            self.extra_limits[coord.group] = (coord.kind, limit, coord.description)
 
     def functions(self, q: ca.SX) -> dict[str, Any]:
         x, p = self.x, self.p
@@ -511,15 +560,16 @@ class Generator:
         pf = self.d.platform
         lo, hi = [], []
         span = 2 * ca.fmax(radius, ca.norm_2(self.P_home))
-        for k, name in enumerate(self.x_names):
-            dim = pf.coordinates[name]
+        for k, coord in enumerate(self.x_coords):
+            name, dim = coord.name, coord.kind
             if name in pf.bounds:
                 a, b = pf.bounds[name]
                 lo.append(self.scalar(a, ("platform", "bounds", name, 0), self.env, dim))
                 hi.append(self.scalar(b, ("platform", "bounds", name, 1), self.env, dim))
             elif dim == "angle":
-                lo.append(self.x_home[k] - math.pi / 3)
-                hi.append(self.x_home[k] + math.pi / 3)
+                half = math.pi / 3 if name in pf.coordinates else math.pi / 2
+                lo.append(self.x_home[k] - half)
+                hi.append(self.x_home[k] + half)
             else:
                 lo.append(self.x_home[k] - span)
                 hi.append(self.x_home[k] + span)
@@ -543,7 +593,8 @@ class Generator:
             if name in pf.task:
                 xs.append(env[name].sx)
             elif name in ik.pose:
-                xs.append(self.scalar(ik.pose[name], ("ik", "pose", name), env, pf.coordinates[name]))
+                dim = self.x_coords[self.x_names.index(name)].kind
+                xs.append(self.scalar(ik.pose[name], ("ik", "pose", name), env, dim))
             else:
                 raise InputError(
                     f"missing the dependent coordinate {name!r} (an expression of the task coordinates)",
@@ -572,6 +623,9 @@ class Generator:
                 seen[c.group] = Option(
                     c.group, c.kind, f"range [low, high] of every actuator {c.group}*", default=None, shape="range"
                 )
+        for fam, (dim, lim, desc) in self.extra_limits.items():
+            if fam not in seen:
+                seen[fam] = Option(fam, dim, f"range [low, high] of every {fam}* ({desc})", default=lim, shape="range")
         for r in self.reported:
             fam = r.coord.group
             if fam not in seen:
