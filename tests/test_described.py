@@ -226,3 +226,29 @@ def test_cli_exit_code_2_without_traceback(tmp_path):
     run = subprocess.run([sys.executable, "-m", "cpm_nlp", "solve", str(pfile)], capture_output=True, text=True)
     assert run.returncode == 2, run.stderr
     assert "Traceback" not in run.stderr and "unknown symbol 'L8'" in run.stderr and "m.yaml" in run.stderr
+
+
+def test_two_joints_on_the_same_body(tmp_path):
+    text = DEFAULTS.replace(
+        "      - {type: P, at: [0, 0, 0], axis: [-1, 0, 0], actuated: q1, gain: A2}",
+        "      - {type: P, at: [0, 0, 0], axis: [-1, 0, 0], actuated: q1, gain: A2, body: slider}\n"
+        "      - {type: R, at: [0, 0, 0], axis: [0, 0, 1], body: slider}",
+    )
+    _error(tmp_path, text, "legs[0].joints[1].body", "two joints on the body 'slider' with no loop")
+
+
+def test_body_chain_that_stops_short_of_the_platform(tmp_path):
+    text = DEFAULTS.replace(
+        "{type: distance, at: [0, 0, 0], to: [L7, 0, 0]}", "{type: distance, at: [0, 0, 0], to: [L7, 0, 0], body: rod}"
+    )
+    _error(tmp_path, text, "legs[0].joints[1].body", "does not reach the platform")
+
+
+def test_vector_of_the_wrong_size_and_mixed_dimensions(tmp_path):
+    _error(tmp_path, DEFAULTS.replace("to: [L7, 0, 0]", "to: [L7, 0]"), "expected a vector of 3 elements")
+    _error(
+        tmp_path,
+        DEFAULTS.replace("rotation: []", "rotation: [[z, L7]]"),
+        "platform.rotation[0][1]",
+        "expected an angle",
+    )

@@ -398,7 +398,9 @@ def _joint(raw: Any, path: tuple, template: dict) -> Joint:  # noqa: C901 - one 
         limit,
         None if rng is None else tuple(rng),
         flex,
-        raw.get("body"),
+        None
+        if raw.get("body") is None
+        else _name(_fill(raw["body"], template, path + ("body",)), path + ("body",), "a body name"),
         path,
     )
 
@@ -458,6 +460,46 @@ def _legs(raw: Any, path: tuple) -> list[Leg]:
     return legs
 
 
+def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a chain can break
+    """Each leg is a serial chain base -> bodies -> platform: a joint carries the next body (its
+    ``body``, default the leg's own next link, the platform for the last joint)."""
+    owner: dict[str, str] = {}
+    for leg in legs:
+        prev, seen = "base", set()
+        for n, j in enumerate(leg.joints):
+            last = n == len(leg.joints) - 1
+            body = j.body or ("platform" if last else f"{leg.name}.link{n + 1}")
+            where = j.path + ("body",)
+            if body == "base":
+                raise InputError(f"a joint cannot carry the base (it joins {prev!r} to the base)", path=where)
+            if body == prev or body in seen:
+                raise InputError(
+                    f"two joints on the body {body!r} with no loop between them: this joint joins {prev!r} "
+                    f"to {body!r} again (a leg is a serial chain; name the body each joint carries)",
+                    path=where,
+                )
+            if last and body != "platform":
+                raise InputError(
+                    f"leg {leg.name} does not reach the platform: its last joint carries {body!r}", path=where
+                )
+            if not last and body == "platform":
+                rest = ", ".join(k.type for k in leg.joints[n + 1 :])
+                raise InputError(
+                    f"leg {leg.name} reaches the platform at joint {n + 1}; the joints after it ({rest}) "
+                    "hang on the platform with no loop",
+                    path=where,
+                )
+            if body != "platform" and owner.get(body, leg.name) != leg.name:
+                raise InputError(
+                    f"the body {body!r} is in legs {owner[body]} and {leg.name}: legs are serial chains that "
+                    "share only the base and the platform",
+                    path=where,
+                )
+            owner[body] = leg.name
+            seen.add(body)
+            prev = body
+
+
 IK_KEYS = {"let": "definitions in order", "pose": "dependent coordinates", "actuators": "", "reach": ""}
 
 
@@ -494,12 +536,14 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
             raw.get("reach"),
         )
     examples = _list(data.get("examples") or [], ("examples",), "a list of problem files")
+    legs = _legs(data.get("legs") or [], ("legs",))
+    check_bodies(legs)
     return Description(
         name=name,
         title=_text(data.get("title"), ("title",)) or name,
         parameters=params,
         platform=_platform(data["platform"], ("platform",)),
-        legs=_legs(data.get("legs") or [], ("legs",)),
+        legs=legs,
         derived=derived,
         actuators=actuators,
         closures=list(_list(data.get("closures") or [], ("closures",), "a list of expressions")),
