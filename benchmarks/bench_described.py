@@ -5,7 +5,7 @@ the file mechanism within 1.5x of the hand-written one).
 
 Both models have the same parameters (problems/prs3_forward_kinematics.yaml); the same N
 random actuator vectors (s within +-2 mm) are solved by ``cn.batch_forward_kinematics``
-(Newton, default backend) for each, interleaved, warm (solvers built before the clock
+(Newton; ``--backend map`` or ``compiled``) for each, interleaved, warm (solvers built before the clock
 starts); the median of the repeats is taken.  The machine's load (os.getloadavg()) is
 recorded beside the figures.
 """
@@ -36,6 +36,7 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=20000)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--backend", default="map", choices=("map", "compiled"))
     args = ap.parse_args()
     newton = cn.SolverConfig("newton")
     models = {
@@ -44,13 +45,13 @@ def main() -> None:
     }
     qs = np.random.default_rng(0).uniform(-2e-3, 2e-3, (args.n, 3))
     for m in models.values():  # warm: solvers and kernels built
-        cn.batch_forward_kinematics(m, qs[:100], newton)
+        cn.batch_forward_kinematics(m, qs[:100], newton, backend=args.backend)
     times: dict[str, list[float]] = {k: [] for k in models}
     load_before = os.getloadavg()
     for _ in range(args.repeat):
         for name, m in models.items():
             t0 = time.perf_counter()
-            res = cn.batch_forward_kinematics(m, qs, newton)
+            res = cn.batch_forward_kinematics(m, qs, newton, backend=args.backend)
             times[name].append(time.perf_counter() - t0)
             assert int(np.sum(res.ok)) == args.n, name
     load_after = os.getloadavg()
@@ -58,6 +59,7 @@ def main() -> None:
     ratio = med["file prs3_file"] / med["hand-written prs3"]
     out = {
         "n": args.n,
+        "backend": args.backend,
         "repeat": args.repeat,
         "median_seconds": med,
         "poses_per_second": {k: args.n / v for k, v in med.items()},
@@ -73,7 +75,9 @@ def main() -> None:
         print(f"{k:20s} {v * 1e3:9.1f} ms for {args.n} poses  ({args.n / v:,.0f} poses/s)")
     print(f"ratio file / hand: {ratio:.3f} (target <= 1.5); load {load_before} -> {load_after}")
     if args.json:
-        args.json.write_text(json.dumps(out, indent=2) + "\n")
+        runs = json.loads(args.json.read_text()) if args.json.exists() else {}
+        runs[args.backend] = out
+        args.json.write_text(json.dumps(runs, indent=2) + "\n")
 
 
 if __name__ == "__main__":
