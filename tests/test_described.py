@@ -3,7 +3,8 @@
 The papers' mechanisms re-described as files must be the hand-derived modules:
 FK, IK, the Jacobians and the passive joint angles to 1e-12 on random poses of
 the working range.  The reference is the hand-written module of each paper
-(cpm_nlp/mechanisms/prs3.py, prc3/kinematics.py, rpr/kinematics.py), whose
+(cpm_nlp/mechanisms/prs3.py, prc3/kinematics.py, rpr/kinematics.py,
+pantograph/kinematics.py), whose
 formulas are pinned to the papers in their own tests; the file's closure is
 generated from the legs and shares no code with them.
 """
@@ -29,6 +30,7 @@ CASES = {
     "prs3": ("prs3_file", "prs3", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}, 2e-3),
     "prc3": ("prc3_file", "prc3", {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}, 15e-6),
     "rpr": ("rpr_file", "rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 50e-6),
+    "pantograph": ("pantograph_file", "pantograph", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
 }
 NEWTON = cn.SolverConfig("newton")
 

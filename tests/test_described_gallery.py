@@ -148,3 +148,42 @@ def test_five_bar_other_working_modes_are_wrong_branch():
     status, message, _ = cn.assess(model, x, q, 1e-9)
     assert np.max(np.abs(cn.residual(model, x, q))) < 1e-12  # it closes the loops
     assert status == Status.WRONG_BRANCH, message
+
+
+def test_prs3_as_built_with_design_values_is_the_paper_model():
+    """With the design guide angles (120, 240 deg) and no height errors the as-built file is
+    the 3-PRS of the paper: FK and passive angles equal the hand-written module's."""
+    design = {"g2": "120 deg", "g3": "240 deg", "dh1": 0, "dh2": 0, "dh3": 0}
+    fm = cn.build_model("prs3_as_built", design)
+    hm = cn.build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"})
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        q = rng.uniform(-2e-3, 2e-3, 3)
+        a, b = cn.forward_kinematics(hm, q, NEWTON), cn.forward_kinematics(fm, q, NEWTON)
+        assert a.status == b.status == Status.SOLVED
+        np.testing.assert_allclose(b.x, a.x, rtol=0, atol=1e-12)
+        pa, pb = cn.passive_joints(hm, a.x, q), cn.passive_joints(fm, b.x, q)
+        np.testing.assert_allclose([pb[n] for n in pa], list(pa.values()), rtol=0, atol=1e-12)
+
+
+def test_prs3_as_built_against_eq20_with_the_measured_guides():
+    """Eq 20 with each leg's own guide: A_i = a (cos g_i, sin g_i, dh_i), s_i0 = -(cos g_i,
+    sin g_i, 0); s_i = k - sqrt(k^2 - |A_iB_i|^2 + L^2), k = s_i0 . A_iB_i (the root of the
+    reference configuration), with the guide angles and base heights of Table 3."""
+    model, poses = _poses("prs3_as_built", 2e-3)
+    p = model.parameters
+    a = p["b"] + p["L"] * math.cos(p["alpha0"])
+    guides = (0.0, p["g2"], p["g3"])
+    heights = (p["dh1"], p["dh2"], p["dh3"])
+    assert math.degrees(p["g2"]) == pytest.approx(120 - (5 + 24 / 60) / 60, abs=1e-12)
+    for x, q in poses:
+        P = np.array(x[:3])
+        R = _ry(x[4]) @ _rx(x[3]) @ _rz(x[5])
+        for i in range(3):
+            e = np.array([math.cos(guides[i]), math.sin(guides[i]), 0.0])
+            A = a * e + np.array([0, 0, heights[i]])
+            B = P + R @ (p["b"] * np.array([math.cos(2 * math.pi * i / 3), math.sin(2 * math.pi * i / 3), 0]))
+            AB = B - A
+            k = -e @ AB
+            want = k - math.sqrt(k**2 - AB @ AB + p["L"] ** 2)
+            assert q[i] == pytest.approx(want, abs=TOL)

@@ -125,7 +125,10 @@ class Generator:
             v = ex.parse(text, env)
         except ex.ExpressionError as exc:
             shown = "[" + ", ".join(str(t) for t in text) + "]" if isinstance(text, list) else str(text)
-            raise InputError(f"in {shown!r}: column {exc.column}: {exc.message}", path=path) from None
+            hint = None
+            if "never closed" in exc.message:
+                hint = "inside a YAML [list] or {mapping}, quote an expression that contains a comma"
+            raise InputError(f"in {shown!r}: column {exc.column}: {exc.message}", path=path, hint=hint) from None
         if dimension is not None and not ex.compatible(v.dim, ex.DIMENSION_OF[dimension]):
             raise InputError(
                 f"expected {ex.describe(ex.DIMENSION_OF[dimension])}, got {ex.describe(v.dim)} in {text!r}", path=path
@@ -220,6 +223,8 @@ class Generator:
         env = dict(self.env)
         if leg.index is not None:
             self._bind(env, leg.index, ex.Value(ca.SX(float(leg.values[0])), None), leg.path + ("repeat", "index"))
+        for name, text in leg.let.items():
+            self._bind(env, name, self.value(text, leg.path + ("let", name), env), leg.path + ("let", name))
         turn = ca.SX.eye(3)
         if leg.rotate is not None:
             turn = _rot(leg.rotate_axis, self.scalar(leg.rotate, leg.path + ("repeat", "rotate"), env, "angle"))
@@ -472,11 +477,11 @@ class Generator:
         self.platform()
         for leg in d.legs:
             self.leg(leg)
-        for name, dim in d.actuators.items():
+        for name, (dim, home) in d.actuators.items():
             if name not in [c.name for c in self.q_coords]:
                 self.q_coords.append(Coordinate(name, dim, "actuator", re.sub(r"\d+$", "", name) or name))
                 self.q_syms.append(ca.SX.sym(name))
-                self.q_home.append(ca.SX(0))
+                self.q_home.append(self.scalar(home, ("actuators", name, "home"), self.env, dim))
         if not self.q_coords:
             raise InputError("no actuators: mark joints 'actuated: name' (or declare 'actuators')", path=("legs",))
         q = ca.vertcat(*self.q_syms)
@@ -485,6 +490,8 @@ class Generator:
             self._bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("actuators", c.name))
         for k, text in enumerate(d.closures):
             self.rows.append((self.scalar(text, ("closures", k), full), f"closures[{k}]"))
+        for k, text in enumerate(d.branch):
+            self.branch.append(self.scalar(text, ("branch", k), full))
         families = list(dict.fromkeys(r.coord.group for r in self.reported))
         self.reported.sort(key=lambda r: families.index(r.coord.group))  # alpha1..3, beta1..3, as the papers list them
         for qty in d.passive:

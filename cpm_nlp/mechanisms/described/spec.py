@@ -133,6 +133,8 @@ class Leg:
     rotate: Expr = None
     rotate_axis: str = "z"
     path: tuple = ()
+    #: definitions of the leg (name -> expression, in order; may use the index)
+    let: dict[str, Expr] = field(default_factory=dict)
 
 
 @dataclass
@@ -171,8 +173,10 @@ class Description:
     platform: Platform
     legs: list[Leg] = field(default_factory=list)
     derived: list[Quantity] = field(default_factory=list)
-    actuators: dict[str, str] = field(default_factory=dict)  # declared without legs: name -> dimension
+    #: actuators declared without joints: name -> (dimension, value at the reference configuration)
+    actuators: dict[str, tuple[str, Expr]] = field(default_factory=dict)
     closures: list[Expr] = field(default_factory=list)
+    branch: list[Expr] = field(default_factory=list)
     passive: list[Quantity] = field(default_factory=list)
     ik: ClosedFormIK | None = None
     characteristic_length: Expr = None
@@ -191,7 +195,8 @@ TOP = {
     "derived": "name -> expression (or {value, dimension, description})",
     "platform": "{coordinates, position, rotation, task, fixed, home, bounds}",
     "legs": "list of {name, repeat, joints}",
-    "actuators": "name -> dimension (for closures written as expressions)",
+    "actuators": "name -> dimension or {dimension, home} (for closures written as expressions)",
+    "branch": "assembly-branch indicators as expressions, positive on the working branch",
     "closures": "list of closure equations as expressions (an escape hatch)",
     "passive": "name -> {value, dimension, family, description}: extra reported joint values",
     "ik": "{let, pose, actuators, reach}: a closed-form inverse kinematics",
@@ -426,7 +431,12 @@ def _fill(text: Any, template: dict, path: tuple) -> Any:
     return _PLACEHOLDER.sub(sub, text)
 
 
-LEG_KEYS = {"name": "the leg's name", "repeat": "{index, values, rotate, axis}", "joints": "base -> platform"}
+LEG_KEYS = {
+    "name": "the leg's name",
+    "repeat": "{index, values, rotate, axis}",
+    "let": "definitions of the leg: name -> expression (in order; may use the index)",
+    "joints": "base -> platform",
+}
 REPEAT_KEYS = {"index": "symbol", "values": "its values", "rotate": "angle expression", "axis": "x, y or z"}
 
 
@@ -456,7 +466,8 @@ def _legs(raw: Any, path: tuple) -> list[Leg]:
         for template, index, rotate, axis in variants:
             suffix = "" if index is None else str(template[index])
             joints = [_joint(j, p + ("joints", n), template) for n, j in enumerate(joints_raw)]
-            legs.append(Leg(name + suffix, joints, index, tuple(template.values()), rotate, axis, p))
+            let = _mapping(item.get("let") or {}, p + ("let",), "name -> expression")
+            legs.append(Leg(name + suffix, joints, index, tuple(template.values()), rotate, axis, p, let))
     return legs
 
 
@@ -522,10 +533,15 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
         _quantity(_name(n, ("passive", n), "a name"), v, ("passive", n))
         for n, v in _mapping(data.get("passive") or {}, ("passive",), "name -> {value, dimension}").items()
     ]
-    actuators = {
-        _name(n, ("actuators", n), "an actuator name"): _dimension(v, ("actuators", n))
-        for n, v in _mapping(data.get("actuators") or {}, ("actuators",), "name -> dimension").items()
-    }
+    actuators = {}
+    for n, v in _mapping(data.get("actuators") or {}, ("actuators",), "name -> dimension").items():
+        path = ("actuators", n)
+        _name(n, path, "an actuator name")
+        if isinstance(v, Mapping):
+            v = _mapping(v, path, "{dimension, home}", {"dimension": "", "home": ""})
+            actuators[n] = (_dimension(v.get("dimension"), path + ("dimension",)), v.get("home", 0))
+        else:
+            actuators[n] = (_dimension(v, path), 0)
     ik = None
     if data.get("ik") is not None:
         raw = _mapping(data["ik"], ("ik",), "{let, pose, actuators, reach}", IK_KEYS)
@@ -547,6 +563,7 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
         derived=derived,
         actuators=actuators,
         closures=list(_list(data.get("closures") or [], ("closures",), "a list of expressions")),
+        branch=list(_list(data.get("branch") or [], ("branch",), "a list of expressions")),
         passive=passive,
         ik=ik,
         characteristic_length=data.get("characteristic_length"),
