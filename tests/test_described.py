@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
+from cpm_nlp.analysis import flexure
 from cpm_nlp.core.result import Status
 from cpm_nlp.mechanisms import described
 
@@ -254,3 +255,75 @@ def test_vector_of_the_wrong_size_and_mixed_dimensions(tmp_path):
         "platform.rotation[0][1]",
         "expected an angle",
     )
+
+
+def test_builder_api_builds_the_same_mechanism_as_the_file():
+    """The 3-PRC stage built in code from the dataclasses gives the file's FK."""
+    legs = [
+        cn.Leg(
+            f"limb{i + 1}",
+            [
+                cn.Joint("P", at=[0, 0, 0], axis=[-(k == i) * 1.0 for k in range(3)], actuated=f"q{i + 1}", gain="A2"),
+                cn.Joint("distance", at=[0, 0, 0], to=["L7" if k == i else 0 for k in range(3)]),
+            ],
+        )
+        for i in range(3)
+    ]
+    desc = cn.Description(
+        name="prc3_code",
+        title="3-PRC built in code",
+        parameters=[
+            cn.Parameter(n, "length", default=v)
+            for n, v in (("L1", 9.5e-3), ("L2", 25e-3), ("L3", 9e-3), ("L4", 30e-3), ("L7", 73.5e-3))
+        ],
+        platform=cn.Platform({"x": "length", "y": "length", "z": "length"}, ["x", "y", "z"], [], ("x", "y", "z")),
+        legs=legs,
+        derived=[cn.Quantity("A2", "L2*L4/(L1*L3)", "dimensionless")],
+    )
+    mech = cn.describe_mechanism(desc)
+    try:
+        code = cn.build_model("prc3_code")
+        ref = cn.build_model("prc3", CASES["prc3"][2])
+        q = np.array([5e-6, 1e-6, 8e-6])
+        a, b = cn.forward_kinematics(ref, q, NEWTON), cn.forward_kinematics(code, q, NEWTON)
+        assert a.status == b.status == Status.SOLVED
+        _close(b.x, a.x)
+        assert mech.origin == "described in code"
+    finally:
+        cn.unregister_mechanism("prc3_code")
+
+
+def test_rank_deficient_mobility_names_the_free_coordinates(tmp_path):
+    """Three legs but two along x: as many equations as coordinates, Φ_x of rank 2; z is free."""
+    text = DEFAULTS.replace("axis: [0, 0, -1], actuated: q3", "axis: [-1, 0, 0], actuated: q3").replace(
+        "to: [0, 0, L7]", "to: [L7, 0, 0]"
+    )
+    msg = _error(tmp_path, text, "wrong mobility", "rank")
+    assert "free: z" in msg or "free: y" in msg, msg
+
+
+def test_flexure_hinge_sets_the_joint_limits(tmp_path):
+    """A circular-notch hinge on the S joints: the limits of beta_m, beta_n, beta_l are the
+    stress-limited rotation of cpm_nlp.analysis.flexure (the built-in formula, eq 38 of the
+    pantograph paper), +- about the reference configuration."""
+    text = (MECH / "prs3.yaml").read_text().replace("name: prs3_file", "name: prs3_flex")
+    text = text.replace(
+        '        coordinates: ["beta_m{i}", "beta_n{i}", "beta_l{i}"]',
+        '        coordinates: ["beta_m{i}", "beta_n{i}", "beta_l{i}"]\n'
+        "        flexure: {hinge: circular_notch, t: 0.5 mm, r: 2 mm, material: Al 7075-T6}",
+    )
+    f = tmp_path / "flex.yaml"
+    f.write_text(text.split("examples:")[0])
+    mech = described.load_file(f)
+    m = flexure.MATERIALS["Al 7075-T6"]
+    rot = flexure.circular_notch_max_rotation(m.E, 0.5e-3, 2e-3, flexure.allowable_stress(m))
+    limits = {o.name: o.default for o in mech.limits}
+    assert limits["beta_m"] == pytest.approx((-rot, rot), rel=1e-12)
+    assert limits["alpha"] is None
+
+
+def test_a_file_may_not_take_a_built_in_name(tmp_path):
+    (tmp_path / "m.yaml").write_text(DEFAULTS.replace("name: prc3_bad", "name: prc3"))
+    problem = {"problem": "forward_kinematics", "mechanism": {"file": "m.yaml"}, "inputs": {"q1": 0, "q2": 0, "q3": 0}}
+    with pytest.raises(cn.InputError, match="taken by a built-in mechanism"):
+        cn.problem_from_dict(problem, base_dir=tmp_path)

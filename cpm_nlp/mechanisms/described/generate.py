@@ -406,8 +406,23 @@ class Generator:
             fam = j.spec.limit or re.sub(r"\d+$", "", name) or name
             desc = f"{j.type} joint of leg {leg}" + (f", axis {k + 1}" if len(names) > 1 else "")
             self.reported.append(
-                _Reported(Coordinate(name, dim, desc, fam), home + val, self._limit(j, dim), j.spec.path)
+                _Reported(Coordinate(name, dim, desc, fam), home + val, self._flexure_range(j, dim, home), j.spec.path)
             )
+
+    def _flexure_range(self, j: _Joint, dim: str, home: Any) -> tuple | None:
+        """The joint's limits; a flexure's are a deflection about the reference value."""
+        lim = self._limit(j, dim)
+        if lim is None or j.spec.flexure is None or (isinstance(home, (int, float)) and home == 0):
+            return lim
+        home_sx = ca.SX(home)
+        if not home_sx.is_constant():
+            raise InputError(
+                "a flexure hinge limits the deflection from the reference configuration, and this joint's "
+                "reference value depends on the parameters; report the deflection (home 0) or give its range",
+                path=j.spec.path + ("flexure",),
+            )
+        h = float(ca.DM(home_sx))
+        return (h + lim[0], h + lim[1])
 
     def report_sphere(self, elim: _Joint, Rm: ca.SX, u0: ca.SX, v: ca.SX, leg: Leg) -> ca.SX | None:
         """The angles of a U (or planar R) whose link is eliminated, and the link's rotation (None: not determined)."""
