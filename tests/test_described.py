@@ -327,3 +327,11 @@ def test_a_file_may_not_take_a_built_in_name(tmp_path):
     problem = {"problem": "forward_kinematics", "mechanism": {"file": "m.yaml"}, "inputs": {"q1": 0, "q2": 0, "q3": 0}}
     with pytest.raises(cn.InputError, match="taken by a built-in mechanism"):
         cn.problem_from_dict(problem, base_dir=tmp_path)
+
+
+def test_spatial_joint_in_a_planar_mechanism(tmp_path):
+    text = (MECH / "five_bar.yaml").read_text().replace("name: five_bar", "name: five_bad")
+    text = text.replace(
+        "{type: planar_R, at: [-cx, cy], coordinates: [e1]}", "{type: R, at: [-cx, cy], coordinates: [e1]}"
+    )
+    _error(tmp_path, text.split("examples:")[0], "legs[0].joints[1].type", "'planar_R'")

@@ -33,12 +33,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import casadi as ca
-import numpy as np
 
 from ...analysis import flexure
 from ...core.errors import InputError, format_key_path
 from ...core.model import Coordinate
-from ...core.options import REQUIRED, Option, validate_mapping
+from ...core.options import Option, validate_mapping
 from ...core.units import parse_quantity
 from . import expr as ex
 from .spec import Description, Joint, Leg
@@ -233,6 +232,15 @@ class Generator:
 
     def resolve(self, j: Joint, env: Mapping[str, ex.Value], turn: ca.SX) -> _Joint:  # noqa: C901 - one rule per joint part
         out = _Joint(j)
+        planar = self.d.platform.planar
+        allowed = ("planar_R", "planar_P", "distance") if planar else ("P", "R", "C", "U", "S", "distance")
+        if j.type not in allowed:
+            other = {"R": "planar_R", "P": "planar_P", "planar_R": "R", "planar_P": "P"}.get(j.type)
+            raise InputError(
+                f"a {'planar' if planar else 'spatial'} mechanism takes {', '.join(allowed)} joints, got {j.type}",
+                path=j.path + ("type",),
+                suggestions=[other] if other else (),
+            )
         if j.at is None:
             raise InputError(f"a {j.type} joint needs its location 'at'", path=j.path)
         out.at = turn @ self.vector(j.at, j.path + ("at",), env, "length")
@@ -346,7 +354,7 @@ class Generator:
         elif elim.type == "C":
             w = Rm @ elim.axis
             up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
-            rp = ca.norm_2(elim.axis * 0 + (u0 - ca.dot(u0, elim.axis) * elim.axis))
+            rp = ca.norm_2(u0 - ca.dot(u0, elim.axis) * elim.axis)
             self.rows.append(((ca.dot(vp, vp) - rp**2) / (2 * rp), f"leg {leg.name}: cylinder of the C joint"))
             self.branch.append(ca.dot(up, vp) / ca.dot(up, up))
             theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
@@ -677,27 +685,11 @@ def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
 
 
 def parameter_options(d: Description) -> tuple[Option, ...]:
-    out = []
-    for par in d.parameters:
-        out.append(
-            Option(
-                par.name,
-                par.dimension,
-                par.description or par.name,
-                default=par.default,
-                lower=par.lower,
-                upper=par.upper,
-            )
-        )
-    return out and tuple(out) or ()
-
-
-def numeric(fn: ca.Function, *args: Any) -> list[np.ndarray]:
-    return (
-        [np.asarray(v, dtype=float).ravel() for v in fn(*args)]
-        if fn.n_out() > 1
-        else [np.asarray(fn(*args), dtype=float).ravel()]
+    """The declared parameters as options (validated like a built-in mechanism's)."""
+    return tuple(
+        Option(p.name, p.dimension, p.description or p.name, default=p.default, lower=p.lower, upper=p.upper)
+        for p in d.parameters
     )
 
 
-__all__ = ["Generator", "closure_parts", "parameter_options", "numeric", "REQUIRED"]
+__all__ = ["Generator", "closure_parts", "parameter_options"]
