@@ -11,6 +11,7 @@ generated from the legs and shares no code with them.
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -335,3 +336,18 @@ def test_spatial_joint_in_a_planar_mechanism(tmp_path):
         "{type: planar_R, at: [-cx, cy], coordinates: [e1]}", "{type: R, at: [-cx, cy], coordinates: [e1]}"
     )
     _error(tmp_path, text.split("examples:")[0], "legs[0].joints[1].type", "'planar_R'")
+
+
+def test_the_readme_example_solves(tmp_path):
+    """The README's smallest complete example: the mechanism file and the problem file that uses it."""
+    readme = (ROOT / "README.md").read_text().split("## Your own mechanism from a file")[1]
+    blocks = re.findall(r"```yaml\n(.*?)```", readme, flags=re.S)
+    (tmp_path / "stage.yaml").write_text(blocks[0])
+    (tmp_path / "fk.yaml").write_text(blocks[1])
+    run = subprocess.run(
+        [sys.executable, "-m", "cpm_nlp", "solve", str(tmp_path / "fk.yaml"), "--set", "mechanism.parameters.l=75mm"],
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 0, run.stderr
+    assert "status  : solved" in run.stdout
