@@ -22,6 +22,7 @@ from typing import Any
 from ..core.errors import CpmError, InputError, suggest
 from ..core.kind import ProblemKind
 from ..kinds.analysis import ActuatorWorkspace, Dynamics
+from ..kinds.compliance import ActuatorForces, NaturalFrequencies, PlatformCompliance
 from ..kinds.kinematic import ForwardKinematics, InverseKinematics, Jacobian, JointRequirements
 from ..kinds.synthesis import Synthesis
 from ..kinds.workspace import InscribedCuboid, Workspace
@@ -44,6 +45,9 @@ GENERIC: dict[str, type[ProblemKind]] = {
         InscribedCuboid,
         Workspace,
         Synthesis,
+        ActuatorForces,
+        PlatformCompliance,
+        NaturalFrequencies,
     )
 }
 
