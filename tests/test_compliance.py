@@ -335,3 +335,87 @@ def test_stress_limit_error_needs_geometry():
     m = build_model("prs3", PRS3)
     with pytest.raises(InputError, match="circular notch"):
         cm.hinge_set(m, {"revolute": {"t": "17 mm"}})
+
+
+# -- stress limits as joint limits ------------------------------------------------------------
+
+
+def test_stress_limit_reproduces_eq38_for_a_circular_notch():
+    """A circular notch whose stiffness is the simplified Paros-Weisbord one and whose
+    stress is the nominal 6M/(w t^2) reaches sigma at delta = 3 pi/(4E) sqrt(r/t) sigma
+    (pantograph-3d-elgammal-2016.md eq 38, cpm_nlp.analysis.flexure)."""
+    from cpm_nlp.analysis import flexure
+
+    E, w, t, r, sigma = 2e9, 5e-3, 0.1e-3, 1e-3, 23.5e6
+    k = flexure.circular_notch_stiffness(E, w, t, r)
+    m = build_model("pantograph", {"a": "20 mm", "b": "50 mm"})
+    hs = cm.hinge_set(
+        m,
+        {"psi": {"joints": "psi", "type": "circular_notch", "t": t, "r": r, "w": w, "k": k}},
+        {"name": "pp", "E": E, "allowable": sigma},
+    )
+    lim = cm.stress_angle_limits(hs, sigma)
+    delta = flexure.circular_notch_max_rotation(E, t, r, sigma)
+    assert lim["psi"] == pytest.approx((math.pi / 2 - delta, math.pi / 2 + delta), rel=1e-12)
+
+
+def test_workspace_kind_accepts_a_stress_limit():
+    """The workspace kind with a stress limit answers as with the joint limits it implies."""
+    from cpm_nlp.analysis import flexure
+
+    E, w, t, r, sigma = 2e9, 5e-3, 0.1e-3, 1e-3, 23.5e6
+    k = flexure.circular_notch_stiffness(E, w, t, r)
+    delta = flexure.circular_notch_max_rotation(E, t, r, sigma)
+    hinge = {"type": "circular_notch", "t": t, "r": r, "w": w, "k": k}
+    points = {"px": [98.99e-3, 95e-3, 101e-3], "py": [0.0, 5e-3, 0.0], "pz": [0.0, 0.0, 10e-3]}
+    stressed = _solve_dict(
+        {
+            "problem": "workspace",
+            "mechanism": {"type": "pantograph", "parameters": {"a": "20 mm", "b": "50 mm"}},
+            "inputs": {
+                **points,
+                "stress_limit": {
+                    "hinges": {"psi": {"joints": "psi", **hinge}, "phi": {"joints": "phi", **hinge}},
+                    "material": {"name": "pp", "E": E, "allowable": sigma},
+                },
+            },
+        }
+    )
+    direct = _solve_dict(
+        {
+            "problem": "workspace",
+            "mechanism": {
+                "type": "pantograph",
+                "parameters": {"a": "20 mm", "b": "50 mm"},
+                "limits": {"psi_min": math.pi / 2 - delta, "psi_max": math.pi / 2 + delta, "phi_max": delta},
+            },
+            "inputs": points,
+        }
+    )
+    assert stressed.values["inside"] == direct.values["inside"]
+    assert not all(direct.values["inside"]) and any(direct.values["inside"])
+
+
+def test_static_point_matches_the_symbolic_reference(prs3):
+    m, hs = prs3
+    x, q = _pose(m, [1e-3, -0.5e-3, 0.7e-3])
+    f = np.array([0.1, 0.2, 0.3, 0.01, 0.02, 0.03])
+    sp = cm.static_point(m, hs, x, q, f)
+    V, F, K, J, _ = cm.energy_function(m.closure)(x, q, m.p, hs.k, hs.theta0, f)
+    np.testing.assert_allclose(sp.F, np.asarray(F).ravel(), rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(sp.K_q, np.asarray(K), rtol=1e-10, atol=1e-6)
+    np.testing.assert_allclose(sp.J, np.asarray(J), rtol=1e-10, atol=1e-14)
+
+
+def test_cutting_force_file():
+    """1 N in x, y, z with the actuator forces held: z deflects by C_zz (15 um/N, about
+    1/(3 k_q) with k_q the per-actuator stiffness 21.97 N/mm of Table 2's model); x and y
+    are parasitic coordinates with no first-order compliance."""
+    res = solve(load_problem(ROOT / "problems" / "prs3_cutting_force.yaml"))
+    assert res.ok
+    v = res.values
+    assert v["d_pz"] == pytest.approx(v["C_pz"] * 1.0, rel=1e-3)
+    assert abs(v["d_px"]) < 1e-12 and abs(v["d_py"]) < 1e-12
+    b, L, a0 = 47.91e-3, 109.215e-3, math.pi / 4
+    kq = (98.37 + 32.67) / (L * math.sin(a0)) ** 2  # per actuator, symmetric motion, dz/ds = 1 at home
+    assert v["C_pz"] == pytest.approx(1 / (3 * kq), rel=1e-6)

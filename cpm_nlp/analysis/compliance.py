@@ -41,6 +41,7 @@ source), combined by von Mises where a hinge carries bending and torsion.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from collections.abc import Mapping
@@ -458,13 +459,14 @@ def joint_vector(model: Model, x: np.ndarray, q: np.ndarray) -> np.ndarray:
 def energy_function(closure: LoopClosure) -> ca.Function:
     """``("pseudo_rigid_body", [x, q, p, k, theta0, f], [V, F, K_q, J, theta])``: the
     energy V = U - fᵀx, the actuator forces F, the input stiffness K_q, the
-    forward Jacobian J and the joint vector θ = (x, q, passive)."""
+    forward Jacobian J and the joint vector θ = (x, q, passive), all symbolic
+    (the reference :func:`static_point` is checked against; slower, as the
+    symbolic Φ_x⁻¹ grows the expression)."""
     c = closure
     x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
     n = c.nx + c.nq + len(c.passive_coords)
     k, th0, f = ca.SX.sym("k", n), ca.SX.sym("theta0", n), ca.SX.sym("f", c.nx)
-    parts = [x, q] + ([c.passive(x, q, p)] if c.passive is not None else [])
-    theta = ca.vertcat(*parts)
+    theta = _theta(c, x, q, p)
     d = theta - th0
     V = 0.5 * ca.dot(k, d * d) - ca.dot(f, x)
     J = c.jacobian(x, q, p)
@@ -477,6 +479,42 @@ def energy_function(closure: LoopClosure) -> ca.Function:
         ["x", "q", "p", "k", "theta0", "f"],
         ["V", "F", "K_q", "J", "theta"],
     )
+
+
+def _theta(c: LoopClosure, x: Any, q: Any, p: Any) -> Any:
+    return ca.vertcat(*([x, q] + ([c.passive(x, q, p)] if c.passive is not None else [])))
+
+
+@functools.lru_cache(maxsize=16)
+def energy_parts(closure: LoopClosure) -> Any:
+    """The derivatives the reduced quantities need, over z = (x, q):
+    ``("pseudo_rigid_body_parts", [x, q, p, k, theta0, f], [V, dV, d2V, dPhi, d2Phi, theta])``
+    with d2Phi the Hessians of the nx residuals stacked.  With λ = Φ_x⁻ᵀ V_x (adjoint),
+    F = V_q - Φ_qᵀ λ and K_q = Zᵀ (∇²V - Σ λ_i ∇²Φ_i) Z, Z = [J; I] (the reduced
+    Hessian of V(x(q), q)); the small linear algebra is done in numpy.  Wrapped for
+    fast calls (:class:`~cpm_nlp.core.kernels.FastFunction`)."""
+    from ..core.kernels import FastFunction
+
+    c = closure
+    x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
+    n = c.nx + c.nq + len(c.passive_coords)
+    k, th0, f = ca.SX.sym("k", n), ca.SX.sym("theta0", n), ca.SX.sym("f", c.nx)
+    z = ca.vertcat(x, q)
+    theta = _theta(c, x, q, p)
+    d = theta - th0
+    V = 0.5 * ca.dot(k, d * d) - ca.dot(f, x)
+    dV, d2V = ca.gradient(V, z), ca.hessian(V, z)[0]
+    phi = c.phi(x, q, p)
+    dphi = ca.jacobian(phi, z)
+    d2phi = ca.vertcat(*[ca.hessian(phi[i], z)[0] for i in range(c.nx)])
+    fn = ca.Function(
+        "pseudo_rigid_body_parts",
+        [x, q, p, k, th0, f],
+        [ca.densify(e) for e in (V, dV, d2V, dphi, d2phi, theta)],
+        ["x", "q", "p", "k", "theta0", "f"],
+        ["V", "dV", "d2V", "dPhi", "d2Phi", "theta"],
+    )
+    return FastFunction(fn)
 
 
 @dataclass
@@ -501,17 +539,31 @@ class StaticPoint:
 def static_point(model: Model, hs: HingeSet, x, q, f=None) -> StaticPoint:
     """Forces, stiffness and stresses at a solved pose (x, q) under the load f (nx)."""
     c = model.closure
-    load = np.zeros(c.nx) if f is None else np.asarray(f, dtype=float)
-    V, F, Kq, J, theta = energy_function(c)(x, q, model.p, hs.k, hs.theta0, load)
-    theta = np.asarray(theta, dtype=float).ravel()
+    nx, nq = c.nx, c.nq
+    nz = nx + nq
+    load = np.zeros(nx) if f is None else np.asarray(f, dtype=float)
+    V, dV, d2V, dphi, d2phi, theta = energy_parts(c)(x, q, model.p, hs.k, hs.theta0, load)
+    d2V = d2V.reshape(nz, nz, order="F")
+    dphi = dphi.reshape(nx, nz, order="F")
+    # the stacked Hessians, (nx nz) x nz column-major: flat index i*nz + a + b*nx*nz -> [b, a, i]
+    d2phi = d2phi.reshape(nz, nx, nz).transpose(0, 2, 1)
+    phi_x, phi_q = dphi[:, :nx], dphi[:, nx:]
+    inv = np.linalg.inv(phi_x)
+    J = -inv @ phi_q
+    lam = inv.T @ dV[:nx]
+    F = dV[nx:] - phi_q.T @ lam
+    H = d2V - d2phi @ lam  # Hessians are symmetric, so [b, a] = [a, b]
+    Z = np.empty((nz, nq))
+    Z[:nx], Z[nx:] = J, np.eye(nq)
+    Kq = Z.T @ H @ Z
     return StaticPoint(
         np.asarray(x, dtype=float),
         np.asarray(q, dtype=float),
-        np.asarray(F, dtype=float).ravel(),
-        np.asarray(Kq, dtype=float),
-        np.asarray(J, dtype=float),
+        F,
+        0.5 * (Kq + Kq.T),
+        J,
         theta,
-        float(V),
+        float(V[0]),
         hs.stresses(theta),
     )
 
@@ -577,8 +629,10 @@ def compliant_fk(
     solver = compliant_fk_solver(c)
     ka = np.zeros(c.nq) if k_actuator is None else np.asarray(k_actuator, dtype=float)
     scale = max(float(np.max(hs.k)), 1e-300)
-    lbx = np.concatenate([model.x_lower, np.full(c.nq, -np.inf)])
-    ubx = np.concatenate([model.x_upper, np.full(c.nq, np.inf)])
+    # no bounds: the loaded pose stays next to the commanded one (checked on the branch
+    # afterwards), and without inequalities IPOPT runs as a plain Newton-SQP (no barrier)
+    lbx = np.full(c.nx + c.nq, -np.inf)
+    ubx = np.full(c.nx + c.nq, np.inf)
     if k_actuator is None:
         lbx[c.nx :] = ubx[c.nx :] = q_c
     par = np.concatenate([q_c, model.p, hs.k, hs.theta0, f, ka, F_c, [scale]])
@@ -589,4 +643,43 @@ def compliant_fk(
     res = float(np.max(np.abs(np.asarray(c.phi(x, q, model.p), dtype=float)))) if c.nx else 0.0
     ok = bool(stats.get("success", False)) and res <= tol
     msg = stats.get("return_status", "") + (f"; residual {res:.3g}" if res > tol else "")
+    if ok and c.branch is not None:
+        g = np.asarray(c.branch(x, q, model.p), dtype=float).ravel()
+        if not np.all(g > 0):
+            ok, msg = False, msg + "; the loaded pose left the assembly branch"
     return CompliantPose(ok, x, q, msg, int(stats.get("iter_count", 0)))
+
+
+# -- stress limits as joint limits ----------------------------------------------------------------
+
+
+def stress_angle_limits(hs: HingeSet, sigma_allow: float) -> dict[str, tuple[float, float]]:
+    """Joint limits from a stress limit: for each joint coordinate carried by a hinge
+    with a geometry, θ0 ± δ, δ the deflection about that axis alone at which the hinge
+    reaches sigma_allow (the smallest over the hinges on that joint).  The minimal
+    generalization of pantograph-3d-elgammal-2016.md eq 31 (ψ = π/2 ∓ δ_max): deflections
+    about several axes of one hinge at once add up, which per-axis limits do not see."""
+    out: dict[str, tuple[float, float]] = {}
+    for h in hs.hinges:
+        for axis, i in h.axes.items():
+            delta = h.angle_limit(axis, sigma_allow)
+            if delta is None:
+                continue
+            name = hs.names[i]
+            lo, hi = hs.theta0[i] - delta, hs.theta0[i] + delta
+            if name in out:
+                lo, hi = max(lo, out[name][0]), min(hi, out[name][1])
+            out[name] = (float(lo), float(hi))
+    return out
+
+
+def with_limits(model: Model, limits: Mapping[str, tuple[float, float]]) -> Model:
+    """A copy of the model with extra joint limits (each intersected with any it has)."""
+    merged = dict(model.limits)
+    coords = {c.name: c for c in list(model.closure.x) + list(model.closure.q) + list(model.closure.passive_coords)}
+    for name, (lo, hi) in limits.items():
+        old = model.limit_of(coords[name])
+        if old is not None:
+            lo, hi = max(lo, old[0]), min(hi, old[1])
+        merged[name] = (lo, hi)
+    return dataclasses.replace(model, limits=merged)

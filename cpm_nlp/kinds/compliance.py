@@ -580,3 +580,47 @@ class NaturalFrequencies(_HingeKind):
     def output_names(self, model: Model) -> list[str]:
         c = model.closure
         return _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)] + ["M", "K", "modes_q", "modes_x"]
+
+
+# -- stress limits for the workspace kinds ---------------------------------------------------------
+
+#: the input the workspace kinds (workspace, inscribed_cuboid, actuator_workspace) accept
+STRESS_LIMIT_OPTION = Option(
+    "stress_limit",
+    "str",
+    "hinge stress limits in place of angle limits: true (the mechanism's hinges and material) or a mapping "
+    "{sigma_allow, safety_factor, hinges, material}; each hinge's deflection about each axis alone at sigma_allow "
+    "becomes a limit of its joint (the generalization of pantograph eq 31)",
+    default=None,
+)
+_STRESS_KEYS = ("sigma_allow", "safety_factor", "hinges", "material")
+
+
+def split_stress_limit(raw: Any, model: Model, path: tuple) -> tuple[Any, Model | None]:
+    """The inputs without ``stress_limit``, and the model with the joint limits it sets
+    (None when not given)."""
+    if not isinstance(raw, Mapping) or raw.get("stress_limit") in (None, False):
+        if isinstance(raw, Mapping) and "stress_limit" in raw:
+            raw = {k: v for k, v in raw.items() if k != "stress_limit"}
+        return raw, None
+    spec = raw["stress_limit"]
+    rest = {k: v for k, v in raw.items() if k != "stress_limit"}
+    sub = path + ("stress_limit",)
+    if spec is True:
+        spec = {}
+    if not isinstance(spec, Mapping):
+        keys = ", ".join(_STRESS_KEYS)
+        raise InputError(f"expected stress_limit: true or a mapping {{{keys}}}, got {spec!r}", path=sub)
+    for key in spec:
+        if key not in _STRESS_KEYS:
+            raise unknown_key_error(str(key), _STRESS_KEYS, sub, "stress_limit key")
+    opts = [
+        Option("sigma_allow", "stress", "allowable stress", default=None, lower=0.0, strict=True),
+        Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
+    ]
+    vals = validate_mapping({k: spec.get(k) for k in ("sigma_allow", "safety_factor")}, opts, sub, what="key")
+    hs = cm.hinge_set(model, spec.get("hinges"), spec.get("material"), None, sub)
+    if not any(h.kind is not None for h in hs.hinges):
+        raise InputError("a stress limit needs hinges with a flexure type and dimensions", path=sub + ("hinges",))
+    sigma = cm.allowable(hs, vals["sigma_allow"], vals["safety_factor"], sub)
+    return rest, cm.with_limits(model, cm.stress_angle_limits(hs, sigma))

@@ -367,5 +367,7 @@ MECHANISM = Mechanism(
         "prs3_jacobian.yaml",
         "prs3_joint_requirements.yaml",
         "prs3_fem_table2.yaml",
+        "prs3_table2_forces.yaml",
+        "prs3_cutting_force.yaml",
     ),
 )
