@@ -416,6 +416,57 @@ def test_cutting_force_file():
     v = res.values
     assert v["d_pz"] == pytest.approx(v["C_pz"] * 1.0, rel=1e-3)
     assert abs(v["d_px"]) < 1e-12 and abs(v["d_py"]) < 1e-12
-    b, L, a0 = 47.91e-3, 109.215e-3, math.pi / 4
+    L, a0 = 109.215e-3, math.pi / 4
     kq = (98.37 + 32.67) / (L * math.sin(a0)) ** 2  # per actuator, symmetric motion, dz/ds = 1 at home
     assert v["C_pz"] == pytest.approx(1 / (3 * kq), rel=1e-6)
+
+
+# -- natural frequencies: the 3-PRC's paper model as a special case -------------------------------
+
+
+def test_prc3_paper_dynamics_is_a_special_case():
+    """prc3-li-2018.md eq 28-41 (the ``dynamics`` kind, problems/prc3_dynamics.yaml) through
+    the generic natural_frequencies kind.  Its energies map onto the generic model as:
+    the amplifier hinges (lever angles A1 q/L2, A2 q/L4, not coordinates of the closure)
+    become a stiffness on each actuator, 2 (4 k (A1/L2)^2 + 3 k (A2/L4)^2); the levers,
+    blocks and sliders a mass on each actuator; the platform and the leg bars a mass on x,
+    y, z; the four leg hinges per limb a stiffness 4k on beta and gamma -- scaled by
+    (L7/L8)^2 on beta because the paper's beta is z/L8 while the closure's legs have the
+    length L7.  M, K and the frequencies then agree with the paper-specific model."""
+    import yaml
+
+    from cpm_nlp.analysis import flexure
+    from cpm_nlp.mechanisms.prc3.kinematics import lever_ratios
+    from cpm_nlp.problems.file import problem_from_dict
+
+    prob = load_problem(ROOT / "problems" / "prc3_dynamics.yaml")
+    ref = solve(prob)
+    P, inp = prob.model.parameters, prob.inputs
+    A1, A2 = lever_ratios(P["L1"], P["L2"], P["L3"], P["L4"])
+    k = flexure.circular_notch_stiffness(inp["E"], P["b"], P["t"], P["r"])
+    L2, L4, L5, L6, L7, L8 = (P[n] for n in ("L2", "L4", "L5", "L6", "L7", "L8"))
+    m = [inp[f"m{j}"] for j in range(8)]
+    IG2, IG3, IG4, IG5 = m[2] * L2**2 / 3, m[3] * L5**2 / 12, m[4] * L4**2 / 3, m[5] * L6**2 / 12
+    IG6, IG7 = m[7] * L8**2 / 12, m[7] * L7**2 / 12
+    k_amp = 2 * (4 * k * (A1 / L2) ** 2 + 3 * k * (A2 / L4) ** 2)
+    m_q = 2 * (m[1] + (IG2 + IG3) * (A1 / L2) ** 2 + m[3] * A1**2 + IG4 * (A2 / L4) ** 2 + (m[5] + m[6]) * A2**2)
+    m_q += 2 * IG5 * (A2 / L4) ** 2 + 2 * m[7] * A2**2
+    m_x = m[0] + m[7] + 2 * IG6 / L8**2 + 2 * IG7 / L7**2
+    data = yaml.safe_load((ROOT / "problems" / "prc3_dynamics.yaml").read_text())
+    data.pop("reproduce")
+    data["problem"] = "natural_frequencies"
+    data["inputs"] = {
+        "hinges": {
+            "amplifier": {"joints": {"axial": "q"}, "k": k_amp},
+            "leg_beta": {"joints": "beta", "k": 4 * k * (L7 / L8) ** 2},
+            "leg_gamma": {"joints": "gamma", "k": 4 * k},
+        },
+        "masses": {"x": m_x, "y": m_x, "z": m_x, "q1": m_q, "q2": m_q, "q3": m_q},
+    }
+    gen = solve(problem_from_dict(data, file="<test>"))
+    assert gen.ok
+    np.testing.assert_allclose(np.array(gen.values["M"]), np.array(ref.values["M"]), rtol=1e-9)
+    np.testing.assert_allclose(np.array(gen.values["K"]), np.array(ref.values["K"]), rtol=1e-6)
+    for j in (1, 2, 3):
+        assert gen.values[f"f{j}"] == pytest.approx(ref.values[f"f{j}"], rel=1e-6)
+    assert ref.values["f1"] == pytest.approx(107.3475722, rel=1e-6)  # the figure the dynamics kind reports
