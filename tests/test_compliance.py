@@ -470,3 +470,19 @@ def test_prc3_paper_dynamics_is_a_special_case():
     for j in (1, 2, 3):
         assert gen.values[f"f{j}"] == pytest.approx(ref.values[f"f{j}"], rel=1e-6)
     assert ref.values["f1"] == pytest.approx(107.3475722, rel=1e-6)  # the figure the dynamics kind reports
+
+
+def test_rpr_eq40_is_the_generic_input_stiffness():
+    """rpr-2rpu-upr-zhang-2022.md eq 40, K' = G_pᵀ K_J G_p, is the generic K_q at the
+    initial pose (hinges undeflected); away from it K_q adds the preload terms."""
+    from cpm_nlp.mechanisms.rpr import compliance as rc
+
+    m = build_model("rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"})
+    k_J = rc.stiffness_order(12.0, 3.0)
+    G, G_p = rc.passive_rates(m, m.x_home)
+    np.testing.assert_allclose(rc.mechanism_stiffness(m, m.x_home, k_J), G_p.T @ np.diag(k_J) @ G_p, rtol=1e-9)
+    x = m.x_home + np.array([0.02, -0.01, 1e-3])
+    G, G_p = rc.passive_rates(m, x)
+    K = rc.mechanism_stiffness(m, x, k_J)
+    assert not np.allclose(K, G_p.T @ np.diag(k_J) @ G_p, rtol=1e-9)
+    np.testing.assert_allclose(K, G_p.T @ np.diag(k_J) @ G_p, rtol=0.2)
