@@ -486,3 +486,42 @@ def test_rpr_eq40_is_the_generic_input_stiffness():
     K = rc.mechanism_stiffness(m, x, k_J)
     assert not np.allclose(K, G_p.T @ np.diag(k_J) @ G_p, rtol=1e-9)
     np.testing.assert_allclose(K, G_p.T @ np.diag(k_J) @ G_p, rtol=0.2)
+
+
+# -- plots ----------------------------------------------------------------------------------------
+
+
+def test_plots_of_the_compliance_kinds(tmp_path):
+    pytest.importorskip("matplotlib")
+    from cpm_nlp.plot.draw import save
+    from cpm_nlp.plot.figures import figure, from_result
+
+    forces = solve(load_problem(ROOT / "problems" / "prs3_fem_table2.yaml"))
+    fig, kind = figure(from_result(forces))
+    assert kind == "forces"
+    save(fig, tmp_path / "forces.png")
+    comp = _solve_dict(
+        {
+            "problem": "platform_compliance",
+            "mechanism": {"type": "prc3", **_example_mechanism("prc3")},
+            "inputs": {"hinges": GENERIC_HINGES["prc3"], "k_actuator": "1e5 N/m"},
+        }
+    )
+    fig, kind = figure(from_result(comp))
+    assert kind == "ellipsoid"
+    save(fig, tmp_path / "ellipsoid.png")
+    modes = _solve_dict(
+        {
+            "problem": "natural_frequencies",
+            "mechanism": {"type": "prc3", **_example_mechanism("prc3")},
+            "inputs": {
+                "hinges": {**GENERIC_HINGES["prc3"], "amp": {"joints": {"axial": "q"}, "k": "1e6 N/m"}},
+                "masses": {"x": "50 g", "y": "50 g", "z": "50 g", "q1": "5 g", "q2": "5 g", "q3": "5 g"},
+            },
+        }
+    )
+    assert modes.ok, modes.message
+    fig, kind = figure(from_result(modes))
+    assert kind == "modes"
+    save(fig, tmp_path / "modes.png")
+    assert all((tmp_path / n).stat().st_size > 1000 for n in ("forces.png", "ellipsoid.png", "modes.png"))

@@ -52,6 +52,8 @@ def _fmt_list(value: list, dim: str | None) -> str:
             return text + (f", {nulls} null" if nulls else "")
 
         def cell(x: Any) -> str:
+            if isinstance(x, list):  # a batch of matrices: one row per point
+                return "[" + ", ".join(cell(v) for v in x) + "]"
             return "—" if x is None else str(x) if isinstance(x, bool) else f"{x:.6g}"
 
         return "matrix " + "; ".join("[" + ", ".join(cell(x) for x in row) + "]" for row in flat)
