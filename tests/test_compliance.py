@@ -216,7 +216,7 @@ def test_json_values_and_set_override():
 
 GENERIC_HINGES = {
     "prc3": {"h": {"joints": "beta", "k": "5 N*m/rad"}, "g": {"joints": "gamma", "k": "5 N*m/rad"}},
-    "rpr": {"r": {"joints": "theta_R", "k": "2 N*m/rad"}, "u": {"joints": "theta_U", "k": "1 N*m/rad"}},
+    "rpr": None,  # its declared Table 1 hinges
     "pantograph": {"psi": {"joints": "psi", "k": "0.05 N*m/rad"}, "phi": {"joints": "phi", "k": "0.05 N*m/rad"}},
     "prs3": None,
 }

@@ -428,18 +428,22 @@ def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hi
 
 
 def allowable(hs: HingeSet, sigma_allow: float | None, safety_factor: float, path: tuple) -> float:
-    """σ_allow: given, else the hinge material's allowable stress, else its yield strength / safety factor."""
+    """σ_allow: sigma_allow / safety_factor when given; else, with a safety factor above 1,
+    the hinge material's yield strength / safety_factor; else the material's allowable
+    (design) stress, which already holds its source's safety factor, or its yield strength.
+    The smallest over the hinge materials."""
     if sigma_allow is not None:
         return sigma_allow / safety_factor
     mats = {h.material.name: h.material for h in hs.hinges if h.material is not None and h.kind is not None}
     if not mats:
         raise InputError("a stress limit needs sigma_allow or a hinge material", path=path + ("sigma_allow",))
     values = []
+    why = "a stress limit needs it (or give sigma_allow)"
     for m in mats.values():
-        if m.allowable is not None:
-            values.append(m.allowable / safety_factor)
+        if safety_factor > 1 or m.allowable is None:
+            values.append(m.require("yield_strength", path + ("material",), why) / safety_factor)
         else:
-            values.append(m.require("yield_strength", path + ("material",), "a stress limit needs it") / safety_factor)
+            values.append(m.allowable)
     return min(values)
 
 
