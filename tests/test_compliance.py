@@ -525,3 +525,27 @@ def test_plots_of_the_compliance_kinds(tmp_path):
     assert kind == "modes"
     save(fig, tmp_path / "modes.png")
     assert all((tmp_path / n).stat().st_size > 1000 for n in ("forces.png", "ellipsoid.png", "modes.png"))
+
+
+def test_hinge_stress_formulas_against_hand_values():
+    """Roark Table 10.7 case 4: a square section's largest torsional shear stress is
+    T/(0.208 a^3); a round neck: 32M/(pi d^3) and 16T/(pi d^3), von Mises."""
+    a, T = 2e-3, 0.3
+    assert cm.rectangle_torsion_stress(T, a, a) == pytest.approx(T / (0.208 * a**3), rel=2e-3)
+    d = {"d": 3e-3, "Kt": 1.0}
+    M, Tq = 0.4, 0.1
+    sigma, tau = 32 * M / (math.pi * 3e-9 * 9), 16 * Tq / (math.pi * 27e-9)
+    assert cm._rod_stress(d, {"bend": M, "torsion": Tq}) == pytest.approx(math.sqrt(sigma**2 + 3 * tau**2))
+    # two bending moments combine as the resultant
+    assert cm._rod_stress(d, {"bend": 0.3, "bend2": 0.4}) == pytest.approx(32 * 0.5 / (math.pi * 27e-9))
+
+
+def test_allowable_stress_rules():
+    m = build_model("prs3", PRS3)
+    hs = cm.hinge_set(m, None)
+    assert cm.allowable(hs, None, 1.0, ()) == 400e6  # the paper's design stress
+    assert cm.allowable(hs, None, 2.0, ()) == pytest.approx(503e6 / 2)  # yield / SF
+    assert cm.allowable(hs, 300e6, 1.5, ()) == pytest.approx(200e6)
+    bare = cm.hinge_set(m, None, {"name": "bare", "E": 72e9})
+    with pytest.raises(InputError, match="yield strength"):
+        cm.allowable(bare, None, 1.0, ("inputs",))
