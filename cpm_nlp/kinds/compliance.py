@@ -498,6 +498,8 @@ class NaturalFrequencies(_HingeKind):
         return opts
 
     def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        if isinstance(raw, Mapping) and "load" in raw:
+            raise unknown_key_error("load", [o.name for o in self.input_options(model)], path, "input")
         inputs = super().parse_inputs(raw, model, path)
         c = model.closure
         masses = inputs.pop("masses_raw")
@@ -590,7 +592,7 @@ STRESS_LIMIT_OPTION = Option(
     "str",
     "hinge stress limits in place of angle limits: true (the mechanism's hinges and material) or a mapping "
     "{sigma_allow, safety_factor, hinges, material}; each hinge's deflection about each axis alone at sigma_allow "
-    "becomes a limit of its joint (the generalization of pantograph eq 31)",
+    "becomes a limit of its joint (generalizing eq 31 of pantograph-3d-elgammal-2016.md)",
     default=None,
 )
 _STRESS_KEYS = ("sigma_allow", "safety_factor", "hinges", "material")
