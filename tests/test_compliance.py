@@ -549,3 +549,16 @@ def test_allowable_stress_rules():
     bare = cm.hinge_set(m, None, {"name": "bare", "E": 72e9})
     with pytest.raises(InputError, match="yield strength"):
         cm.allowable(bare, None, 1.0, ("inputs",))
+
+
+def test_prs3_vertical_mode_against_a_hand_value():
+    """The z mode of problems/prs3_natural_frequencies.yaml: K_z = 3 (K_Rrev + K_Rsph)/(L sin a0)^2
+    (three legs, dz/ds = 1 at home), m = 0.12 x 0.12 x 0.01 m^3 x 2810 kg/m^3."""
+    res = solve(load_problem(ROOT / "problems" / "prs3_natural_frequencies.yaml"))
+    assert res.ok
+    L, a0 = 109.215e-3, math.pi / 4
+    kz = 3 * (98.37 + 32.67) / (L * math.sin(a0)) ** 2
+    m = 0.12 * 0.12 * 0.01 * 2810
+    assert res.values["f1"] == pytest.approx(math.sqrt(kz / m) / (2 * math.pi), rel=1e-6)
+    shape = np.array(res.values["modes_x"][0])
+    assert abs(shape[2]) > 1e3 * max(abs(shape[3]), abs(shape[4]))  # a pure z translation

@@ -369,5 +369,6 @@ MECHANISM = Mechanism(
         "prs3_fem_table2.yaml",
         "prs3_table2_forces.yaml",
         "prs3_cutting_force.yaml",
+        "prs3_natural_frequencies.yaml",
     ),
 )
