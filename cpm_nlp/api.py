@@ -27,7 +27,7 @@ from .core.kinematics import (
     passive_joints,
     residual,
 )
-from .core.mechanism import CuboidExtras, DynamicsModel, Mechanism, declare
+from .core.mechanism import CuboidExtras, DynamicsModel, JointStiffness, Mechanism, declare
 from .core.model import Coordinate, LoopClosure, Model
 from .core.result import Result, SolverInfo, Status
 from .core.solver import SolverConfig
@@ -101,6 +101,7 @@ __all__ = [
     "CuboidExtras",
     "CuboidResult",
     "DynamicsModel",
+    "JointStiffness",
     "InputError",
     "JacobianReport",
     "LoopClosure",

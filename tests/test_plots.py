@@ -259,7 +259,8 @@ def test_plot_bad_input(cli, tmp_path):
     )
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "heatmap")
     assert run.err == (
-        "error: --type: unknown plot type 'heatmap'; expected one of: io, lines, map, requirements, workspace; "
+        "error: --type: unknown plot type 'heatmap'; expected one of: ellipsoid, forces, io, lines, map, modes, "
+        "requirements, workspace; "
         "did you mean 'map'?\n"
     )
     run = cli("plot", str(out), "-o", str(tmp_path / "x.jpg"))

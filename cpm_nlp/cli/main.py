@@ -61,6 +61,8 @@ def _fmt_list(value: list, dim: str | None) -> str:
             return text + (f", {nulls} null" if nulls else "")
 
         def cell(x: Any) -> str:
+            if isinstance(x, list):  # a batch of matrices: one row per point
+                return "[" + ", ".join(cell(v) for v in x) + "]"
             return "—" if x is None else str(x) if isinstance(x, bool) else f"{x:.6g}"
 
         return "matrix " + "; ".join("[" + ", ".join(cell(x) for x in row) + "]" for row in flat)
@@ -380,6 +382,11 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
         out.write(f"  {o.name:<8} {o.description}\n")
     caps = mt.capabilities()
     out.write("capabilities: " + (", ".join(caps) if caps else "none beyond the required parts") + "\n")
+    if mt.stiffness is not None:  # the default hinges of the compliance kinds
+        out.write(f"joint stiffness ({mt.stiffness.source}):\n")
+        for hname, spec in mt.stiffness.hinges.items():
+            text = ", ".join(f"{k}: {v}" for k, v in spec.items())
+            out.write(f"  {hname:<10} {text}\n")
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
     return EXIT_OK
