@@ -283,19 +283,33 @@ def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
     return EXIT_OK
 
 
+def _category_cell(r: Any) -> str:
+    text = r.category.replace("_", " ")
+    return text + (", echo" if r.echoes else "")
+
+
 def render_reproduce(rows: Sequence[Any]) -> str:
-    """The reproduction table, reasons numbered once below it."""
-    header = ("paper", "quantity", "source", "published", "computed", "rel. error", "verdict")
+    """The reproduction table, reasons numbered once below it.  The "what" column
+    says what the published value is (its category) and ", echo" when the
+    computed value is an input given back."""
+    header = ("paper", "quantity", "source", "what", "published", "computed", "rel. error", "verdict")
     table = []
     reasons: dict[str, int] = {}
+
+    def note(text: str) -> str:
+        return f" [{reasons.setdefault(text, len(reasons) + 1)}]"
+
     for r in rows:
         comp = "—" if r.computed is None else format_quantity(r.computed, r.dimension, 5)
         rel = "—" if r.rel_error is None else f"{r.rel_error * 100:.2f} %"
         verdict = r.verdict + ("" if r.expected else "  [UNEXPECTED]")
         if r.reason:
-            n = reasons.setdefault(r.reason, len(reasons) + 1)
-            verdict += f" [{n}]"
-        table.append((r.paper, r.quantity, r.source, r.published_text, comp, rel, verdict))
+            verdict += note(r.reason)
+        if r.tolerance_reason:
+            verdict += note("tolerance: " + r.tolerance_reason)
+        if r.echoes:
+            verdict += note("computed value echoes an input: " + r.echoes)
+        table.append((r.paper, r.quantity, r.source, _category_cell(r), r.published_text, comp, rel, verdict))
     widths = [max(len(str(x)) for x in col) for col in zip(header, *table)]
 
     def line(cells: Sequence[Any]) -> str:
@@ -307,19 +321,36 @@ def render_reproduce(rows: Sequence[Any]) -> str:
     return "\n".join(out)
 
 
+def render_reproduce_summary(summary: dict[str, Any]) -> str:
+    """Independent agreements apart from those that are not; the last line is
+    "N figures, M unexpected"."""
+    parts = [f"{n} {c.replace('_', ' ')}" for c, n in summary["agree_not_independent_by_category"].items()]
+    if summary["agree_echoing_an_input"]:
+        parts.append(f"{summary['agree_echoing_an_input']} echo an input")
+    lines = [
+        f"agree, independently: {summary['agree_independent']} (a printed figure, computed from other inputs)",
+        f"agree, not independently: {summary['agree_not_independent']}" + (f" ({', '.join(parts)})" if parts else ""),
+        f"differ, as explained: {summary['differ'] - summary['unexpected_differ']}; "
+        f"not reproducible: {summary['not_reproducible']}",
+        f"{summary['figures']} figures, {summary['unexpected']} unexpected",
+    ]
+    return "\n".join(lines)
+
+
 def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
+    from ..problems.published import summarize
     from ..problems.reproduce import reproduce
 
     check_output_path(args.output)
     rows = reproduce(args.paths or None)
+    summary = summarize(rows)
+    document = json.dumps({"figures": [r.to_dict() for r in rows], "summary": summary}, indent=2) + "\n"
     if args.json:
-        out.write(json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+        out.write(document)
     else:
-        out.write(render_reproduce(rows) + "\n")
-        bad = [r for r in rows if not r.expected]
-        out.write(f"\n{len(rows)} figures, {len(bad)} unexpected\n")
+        out.write(render_reproduce(rows) + "\n\n" + render_reproduce_summary(summary) + "\n")
     if args.output:
-        write_atomic(args.output, json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+        write_atomic(args.output, document)
     return EXIT_OK if all(r.expected for r in rows) else EXIT_FAILED
 
 
