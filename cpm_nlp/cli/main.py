@@ -20,6 +20,7 @@ from typing import Any, TextIO
 from ..core.errors import CpmError, InputError
 from ..core.result import STATUS_TEXT, Result
 from ..core.units import DIMENSIONS, format_quantity
+from ..core.version import __version__
 from ..io.atomic import check_output_path, write_atomic
 
 EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
@@ -368,6 +369,19 @@ def cmd_export(args: argparse.Namespace, out: TextIO) -> int:
     return EXIT_OK
 
 
+def cmd_examples(args: argparse.Namespace, out: TextIO) -> int:
+    from ..problems.shipped import copy_examples
+
+    written = copy_examples(args.dir, force=args.force)
+    n_problems = sum(1 for f in written if f.parent.name != "configs")
+    out.write(
+        f"{args.dir}: {n_problems} problem files in problems/, {len(written) - n_problems} solver presets in "
+        f"configs/\n(edit them, then e.g. cd {args.dir} && cpm-nlp solve problems/prs3_forward_kinematics.yaml "
+        "or cpm-nlp reproduce)\n"
+    )
+    return EXIT_OK
+
+
 def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
     from ..mechanisms.registry import mechanism_names, mechanism_type
     from ..problems.registry import kind_names, kind_origin, problem_kind
@@ -411,6 +425,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Kinematics and design of compliant parallel mechanisms (CasADi + IPOPT).",
         epilog="Exit status: 0 solved, 1 solve failed, 2 bad input.",
     )
+    parser.add_argument("--version", action="store_true", help="print the version of cpm_nlp and exit")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="log progress to stderr (-vv: debug)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -485,6 +500,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file")
     p.set_defaults(func=cmd_export)
 
+    p = sub.add_parser(
+        "examples",
+        help="copy the shipped problem files and solver presets into a directory, to edit",
+        description="Copy the shipped problem files into DIR/problems and the solver presets into DIR/configs "
+        "(where cpm-nlp looks for them when run in DIR). Existing files are left alone unless --force.",
+    )
+    p.add_argument("dir", metavar="DIR", help="directory to copy into (created if missing)")
+    p.add_argument("--force", action="store_true", help="overwrite files of the same name")
+    p.set_defaults(func=cmd_examples)
+
     p = sub.add_parser("describe", help="list mechanisms and problem kinds, or describe one")
     p.add_argument("name", nargs="?")
     p.set_defaults(func=cmd_describe)
@@ -512,6 +537,9 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse already printed the usage message
         return int(exc.code) if isinstance(exc.code, int) else EXIT_INPUT
+    if args.version:
+        out.write(f"cpm-nlp {__version__}\n")
+        return EXIT_OK
     if args.command is None:
         parser.print_help(out)
         return EXIT_INPUT
