@@ -273,3 +273,11 @@ def test_the_full_shipped_summary_counts_dependent_agreements_apart():
     assert len(cats) == 141
     assert cats.count("read_off_matrix") == 21 and cats.count("derived") == 1
     assert summarize([])["figures"] == 0
+
+
+def test_a_directory_is_read_with_its_subdirectories(cli, tmp_path):
+    (tmp_path / "mechanisms").mkdir()
+    _file(tmp_path / "mechanisms", [A1])
+    run = cli("reproduce", str(tmp_path))
+    assert run.code == 0, run.err
+    assert run.out.rstrip().endswith("1 figures, 0 unexpected")

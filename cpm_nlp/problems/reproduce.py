@@ -15,12 +15,13 @@ from .shipped import shipped_problems_dir
 
 
 def problem_files(paths: Iterable[str | Path]) -> list[Path]:
-    """YAML files under the given files/directories, sorted."""
+    """YAML files under the given files/directories (and their subdirectories,
+    e.g. problems/mechanisms/), sorted."""
     out: list[Path] = []
     for p in paths:
         p = Path(p)
         if p.is_dir():
-            out += sorted(p.glob("*.yaml"))
+            out += sorted(p.rglob("*.yaml"))
         else:
             out.append(p)
     return out
