@@ -137,6 +137,14 @@ def test_an_unknown_category_is_exit_2_with_did_you_mean(cli, tmp_path):
     assert "reproduce.rows[0].category" in run.err and "did you mean 'derived'" in run.err
 
 
+@pytest.mark.parametrize(
+    "key, value", [("category", []), ("category", {"a": 1}), ("category", 3), ("echoes", ["x"]), ("echoes", "")]
+)
+def test_a_category_or_echo_that_is_not_text_is_exit_2(cli, tmp_path, key, value):
+    run = cli("check", str(_file(tmp_path, [{**A1, key: value}])))
+    assert run.code == 2 and f"reproduce.rows[0].{key}" in run.err and "internal error" not in run.err
+
+
 def test_a_row_not_computed_takes_no_tolerance_or_echo(cli, tmp_path):
     row = {"quantity": "A_act", "source": "eq 3", "published": 8.245, "value": None, "reason": "FEA"}
     assert cli("check", str(_file(tmp_path, [row]))).code == 0

@@ -235,7 +235,7 @@ def _text(row: Mapping, key: str, path: tuple, required: bool = True) -> str:
 
 def _category(row: Mapping, path: tuple) -> str:
     category = row.get("category", "published")
-    if category not in CATEGORIES:
+    if not isinstance(category, str) or category not in CATEGORIES:
         raise InputError(
             f"expected one of {', '.join(CATEGORIES)}, got {category!r}",
             path=path + ("category",),
