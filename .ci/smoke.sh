@@ -5,10 +5,11 @@
 # (ipopt and newton presets), reproduce --json (parsed) and -o, export, a small
 # sweep and its plot.  Usage: bash .ci/smoke.sh (from anywhere).
 #
-# SMOKE_DEPS=reuse (what .ci/run sets): the venv sees the site-packages of the
+# SMOKE_DEPS=reuse (what .ci/run sets): the venv also sees the site-packages of the
 # Python running this script, so the wheel's dependencies that the test step has
-# just installed are not downloaded again (pip still checks them against the
-# wheel's metadata); cpm_nlp itself must come from the wheel (checked below).
+# just installed are not downloaded again (this machine keeps no pip cache; pip
+# still checks them against the wheel's metadata); cpm_nlp itself must come from
+# the wheel (checked below).
 # Without it, the venv is isolated and pip downloads every dependency.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
@@ -24,10 +25,14 @@ step "build sdist and wheel"
 wheel="$(ls "$work"/dist/cpm_nlp-*.whl)"
 
 step "install $(basename "$wheel") into a fresh venv"
+"$py" -m venv "$work/venv"
 if [ "${SMOKE_DEPS:-}" = reuse ]; then
-    "$py" -m venv --system-site-packages "$work/venv"
-else
-    "$py" -m venv "$work/venv"
+    # the running Python's site-packages, after the venv's own (its .pth files, such as an
+    # editable install of cpm_nlp, are not read); the wheel is installed over what is there
+    venv_site="$("$work/venv/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')"
+    "$py" -c 'import sysconfig; p = sysconfig.get_paths(); print("\n".join(dict.fromkeys([p["purelib"], p["platlib"]])))' \
+        > "$venv_site/_cpm_nlp_smoke_reuse.pth"
+    "$work/venv/bin/python" -m pip install -q --no-deps --force-reinstall "$wheel"
 fi
 "$work/venv/bin/python" -m pip install -q "$wheel[sweep,plot]"
 export PATH="$work/venv/bin:$PATH"
