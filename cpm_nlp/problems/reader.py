@@ -132,8 +132,30 @@ _Loader.add_implicit_resolver(
 )
 
 
+def _precheck(text: str) -> None:
+    """Nesting and aliases counted on LibYAML's event stream (C, linear time)
+    before PyYAML's scanner sees the text: its look-ahead for simple keys is
+    quadratic in the nesting depth, seconds for ``[[[[...`` ten thousand deep."""
+    loader = getattr(yaml, "CSafeLoader", None)
+    if loader is None:  # PyYAML without LibYAML: the composer's limits still hold
+        return
+    depth = aliases = 0
+    for event in yaml.parse(text, Loader=loader):
+        if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise ComposerError(None, None, f"nested more than {MAX_DEPTH} levels deep", event.start_mark)
+        elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+            depth -= 1
+        elif isinstance(event, yaml.AliasEvent):
+            aliases += 1
+            if aliases > MAX_ALIASES:
+                raise ComposerError(None, None, f"more than {MAX_ALIASES} aliases", event.start_mark)
+
+
 def load_yaml_text(text: str) -> Any:
     """Parse YAML text with the problem-file rules (see :class:`_Loader`)."""
+    _precheck(text)
     return yaml.load(text, Loader=_Loader)  # noqa: S506 - a SafeLoader subclass
 
 
