@@ -732,3 +732,25 @@ def test_batch_progress_on_a_terminal_only(problem):
     show = _batch_progress(argparse.Namespace(quiet=False, err=err))
     show("forward kinematics", 50_000, 100_000)
     assert "forward kinematics: 50000/100000 poses (50%)" in err.getvalue()
+
+
+def test_a_sweep_that_ran_but_cannot_plot_exits_1(tmp_path, sweep_file, monkeypatch):
+    """The solve succeeded: a plot that cannot be drawn afterwards is a failure
+    (exit 1, one message), not bad input (it was exit 2)."""
+    pytest.importorskip("matplotlib")
+    import cpm_nlp.sweep.run
+    from cpm_nlp.sweep.run import SweepSummary
+
+    out = tmp_path / "r.csv"
+    out.write_text("# cpm_nlp sweep {}\n")  # a results file the plot cannot use
+    monkeypatch.setattr(
+        cpm_nlp.sweep.run,
+        "run_sweep",
+        lambda problem, output, **kw: SweepSummary(str(output), 1, {"solved": 1}, 1, 0.1, 1),
+    )
+    fig = tmp_path / "f.png"
+    run = run_cli("sweep", str(sweep_file), "-o", str(out), "-q", "--plot", str(fig))
+    assert run.code == 1
+    lines = run.err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: no plot written: ") and str(out) in lines[0], run.err
+    assert not fig.exists()

@@ -140,7 +140,14 @@ def _precheck(text: str) -> None:
     if loader is None:  # PyYAML without LibYAML: the composer's limits still hold
         return
     depth = aliases = 0
-    for event in yaml.parse(text, Loader=loader):
+    events = yaml.parse(text, Loader=loader)
+    while True:
+        try:
+            event = next(events)
+        except StopIteration:
+            return
+        except yaml.YAMLError:  # a syntax error: PyYAML reports it below, in its own words
+            return
         if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
             depth += 1
             if depth > MAX_DEPTH:
