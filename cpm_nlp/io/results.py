@@ -302,6 +302,8 @@ def open_store(path: str | os.PathLike, meta: dict[str, Any], columns: list[str]
     target = Path(path)
     fmt = results_format(target)
     check_output_path(str(target))
+    if fmt == ".parquet":  # the journal is appended to: a regular file too, never an input
+        check_output_path(str(journal_path(target)))
     meta = json.loads(json.dumps(meta))  # a copy: the store adds units as it learns them
     if fmt == ".csv":
         return CsvStore(target, meta, columns, overwrite)
