@@ -253,8 +253,8 @@ def test_plot_bad_input(cli, tmp_path):
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"))
     assert run.code == 2
     assert run.err == (
-        "error: no plot fits this result (io: an output/input plot needs per-point lists of s1, s2, s3, px, py, "
-        "dz, psi, theta, phi (solve a batch, without an outputs selection); workspace: a workspace cloud needs "
+        f"error: {out}: no plot fits this result (io: an output/input plot needs per-point lists of s1, s2, s3, "
+        "px, py, dz, psi, theta, phi (solve a batch, without an outputs selection); workspace: a workspace cloud needs "
         "per-point lists of dz, psi, theta (solve a batch, without an outputs selection))\n"
     )
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "heatmap")

@@ -135,22 +135,22 @@ def axis_label(name: str, unit: str) -> str:
 # -- saving -----------------------------------------------------------------------------------
 
 
-def check_figure_path(path: str | os.PathLike, option: str = "-o") -> None:
-    """Fail early (an :class:`InputError`) if a figure cannot be written there."""
+def check_figure_path(path: str | os.PathLike, option: str = "-o", inputs: Sequence[str | os.PathLike] = ()) -> None:
+    """Fail early (an :class:`InputError`) if a figure cannot be written there
+    (or would replace one of ``inputs``)."""
     if Path(path).suffix.lower() not in FIGURE_FORMATS:
         raise InputError(
             f"expected a figure file ending in {', '.join(FIGURE_FORMATS)}, got {str(path)!r}", path=(option,)
         )
-    try:
-        check_output_path(str(path))
-    except InputError as exc:
-        raise InputError(exc.message, path=(option,)) from None
+    check_output_path(str(path), inputs, option=option)
 
 
-def save(fig: Any, path: str | os.PathLike) -> None:
+def save(fig: Any, path: str | os.PathLike, option: str = "-o", inputs: Sequence[str | os.PathLike] = ()) -> None:
     """Write a figure (format from the suffix) all at once."""
     fmt = Path(path).suffix.lower().lstrip(".")
-    replace_atomically(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=150), suffix=f".{fmt}")
+    replace_atomically(
+        path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=150), suffix=f".{fmt}", inputs=inputs, option=option
+    )
 
 
 # -- (a) workspace -------------------------------------------------------------------------------
