@@ -47,7 +47,9 @@ DIMENSIONS: dict[str, Dimension] = {
     d.name: d
     for d in (
         Dimension("length", "m", "mm", "47.91 mm", ("m", "mm", "um", "µm", "nm", "cm"), 1e3),
-        Dimension("angle", "rad", "deg", "0.2 deg", ("rad", "deg", "mrad", "urad", "arcmin", "arcsec"), 2 * math.pi),
+        Dimension(
+            "angle", "rad", "deg", "0.2 deg", ("rad", "deg", "mrad", "urad", "arcmin", "arcsec"), 4 * math.pi
+        ),  # two turns: crank angles of a 3-RRR reach 380 deg
         Dimension("stress", "Pa", "MPa", "400 MPa", ("Pa", "kPa", "MPa", "GPa"), 1e13),
         Dimension("force", "N", "N", "20 N", ("N", "mN", "kN"), 1e7),
         Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg"), 1e4),
