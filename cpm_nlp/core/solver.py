@@ -150,6 +150,21 @@ COMMON_OPTIONS: dict[str, Option] = {
 }
 
 
+def run_nlp(solver: ca.Function, what: str, **args: Any) -> tuple[np.ndarray, bool, str, int]:
+    """One call of an IPOPT ``nlpsol``: ``(x, converged, return status, iterations)``.
+    An evaluation error inside the NLP (a NaN in a start far from home) is a failed
+    start, reported as such, not a crash."""
+    try:
+        out = solver(**args)
+    except RuntimeError as exc:
+        log.debug("%s raised: %s", what, exc)
+        return np.full(len(np.atleast_1d(args["x0"])), np.nan), False, f"solver error: {exc}".splitlines()[0], 0
+    stats = solver.stats()
+    z = np.asarray(out["x"]).ravel()
+    ok = bool(stats.get("success", False)) and bool(np.all(np.isfinite(z)))
+    return z, ok, str(stats.get("return_status", "")), int(stats.get("iter_count", 0))
+
+
 def check_options(method: str, options: Mapping[str, Any]) -> dict[str, Any]:
     """The options checked by type and range where they are known; the
     checked values (an integer written ``50.0`` becomes ``50``).  An unknown
