@@ -107,7 +107,8 @@ def parse_solver(raw: Any, base_dir: Path | None, path: tuple = ("solver",)) -> 
         merged.update({k: v for k, v in preset.items() if k in ("method", "tolerance") and v is not None})
         # a preset's options belong to its method: they do not survive a method override
         # ({preset: newton, method: ipopt} must not pass Newton's abstol to IPOPT)
-        overridden = section.get("method") is not None and section["method"] != (merged["method"] or SolverConfig.method)
+        preset_method = merged["method"] or SolverConfig.method
+        overridden = section.get("method") is not None and section["method"] != preset_method
         merged["options"] = {} if overridden else dict(preset["options"])
     for k in ("method", "tolerance"):
         if section.get(k) is not None:
