@@ -74,3 +74,26 @@ def test_reference_page_has_every_kind():
     for name in kind_names():
         assert f"## `{name}`" in page
     assert "| `s1` | mm | optional |" in page  # prs3 forward kinematics
+
+
+def test_a_kind_without_declared_inputs_or_with_a_broken_one(monkeypatch):
+    import cpm_nlp.problems.describe as describe
+    from cpm_nlp.core.kind import ProblemKind
+    from cpm_nlp.mechanisms.registry import PluginError
+
+    class Undeclared(ProblemKind):
+        name = "undeclared"
+
+    class Broken(ProblemKind):
+        name = "broken"
+
+        def input_options(self, model):
+            raise KeyError(model.name)
+
+    kinds = {"undeclared": Undeclared, "broken": Broken}
+    monkeypatch.setattr(describe, "problem_kind", lambda name, path=(): kinds[name]())
+    monkeypatch.setattr(describe, "kind_origin", lambda name: "plugin")
+    desc = describe.describe_kind("undeclared", "prs3")
+    assert desc.unsupported and "declares no inputs" in desc.unsupported
+    with pytest.raises(PluginError, match="problem kind 'broken' \\(plugin\\): describing its inputs failed"):
+        describe.describe_kind("broken", "prs3")

@@ -13,12 +13,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..core.errors import CpmError
 from ..core.kind import ProblemKind
 from ..core.mechanism import Mechanism
 from ..core.model import Model
 from ..core.options import Option
 from ..core.units import DIMENSIONS
-from ..mechanisms.registry import build_model, mechanism_names, mechanism_type
+from ..mechanisms.registry import PluginError, build_model, mechanism_names, mechanism_type
 from .reader import read_yaml
 from .registry import kind_names, kind_origin, problem_kind
 from .shipped import shipped_problems_dir
@@ -118,12 +119,19 @@ def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, so
     reason = kind.supports(model)
     if reason:
         return KindDescription(kind.name, kind.description, kind_origin(kind.name), mechanism, source, reason, (), ())
-    rows = tuple(
-        InputRow(o.name, _unit(o), _default(o), _meaning(o))
-        for o in kind.input_options(model)  # the declared options: the same the file reader validates against
-    )
-    values = tuple(kind.output_names(model))
-    return KindDescription(kind.name, kind.description, kind_origin(kind.name), mechanism, source, None, rows, values)
+    origin = kind_origin(kind.name)
+    try:
+        options = kind.input_options(model)  # the declared options: the same the file reader validates against
+        values = tuple(kind.output_names(model))
+    except NotImplementedError:  # a plugin's kind that declares neither (it cannot be solved either)
+        reason = "the kind declares no inputs and values (input_options, output_names)"
+        return KindDescription(kind.name, kind.description, origin, mechanism, source, reason, (), ())
+    except CpmError:
+        raise
+    except Exception as exc:
+        raise PluginError(f"problem kind {kind.name!r} ({origin}): describing its inputs failed: {exc}") from exc
+    rows = tuple(InputRow(o.name, _unit(o), _default(o), _meaning(o)) for o in options)
+    return KindDescription(kind.name, kind.description, origin, mechanism, source, None, rows, values)
 
 
 def kind_text(desc: KindDescription) -> str:
