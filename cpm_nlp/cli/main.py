@@ -471,9 +471,9 @@ def cmd_examples(args: argparse.Namespace, out: TextIO) -> int:
     return EXIT_OK
 
 
-def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
+def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - one branch per thing described
     from ..mechanisms.registry import mechanism_names, mechanism_type
-    from ..problems.registry import kind_names, kind_origin, problem_kind
+    from ..problems.registry import kind_names, problem_kind
 
     if not args.name:
         out.write("mechanisms:\n")
@@ -486,10 +486,9 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
             out.write(f"  {name:<20} {problem_kind(name).description}\n")
         return EXIT_OK
     if args.name in kind_names():
-        kind = problem_kind(args.name)
-        out.write(f"{kind.name}: {kind.description}\n[{kind_origin(kind.name)}]\n")
-        out.write("(inputs depend on the mechanism; see problems/*.yaml)\n")
-        return EXIT_OK
+        return _describe_kind(args, out)
+    if args.mechanism:
+        problem_kind(args.name, path=("describe",))  # the unknown kind, with a "did you mean"
     mt = mechanism_type(args.name, path=("describe",))
     out.write(f"{mt.name}: {mt.title}\n{mt.paper}\n[{mt.origin}]\n\nparameters:\n")
     for o in mt.parameters:
@@ -507,6 +506,25 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
             out.write(f"  {hname:<10} {text}\n")
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
+    return EXIT_OK
+
+
+def _describe_kind(args: argparse.Namespace, out: TextIO) -> int:
+    """The inputs (name, unit, default, meaning) and values of a kind: on the mechanism
+    named by --mechanism, else on every mechanism it applies to."""
+    from ..mechanisms.registry import mechanism_names
+    from ..problems.describe import describe_kind, kind_text
+
+    if args.mechanism:
+        out.write(kind_text(describe_kind(args.name, args.mechanism)))
+        return EXIT_OK
+    descriptions = [describe_kind(args.name, m) for m in mechanism_names()]
+    applies = [d for d in descriptions if not d.unsupported]
+    for k, desc in enumerate(applies or descriptions[:1]):
+        out.write(("\n" if k else "") + kind_text(desc))
+    skipped = [d.mechanism for d in descriptions if d.unsupported]
+    if applies and skipped:
+        out.write(f"\n(does not apply to: {', '.join(skipped)})\n")
     return EXIT_OK
 
 
@@ -605,7 +623,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_examples)
 
     p = sub.add_parser("describe", help="list mechanisms and problem kinds, or describe one")
-    p.add_argument("name", nargs="?")
+    p.add_argument("name", nargs="?", help="a mechanism or a problem kind")
+    p.add_argument("--mechanism", metavar="NAME", help="with a problem kind: its inputs and values for this mechanism")
     p.set_defaults(func=cmd_describe)
     return parser
 

@@ -105,7 +105,11 @@ def parse_solver(raw: Any, base_dir: Path | None, path: tuple = ("solver",)) -> 
     if section.get("preset"):
         preset = load_preset(section["preset"], base_dir, path + ("preset",))
         merged.update({k: v for k, v in preset.items() if k in ("method", "tolerance") and v is not None})
-        merged["options"] = dict(preset["options"])
+        # a preset's options belong to its method: they do not survive a method override
+        # ({preset: newton, method: ipopt} must not pass Newton's abstol to IPOPT)
+        preset_method = merged["method"] or SolverConfig.method
+        overridden = section.get("method") is not None and section["method"] != preset_method
+        merged["options"] = {} if overridden else dict(preset["options"])
     for k in ("method", "tolerance"):
         if section.get(k) is not None:
             merged[k] = section[k]

@@ -1,0 +1,208 @@
+"""What a problem kind takes and gives, for one mechanism, from the declared options.
+
+``cpm-nlp describe KIND --mechanism NAME`` prints :func:`kind_text`; the documentation's
+reference page is :func:`reference_markdown` (generated when the site is built), so the two
+say the same and neither can drift from the code.  A kind's inputs may depend on the
+mechanism (``input_options(model)``), so a model is built: from the mechanism section of
+its first shipped problem file (``Mechanism.problem_files``), else from its defaults.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..core.errors import CpmError, InputError
+from ..core.kind import ProblemKind
+from ..core.mechanism import Mechanism
+from ..core.model import Model
+from ..core.options import Option
+from ..core.units import DIMENSIONS
+from ..mechanisms.registry import PluginError, build_model, mechanism_names, mechanism_type
+from .reader import read_yaml
+from .registry import kind_names, kind_origin, problem_kind
+from .shipped import shipped_problems_dir
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class InputRow:
+    """One input of a kind: name, unit (the display unit of its dimension, or its type),
+    default ("required", "optional" or the value) and meaning (description and what it accepts)."""
+
+    name: str
+    unit: str
+    default: str
+    meaning: str
+
+
+@dataclass(frozen=True)
+class KindDescription:
+    """A kind described for one mechanism; ``unsupported`` is the reason it does not apply
+    (then ``inputs`` and ``values`` are empty)."""
+
+    kind: str
+    description: str
+    origin: str
+    mechanism: str
+    model_from: str
+    unsupported: str | None
+    inputs: tuple[InputRow, ...]
+    values: tuple[str, ...]
+
+
+def _mechanism_section(mech: Mechanism) -> tuple[dict[str, Any], str]:
+    """The mechanism section of the first shipped problem file of ``mech`` (and its name),
+    or the defaults."""
+    for name in mech.problem_files:
+        path = Path(name) if Path(name).is_absolute() else shipped_problems_dir() / name
+        if path.is_file():
+            section = read_yaml(path).get("mechanism")
+            if isinstance(section, dict) and section.get("type") == mech.name:
+                return section, f"problems/{path.name}" if not Path(name).is_absolute() else str(path)
+    return {"type": mech.name}, "the declared defaults"
+
+
+def reference_model(mechanism: str) -> tuple[Model, str]:
+    """A model of ``mechanism`` to describe kinds on, and where its values come from."""
+    mech = mechanism_type(mechanism, path=("--mechanism",))
+    section, source = _mechanism_section(mech)
+    return build_model(mech.name, section.get("parameters"), section.get("limits")), source
+
+
+def _unit(option: Option) -> str:
+    if option.kind in DIMENSIONS:
+        return DIMENSIONS[option.kind].display or "1"
+    return option.kind
+
+
+def _default(option: Option) -> str:
+    if option.required:
+        return "required"
+    value = option.default
+    if value is None:
+        return "optional"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)) and option.kind in DIMENSIONS:
+        return option.format_value(float(value))
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_default_item(option, v) for v in value) + "]"
+    return str(value)
+
+
+def _default_item(option: Option, value: Any) -> str:
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and option.kind in DIMENSIONS:
+        return option.format_value(float(value))
+    return str(value)
+
+
+_SHAPES = {
+    "list": "a list of ",
+    "grid": "a list or {from, to, count} of ",
+    "range": "a pair [low, high] of ",
+}
+
+
+def _meaning(option: Option) -> str:
+    accepts = "" if option.kind == "str" else option.expectation()
+    prefix = _SHAPES.get(option.shape, "")
+    text = option.description.rstrip(".")
+    return f"{text}; {prefix}{accepts}" if accepts else text
+
+
+def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, source: str = "") -> KindDescription:
+    """Describe ``kind_name`` on ``mechanism`` (a model is built unless given)."""
+    kind: ProblemKind = problem_kind(kind_name, path=("describe",))
+    if model is None:
+        model, source = reference_model(mechanism)
+    reason = kind.supports(model)
+    if reason:
+        return KindDescription(kind.name, kind.description, kind_origin(kind.name), mechanism, source, reason, (), ())
+    origin = kind_origin(kind.name)
+    try:
+        options = kind.input_options(model)  # the declared options: the same the file reader validates against
+        values = tuple(kind.output_names(model))
+    except NotImplementedError:  # a plugin's kind that declares neither (it cannot be solved either)
+        reason = "the kind declares no inputs and values (input_options, output_names)"
+        return KindDescription(kind.name, kind.description, origin, mechanism, source, reason, (), ())
+    except CpmError:
+        raise
+    except Exception as exc:
+        raise PluginError(f"problem kind {kind.name!r} ({origin}): describing its inputs failed: {exc}") from exc
+    rows = tuple(InputRow(o.name, _unit(o), _default(o), _meaning(o)) for o in options)
+    return KindDescription(kind.name, kind.description, origin, mechanism, source, None, rows, values)
+
+
+def kind_text(desc: KindDescription) -> str:
+    """Plain text, as ``cpm-nlp describe KIND --mechanism NAME`` prints it."""
+    lines = [f"{desc.kind}: {desc.description}", f"[{desc.origin}]", f"mechanism: {desc.mechanism}"]
+    if desc.unsupported:
+        lines.append(f"does not apply: {desc.unsupported}")
+        return "\n".join(lines) + "\n"
+    lines.append(f"(defaults and bounds for the model of {desc.model_from})")
+    lines.append("inputs:")
+    if not desc.inputs:
+        lines.append("  (none)")
+    for row in desc.inputs:
+        lines.append(f"  {row.name:<14} [{row.unit}] {row.default}")
+        lines.append(f"  {'':<14} {row.meaning}")
+    lines.append("values:")
+    lines.append("  " + (", ".join(desc.values) if desc.values else "(none)"))
+    return "\n".join(lines) + "\n"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def kind_markdown(desc: KindDescription, level: int = 3) -> str:
+    """One kind on one mechanism as a Markdown section (a table of inputs, the values)."""
+    head = "#" * level
+    out = [f"{head} `{desc.kind}` on `{desc.mechanism}`", ""]
+    if desc.unsupported:
+        return "\n".join(out + [f"Does not apply: {_cell(desc.unsupported)}.", ""])
+    out.append(f"Defaults and bounds for the model of `{desc.model_from}`.")
+    out.append("")
+    if desc.inputs:
+        out += ["| input | unit | default | meaning |", "| --- | --- | --- | --- |"]
+        out += [f"| `{r.name}` | {_cell(r.unit)} | {_cell(r.default)} | {_cell(r.meaning)} |" for r in desc.inputs]
+    else:
+        out.append("No inputs.")
+    out += ["", "Values: " + (", ".join(f"`{v}`" for v in desc.values) if desc.values else "none") + ".", ""]
+    return "\n".join(out)
+
+
+def reference_markdown() -> str:
+    """The reference page of every problem kind on every registered mechanism it applies to."""
+    models = {}
+    for name in mechanism_names():
+        try:
+            models[name] = reference_model(name)
+        except InputError as exc:  # e.g. a mechanism file with required parameters and no shipped example of its own
+            log.info("kinds are not described on %s: %s", name, exc.message)
+    out = [
+        "# Problem kinds",
+        "",
+        "Generated from the declared options when the site is built "
+        "(`cpm_nlp/problems/describe.py`); `cpm-nlp describe KIND --mechanism NAME` prints the same. "
+        "Units are the display units; a bare number is read in SI. A list makes a batch where the "
+        "kind allows it.",
+        "",
+    ]
+    for kind_name in kind_names():
+        kind = problem_kind(kind_name)
+        out += [f"## `{kind_name}`", "", f"{_cell(kind.description)} ({kind_origin(kind_name)}).", ""]
+        skipped = []
+        for mech, (model, source) in models.items():
+            desc = describe_kind(kind_name, mech, model, source)
+            if desc.unsupported:
+                skipped.append(f"`{mech}` ({_cell(desc.unsupported)})")
+                continue
+            out.append(kind_markdown(desc))
+        if skipped:
+            out += ["Does not apply to: " + "; ".join(skipped) + ".", ""]
+    return "\n".join(out)

@@ -1,0 +1,99 @@
+"""``cpm-nlp describe KIND --mechanism NAME`` and the generated reference page
+(cpm_nlp/problems/describe.py): both come from the kinds' declared options."""
+
+from __future__ import annotations
+
+import pytest
+
+from cpm_nlp.core.units import DIMENSIONS
+from cpm_nlp.mechanisms.registry import mechanism_names
+from cpm_nlp.problems.describe import describe_kind, kind_text, reference_markdown, reference_model
+from cpm_nlp.problems.registry import kind_names, problem_kind
+
+
+@pytest.fixture(scope="module")
+def models():
+    return {name: reference_model(name) for name in mechanism_names()}
+
+
+def test_every_input_of_every_kind_is_described_from_its_declared_option(models):
+    applied = 0
+    for kind_name in kind_names():
+        kind = problem_kind(kind_name)
+        for mech, (model, source) in models.items():
+            desc = describe_kind(kind_name, mech, model, source)
+            if kind.supports(model):
+                assert desc.unsupported == kind.supports(model) and not desc.inputs
+                continue
+            applied += 1
+            options = kind.input_options(model)
+            assert [r.name for r in desc.inputs] == [o.name for o in options]
+            for row, option in zip(desc.inputs, options):
+                assert option.description.rstrip(".") in row.meaning
+                if option.kind in DIMENSIONS and option.kind != "dimensionless":
+                    assert row.unit == DIMENSIONS[option.kind].display
+                assert row.default == ("required" if option.required else row.default)
+            assert list(desc.values) == kind.output_names(model)
+    assert applied >= 4 * 8  # the generic kinematic and workspace kinds on all four mechanisms, at least
+
+
+def test_the_model_comes_from_the_first_shipped_problem_file(models):
+    model, source = models["prs3"]
+    assert source == "problems/prs3_forward_kinematics.yaml"
+    assert model.p[0] == pytest.approx(47.91e-3)  # b of the paper (prs3-ruiz, section 4)
+
+
+def test_defaults_are_shown_in_display_units():
+    desc = describe_kind("rpr_twists", "rpr")
+    row = {r.name: r for r in desc.inputs}
+    assert row["d"].default == "0.01 mm" and row["d"].unit == "mm"  # 10 µm, section 5.1
+    assert "one of 'o_prime', 'o', 'point'" in row["reference"].meaning
+
+
+def test_cli_prints_the_same_text(cli):
+    run = cli("describe", "jacobian", "--mechanism", "pantograph")
+    assert run.code == 0, run.err
+    assert run.out == kind_text(describe_kind("jacobian", "pantograph"))
+    assert "inputs:" in run.out and "values:" in run.out and "manipulability" in run.out
+
+
+def test_cli_kind_without_mechanism_lists_every_mechanism_it_applies_to(cli):
+    run = cli("describe", "amplifier")
+    assert run.code == 0 and "mechanism: prc3" in run.out and "does not apply to: pantograph, prs3, rpr" in run.out
+
+
+def test_cli_bad_names_are_input_errors(cli):
+    run = cli("describe", "jacobain", "--mechanism", "prs3")
+    assert run.code == 2 and "did you mean 'jacobian'" in run.err
+    run = cli("describe", "jacobian", "--mechanism", "prs4")
+    assert run.code == 2 and "--mechanism" in run.err and "did you mean 'prs3'" in run.err
+
+
+def test_reference_page_has_every_kind():
+    page = reference_markdown()
+    for name in kind_names():
+        assert f"## `{name}`" in page
+    assert "| `s1` | mm | optional |" in page  # prs3 forward kinematics
+
+
+def test_a_kind_without_declared_inputs_or_with_a_broken_one(monkeypatch):
+    import cpm_nlp.problems.describe as describe
+    from cpm_nlp.core.kind import ProblemKind
+    from cpm_nlp.mechanisms.registry import PluginError
+
+    class Undeclared(ProblemKind):
+        name = "undeclared"
+
+    class Broken(ProblemKind):
+        name = "broken"
+
+        def input_options(self, model):
+            raise KeyError(model.name)
+
+    kinds = {"undeclared": Undeclared, "broken": Broken}
+    monkeypatch.setattr(describe, "problem_kind", lambda name, path=(): kinds[name]())
+    monkeypatch.setattr(describe, "kind_origin", lambda name: "plugin")
+    desc = describe.describe_kind("undeclared", "prs3")
+    assert desc.unsupported and "declares no inputs" in desc.unsupported
+    with pytest.raises(PluginError, match="problem kind 'broken' \\(plugin\\): describing its inputs failed"):
+        describe.describe_kind("broken", "prs3")
