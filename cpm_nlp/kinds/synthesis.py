@@ -37,6 +37,7 @@ def formulation(model: Model) -> SynthesisFormulation | None:
 
 class Synthesis(ProblemKind):
     name = "synthesis"
+    plots = ("comparison", "design")
     description = "dimensional synthesis by the mechanism's own formulation (IPOPT, multi-start)"
 
     def supports(self, model: Model) -> str | None:

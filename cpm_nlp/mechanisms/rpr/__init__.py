@@ -22,6 +22,7 @@ MECHANISM = Mechanism(
     closure=kinematics.closure,
     build=kinematics.build,
     synthesis=Synthesis,
+    geometry=kinematics.geometry,
     kinds={k.name: k for k in (ScrewJacobian, Twists, TransmissionMap, JointDesign, Compliance)},
     problem_files=(
         "rpr_forward_kinematics.yaml",
