@@ -385,3 +385,25 @@ def test_html_of_a_flat_plot_is_refused_clearly():
         figures.figure(data, "requirements", interactive=True)
     fig, kind = figures.figure(data, interactive=True)  # the default falls through to the 3-D one
     assert kind == "workspace" and type(fig).__module__.startswith("plotly")
+
+
+def test_without_plotly_an_html_plot_says_what_to_install(tmp_path):
+    import subprocess
+    import sys
+
+    from .conftest import PROBLEMS
+
+    fk, html = str(PROBLEMS / "prs3_forward_kinematics.yaml"), str(tmp_path / "f.html")
+    code = f"""
+import sys
+sys.modules["plotly"] = None  # ImportError on import, as when not installed
+from cpm_nlp.cli.main import main
+print("exit", main(["solve", {fk!r}, "-q", "--plot", {html!r}]))
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.stdout.splitlines()[-1] == "exit 2", proc.stderr
+    assert proc.stderr.splitlines()[-1] == (
+        "error: interactive (.html) plots needs the Python package 'plotly', which is not installed "
+        "(pip install 'cpm_nlp[plot]')"
+    )
+    assert list(tmp_path.iterdir()) == []

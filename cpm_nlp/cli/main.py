@@ -282,9 +282,12 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
     if args.plot:
         from ..plot.figures import figure, load
 
-        _save_figure(
-            args, figure(load(output), args.type, _plot_options(args), interactive=_interactive(args.plot)), out
-        )
+        try:
+            drawn = figure(load(output), args.type, _plot_options(args), interactive=_interactive(args.plot))
+        except InputError as exc:  # the results file is written: a plot that cannot be drawn is a failure, exit 1
+            args.err.write(f"error: --plot: no plot written: {exc.message}\n")
+            return EXIT_FAILED
+        _save_figure(args, drawn, out)
     return EXIT_OK if summary.ok else EXIT_FAILED
 
 

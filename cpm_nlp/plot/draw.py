@@ -877,8 +877,11 @@ def matrix_axes(ax: Any, M: Any, *, title: str = "", rows: Sequence[str] = (), c
     M = np.asarray(M, dtype=float)
     mag = np.log10(np.where(np.abs(M) > 0, np.abs(M), np.nan))
     im = ax.imshow(mag, cmap="Blues", aspect="auto")
+    big = float(np.abs(M).max()) if M.size else 0.0
     for (i, j), v in np.ndenumerate(M):
-        ax.text(j, i, f"{v:.3g}", ha="center", va="center", fontsize="x-small")
+        v = 0.0 if abs(v) <= 1e-12 * big else v  # rounding noise of an exact zero
+        dark = np.isfinite(mag[i, j]) and im.norm(mag[i, j]) > 0.6
+        ax.text(j, i, f"{v:.3g}", ha="center", va="center", fontsize="x-small", color="white" if dark else "black")
     ax.set_xticks(range(M.shape[1]), [pretty(c) for c in cols] if len(cols) == M.shape[1] else range(1, M.shape[1] + 1))
     ax.set_yticks(range(M.shape[0]), [pretty(r) for r in rows] if len(rows) == M.shape[0] else range(1, M.shape[0] + 1))
     ax.set_title(title, fontsize="small")
@@ -999,8 +1002,16 @@ def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, 
     fy, uy = display_unit(kinds[1], gy)
     for (name, pos), Z in zip(panels, (cond, manip)):
         a = fig.add_subplot(1, 3, pos)
-        mesh = a.pcolormesh(_edges(gx * fx), _edges(gy * fy), np.ma.masked_invalid(Z), cmap="viridis", shading="flat")
-        fig.colorbar(mesh, ax=a, pad=0.01, fraction=0.05, label=name)
+        finite = Z[np.isfinite(Z) & (Z > 0)]
+        norm = None
+        if finite.size and finite.max() / finite.min() > 20:  # near a singularity: a log scale keeps the rest readable
+            from matplotlib.colors import LogNorm
+
+            norm = LogNorm(finite.min(), finite.max())
+        mesh = a.pcolormesh(
+            _edges(gx * fx), _edges(gy * fy), np.ma.masked_invalid(Z), cmap="viridis", shading="flat", norm=norm
+        )
+        fig.colorbar(mesh, ax=a, pad=0.01, fraction=0.05, label=name + (", log scale" if norm is not None else ""))
         a.plot(t0[0] * fx, t0[1] * fy, "*", color="tab:red", ms=14, mec="k", label="the pose")
         a.set_xlabel(axis_label(names[0], ux))
         a.set_ylabel(axis_label(names[1], uy))
