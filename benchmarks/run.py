@@ -8,7 +8,12 @@ one.  Rates are the best of ``--repeats`` runs (the machine is shared; the best
 run is the least disturbed), times of single calls the median of many.
 
 Measurements
-  batch_fk_compiled   3-PRS batch FK, compiled kernel, all threads (poses/s)
+  batch_fk_compiled   3-PRS batch FK, compiled kernel, all threads (poses/s): Newton on the
+                      task coordinates through the closed-form IK, full Newton as fallback
+  batch_fk_full_compiled  the same poses through the full Newton on Φ alone (the formulation
+                      before issue 15), for the ratio reduced / full
+  batch_fk_1000_1_thread, batch_fk_1000_2_threads  1,000-pose batches (fixed cost per call)
+  batch_fk_simd       the reduced kernel as structure-of-arrays C over poses (SIMD experiment)
   batch_fk_map        3-PRS batch FK, CasADi VM through map, all threads
   batch_fk_casadi_thread_map  the kernel through CasADi's own map(n, "thread") (for the record)
   batch_ik_map, batch_ik_casadi_thread_map  closed-form IK (an SX kernel), both ways of threading
@@ -19,12 +24,15 @@ Measurements
   single_fk_newton    one cn.forward_kinematics(model, q, newton) call (µs, median)
   single_fk_ipopt     one cn.forward_kinematics(model, q) call (IPOPT)
   single_fk_function  one call of cn.functions(model).fk (the embedding Function)
+  casadi_trivial_call one call of a CasADi Function y = x from Python (the floor of the above)
   reproduce           `cpm-nlp reproduce`, end to end in a fresh process (s)
   memory_1m           batch FK of 1,000,000 poses in a fresh process: peak RSS (MB)
   cases               problem files listed in benchmarks/cases.yaml (median s)
 
 The batch rates include every check of every pose (residual, branch, IK round
 trip, conditioning, limits, passive joints); the fsolve loops only solve.
+The machine's load (os.getloadavg(), 1 minute) is recorded beside every
+figure (``load``).
 """
 
 from __future__ import annotations
@@ -46,23 +54,34 @@ import yaml
 from scipy.optimize import fsolve
 
 import cpm_nlp as cn
-from cpm_nlp.core.batch import default_threads
-from cpm_nlp.core.compiled import compiler_available
-from cpm_nlp.core.kernels import FastFunction, fk_kernel, ik_kernel, shared_values
+from cpm_nlp.core.batch import default_threads, evaluate
+from cpm_nlp.core.compiled import compiled_function, compiler_available
+from cpm_nlp.core.kernels import FastFunction, fk_kernel, full_fk_kernel, ik_kernel, shared_values
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
 STROKE = 2.3e-3  # m, the actuator range of prs3-ruiz.md Fig. 6
 
-#: issue-6 targets: name -> (kind, value); kind "min" (at least) or "max" (at most)
+#: targets of issues 6 and 15: name -> (kind, value); kind "min" (at least) or "max" (at most)
 TARGETS = {
-    "batch_fk_compiled": ("min", 300_000.0),
-    "ratio_compiled_vs_fsolve_casadi": ("min", 200.0),
-    "ratio_compiled_vs_fsolve_buffer": ("min", 200.0),
-    "single_fk_newton": ("max", 100.0),
+    "batch_fk_compiled": ("min", 2_000_000.0),
+    "ratio_compiled_vs_fsolve_casadi": ("min", 250.0),
+    "ratio_compiled_vs_fsolve_buffer": ("min", 250.0),
+    "single_fk_newton": ("max", 15.0),
+    "single_fk_function": ("max", 10.0),
+    "ratio_2_vs_1_threads_at_1000": ("min", 1.0),
     "reproduce": ("max", 60.0),
     "memory_1m": ("max", 1024.0),
 }
+
+#: os.getloadavg()[0] when each figure was measured (filled as the run goes)
+LOAD: dict[str, float] = {}
+
+
+def noted(out: dict, name: str, value) -> None:
+    """Store a figure and the machine's load beside it."""
+    out[name] = value
+    LOAD[name] = os.getloadavg()[0]
 
 
 def actuators(n: int, seed: int = 0) -> np.ndarray:
@@ -136,52 +155,93 @@ def bench_batch(model: cn.Model, quick: bool, repeats: int) -> dict:
         out["compile_or_load_seconds"] = time.perf_counter() - t0
         res = cn.batch_forward_kinematics(model, q, backend="compiled")
         out["compiled_statuses"] = res.counts()
-        out["batch_fk_compiled"] = best_rate(
-            lambda: cn.batch_forward_kinematics(model, q, backend="compiled"), n_c, repeats
+        out["compiled_reduced_share"] = float(np.mean(res.path_codes == 0))
+        noted(
+            out,
+            "batch_fk_compiled",
+            best_rate(lambda: cn.batch_forward_kinematics(model, q, backend="compiled"), n_c, repeats),
         )
-        out["batch_fk_compiled_1_thread"] = best_rate(
-            lambda: cn.batch_forward_kinematics(model, q[: n_c // 4], backend="compiled", threads=1), n_c // 4, repeats
+        noted(
+            out,
+            "batch_fk_compiled_1_thread",
+            best_rate(
+                lambda: cn.batch_forward_kinematics(model, q[: n_c // 4], backend="compiled", threads=1),
+                n_c // 4,
+                repeats,
+            ),
         )
+        # the full Newton on Φ alone (the formulation before issue 15), same poses, same run
+        full = full_fk_kernel(model.closure, cn.SolverConfig("newton"))
+        fn = compiled_function(model.closure, full)
+        args = [q, model.x_home, *shared_values(full, model, 1e-10)]
+        noted(out, "batch_fk_full_compiled", best_rate(lambda: evaluate(fn, args), n_c, repeats))
+        noted(out, "ratio_reduced_vs_full", out["batch_fk_compiled"] / out["batch_fk_full_compiled"])
+        # fixed cost per call: 1,000 poses on 1 and on 2 threads (persistent pool)
+        q1k = q[:1000]
+        for threads in (1, 2):
+            noted(
+                out,
+                f"batch_fk_1000_{threads}_thread{'s' if threads > 1 else ''}",
+                best_rate(
+                    lambda threads=threads: cn.batch_forward_kinematics(
+                        model, q1k, backend="compiled", threads=threads
+                    ),
+                    1000,
+                    20 * repeats,
+                ),
+            )
+        noted(out, "ratio_2_vs_1_threads_at_1000", out["batch_fk_1000_2_threads"] / out["batch_fk_1000_1_thread"])
     else:
         out["note_compiled"] = "no C compiler on this machine: compiled path not measured"
     q = actuators(n_m, 1)
-    out["batch_fk_map"] = best_rate(lambda: cn.batch_forward_kinematics(model, q, backend="map"), n_m, repeats)
-    out["batch_fk_map_1_thread"] = best_rate(
-        lambda: cn.batch_forward_kinematics(model, q[: n_m // 4], backend="map", threads=1), n_m // 4, repeats
+    noted(out, "batch_fk_map", best_rate(lambda: cn.batch_forward_kinematics(model, q, backend="map"), n_m, repeats))
+    noted(
+        out,
+        "batch_fk_map_1_thread",
+        best_rate(
+            lambda: cn.batch_forward_kinematics(model, q[: n_m // 4], backend="map", threads=1), n_m // 4, repeats
+        ),
     )
     # CasADi's own threaded map of the same kernel (why cpm_nlp threads over chunks itself)
     n_t = n_m // 4
-    out["batch_fk_casadi_thread_map"] = casadi_thread_map_rate(
-        fk_kernel(model.closure, cn.SolverConfig("newton")), model, [q[:n_t], model.x_home], repeats
-    )
+    kern = fk_kernel(model.closure, cn.SolverConfig("newton"))
+    noted(out, "batch_fk_casadi_thread_map", casadi_thread_map_rate(kern, model, [q[:n_t], model.x_home], repeats))
     # closed-form IK (an SX kernel) on the map path, both ways of threading
     t = np.column_stack([model.derived["pz0"] + q[:, 0], q[:, 1], q[:, 2]])
-    out["batch_ik_map"] = best_rate(lambda: cn.batch_inverse_kinematics(model, t, backend="map"), n_m, repeats)
-    out["batch_ik_casadi_thread_map"] = casadi_thread_map_rate(ik_kernel(model.closure), model, [t[:n_t]], repeats)
+    noted(out, "batch_ik_map", best_rate(lambda: cn.batch_inverse_kinematics(model, t, backend="map"), n_m, repeats))
+    noted(
+        out,
+        "batch_ik_casadi_thread_map",
+        casadi_thread_map_rate(ik_kernel(model.closure), model, [t[:n_t]], repeats),
+    )
     qf = actuators(n_f, 2)
-    out["fsolve_buffer"] = best_rate(lambda: fsolve_loop(model, qf, True), n_f, 1)
-    out["fsolve_casadi"] = best_rate(lambda: fsolve_loop(model, qf[: n_f // 2], False), n_f // 2, 1)
+    noted(out, "fsolve_buffer", best_rate(lambda: fsolve_loop(model, qf, True), n_f, 1))
+    noted(out, "fsolve_casadi", best_rate(lambda: fsolve_loop(model, qf[: n_f // 2], False), n_f // 2, 1))
     # the baseline solves the same equations: its poses agree with the batch's
     batch = cn.batch_forward_kinematics(model, qf[:200])
     x_fs = fsolve_loop(model, qf[:200], True)
     out["fsolve_vs_batch_max_abs_difference"] = float(np.max(np.abs(x_fs[batch.ok] - batch.x[batch.ok])))
     for base in ("fsolve_casadi", "fsolve_buffer"):
         if "batch_fk_compiled" in out:
-            out[f"ratio_compiled_vs_{base}"] = out["batch_fk_compiled"] / out[base]
-        out[f"ratio_map_vs_{base}"] = out["batch_fk_map"] / out[base]
+            noted(out, f"ratio_compiled_vs_{base}", out["batch_fk_compiled"] / out[base])
+        noted(out, f"ratio_map_vs_{base}", out["batch_fk_map"] / out[base])
     return out
 
 
 def bench_single(model: cn.Model, quick: bool) -> dict:
-    q = [1e-3, 0.5e-3, -0.3e-3]
+    q = np.array([1e-3, 0.5e-3, -0.3e-3])
     newton = cn.SolverConfig("newton")
     fns = cn.functions(model)
     n = 200 if quick else 3000
-    return {
-        "single_fk_newton": 1e6 * median_call(lambda: cn.forward_kinematics(model, q, newton), n),
-        "single_fk_ipopt": 1e6 * median_call(lambda: cn.forward_kinematics(model, q), max(50, n // 10)),
-        "single_fk_function": 1e6 * median_call(lambda: fns.fk(q, model.x_home), n),
-    }
+    y = ca.SX.sym("y")
+    trivial = ca.Function("trivial", [y], [y], ["y"], ["z"])
+    out: dict = {}
+    noted(out, "single_fk_newton", 1e6 * median_call(lambda: cn.forward_kinematics(model, q, newton), n))
+    out["single_fk_newton_path"] = cn.forward_kinematics(model, q, newton).path
+    noted(out, "single_fk_ipopt", 1e6 * median_call(lambda: cn.forward_kinematics(model, q), max(50, n // 10)))
+    noted(out, "single_fk_function", 1e6 * median_call(lambda: fns.fk(q, model.x_home), n))
+    noted(out, "casadi_trivial_call", 1e6 * median_call(lambda: trivial(1.0), n))
+    return out
 
 
 def bench_reproduce(repeats: int) -> dict:
@@ -196,6 +256,7 @@ def bench_reproduce(repeats: int) -> dict:
             check=False,
         )
         times.append(time.perf_counter() - t0)
+    LOAD["reproduce"] = os.getloadavg()[0]
     return {"reproduce": statistics.median(times), "reproduce_exit": run.returncode}
 
 
@@ -219,6 +280,7 @@ def bench_memory(quick: bool) -> dict:
     script = MEMORY_SCRIPT.format(params=PAPER, stroke=STROKE, n=n, backend=backend)
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
     data = json.loads(run.stdout)
+    LOAD["memory_1m"] = os.getloadavg()[0]
     return {
         "memory_1m": data["peak_mb"],
         "memory_1m_before_mb": data["before_mb"],
@@ -238,10 +300,11 @@ def bench_cases(quick: bool) -> list[dict]:
             entry["note"] = f"skipped: {case['file']} is not in this checkout (yet)"
             out.append(entry)
             continue
-        problem = cn.load_problem(path)
+        problem = cn.load_problem(path, case.get("set", []))
         result = cn.solve(problem)
         repeats = 2 if quick else int(case.get("repeats", 5))
         entry["seconds"] = median_call(lambda problem=problem: cn.solve(problem), repeats)
+        entry["load"] = os.getloadavg()[0]
         entry["status"] = result.status.value
         out.append(entry)
     return out
@@ -259,6 +322,12 @@ def verdict(name: str, value: float) -> str:
 UNITS = {
     "batch_fk_compiled": "poses/s",
     "batch_fk_compiled_1_thread": "poses/s",
+    "batch_fk_full_compiled": "poses/s",
+    "batch_fk_1000_1_thread": "poses/s",
+    "batch_fk_1000_2_threads": "poses/s",
+    "batch_fk_simd": "poses/s",
+    "batch_fk_simd_1_thread": "poses/s",
+    "casadi_trivial_call": "µs",
     "batch_fk_map": "poses/s",
     "batch_fk_casadi_thread_map": "poses/s",
     "batch_fk_map_1_thread": "poses/s",
@@ -276,10 +345,11 @@ UNITS = {
 
 
 def table(results: dict) -> str:
-    rows = [("measurement", "value", "unit", "target", "verdict")]
+    rows = [("measurement", "value", "unit", "target", "verdict", "load")]
     flat = {**results["batch"], **results["single"], **results["reproduce"], **results["memory"]}
     for name, value in flat.items():
-        if not isinstance(value, (int, float)) or name.endswith(("_exit", "_mb", "_poses", "threads", "difference")):
+        skipped = name == "threads" or name.endswith(("_exit", "_mb", "_poses", "difference"))
+        if not isinstance(value, (int, float)) or skipped:
             continue
         unit = UNITS.get(name, "x" if name.startswith("ratio") else "")
         target = ""
@@ -287,16 +357,20 @@ def table(results: dict) -> str:
             kind, t = TARGETS[name]
             target = (">= " if kind == "min" else "<= ") + f"{t:,.0f}"
         text = f"{value:,.0f}" if value >= 1e4 else f"{value:,.1f}" if value >= 10 else f"{value:.3g}"
-        rows.append((name, text, unit, target, verdict(name, value)))
+        load = results.get("load", {}).get(name)
+        rows.append((name, text, unit, target, verdict(name, value), "" if load is None else f"{load:.2f}"))
     for case in results["cases"]:
         target = f"<= {case['target_seconds']} s" if case.get("target_seconds") else ""
         if "seconds" in case:
             v = case["seconds"]
             ok = "" if not case.get("target_seconds") else ("met" if v <= case["target_seconds"] else "MISSED")
-            rows.append((f"case: {case['name']}", f"{v * 1e3:,.2f}", "ms", target, f"{case['status']} {ok}".strip()))
+            load = f"{case['load']:.2f}" if "load" in case else ""
+            rows.append(
+                (f"case: {case['name']}", f"{v * 1e3:,.2f}", "ms", target, f"{case['status']} {ok}".strip(), load)
+            )
         else:
-            rows.append((f"case: {case['name']}", "-", "", target, case["note"]))
-    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+            rows.append((f"case: {case['name']}", "-", "", target, case["note"], ""))
+    widths = [max(len(r[i]) for r in rows) for i in range(6)]
     lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
     lines.insert(1, "  ".join("-" * w for w in widths))
     return "\n".join(lines)
@@ -329,12 +403,14 @@ def main(argv: list[str] | None = None) -> int:
         "cases": [] if "cases" in skip else bench_cases(args.quick),
     }
     flat = {**results["batch"], **results["single"], **results["reproduce"], **results["memory"]}
+    results["load"] = dict(LOAD)
     results["targets"] = {
         name: {
             "target": TARGETS[name][1],
             "kind": TARGETS[name][0],
             "value": flat[name],
             "verdict": verdict(name, flat[name]),
+            "load": LOAD.get(name),
         }
         for name in TARGETS
         if name in flat

@@ -11,19 +11,35 @@ or, from a problem file::
 
     result = cn.solve(cn.load_problem("problems/prs3_forward_kinematics.yaml"))
 
-The public names are those of :mod:`cpm_nlp.api` (listed once, there).  The
-package's layers: ``core`` (model, kernels, solvers, units), ``analysis``
-(workspace, cuboid, flexures, dynamics), ``io`` (atomic files, export,
-results files), ``kinds`` (the generic problem kinds), ``mechanisms`` (the
-registry and the built-in mechanisms), ``problems`` (problem files, kinds
-registry, reproduce), ``sweep``, ``plot`` and ``cli``.
+The public names are those of :mod:`cpm_nlp.api` (listed once, there), loaded
+on first use (PEP 562): ``import cpm_nlp`` and the ``cpm-nlp`` command start
+without loading CasADi and the solvers until a name is used.  The package's
+layers: ``core`` (model, kernels, solvers, units), ``analysis`` (workspace,
+cuboid, flexures, dynamics), ``io`` (atomic files, export, results files),
+``kinds`` (the generic problem kinds), ``mechanisms`` (the registry and the
+built-in mechanisms), ``problems`` (problem files, kinds registry, reproduce),
+``sweep``, ``plot`` and ``cli``.
 """
 
+import importlib
 import logging
 
 from . import _legacy
-from .api import *  # noqa: F403 - the public API, listed once in api.__all__
-from .api import __all__, __version__  # noqa: F401
+from .core.version import __version__ as __version__
 
 _legacy.install()
 logging.getLogger(__name__).addHandler(logging.NullHandler())
+
+
+def __getattr__(name: str) -> object:
+    """A public name of :mod:`cpm_nlp.api` (and ``__all__`` itself), imported on first use."""
+    api = importlib.import_module(".api", __name__)
+    if name == "__all__" or name in api.__all__:
+        value = getattr(api, name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(importlib.import_module(".api", __name__).__all__))

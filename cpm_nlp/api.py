@@ -9,6 +9,8 @@ to the ``cpm_nlp`` logger.
 
 import os
 
+from .analysis.assembly import AssemblyMode, AssemblyModes, assembly_modes
+from .analysis.certify import Certificate, certify_box
 from .analysis.requirements import RequirementsReport, joint_requirements
 from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
@@ -61,6 +63,11 @@ register_mechanism = register
 unregister_mechanism = unregister
 
 __all__ = [
+    "AssemblyMode",
+    "AssemblyModes",
+    "assembly_modes",
+    "Certificate",
+    "certify_box",
     "BatchJacobians",
     "BatchResult",
     "Comparison",

@@ -208,7 +208,10 @@ def test_missing_actuator(cli, tmp_path):
 
 def test_unknown_input(cli, tmp_path):
     expect_input_error(
-        cli, tmp_path, GOOD.replace("s3:", "s4: 1 mm, s3:"), "inputs: unknown input 's4'; expected one of: s1, s2, s3"
+        cli,
+        tmp_path,
+        GOOD.replace("s3:", "s4: 1 mm, s3:"),
+        "inputs: unknown input 's4'; expected one of: assembly_modes, mode_seed, mode_starts, s1, s2, s3",
     )
 
 

@@ -35,3 +35,15 @@ def test_sweep_benchmark_smoke(tmp_path, capsys):
     assert [c["case"] for c in data["cases"]] == ["fk", "requirements"]
     assert all(c["ratio_wall"] > 0 and c["ratio_cpu"] > 0 and c["speed_up"] > 0 for c in data["cases"])
     assert "sweep on 1 worker process / plain loop" in capsys.readouterr().out
+
+
+def test_modes_benchmark_smoke(tmp_path, capsys):
+    """benchmarks/bench_modes.py runs end to end (few starts; no timing is asserted)."""
+    spec = importlib.util.spec_from_file_location("bench_modes", ROOT / "benchmarks" / "bench_modes.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = tmp_path / "bench_modes.json"
+    assert bench.main(["--starts", "64", "--repeats", "1", "--baseline", "4", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["modes"] >= 1 and data["seconds"] > 0 and len(data["load_avg_1min"]) == 1
+    assert "all assembly modes, 6-UPS" in capsys.readouterr().out

@@ -150,3 +150,27 @@ def test_library_does_not_print(capfd):
     cn.forward_kinematics(model, [0.3, -0.3, 0])  # a failing solve
     captured = capfd.readouterr()
     assert captured.out == "" and captured.err == ""
+
+
+def test_start_up_loads_only_what_the_command_needs():
+    """`import cpm_nlp` and `cpm-nlp --help` load neither numpy nor CasADi; a solve of a
+    file with plain units loads neither pint, scipy, matplotlib, Dask nor pyarrow
+    (issue 15: start-up time)."""
+    heavy = ("numpy", "casadi", "pint", "scipy", "matplotlib", "dask", "distributed", "pyarrow")
+    report = f"print('loaded:' + ','.join(m for m in {heavy!r} if m in sys.modules))"
+
+    def loaded(body: str) -> set[str]:
+        argv = [sys.executable, "-c", f"import sys, io; {body}; {report}"]
+        out = subprocess.run(argv, capture_output=True, text=True, check=True, cwd=ROOT).stdout
+        line = [ln for ln in out.splitlines() if ln.startswith("loaded:")][-1]
+        return {m for m in line[len("loaded:") :].split(",") if m}
+
+    assert loaded("import cpm_nlp") == set()
+    assert loaded("from cpm_nlp.cli.main import main; main(['--help'], out=io.StringIO())") == set()
+    fk = "problems/prs3_forward_kinematics.yaml"
+    solve = f"from cpm_nlp.cli.main import main; assert main(['solve', '{fk}'], out=io.StringIO()) == 0"
+    assert loaded(solve) == {"numpy", "casadi"}
+    # the lazy API still answers every public name
+    import cpm_nlp
+
+    assert all(getattr(cpm_nlp, name) is not None for name in cpm_nlp.__all__)

@@ -144,3 +144,40 @@ def test_auto_keeps_pose_unknowns_where_the_ik_reach_bounds_the_workspace():
     np.testing.assert_array_equal(auto.lower, poses.lower)
     closed = W.inscribed_cuboid(m, starts=4, formulation="closed_form")
     assert closed.found and closed.converged == 4 and closed.volume == pytest.approx(poses.volume, rel=1e-5)
+
+
+@pytest.mark.parametrize("name", ["pantograph_cuboid", "prc3_cuboid"])
+def test_starts_together_give_the_starts_one_by_one(name, monkeypatch):
+    """The starts after the first, solved as one block-separable NLP, reach the optima
+    the same starts reach one by one (each start's volume, to IPOPT's tolerance)."""
+    from cpm_nlp.analysis import cuboid_ik
+
+    problem = cn.load_problem(PROBLEMS / f"{name}.yaml")
+    model, starts = problem.model, problem.inputs["starts"]
+    together = W.inscribed_cuboid(model, problem.solver, starts=starts, formulation="closed_form")
+    monkeypatch.setattr(cuboid_ik.ClosedFormCuboid, "start_all", lambda self, boxes: (None, 0))
+    alone = W.inscribed_cuboid(model, problem.solver, starts=starts, formulation="closed_form")
+    assert together.found and alone.found and together.agreed == alone.agreed == starts
+    np.testing.assert_allclose(together.start_volumes, alone.start_volumes, rtol=1e-8)
+    assert together.iterations < alone.iterations  # IPOPT iterations: one run for the seven starts
+    scale = alone.upper - alone.lower
+    np.testing.assert_allclose((together.lower - alone.lower) / scale, 0, atol=1e-8)
+
+
+def test_a_failed_joint_start_falls_back_to_one_by_one(monkeypatch):
+    """If the joint solve of the later starts does not converge, they run one by one:
+    the same optima as without the joint solve, its iterations still counted."""
+    from cpm_nlp.analysis import cuboid_ik
+
+    problem = cn.load_problem(PROBLEMS / "prc3_cuboid.yaml")
+    model, starts = problem.model, problem.inputs["starts"]
+    monkeypatch.setattr(cuboid_ik.ClosedFormCuboid, "start_all", lambda self, boxes: (None, 0))
+    alone = W.inscribed_cuboid(model, problem.solver, starts=starts, formulation="closed_form")
+    monkeypatch.undo()
+    monkeypatch.setattr(
+        cuboid_ik.ClosedFormCuboid, "settle_blocks", lambda self, z0s, works: ([], False, "forced failure", 7, [])
+    )
+    fallback = W.inscribed_cuboid(model, problem.solver, starts=starts, formulation="closed_form")
+    assert fallback.found and fallback.agreed == starts
+    np.testing.assert_array_equal(fallback.start_volumes, alone.start_volumes)
+    assert fallback.iterations == alone.iterations + 7

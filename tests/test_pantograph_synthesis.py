@@ -141,14 +141,14 @@ def test_required_cuboid_too_large_is_infeasible(cli, tmp_path):
     assert "the required cuboid does not fit" in data["message"]
 
 
-def test_synthesis_needs_a_formulation(cli, tmp_path):
+def test_synthesis_without_a_formulation_is_the_generic_one(cli, tmp_path):
+    """A mechanism without a paper formulation gets the generic synthesis
+    (tests/test_synthesis_generic.py), which needs the parameters to vary."""
     path = tmp_path / "p.yaml"
     path.write_text(
         "problem: synthesis\nmechanism:\n  type: prs3\n  parameters: {b: 47.91 mm, L: 109.215 mm}\ninputs: {}\n"
     )
     run = cli("solve", str(path))
     assert run.code == 2
-    assert run.err == (
-        f"error: {path}: problem: problem kind 'synthesis' does not apply to mechanism 'prs3': "
-        "the mechanism 'prs3' declares no synthesis formulation (Mechanism.synthesis)\n"
-    )
+    assert run.err.startswith(f"error: {path}: inputs: missing required input 'design' (the parameters to vary")
+    assert run.err.endswith("parameters of prs3: b, L, alpha0\n")

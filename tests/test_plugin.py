@@ -21,6 +21,7 @@ import pytest
 import cpm_nlp as cn
 from cpm_nlp.core.mechanism import MechanismDeclarationError
 from cpm_nlp.core.options import Option
+from cpm_nlp.mechanisms.registry import REGISTRY
 
 ROOT = Path(__file__).resolve().parent.parent
 PLUGIN = Path(__file__).resolve().parent / "plugin_pkg"
@@ -215,3 +216,145 @@ def test_two_sources_of_one_kind_name_are_an_error():
             cn.kind_names()
     finally:
         cn.unregister_mechanism("clash")
+
+
+# -- the same rules in-process (the registry reads the entry points of sys.path) --------------
+
+
+@pytest.fixture
+def site(tmp_path, monkeypatch):
+    """A directory on sys.path for fake installed packages; the registries forget it afterwards."""
+    root = tmp_path / "site"
+    root.mkdir()
+    monkeypatch.syspath_prepend(str(root))
+
+    def reset():
+        REGISTRY._specs = None
+        REGISTRY._loaded = {k: v for k, v in REGISTRY._loaded.items() if v.origin == "built-in"}
+        REGISTRY.version += 1
+        for name in [m for m in sys.modules if m.startswith("plug")]:
+            del sys.modules[name]
+
+    reset()
+    yield root
+    monkeypatch.undo()
+    reset()
+
+
+def _install(root: Path, module: str, text: str, groups: dict[str, dict[str, str]]) -> None:
+    (root / f"{module}.py").write_text(textwrap.dedent(text))
+    info = root / f"{module}-1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {module}\nVersion: 1.0\n")
+    lines = []
+    for group, entries in groups.items():
+        lines.append(f"[{group}]")
+        lines += [f"{k} = {v}" for k, v in entries.items()]
+    (info / "entry_points.txt").write_text("\n".join(lines) + "\n")
+    REGISTRY._specs = None  # entry points are read once per process: read them again
+    REGISTRY.version += 1
+
+
+BIGLIDE = (PLUGIN / "cpm_nlp_demo_plugin" / "__init__.py").read_text()
+
+
+def test_in_process_plugin_mechanism_and_kind(site, cli):
+    kind = """
+    import cpm_nlp as cn
+    class Echo(cn.ProblemKind):
+        name = "echo"
+        description = "a kind from a plugin"
+    """
+    _install(site, "plugmech", BIGLIDE, {"cpm_nlp.mechanisms": {"biglide": "plugmech:MECHANISM"}})
+    _install(site, "plugkind", kind, {"cpm_nlp.kinds": {"echo": "plugkind:Echo"}})
+    assert "biglide" in cn.mechanism_names()
+    assert "echo" in cn.kind_names()
+    run = cli("describe", "echo")
+    assert run.code == 0 and "plugin 'echo' (plugkind:Echo)" in run.out
+    run = cli("describe", "biglide")
+    assert "capabilities: problem_files" in run.out
+    model = cn.build_model("biglide", {"d": "50 mm", "L": "100 mm"})
+    pose = cn.forward_kinematics(model, [2e-3, -1e-3], cn.SolverConfig("newton"))
+    assert pose.status == cn.Status.SOLVED
+
+
+@pytest.mark.parametrize(
+    ("text", "target", "message"),
+    [
+        ("MECHANISM = 3\n", "plugbad:MECHANISM", "must name a Mechanism declaration, got int"),
+        (
+            "def MECHANISM():\n    raise RuntimeError('boom')\n",
+            "plugbad:MECHANISM",
+            "failed to load: RuntimeError: boom",
+        ),
+        ("", "plugbad:MISSING", "failed to load: AttributeError"),
+    ],
+)
+def test_in_process_broken_mechanism_plugins(site, text, target, message):
+    _install(site, "plugbad", text, {"cpm_nlp.mechanisms": {"bad": target}})
+    with pytest.raises(cn.InputError, match=message) as exc:
+        cn.mechanism_type("bad")
+    assert "mechanism 'bad' (plugin 'bad'" in exc.value.message
+
+
+def test_in_process_name_mismatch_and_build_failure(site):
+    text = BIGLIDE.replace('name="biglide"', 'name="other"')
+    _install(site, "plugname", text, {"cpm_nlp.mechanisms": {"biglide2": "plugname:MECHANISM"}})
+    with pytest.raises(cn.InputError, match="declares the name 'other'; the two must agree"):
+        cn.mechanism_type("biglide2")
+    text = BIGLIDE.replace(
+        "return cn.Model(closure_, parameters", "raise ValueError('no model')\n    return cn.Model(closure_, parameters"
+    )
+    _install(site, "plugbuild", text, {"cpm_nlp.mechanisms": {"biglide": "plugbuild:MECHANISM"}})
+    with pytest.raises(cn.InputError, match=r"mechanism 'biglide' \(plugin .*\): build failed: ValueError: no model"):
+        cn.build_model("biglide")
+
+
+def test_in_process_plugin_cannot_take_a_builtin_name(site, caplog):
+    _install(site, "plugclash", BIGLIDE, {"cpm_nlp.mechanisms": {"prs3": "plugclash:MECHANISM"}})
+    assert cn.mechanism_type("prs3").origin == "built-in"
+    assert "mechanism plugin plugin 'prs3'" in caplog.text and "ignored" in caplog.text
+
+
+@pytest.mark.parametrize(
+    ("text", "target", "message"),
+    [
+        ("X = 3\n", "plugk:X", "must be a ProblemKind subclass"),
+        ("import cpm_nlp as cn\nclass K(cn.ProblemKind):\n    name = 'other'\n", "plugk:K", "names itself 'other'"),
+        ("raise ImportError('nope')\n", "plugk:K", "failed to load: ImportError: nope"),
+    ],
+)
+def test_in_process_broken_kind_plugins(site, text, target, message):
+    _install(site, "plugk", text, {"cpm_nlp.kinds": {"kk": target}})
+    with pytest.raises(cn.InputError, match=message):
+        cn.kind_names()
+
+
+def test_unknown_kind_with_suggestion_and_a_kind_that_fails_to_start():
+    with pytest.raises(cn.InputError, match="unknown problem kind 'forward_kinematic'") as exc:
+        cn.problem_kind("forward_kinematic")
+    assert "forward_kinematics" in exc.value.suggestions
+
+    class Broken(cn.ProblemKind):
+        name = "broken_kind"
+
+        def __init__(self):
+            raise RuntimeError("cannot start")
+
+    base = cn.mechanism_type("prs3")
+    cn.register_mechanism(
+        cn.Mechanism(
+            name="prs3_b",
+            title="t",
+            parameters=base.parameters,
+            limits=base.limits,
+            closure=base.closure,
+            build=base.build,
+            kinds={"broken_kind": Broken},
+        )
+    )
+    try:
+        with pytest.raises(cn.InputError, match="problem kind 'broken_kind' .* failed to start: cannot start"):
+            cn.problem_kind("broken_kind")
+    finally:
+        cn.unregister_mechanism("prs3_b")

@@ -108,8 +108,10 @@ def test_rpr_kinds_need_the_rpr_mechanism(cli, tmp_path):
         SYNTHESIS.replace("type: rpr", "type: prs3").replace(
             "{r1: 40 mm, r2: 80 mm, P0: 40 mm}", "{b: 47.91 mm, L: 109.215 mm}"
         ),
-        "problem: problem kind 'synthesis' does not apply to mechanism 'prs3': the mechanism 'prs3' "
-        "declares no synthesis formulation (Mechanism.synthesis)",
+        # prs3 has no synthesis of its own: the generic one (tests/test_synthesis_generic.py) asks for its inputs
+        "inputs: missing required input 'design' (the parameters to vary: a list of names, which vary within "
+        "their declared bounds, or a mapping name -> [low, high]; e.g. design: {L: [90 mm, 130 mm]}); "
+        "parameters of prs3: b, L, alpha0",
     )
 
 

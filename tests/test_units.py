@@ -62,3 +62,102 @@ def test_unknown_unit_suggests():
 def test_format_quantity():
     assert format_quantity(0.04791, "length") == "47.91 mm"
     assert format_quantity(math.radians(0.2), "angle") == "0.2 deg"
+
+
+# -- the fast path (issue 15): the same answers and messages as pint ---------------------------------
+
+
+def test_fast_units_are_pints_factors():
+    """Every factor of the fast path is the float pint computes for that unit, and of the
+    dimension pint gives it (same root units as the dimension's SI unit)."""
+    from cpm_nlp.core import units as U
+
+    for unit, (factor, dim) in U.FAST_UNITS.items():
+        got, root = U._root(U._ureg().parse_units(unit))
+        assert got == factor, unit
+        si = U.DIMENSIONS[dim].si
+        assert root == (U._root(U._ureg().parse_units(si))[1] if si else U._root("")[1]), unit
+
+
+def _outcome(text, dim):
+    try:
+        return ("ok", parse_quantity(text, dim))
+    except InputError as exc:
+        return ("error", str(exc), tuple(exc.suggestions))
+
+
+def test_fast_path_agrees_with_pint_over_many_strings(monkeypatch):
+    """Numbers in every form the parser admits (and some it does not) times the fast
+    units, near misses, other spellings and units of other dimensions, for every
+    dimension: the fast path and pint alone accept the same strings with the same
+    value (bit for bit) and reject the same strings with the same message."""
+    from cpm_nlp.core import units as U
+
+    numbers = ["47.91", "-2.5E-3", ".5", "+3.", "1e308", "1,5", "nan", "", "0x10"]
+    units = list(U.FAST_UNITS) + [
+        "MM", "Mm", "millimeter", "μm", "degree", "°", "kgs", "m^2", "1/s", "N m", "N*m", "mm/m",
+        "foo", "m m", "m/", "%%", "percent", "deg/s", "rad/s", "kN/mm", "g/mm^3", "nm^3", "ks", "GHz",
+    ]  # fmt: skip
+    strings = []
+    for n in numbers:
+        for u in units:
+            strings += [f"{n} {u}", f"  {n}{u} "]
+    assert len(strings) > 1000
+    fast = {(s, d): _outcome(s, d) for s in strings for d in U.DIMENSIONS}
+    monkeypatch.setattr(U, "FAST_UNITS", {})  # pint alone
+    slow = {(s, d): _outcome(s, d) for s in strings for d in U.DIMENSIONS}
+    differ = [k for k in fast if fast[k] != slow[k]]
+    assert not differ, differ[:5]
+    accepted = sum(1 for v in fast.values() if v[0] == "ok")
+    assert accepted > 300 and accepted < len(fast)  # both kinds covered
+
+
+def test_fast_display_is_pints(monkeypatch):
+    from cpm_nlp.core import units as U
+
+    fast = {d: format_quantity(0.0123456789, d) for d in U.DIMENSIONS}
+    monkeypatch.setattr(U, "FAST_UNITS", {})
+    assert fast == {d: format_quantity(0.0123456789, d) for d in U.DIMENSIONS}
+
+
+def test_plain_units_do_not_build_the_registry():
+    """A fresh process parses the usual units without importing pint."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from cpm_nlp.core.units import parse_quantity, format_quantity; "
+        "parse_quantity('47.91 mm', 'length'); parse_quantity('0.2 deg', 'angle'); "
+        "parse_quantity('2 GPa', 'stress'); format_quantity(0.04791, 'length'); "
+        "print('pint' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"
+
+
+def test_published_quantities_find_the_same_dimension_either_way(monkeypatch):
+    """reproduce's parse_any_quantity tries the fast unit's dimension first: the same
+    value and dimension as trying every dimension in order through pint, for every
+    `published` figure of the shipped problem files and some bad ones."""
+    import yaml
+
+    from cpm_nlp.core import units as U
+    from cpm_nlp.problems.published import parse_any_quantity
+
+    from .conftest import PROBLEMS
+
+    published = ["1.78e-6 m^3", "2 N/um", "5 %", "93.8 Hz", "3 rad", "1,5 mm", "2 furlong", "mm", 0.5]
+    for f in sorted(PROBLEMS.glob("*.yaml")):
+        rows = (yaml.safe_load(f.read_text()).get("reproduce") or {}).get("rows") or []
+        published += [r["published"] for r in rows if "published" in r]
+    assert len(published) > 100
+
+    def outcome(v):
+        try:
+            return parse_any_quantity(v, ("published",))
+        except InputError as exc:
+            return str(exc)
+
+    fast = [outcome(v) for v in published]
+    monkeypatch.setattr(U, "FAST_UNITS", {})
+    assert fast == [outcome(v) for v in published]

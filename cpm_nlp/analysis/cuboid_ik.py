@@ -29,6 +29,13 @@ of the working set across starts), and each start runs from its own initial
 box.  An exchange round adds sample points and continues from the current
 optimum the same way.
 
+The starts after the first are solved together (:meth:`ClosedFormCuboid.start_all`):
+J copies of the working-set NLP, one per start with its own box and rows, as one
+block-separable NLP (no constraint couples two blocks, the objective is the sum),
+whose KKT points are exactly the tuples of the starts' KKT points; IPOPT's fixed
+cost per iteration, which dominates for so few unknowns, is then paid once.  If
+that joint solve fails the starts run one by one, as the first.
+
 The working-set NLP has K row slots (K = 16, 32, 64, ...; one IPOPT solver
 per K, built once per mechanism type and configuration); a slot holds a
 sample point s_k and a one-hot selector e_k of the quantity it bounds, both
@@ -97,25 +104,42 @@ def slots(rows: int) -> int:
 class SlotNLP:
     """IPOPT on the working-set cuboid NLP with K row slots (see the module docstring),
     for the quantities ``sel`` (positions in the output of ``rows_fn``; the others
-    are not evaluated)."""
+    are not evaluated).
 
-    def __init__(self, closure: LoopClosure, rows_fn: ca.Function, sel: tuple[int, ...], K: int, options: dict):
+    With ``blocks`` = J > 1 it solves J such NLPs (J starts, each with its own box
+    z_j = (u_j, w_j), K slots and selectors) as one block-separable NLP: the
+    objective is the sum of theirs and no constraint couples two blocks, so its
+    KKT points are exactly the tuples of KKT points of the J NLPs; IPOPT's
+    fixed cost per iteration is then paid once for all J starts.  The unknowns
+    are (z_1, ..., z_J), the parameters (p, S_1 ... S_J, E_1 ... E_J, c, D).
+    """
+
+    def __init__(
+        self, closure: LoopClosure, rows_fn: ca.Function, sel: tuple[int, ...], K: int, options: dict, blocks: int = 1
+    ):
         c = closure
-        d, m = c.nq, len(sel)
-        self.d, self.m, self.K = d, m, K
-        u, w = ca.SX.sym("u", d), ca.SX.sym("w", d)
+        d, m, J = c.nq, len(sel), blocks
+        self.d, self.m, self.K, self.J = d, m, K, J
+        Z = ca.SX.sym("z", 2 * d, J)
         p = ca.SX.sym("p", c.np)
-        S, E = ca.SX.sym("S", d, K), ca.SX.sym("E", m, K)
+        S, E = ca.SX.sym("S", d, K * J), ca.SX.sym("E", m, K * J)
         centre, size = ca.SX.sym("c", d), ca.SX.sym("D", d)
-        T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + S * ca.repmat(w, 1, K))
-        G = rows_fn.map(K)(T, ca.repmat(p, 1, K))[list(sel), :]
+        f, g = 0, []
+        for j in range(J):
+            u, w = Z[:d, j], Z[d:, j]
+            Sj, Ej = S[:, j * K : (j + 1) * K], E[:, j * K : (j + 1) * K]
+            T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
+            G = rows_fn.map(K)(T, ca.repmat(p, 1, K))[list(sel), :]
+            f -= ca.sum1(ca.log(w))
+            g.append(ca.sum1(Ej * G).T)
         nlp = {
-            "x": ca.vertcat(u, w),
+            "x": ca.vec(Z),
             "p": ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size),
-            "f": -ca.sum1(ca.log(w)),
-            "g": ca.sum1(E * G).T,
+            "f": f,
+            "g": ca.vertcat(*g),
         }
-        self._solver = ca.nlpsol(f"{c.name}_cuboid_slots_{K}", "ipopt", nlp, options)
+        name = f"{c.name}_cuboid_slots_{K}" + (f"_x{J}" if J > 1 else "")
+        self._solver = ca.nlpsol(name, "ipopt", nlp, options)
         self._out = {name: k for k, name in enumerate(self._solver.name_out())}
         self._local = threading.local()
 
@@ -126,7 +150,7 @@ class SlotNLP:
         without the conversions of a regular call.
         """
         buf, run = self._buffer()
-        n, K = len(z0), self.K
+        n, K = len(z0), self.K * self.J
         given = {"x0": z0, "p": params, "lbx": lbx, "ubx": np.full(n, np.inf), "lbg": lbg, "ubg": ubg}
         ins = [
             np.ascontiguousarray(given.get(name, np.zeros(self._solver.nnz_in(k))), dtype=float)
@@ -198,21 +222,47 @@ class ClosedFormCuboid:
 
     # -- the NLP ----------------------------------------------------------------------------------
 
-    def _nlp(self, sel: tuple[int, ...], K: int) -> SlotNLP:
-        key = ("cuboid_slots", self.rows, sel, K, repr(sorted(self.options.items())))
+    def _nlp(self, sel: tuple[int, ...], K: int, blocks: int = 1) -> SlotNLP:
+        key = ("cuboid_slots", self.rows, sel, K, blocks, repr(sorted(self.options.items())))
         return self.closure.solvers.get(
-            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, sel, K, self.options)
+            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, sel, K, self.options, blocks)
         )
 
-    def _solve(self, z0: np.ndarray, work: list[tuple[int, int]]):
-        K = slots(len(work))
-        sel = tuple(sorted({r for _, r in work}))  # the quantities with rows: only those are evaluated
+    def _slots(self, work: list[tuple[int, int]], K: int, sel: tuple[int, ...]):
+        """The parameters of K slots holding the rows ``work``: S (K, d), E (K, m), lbg, ubg."""
         S, E = np.full((K, self.d), 0.5), np.zeros((K, len(sel)))
         lbg, ubg = np.full(K, -np.inf), np.full(K, np.inf)
         for k, (j, r) in enumerate(work):
             S[k], E[k, sel.index(r)], lbg[k], ubg[k] = self.S[j], 1.0, self.lo[r], self.hi[r]
+        return S, E, lbg, ubg
+
+    def _solve(self, z0: np.ndarray, work: list[tuple[int, int]]):
+        K = slots(len(work))
+        sel = tuple(sorted({r for _, r in work}))  # the quantities with rows: only those are evaluated
+        S, E, lbg, ubg = self._slots(work, K, sel)
         params = np.r_[self.model.p, S.ravel(), E.ravel(), self.centre, self.size]
         return self._nlp(sel, K).solve(z0, params, self._lbx, lbg, ubg)
+
+    def _solve_blocks(self, z0s: list[np.ndarray], works: list[list[tuple[int, int]]]):
+        """Several starts, each on its own working set, as one block-separable NLP
+        (:class:`SlotNLP` with blocks): (Z (J, 2d), ok, status, iterations, multipliers (J, K))."""
+        J = len(works)
+        K = slots(max(len(w) for w in works))
+        sel = tuple(sorted({r for w in works for _, r in w}))
+        parts = [self._slots(w, K, sel) for w in works]
+        params = np.r_[
+            self.model.p,
+            np.concatenate([S.ravel() for S, *_ in parts]),
+            np.concatenate([E.ravel() for _, E, *_ in parts]),
+            self.centre,
+            self.size,
+        ]
+        lbg = np.concatenate([q[2] for q in parts])
+        ubg = np.concatenate([q[3] for q in parts])
+        z, ok, status, iters, lam = self._nlp(sel, K, J).solve(
+            np.concatenate(z0s), params, np.tile(self._lbx, J), lbg, ubg
+        )
+        return z.reshape(J, 2 * self.d), ok, status, iters, lam.reshape(J, K)
 
     def values(self, z: np.ndarray) -> np.ndarray:
         """Every quantity at every sample of the box z: (N, m)."""
@@ -257,6 +307,34 @@ class ClosedFormCuboid:
             work |= new
         return z, False, f"the working set did not settle in {MAX_SETTLE} solves", iterations, set()
 
+    def settle_blocks(self, z0s: list[np.ndarray], works: list[set]) -> tuple[list, bool, str, int, list[set]]:
+        """:meth:`settle` for several starts at once (one block-separable NLP per round;
+        every start solved again from its own z0 while any start's rows grow).
+        Returns (the z of each start, ok, status, iterations, the active rows of each)."""
+        works = [set(w) for w in works]
+        iterations = 0
+        for solve in range(MAX_SETTLE):
+            orders = [sorted(w) for w in works]
+            Z, ok, status, iters, lam = self._solve_blocks(z0s, orders)
+            iterations += iters
+            if not ok:
+                return [], False, status, iterations, []
+            grown = False
+            for j, z in enumerate(Z):
+                new = self._violated(self.values(z), works[j], ADD_PER_QUANTITY if solve < ESCALATE else None)
+                if new:
+                    works[j] |= new
+                    grown = True
+            if not grown:
+                actives = []
+                for order, lj in zip(orders, lam):
+                    lj = np.abs(lj[: len(order)])
+                    top = float(lj.max()) if lj.size else 0.0
+                    actives.append({row for row, v in zip(order, lj) if v > ACTIVE_MULTIPLIER * top})
+                return list(Z), True, status, iterations, actives
+            log.debug("joint working sets grew, solving again")
+        return [], False, f"the working sets did not settle in {MAX_SETTLE} solves", iterations, []
+
     # -- what inscribed_cuboid calls --------------------------------------------------------------
 
     def start(self, u0: np.ndarray, w0: np.ndarray, *_poses) -> tuple[bool, np.ndarray | None, str, int]:
@@ -271,6 +349,23 @@ class ClosedFormCuboid:
         if ok:
             self.memory |= active
         return ok, (z if ok else None), status, iters
+
+    def start_all(self, boxes: list[tuple[np.ndarray, np.ndarray]]) -> tuple[list[tuple] | None, int]:
+        """Several starts from the boxes (u0, w0) at once, as one block-separable NLP,
+        each from the rows of the optima found before (the first start's, run by
+        :meth:`start`): ([(converged, z, status, 0) per start], IPOPT iterations).  The
+        runs are None if the joint solve did not converge: the caller then runs the
+        starts one by one (which also retries a start with the corners' rows)."""
+        if not self.memory or len(boxes) < 2:
+            return None, 0
+        z0s = [np.r_[u0, w0] for u0, w0 in boxes]
+        Z, ok, status, iters, actives = self.settle_blocks(z0s, [self.memory] * len(boxes))
+        if not ok:
+            log.debug("joint start of %d boxes did not converge (%s); one by one", len(boxes), status)
+            return None, iters
+        for active in actives:
+            self.memory |= active
+        return [(True, z, status, 0) for z in Z], iters
 
     def exchange(self, z: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, bool, str, int]:
         """Add sample points (unit box) and solve again from z."""

@@ -658,6 +658,33 @@ def _start_box(model: Model, t_c: np.ndarray, S: np.ndarray, centre, size, confi
     return None
 
 
+def _start_boxes(model: Model, seeds: list, S: np.ndarray, centre, size, config: SolverConfig) -> list:
+    """:func:`_start_box` of every seed; with a closed-form IK the poses of all seeds'
+    samples in one call per shrink step (the same boxes)."""
+    if model.closure.ik is None:
+        return [_start_box(model, t_c, S, centre, size, config) for t_c in seeds]
+    d = model.closure.nq
+    boxes: list = [None] * len(seeds)
+    todo = list(range(len(seeds)))
+    w0 = np.full(d, 1e-3)
+    for _ in range(4):
+        if not todo:
+            break
+        u0 = [(seeds[k] - centre) / size - 0.5 * w0 for k in todo]
+        X, Q, ok = poses(model, np.vstack([centre + size * (u + S * w0) for u in u0]), config)
+        n = len(S)
+        left = []
+        for i, k in enumerate(todo):
+            part = slice(i * n, (i + 1) * n)
+            if np.all(ok[part]):
+                boxes[k] = (u0[i], w0.copy(), X[part], Q[part])
+            else:
+                left.append(k)
+        todo = left
+        w0 = w0 * 0.1
+    return boxes
+
+
 #: formulations of the cuboid NLP: "closed_form" needs the mechanism's closed-form IK
 FORMULATIONS = ("auto", "closed_form", "poses")
 
@@ -743,16 +770,31 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
         engine = _closed_form_cuboid(model, config, base, centre, size, cloud_mem)
     else:
         engine = _PoseCuboid(model, config, base, centre, size)
-    runs = []
+    runs: list = [None] * len(seeds)
     iterations = 0
-    for t_c in seeds:
-        box = _start_box(model, t_c, engine.S, centre, size, config)
+    boxes = _start_boxes(model, seeds, engine.S, centre, size, config)
+    pending = []
+    for k, box in enumerate(boxes):
         if box is None:
-            runs.append((False, None, "no pose at the start", 0))
-            continue
-        ok, z, status, iters = engine.start(*box)
+            runs[k] = (False, None, "no pose at the start", 0)
+        else:
+            pending.append(k)
+    # the first start alone; the others together where the engine can (one block-separable
+    # NLP, see cuboid_ik.SlotNLP), else, or if that fails, one by one
+    joint = None
+    if len(pending) > 2 and hasattr(engine, "start_all"):
+        k0 = pending.pop(0)
+        runs[k0] = engine.start(*boxes[k0])
+        iterations += runs[k0][3]
+        joint, iters = engine.start_all([boxes[k][:2] for k in pending])
         iterations += iters
-        runs.append((ok, z, status, iters))
+    if joint is not None:
+        for k, run in zip(pending, joint):
+            runs[k] = run
+    else:
+        for k in pending:
+            runs[k] = engine.start(*boxes[k])
+            iterations += runs[k][3]
     volumes = [float(np.prod(size * r[1][d : 2 * d])) if r[0] else None for r in runs]
     ok_vols = [v for v in volumes if v is not None]
     best, agreed = best_and_agreement([-v if v is not None else None for v in volumes])

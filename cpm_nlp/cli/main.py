@@ -3,6 +3,11 @@
 Exit status: 0 solved, 1 a solve that did not succeed (the result says why),
 2 bad input (one message naming the file, the key path and what was
 expected), 70 an internal error (a bug: please report it).
+
+Start-up is kept short on purpose: this module imports only the standard
+library and the light :mod:`cpm_nlp.core.errors`; each subcommand and
+renderer imports what it needs when it runs (units, numpy, CasADi, the
+problem kinds, Matplotlib, Dask), so ``cpm-nlp --help`` loads none of them.
 """
 
 from __future__ import annotations
@@ -12,15 +17,17 @@ import json
 import logging
 import sys
 import time
-import traceback
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, TextIO
 
 from ..core.errors import CpmError, InputError
-from ..core.result import STATUS_TEXT, Result
-from ..core.units import DIMENSIONS, format_quantity
 from ..io.atomic import check_output_path, write_atomic
+
+TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
+if TYPE_CHECKING:
+    from typing import Any, TextIO
+
+    from ..core.result import Result
 
 EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
@@ -29,6 +36,8 @@ EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
 
 def _fmt_scalar(value: Any, dim: str | None) -> tuple[str, str]:
+    from ..core.units import DIMENSIONS, format_quantity
+
     if value is None:
         return "—", ""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -72,6 +81,9 @@ def _fmt_list(value: list, dim: str | None) -> str:
 
 def render_result(result: Result, title: str = "") -> str:
     """A readable table of a result."""
+    from ..core.result import STATUS_TEXT
+    from ..core.units import DIMENSIONS
+
     lines = []
     lines.append(f"problem : {result.problem}" + (f"  ({title})" if title else ""))
     lines.append(f"status  : {result.status.value}  -- {result.message or STATUS_TEXT[result.status]}")
@@ -301,6 +313,8 @@ def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
 
 def render_reproduce(rows: Sequence[Any]) -> str:
     """The reproduction table, reasons numbered once below it."""
+    from ..core.units import format_quantity
+
     header = ("paper", "quantity", "source", "published", "computed", "rel. error", "verdict")
     table = []
     reasons: dict[str, int] = {}
@@ -525,6 +539,8 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
         return 130
     except Exception as exc:  # a bug, not a user error: say so, and how to get details
         if args.debug:
+            import traceback
+
             traceback.print_exc(file=err)
         err.write(f"internal error: {exc.__class__.__name__}: {exc} (please report; rerun with --debug)\n")
         return EXIT_INTERNAL

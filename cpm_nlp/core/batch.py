@@ -16,8 +16,10 @@ Backends:
 * ``"auto"`` -- compiled when a C compiler is available, else map.
 
 Threads: each chunk of poses has its own FunctionBuffer, and CasADi releases
-the GIL while it evaluates, so chunks run in parallel (2-core machine, FK
-compiled: 436k poses/s on one thread, 759k on two).  CasADi's own
+the GIL while it evaluates, so chunks run in parallel on a persistent pool
+(:func:`thread_pool`; the calling thread takes the first chunk) with the
+mapped Functions kept between calls (:func:`mapped`), so the fixed cost per
+call is small and two threads beat one already at 1,000 poses.  CasADi's own
 ``map(n, "thread")`` reaches similar rates on these kernels
 (``benchmarks/run.py`` measures both); chunks also keep the memory for values
 shared by all poses (parameters, limits) to one chunk.
@@ -27,7 +29,9 @@ from __future__ import annotations
 
 import logging
 import os
+import threading
 import time
+from collections import OrderedDict
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -35,9 +39,12 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from .compiled import BACKENDS as BACKENDS  # noqa: F401 - re-exported
+from .compiled import NativeLoop, backend_function, native_loop
 from .errors import InputError
 from .kernels import (
     NUMPY,
+    PATHS,
     STATUSES,
     Kernel,
     code_of,
@@ -57,11 +64,47 @@ from .solver import SolverConfig
 
 log = logging.getLogger(__name__)
 
-BACKENDS = ("map", "compiled", "auto")
 #: poses per mapped evaluation (one FunctionBuffer); chunks are spread over threads
 CHUNK = 4096
 #: points below which :func:`evaluate_points` makes one mapped call on one thread
 THREADED_POINTS = 16384
+
+
+#: mapped Functions kept for reuse (built code, not problem data): (id, size) -> (function, mapped)
+_MAPPED: OrderedDict[tuple[int, int], tuple[ca.Function, ca.Function]] = OrderedDict()
+_MAPPED_SIZE = 64
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+_LOCK = threading.Lock()
+
+
+def thread_pool(threads: int) -> ThreadPoolExecutor:
+    """The persistent pool of ``threads`` workers (created once per process and
+    size, so a batch pays no thread start-up: 2 threads beat 1 already at
+    1,000 poses)."""
+    with _LOCK:
+        pool = _POOLS.get(threads)
+        if pool is None:
+            pool = _POOLS[threads] = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="cpm_nlp_batch")
+        return pool
+
+
+def mapped(function: ca.Function, size: int) -> ca.Function:
+    """``function.map(size)``, built once and kept (the most recent
+    :data:`_MAPPED_SIZE` are kept; building one costs more than a small batch)."""
+    if size == 1:
+        return function
+    key = (id(function), size)
+    with _LOCK:
+        hit = _MAPPED.get(key)
+        if hit is not None and hit[0] is function:
+            _MAPPED.move_to_end(key)
+            return hit[1]
+    built = function.map(size)
+    with _LOCK:
+        _MAPPED[key] = (function, built)  # the reference keeps id(function) unique
+        while len(_MAPPED) > _MAPPED_SIZE:
+            _MAPPED.popitem(last=False)
+    return built
 
 
 def default_threads() -> int:
@@ -99,6 +142,9 @@ class BatchResult:
     solver: str
     #: (x, q, passive) as solved, kept for the messages of failed poses
     raw_joints: np.ndarray | None = field(default=None, repr=False)
+    #: FK of mechanisms with a closed-form IK: which formulation answered each pose,
+    #: int8 positions in :data:`cpm_nlp.core.kernels.PATHS` (0 "reduced", 1 "full"); else None
+    path_codes: np.ndarray | None = field(default=None, repr=False)
     _statuses: list[Status] | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
@@ -120,6 +166,12 @@ class BatchResult:
         """Solved only if every pose is solved, else the status of the first failed pose."""
         bad = np.flatnonzero(~self.ok)
         return Status.SOLVED if bad.size == 0 else STATUSES[int(self.status[bad[0]])]
+
+    def path(self, i: int) -> str:
+        """Which FK formulation answered pose i: "reduced" (Newton on the task
+        coordinates through the closed-form IK), "full" (Newton on Φ), or ""
+        (IK, or a mechanism without a closed-form IK)."""
+        return "" if self.path_codes is None else PATHS[int(self.path_codes[i])]
 
     def counts(self) -> dict[str, int]:
         """Number of poses per status."""
@@ -161,6 +213,7 @@ class BatchResult:
                 solver=self.solver,
                 message=self.message(i),
                 details=self.details(i),
+                path=self.path(i),
             )
         passive = self.passive[i].copy() if self.model.closure.passive is not None else None
         return PoseSolution(
@@ -174,6 +227,7 @@ class BatchResult:
             self.solver,
             "",
             self.details(i),
+            self.path(i),
         )
 
     def solutions(self) -> list[PoseSolution]:
@@ -215,69 +269,69 @@ def _broadcast_rows(values, n: int, n_cols: int, name: str) -> np.ndarray:
     return arr
 
 
-def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Function, str]:
-    if backend not in BACKENDS:
-        from .errors import suggest
-
-        raise InputError(
-            f"unknown backend {backend!r}; expected one of: {', '.join(BACKENDS)}",
-            path=("backend",),
-            suggestions=suggest(str(backend), BACKENDS),
-        )
-    if backend in ("compiled", "auto"):
-        from .compiled import compiled_function, compiler_available
-
-        if backend == "compiled" or compiler_available():
-            return compiled_function(model.closure, kern), "compiled"
-        log.info("no C compiler: backend 'auto' uses 'map'")
-    return kern.function, "map"
+def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Function | NativeLoop, str]:
+    """The kernel's CasADi Function ("map") or the compiled library's loop over poses ("compiled")."""
+    fn, used = backend_function(model.closure, kern, backend)
+    return (native_loop(model.closure, kern), used) if used == "compiled" else (fn, used)
 
 
 def evaluate(
-    function: ca.Function,
+    function: ca.Function | NativeLoop,
     args: Sequence[np.ndarray],
     threads: int | None = None,
     chunk: int = CHUNK,
 ) -> list[np.ndarray]:
-    """Evaluate a Function over N poses.
+    """Evaluate a Function (or a compiled kernel's :class:`NativeLoop`) over N poses.
 
     args: one array per input of ``function``: (N, nnz_in(k)) C-contiguous
     for a per-pose input, 1-D for a value shared by every pose.  Returns
     (N, nnz_out(k)) arrays (dense, column-major per pose).  Chunks of
     ``chunk`` poses go through ``function.map(chunk)`` (one FunctionBuffer
-    each), spread over ``threads`` threads.
+    each; a NativeLoop runs them in C directly), spread over ``threads``
+    threads of the persistent pool.
     """
+    native = isinstance(function, NativeLoop)
     per_pose = [a for a in args if a.ndim == 2]
     n = per_pose[0].shape[0] if per_pose else 1
-    outs = [np.empty((n, function.nnz_out(k))) for k in range(function.n_out())]
+    nnz_out = function.nnz_out if native else [function.nnz_out(k) for k in range(function.n_out())]
+    outs = [np.empty((n, m)) for m in nnz_out]
     if n == 0:
         return outs
     threads = default_threads() if threads is None else max(1, int(threads))
     chunk = max(1, min(int(chunk), -(-n // threads)))
     starts = list(range(0, n, chunk))
-    maps: dict[int, tuple[ca.Function, list[np.ndarray | None]]] = {}
-    for size in {min(chunk, n - a) for a in starts}:  # built before the threads start
-        tiled = [None if a.ndim == 2 else np.ascontiguousarray(np.broadcast_to(a, (size, a.size))) for a in args]
-        maps[size] = (function.map(size) if size > 1 else function, tiled)
+    if native:
+        args = [np.ascontiguousarray(a, dtype=float) for a in args]
 
-    def run(start: int) -> int:
-        stop = min(start + chunk, n)
-        mapped, tiled = maps[stop - start]
-        buf, call = mapped.buffer()
-        for k, (arr, rep) in enumerate(zip(args, tiled)):
-            buf.set_arg(k, memoryview((arr[start:stop] if rep is None else rep).reshape(-1)))
-        for k, arr in enumerate(outs):
-            buf.set_res(k, memoryview(arr[start:stop].reshape(-1)))
-        call()
-        return buf.ret()
+        def run(start: int) -> int:
+            return function.run(start, min(start + chunk, n), args, outs)
+
+    else:
+        maps: dict[int, tuple[ca.Function, list[np.ndarray | None]]] = {}
+        for size in {min(chunk, n - a) for a in starts}:  # built before the threads start
+            tiled = [None if a.ndim == 2 else np.ascontiguousarray(np.broadcast_to(a, (size, a.size))) for a in args]
+            maps[size] = (mapped(function, size), tiled)
+
+        def run(start: int) -> int:
+            stop = min(start + chunk, n)
+            fn, tiled = maps[stop - start]
+            buf, call = fn.buffer()
+            for k, (arr, rep) in enumerate(zip(args, tiled)):
+                buf.set_arg(k, memoryview((arr[start:stop] if rep is None else rep).reshape(-1)))
+            for k, arr in enumerate(outs):
+                buf.set_res(k, memoryview(arr[start:stop].reshape(-1)))
+            call()
+            return buf.ret()
 
     if threads == 1 or len(starts) == 1:
         codes = [run(a) for a in starts]
     else:
-        with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="cpm_nlp_batch") as pool:
-            codes = list(pool.map(run, starts))
+        # the caller's thread takes the first chunk; the persistent pool the others
+        rest = [thread_pool(threads).submit(run, a) for a in starts[1:]]
+        codes = [run(starts[0])] + [f.result() for f in rest]
     if any(codes):
-        raise RuntimeError(f"evaluation of {function.name()} failed")
+        name = function.function.name() if native else function.name()
+        raise RuntimeError(f"evaluation of {name} failed")
     return outs
 
 
@@ -364,7 +418,10 @@ def _finish(
         q = q.copy()
         q[bad] = np.nan
         passive[bad] = np.nan
-    return BatchResult(kind, model, codes, x, q, passive, checks, tolerance, backend, threads, seconds, solver, raw)
+    path = out["path"].reshape(-1).astype(np.int8) if "path" in out else None
+    return BatchResult(
+        kind, model, codes, x, q, passive, checks, tolerance, backend, threads, seconds, solver, raw, path
+    )
 
 
 def batch_forward_kinematics(
@@ -382,6 +439,13 @@ def batch_forward_kinematics(
     (default: the home pose).  solver: a Newton configuration (its
     ``tolerance`` and the options abstol, abstolStep, max_iter; default
     ``SolverConfig("newton")``).  backend: "map", "compiled" or "auto".
+
+    Each pose goes through :func:`cpm_nlp.core.kernels.fk_kernel`, the same
+    kernel as a single Newton solve (:func:`cpm_nlp.core.kinematics.forward_kinematics`)
+    with the same initial guess, so statuses and values equal N single solves:
+    mechanisms with a closed-form IK first by Newton on the task coordinates
+    from the first-order guess about the guess, falling back to Newton on Φ
+    from the guess (``BatchResult.path(i)`` says which answered).
     """
     config = solver or SolverConfig("newton")
     if config.method != "newton":

@@ -15,6 +15,7 @@ a mechanism type (a design sweep does not recompile).
 
 from __future__ import annotations
 
+import ctypes
 import hashlib
 import logging
 import os
@@ -24,11 +25,13 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any
 
 import casadi as ca
+import numpy as np
 
-from .errors import CpmError
-from .kernels import Kernel
+from .errors import CpmError, InputError, suggest
+from .kernels import BoundCall, Kernel
 from .model import LoopClosure
 
 log = logging.getLogger(__name__)
@@ -89,6 +92,99 @@ def generate_source(function: ca.Function, name: str) -> str:
         return Path(tmp, f"{name}.c").read_text()
 
 
+def batch_loop_source(function: ca.Function, name: str) -> str:
+    """C of ``<name>_batch``: the kernel over n poses in one call, with no
+    per-pose overhead of CasADi's ``map`` of an external function.
+
+    ``int <name>_batch(long n, const casadi_real* const* in, const long* in_step,
+    casadi_real* const* out, const long* out_step)``: input k of pose i is
+    ``in[k] + i * in_step[k]`` (step 0 for a value shared by every pose),
+    output k ``out[k] + i * out_step[k]``.  Work memory on the stack:
+    reentrant, so threads may run it on disjoint ranges.  Returns 0 on
+    success."""
+    n_in, n_out = function.n_in(), function.n_out()
+    return f"""
+/* cpm_nlp: the kernel over n poses (arrays of structures, one row per pose) */
+CASADI_SYMBOL_EXPORT int {name}_batch(long n, const casadi_real* const* in, const long* in_step,
+                                      casadi_real* const* out, const long* out_step) {{
+  const casadi_real* arg[{function.sz_arg()}];
+  casadi_real* res[{function.sz_res()}];
+  casadi_int iw[{function.sz_iw() + 1}];
+  casadi_real w[{function.sz_w() + 1}];
+  long i;
+  int k;
+  for (i = 0; i < n; ++i) {{
+    for (k = 0; k < {n_in}; ++k) arg[k] = in[k] + i * in_step[k];
+    for (k = 0; k < {n_out}; ++k) res[k] = out[k] + i * out_step[k];
+    if ({name}(arg, res, iw, w, 0)) return 1;
+  }}
+  return 0;
+}}
+"""
+
+
+class NativeLoop:
+    """``<name>_batch`` of a compiled kernel library, called through ctypes
+    (which releases the GIL, so threads run chunks in parallel)."""
+
+    def __init__(self, library: Path, name: str, function: ca.Function) -> None:
+        self.function = function
+        self._lib = ctypes.CDLL(str(library))
+        self.call = getattr(self._lib, f"{name}_batch")
+        self.call.restype = ctypes.c_int
+        self.call.argtypes = [ctypes.c_long, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+        self.n_in, self.n_out = function.n_in(), function.n_out()
+        self.nnz_in = [function.nnz_in(k) for k in range(self.n_in)]
+        self.nnz_out = [function.nnz_out(k) for k in range(self.n_out)]
+
+    def run(self, start: int, stop: int, inputs: list[np.ndarray], outputs: list[np.ndarray]) -> int:
+        """Poses start..stop-1.  inputs: (N, nnz) C-contiguous per-pose arrays or
+        1-D shared values; outputs: (N, nnz_out) C-contiguous arrays."""
+        ins = (ctypes.c_void_p * self.n_in)()
+        in_step = (ctypes.c_long * self.n_in)()
+        for k, a in enumerate(inputs):
+            step = a.shape[1] if a.ndim == 2 else 0
+            ins[k] = a.ctypes.data + 8 * start * step
+            in_step[k] = step
+        outs = (ctypes.c_void_p * self.n_out)()
+        out_step = (ctypes.c_long * self.n_out)()
+        for k, a in enumerate(outputs):
+            outs[k] = a.ctypes.data + 8 * start * a.shape[1]
+            out_step[k] = a.shape[1]
+        return int(self.call(stop - start, ins, in_step, outs, out_step))
+
+
+class BoundNative(BoundCall):
+    """A compiled kernel for one model, called on one pose at a time (the
+    single-solve twin of :class:`cpm_nlp.core.kernels.BoundCall`, same
+    interface): straight into the library's loop for one pose, through ctypes."""
+
+    def __init__(self, loop: NativeLoop, shared: list[np.ndarray], defaults: list) -> None:
+        super().__init__(loop.function, shared, defaults)
+        self.loop = loop
+
+    def _state(self):
+        state = getattr(self._local, "state", None)
+        if state is None:
+            loop = self.loop
+            pose = [np.zeros(loop.nnz_in[k]) for k in range(len(self._defaults))]
+            ins = pose + self._shared
+            outs = [np.empty(m) for m in loop.nnz_out]
+            c_in = (ctypes.c_void_p * loop.n_in)(*[a.ctypes.data for a in ins])
+            c_out = (ctypes.c_void_p * loop.n_out)(*[a.ctypes.data for a in outs])
+            steps_in, steps_out = (ctypes.c_long * loop.n_in)(), (ctypes.c_long * loop.n_out)()
+            args = (1, c_in, steps_in, c_out, steps_out)
+            state = self._local.state = [args, ins, pose, outs, [False] * len(pose)]
+        return state
+
+    def __call__(self, *pose: Any) -> list[np.ndarray]:
+        state = self._state()
+        self._fill(state, pose)
+        if self.loop.call(*state[0]):
+            raise RuntimeError(f"evaluation of {self.loop.function.name()} failed")
+        return state[3]
+
+
 def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Path:
     """Compile ``source`` into a shared library in the cache (once per content)."""
     cmd = find_compiler()
@@ -130,12 +226,57 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
     return lib
 
 
+BACKENDS = ("map", "compiled", "auto")
+
+
+def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[ca.Function, str]:
+    """The kernel's Function for a backend ("map": CasADi's virtual machine;
+    "compiled": C; "auto": compiled when a C compiler is available) and the
+    backend used."""
+    if backend not in BACKENDS:
+        raise InputError(
+            f"unknown backend {backend!r}; expected one of: {', '.join(BACKENDS)}",
+            path=("backend",),
+            suggestions=suggest(str(backend), BACKENDS),
+        )
+    if backend == "compiled":
+        return compiled_function(closure, kern), "compiled"
+    if backend == "auto":
+
+        def decide() -> str:
+            if not compiler_available():
+                log.info("no C compiler: backend 'auto' uses 'map'")
+                return "map"
+            try:
+                compiled_function(closure, kern)
+            except CompilerError as exc:  # "auto" means the best available: the virtual machine then
+                log.warning("backend 'auto' uses 'map': %s", exc)
+                return "map"
+            return "compiled"
+
+        if closure.solvers.memo(("auto_backend", str(cache_dir())) + kern.key, decide) == "compiled":
+            return compiled_function(closure, kern), "compiled"
+    return kern.function, "map"
+
+
+def _library(closure: LoopClosure, kern: Kernel) -> Path:
+    def build() -> Path:
+        source = generate_source(kern.function, kern.name) + batch_loop_source(kern.function, kern.name)
+        return build_library(source, kern.name)
+
+    return closure.solvers.memo(("library", str(cache_dir())) + kern.key, build)
+
+
 def compiled_function(closure: LoopClosure, kern: Kernel) -> ca.Function:
     """The kernel's compiled twin (same inputs and outputs), built or loaded once per process."""
+    return closure.solvers.memo(
+        ("compiled", str(cache_dir())) + kern.key, lambda: ca.external(kern.name, str(_library(closure, kern)))
+    )
 
-    def build() -> ca.Function:
-        source = generate_source(kern.function, kern.name)
-        lib = build_library(source, kern.name)
-        return ca.external(kern.name, str(lib))
 
-    return closure.solvers.memo(("compiled", str(cache_dir())) + kern.key, build)
+def native_loop(closure: LoopClosure, kern: Kernel) -> NativeLoop:
+    """The compiled kernel's loop over poses (:func:`batch_loop_source`), loaded once per process."""
+    return closure.solvers.memo(
+        ("native_loop", str(cache_dir())) + kern.key,
+        lambda: NativeLoop(_library(closure, kern), kern.name, compiled_function(closure, kern)),
+    )

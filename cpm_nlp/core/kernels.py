@@ -127,12 +127,21 @@ def _robust_max_abs(v: ca.SX) -> ca.SX:
 
 
 def check_expressions(
-    closure: LoopClosure, x: ca.SX, q: ca.SX, p: ca.SX, lower: ca.SX, upper: ca.SX
+    closure: LoopClosure,
+    x: ca.SX,
+    q: ca.SX,
+    p: ca.SX,
+    lower: ca.SX,
+    upper: ca.SX,
+    phi_x_home_inv: ca.SX | None = None,
 ) -> dict[str, ca.SX]:
     """Symbolic checks of the pose (x, q): see :data:`CHECKS`.
 
     lower, upper: limits of :func:`limited_coordinates` (q, x, passive joints),
     ±inf where none is declared.
+    phi_x_home_inv: if given (a numeric nx x nx input, Φ_x⁻¹ at the home pose),
+    ``cond1`` is the certified upper bound of :func:`cond1_bound` instead of
+    the exact 1-norm condition number (which needs a symbolic inverse of Φ_x).
     """
     c = closure
     out: dict[str, ca.SX] = {"finite": _all_finite(ca.vertcat(x, q))}
@@ -150,7 +159,9 @@ def check_expressions(
         out["round_trip_error"] = ca.SX(0)
     phi_x = c.phi_x(x, q, p)
     out["phi_x"] = phi_x
-    if ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
+    if phi_x_home_inv is not None:
+        out["cond1"] = cond1_bound(ca.densify(phi_x), phi_x_home_inv)
+    elif ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
         out["cond1"] = ca.SX(ca.inf)
     else:
         out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
@@ -164,6 +175,33 @@ def check_expressions(
     else:  # pragma: no cover - every mechanism has actuators
         out["limit_margin"] = ca.SX(ca.inf)
     return out
+
+
+#: the preconditioned residual ‖I - Φ_x B‖₁ must stay below this for :func:`cond1_bound` to certify
+CERTIFY_DELTA = 0.9
+
+
+def _induced_norm_1(m: ca.SX) -> ca.SX:
+    """‖M‖₁ = largest column sum of |M| (the induced 1-norm)."""
+    return ca.mmax(ca.sum1(ca.fabs(m)))
+
+
+def cond1_bound(phi_x: ca.SX, b: ca.SX) -> ca.SX:
+    """A certified upper bound of the 1-norm condition number of Φ_x, from an
+    approximate inverse B (Φ_x⁻¹ at the home pose, numbers) and no inverse
+    at the pose itself.
+
+    With δ = ‖I - Φ_x B‖₁ < 1, Φ_x B is invertible (Neumann series) and
+    ‖Φ_x⁻¹‖₁ = ‖B (Φ_x B)⁻¹‖₁ ≤ ‖B‖₁ / (1 - δ), so
+    κ₁(Φ_x) ≤ ‖Φ_x‖₁ ‖B‖₁ / (1 - δ) (induced 1-norms).  Where δ >
+    :data:`CERTIFY_DELTA` (far from home) or Φ_x is not finite the bound is
+    +inf: nothing is certified.  Costs one nx x nx product instead of a
+    symbolic inverse.
+    """
+    n = phi_x.size1()
+    delta = _induced_norm_1(ca.DM.eye(n) - ca.mtimes(phi_x, b))
+    bound = _induced_norm_1(phi_x) * _induced_norm_1(b) / (1 - delta)
+    return ca.if_else(ca.logic_and(_all_finite(ca.vec(phi_x)), delta <= CERTIFY_DELTA), bound, ca.inf)
 
 
 def limited_coordinates(closure: LoopClosure) -> tuple[Coordinate, ...]:
@@ -267,6 +305,8 @@ class Kernel:
     pose_inputs: tuple[str, ...]
     outputs: tuple[str, ...]
     key: tuple = ()  # identity in the closure's cache
+    #: inputs shared by every pose (numbers of one model), after ``pose_inputs``
+    shared_inputs: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
@@ -274,6 +314,12 @@ class Kernel:
 
 
 SHARED_INPUTS = ("p", "lower", "upper", "tol")
+#: shared inputs of the FK through the closed-form IK: also the model's linearization at home
+REDUCED_SHARED_INPUTS = SHARED_INPUTS + ("J_home", "Phi_x_home_inv")
+#: ``path`` output of the FK kernel: which formulation answered
+PATHS = ("reduced", "full")
+#: outputs of the FK as embedded (:func:`cpm_nlp.io.embed.functions`) and exported: without ``path``
+FK_OUTPUTS = ("x", "passive", "residual", "branch_margin", "round_trip_error", "cond1", "limit_margin", "status")
 _STATUS_OUTPUTS = ("residual", "branch_margin", "round_trip_error", "cond1", "limit_margin", "status")
 
 
@@ -304,12 +350,15 @@ def _rootfinder(name: str, residual: ca.Function, ny: int, nw: int, opts: Mappin
     return ca.rootfinder(name, "fast_newton", g, {**opts, "error_on_fail": False})
 
 
-def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
-    """``<name>_fk: (q, x0, p, lower, upper, tol) -> (x, passive, residual,
-    branch_margin, round_trip_error, cond1, limit_margin, status)``.
+def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
+    """``<name>_fk_full: (q, x0, p, lower, upper, tol) -> (x, passive, residual,
+    branch_margin, round_trip_error, cond1, limit_margin, status)`` (named
+    ``<name>_fk`` for a mechanism without a closed-form IK).
 
-    Newton from x0; a pose whose residual is not within ``tol`` after the
-    iterations is ``not_converged``; then the checks.
+    Newton on Φ(x, q) = 0 (nx unknowns) from x0; a pose whose residual is
+    not within ``tol`` after the iterations is ``not_converged``; then the
+    checks.  The FK of mechanisms without a closed-form IK, and the fallback
+    of :func:`fk_kernel` for the others.
     """
     opts = newton_options(config)
 
@@ -323,11 +372,130 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         status = _first(ca.logic_not(_converged(x, chk["residual"], shared[3])), Status.NOT_CONVERGED, chk["status"])
         names = ("x", "passive", *_STATUS_OUTPUTS)
         outs = [x] + [chk[n] for n in names[1:-1]] + [status]
-        fn = ca.Function(f"{c.name}_fk", [q, x0, *shared], outs, ["q", "x0", *SHARED_INPUTS], list(names))
-        return Kernel(fn, "fk", ("q", "x0"), names, key)
+        name = f"{c.name}_fk" if c.ik is None else f"{c.name}_fk_full"  # the FK itself, or the fallback
+        fn = ca.Function(name, [q, x0, *shared], outs, ["q", "x0", *SHARED_INPUTS], list(names))
+        return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
+
+    key = ("full_fk_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
+
+
+#: Newton steps of the reduced FK (unrolled: straight-line code, no loop); from the
+#: first-order guess two or three reach machine precision in the workspace
+REDUCED_STEPS = 3
+
+
+def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, steps: int = REDUCED_STEPS) -> Kernel:
+    """``<name>_fk_reduced: (q, x0, p, lower, upper, tol, J_home, Phi_x_home_inv)
+    -> (x, passive, residual, branch_margin, round_trip_error, cond1,
+    limit_margin, status)``: FK by Newton on the task coordinates through the
+    closed-form IK (mechanisms that have one).  One flat SX graph.
+
+    Unknowns: the nq task coordinates t, solving g(t) = q_ik(t) - q = 0 by
+    ``steps`` Newton steps t <- t - (dq/dt)⁻¹ g(t) (dq/dt = the inverse
+    Jacobian J_inv from AD of the closed form, an nq x nq solve), from the
+    first-order guess about x0: t0 = t_s + J_home (q - q_ik(t_s)), t_s =
+    x0[task], J_home = dt/dq at the home pose (for x0 = home:
+    t0 = t_home + J_home (q - q_home)).  The pose is x_ik(t).
+
+    ``status`` is ``solved`` only where max |g| <= abstol after the steps
+    (Newton converged) and every check of the full path passes on (x, q):
+    residual of the full Φ, branch, reach and IK round trip, limits, with
+    ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x)
+    and a margin of 2 on the singularity threshold.  Any other status means
+    "not settled here": the full path decides (see :func:`fk_kernel`).
+    """
+    opts = newton_options(config)
+    abstol = float(opts.get("abstol", DEFAULT_OPTIONS["newton"]["abstol"]))
+
+    def build() -> Kernel:
+        c = closure
+        if c.ik is None:  # pragma: no cover - guarded by fk_kernel
+            raise ValueError(f"{c.name} has no closed-form IK")
+        nl = n_joints(c)
+        q, x0, p = ca.SX.sym("q", c.nq), ca.SX.sym("x0", c.nx), ca.SX.sym("p", c.np)
+        lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
+        jac_home = ca.SX.sym("J_home", c.nq, c.nq)
+        b = ca.SX.sym("Phi_x_home_inv", c.nx, c.nx)
+        # one Newton step as a Function (inlined below: calls on SX expand)
+        t_sym = ca.SX.sym("t", c.nq)
+        q_of_t = c.ik(t_sym, p)[1]
+        step = ca.Function(
+            f"{c.name}_fk_task_step",
+            [t_sym, q, p],
+            [t_sym - ca.solve(ca.jacobian(q_of_t, t_sym), q_of_t - q)],
+            ["t", "q", "p"],
+            ["t_next"],
+        )
+        ts = x0[list(c.task_index)]
+        t = ts + ca.mtimes(jac_home, q - c.ik(ts, p)[1])
+        for _ in range(steps):
+            t = step(t, q, p)
+        x, q_ik, _reach = c.ik(t, p)
+        converged = _robust_max_abs(q_ik - q) <= abstol
+        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
+        singular = is_singular(chk["cond1"], CASADI, factor=2 * c.nx)  # margin 2 over the certified bound
+        status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
+        status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)
+        names = ("x", "passive", *_STATUS_OUTPUTS)
+        outs = ca.cse([x] + [ca.densify(chk[n]) for n in names[1:-1]] + [status])
+        fn = ca.Function(
+            f"{c.name}_fk_reduced",
+            [q, x0, p, lower, upper, tol, jac_home, b],
+            outs,
+            ["q", "x0", *REDUCED_SHARED_INPUTS],
+            list(names),
+        )
+        return Kernel(fn, "fk", ("q", "x0"), names, key, REDUCED_SHARED_INPUTS)
+
+    key = ("reduced_fk_kernel", _options_key(opts), steps)
+    return closure.solvers.memo(key, build)
+
+
+def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
+    """``<name>_fk: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) ->
+    (x, passive, residual, branch_margin, round_trip_error, cond1,
+    limit_margin, status[, path])``: the FK of every path in cpm_nlp (single
+    Newton solves, batches, the embedding Functions, exported code).
+
+    Mechanisms with a closed-form IK: first :func:`reduced_fk_kernel` (nq
+    unknowns); a pose it does not settle as ``solved`` -- Newton did not
+    converge, a check failed, or the conditioning bound is not certified --
+    goes to :func:`full_fk_kernel` from x0 (only that branch is evaluated: a
+    CasADi Switch), so every status other than ``solved`` comes from the full
+    path exactly as it did before the reduced one existed.  ``path`` says
+    which one answered (0 reduced, 1 full; :data:`PATHS`).  Mechanisms without
+    a closed-form IK: :func:`full_fk_kernel` alone (no ``path`` output).
+    """
+    c = closure
+    if c.ik is None:
+        return full_fk_kernel(c, config)
+    opts = newton_options(config)
+
+    def build() -> Kernel:
+        reduced = reduced_fk_kernel(c, config).function
+        full = full_fk_kernel(c, config).function
+        q, x0 = ca.MX.sym("q", c.nq), ca.MX.sym("x0", c.nx)
+        shared = _shared_symbols(c) + [ca.MX.sym("J_home", c.nq, c.nq), ca.MX.sym("Phi_x_home_inv", c.nx, c.nx)]
+        r = reduced(q, x0, *shared)
+        names = ("x", "passive", *_STATUS_OUTPUTS)
+        # the Switch's branches share one signature: (q, x0, p, lower, upper, tol, reduced outputs)
+        ins = [ca.MX.sym(n, s.sparsity()) for n, s in zip(["q", "x0", *SHARED_INPUTS], [q, x0, *shared[:4]])]
+        r_in = [ca.MX.sym(f"reduced_{n}", reduced.sparsity_out(k)) for k, n in enumerate(names)]
+        # outputs: (x, passive, checks..., path, status): status stays last
+        out_names = [*names[:-1], "path", "status"]
+        io = ([n.name() for n in ins + r_in], out_names)
+        keep = ca.Function(f"{c.name}_fk_keep", ins + r_in, r_in[:-1] + [ca.MX(0), r_in[-1]], *io)
+        f = list(full(*ins))
+        fallback = ca.Function(f"{c.name}_fk_fallback", ins + r_in, f[:-1] + [ca.MX(1), f[-1]], *io)
+        switch = ca.Function.if_else(f"{c.name}_fk_switch", keep, fallback)
+        settled = r[-1] == code_of(Status.SOLVED)
+        outs = switch(settled, q, x0, *shared[:4], *r)
+        fn = ca.Function(f"{c.name}_fk", [q, x0, *shared], list(outs), ["q", "x0", *REDUCED_SHARED_INPUTS], out_names)
+        return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS)
 
     key = ("fk_kernel", _options_key(opts))
-    return closure.solvers.memo(key, build)
+    return c.solvers.memo(key, build)
 
 
 def ik_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
@@ -369,7 +537,7 @@ def ik_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         names = ("x", "q", "passive", "reach", *_STATUS_OUTPUTS)
         outs = [x, q, chk["passive"], reach] + [chk[n] for n in _STATUS_OUTPUTS[:-1]] + [status]
         fn = ca.Function(f"{c.name}_ik", [*ins, *shared], outs, [*pose_inputs, *SHARED_INPUTS], list(names))
-        return Kernel(fn, "ik", pose_inputs, names, key)
+        return Kernel(fn, "ik", pose_inputs, names, key, SHARED_INPUTS)
 
     key = ("ik_kernel", _options_key(opts))
     return closure.solvers.memo(key, build)
@@ -384,7 +552,7 @@ def jacobian_kernel(closure: LoopClosure) -> Kernel:
         outs = [ca.densify(f(x, q, p)) for f in (c.jacobian, c.inverse_jacobian, c.phi_x, c.phi_q)]
         names = ("J", "J_inv", "Phi_x", "Phi_q")
         fn = ca.Function(f"{c.name}_jacobian", [x, q, p], outs, ["x", "q", "p"], list(names))
-        return Kernel(fn, "jacobian", ("x", "q"), names, key)
+        return Kernel(fn, "jacobian", ("x", "q"), names, key, ("p",))
 
     key = ("jacobian_kernel",)
     return closure.solvers.memo(key, build)
@@ -401,26 +569,65 @@ def kernel(closure: LoopClosure, kind: str, config: SolverConfig | None = None) 
     raise ValueError(f"unknown kernel kind {kind!r}")  # pragma: no cover - programming error
 
 
+def linearization(model: Model) -> dict[str, np.ndarray]:
+    """The model's numbers behind the reduced FK (cached on the model):
+    ``J_home`` = dt/dq at the home pose (nq x nq, the first-order guess) and
+    ``Phi_x_home_inv`` = Φ_x⁻¹ at home (nx x nx, the conditioning
+    certificate).  Non-finite (a singular home pose) becomes zeros: the guess
+    is then x0's task coordinates and nothing is certified."""
+    cached = model.__dict__.get("_fk_linearization")
+    if cached is not None:
+        return cached
+    c = model.closure
+    x, q, p = model.x_home, model.q_home, model.p
+    with np.errstate(all="ignore"):
+        jac = np.asarray(c.jacobian(x, q, p))[c.task_index, :]
+        try:
+            b = np.linalg.inv(np.asarray(c.phi_x(x, q, p)))
+        except np.linalg.LinAlgError:
+            b = np.zeros((c.nx, c.nx))
+    jac = jac if np.all(np.isfinite(jac)) else np.zeros((c.nq, c.nq))
+    b = b if np.all(np.isfinite(b)) else np.zeros((c.nx, c.nx))
+    out = {"J_home": jac.reshape(-1, order="F"), "Phi_x_home_inv": b.reshape(-1, order="F")}
+    model.__dict__["_fk_linearization"] = out
+    return out
+
+
 def shared_values(kern: Kernel, model: Model, tolerance: float) -> list[np.ndarray]:
-    """The values of the kernel's shared inputs for a model."""
-    n_shared = kern.function.n_in() - len(kern.pose_inputs)
+    """The values of the kernel's shared inputs for a model (flat, column-major)."""
     lower, upper = limit_vectors(model)
-    return [model.p, lower, upper, np.array([float(tolerance)])][:n_shared]
+    values = {"p": model.p, "lower": lower, "upper": upper, "tol": np.array([float(tolerance)])}
+    if "J_home" in kern.shared_inputs:
+        values.update(linearization(model))
+    return [values[n] for n in kern.shared_inputs]
 
 
-def bake(kern: Kernel, model: Model, tolerance: float, function: ca.Function | None = None) -> ca.Function:
+def bake(
+    kern: Kernel,
+    model: Model,
+    tolerance: float,
+    function: ca.Function | None = None,
+    outputs: Sequence[str] | None = None,
+) -> ca.Function:
     """The kernel with one model's parameters, limits and tolerance built in:
     a Function of the per-pose inputs only, same output names.
 
     function: the Function to wrap (default the kernel's own; the compiled
-    library's twin for the compiled path).
+    library's twin for the compiled path).  outputs: the outputs to keep, by
+    name (default all, in the kernel's order).
     """
     fn = kern.function if function is None else function
     syms = [ca.MX.sym(n, fn.size_in(i)) for i, n in enumerate(kern.pose_inputs)]
-    fixed = [ca.DM(v) for v in shared_values(kern, model, tolerance)]
+    n_pose = len(kern.pose_inputs)
+    fixed = [
+        ca.DM(ca.Sparsity.dense(*fn.size_in(n_pose + k)), v)
+        for k, v in enumerate(shared_values(kern, model, tolerance))
+    ]
     outs = fn(*syms, *fixed)
     outs = list(outs) if isinstance(outs, (list, tuple)) else [outs]
-    return ca.Function(kern.name, syms, outs, list(kern.pose_inputs), list(kern.outputs))
+    names = list(kern.outputs if outputs is None else outputs)
+    by_name = dict(zip(fn.name_out(), outs))
+    return ca.Function(kern.name, syms, [by_name[n] for n in names], list(kern.pose_inputs), names)
 
 
 # -- fast numeric calls ---------------------------------------------------------------------
@@ -474,6 +681,57 @@ class FastFunction:
 
     def named(self, *args: Any) -> dict[str, np.ndarray]:
         return dict(zip(self.names_out, self(*args)))
+
+
+class BoundCall:
+    """One kernel for one model, called on one pose at a time with the least
+    overhead: the model's shared inputs (parameters, limits, tolerance,
+    linearization) and every input and output array are bound to a
+    FunctionBuffer once per thread; a call copies the pose inputs in,
+    evaluates, and returns the (per-thread, reused) output arrays -- copy
+    what you keep.  ``defaults``: a value per pose input (or None), used
+    where a call passes None (e.g. the home pose as x0).
+    """
+
+    def __init__(self, function: ca.Function, shared: Sequence[np.ndarray], defaults: Sequence[Any]) -> None:
+        self.function = function
+        self._shared = [np.ascontiguousarray(v, dtype=float).reshape(-1) for v in shared]
+        self._defaults = [None if d is None else np.asarray(d, dtype=float).reshape(-1) for d in defaults]
+        self._local = threading.local()
+
+    def _state(self):
+        state = getattr(self._local, "state", None)
+        if state is None:
+            fn = self.function
+            buf, evaluate = fn.buffer()
+            pose = [np.zeros(fn.nnz_in(i)) for i in range(len(self._defaults))]
+            for i, arr in enumerate(pose + self._shared):
+                buf.set_arg(i, memoryview(arr))
+            outs = [np.empty(fn.nnz_out(i)) for i in range(fn.n_out())]
+            for i, arr in enumerate(outs):
+                buf.set_res(i, memoryview(arr))
+            state = self._local.state = [buf, evaluate, pose, outs, [False] * len(pose)]
+        return state
+
+    def _fill(self, state: list, pose: Sequence[Any]) -> None:
+        arrays, is_default = state[2], state[4]
+        for k, value in enumerate(pose):
+            if value is None:
+                if not is_default[k]:
+                    arrays[k][:] = self._defaults[k]
+                    is_default[k] = True
+            else:
+                arrays[k][:] = value
+                is_default[k] = False
+
+    def __call__(self, *pose: Any) -> list[np.ndarray]:
+        state = self._state()
+        self._fill(state, pose)
+        buf = state[0]
+        state[1]()
+        if buf.ret() != 0:
+            raise RuntimeError(f"evaluation of {self.function.name()} failed (code {buf.ret()})")
+        return state[3]
 
 
 def fast(closure: LoopClosure, key: tuple, function: Callable[[], ca.Function]) -> FastFunction:

@@ -14,24 +14,32 @@ Sizes: nx = pose coordinates, nq = actuated joints (= task coordinates).
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .compiled import BoundNative, backend_function, native_loop
 from .errors import InputError
-from .kernels import ROUND_TRIP_FACTOR as ROUND_TRIP_FACTOR  # noqa: F401 - re-exported (defined in kernels)
 from .kernels import (
+    PATHS,
     SCALAR,
     STATUSES,
+    BoundCall,
+    batch_newton_supported,
     checks_function,
+    code_of,
     fast,
+    fk_kernel,
     is_singular,
     limit_vectors,
+    shared_values,
     status_code,
     status_rules,
 )
+from .kernels import ROUND_TRIP_FACTOR as ROUND_TRIP_FACTOR  # noqa: F401 - re-exported (defined in kernels)
 from .kernels import SINGULAR_CONDITION as SINGULAR_CONDITION  # noqa: F401
 from .model import Model
 from .result import Status
@@ -59,6 +67,9 @@ class PoseSolution:
     solver: str = ""
     message: str = ""
     details: dict = field(default_factory=dict)
+    #: Newton FK of a mechanism with a closed-form IK: "reduced" (Newton on the
+    #: task coordinates through the IK answered) or "full" (Newton on Φ); else ""
+    path: str = ""
 
     @property
     def ok(self) -> bool:
@@ -69,7 +80,7 @@ def _vector(values, n: int, name: str) -> np.ndarray:
     arr = np.asarray(values, dtype=float).ravel()
     if arr.size != n:
         raise InputError(f"expected {n} values, got {arr.size}", path=(name,))
-    if not np.all(np.isfinite(arr)):
+    if not all(map(math.isfinite, arr.tolist())):
         raise InputError(f"expected finite numbers, got {arr.tolist()}", path=(name,))
     return arr
 
@@ -180,22 +191,132 @@ def _checked(model: Model, x, q, tolerance: float, iterations: int, seconds: flo
     return PoseSolution(status, None, None, None, residual, iterations, seconds, solver, message, details)
 
 
+_CHECK_NAMES = ("residual", "branch_margin", "round_trip_error", "cond1", "limit_margin")
+
+
+def _bound_fk(model: Model, config: SolverConfig, backend: str) -> tuple[BoundCall | BoundNative, tuple[int, ...]]:
+    """The FK kernel bound to this model (built once per model, configuration
+    and backend) and the positions of its outputs."""
+    key = ("fk", config.key(), float(config.tolerance), backend)
+    cache = model.__dict__.setdefault("_bound_kernels", {})
+    hit = cache.get(key)
+    if hit is None:
+        kern = fk_kernel(model.closure, config)
+        fn, used = backend_function(model.closure, kern, backend)
+        shared = shared_values(kern, model, config.tolerance)
+        defaults = [None, model.x_home]  # x0: the home pose unless a guess is given
+        if used == "compiled":  # straight into the library's loop, through ctypes
+            bound: BoundCall | BoundNative = BoundNative(native_loop(model.closure, kern), shared, defaults)
+        else:
+            bound = BoundCall(fn, shared, defaults)
+        hit = cache[key] = (bound, _fk_index(kern.outputs))
+    return hit
+
+
+#: outputs of the FK kernel that make a PoseSolution, in this order (path: absent for mechanisms without an IK)
+_FK_FIELDS = (
+    "x",
+    "passive",
+    "residual",
+    "branch_margin",
+    "round_trip_error",
+    "limit_margin",
+    "cond1",
+    "path",
+    "status",
+)
+
+
+def _fk_index(outputs: Sequence[str]) -> tuple[int, ...]:
+    return tuple(outputs.index(n) if n in outputs else -1 for n in _FK_FIELDS)
+
+
+def pose_from_kernel(
+    model: Model,
+    outs: Sequence[np.ndarray],
+    index: tuple[int, ...],
+    q: np.ndarray,
+    tolerance: float,
+    seconds: float,
+    solver: str,
+) -> PoseSolution:
+    """A :class:`PoseSolution` from the outputs of the FK kernel for one pose
+    (``index``: positions of :data:`_FK_FIELDS` among them), exactly as
+    :class:`cpm_nlp.core.batch.BatchResult` turns a batch row into one (the
+    1-norm singularity screen refined by the 2-norm condition number)."""
+    c = model.closure
+    i_x, i_passive, i_res, i_branch, i_trip, i_limit, i_cond, i_path, i_status = index
+    code = int(outs[i_status][0])
+    residual = float(outs[i_res][0])
+    details = {
+        "residual": residual,
+        "branch_margin": float(outs[i_branch][0]),
+        "round_trip_error": float(outs[i_trip][0]),
+        "limit_margin": float(outs[i_limit][0]),
+        "cond1_phi_x": float(outs[i_cond][0]),
+    }
+    path = PATHS[int(outs[i_path][0])] if i_path >= 0 else ""
+    x = outs[i_x].copy()
+    passive = outs[i_passive].copy()
+    if code == code_of(Status.SINGULAR):
+        a = fast(c, ("phi_x",), lambda: c.phi_x)(x, q, model.p)[0].reshape(c.nx, c.nx)
+        sv = np.linalg.svd(a, compute_uv=False)
+        cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+        rows = {k: details[k] for k in ("residual", "branch_margin", "round_trip_error", "limit_margin")}
+        rows["finite"] = True
+        code = int(status_code(status_rules(rows, tolerance, is_singular(cond, SCALAR), SCALAR), SCALAR))
+        details["cond_phi_x"] = cond
+    if code == 0:
+        passive_out = passive if c.passive is not None else None
+        return PoseSolution(Status.SOLVED, x, q, passive_out, residual, 0, seconds, solver, "", details, path)
+    status = STATUSES[code]
+    message = failure_message(model, status, details, x, q, passive, tolerance)
+    return PoseSolution(
+        status, residual=residual, seconds=seconds, solver=solver, message=message, details=details, path=path
+    )
+
+
+def _kernel_forward(
+    model: Model, q: np.ndarray, x0: np.ndarray | None, config: SolverConfig, backend: str
+) -> PoseSolution:
+    t0 = time.perf_counter()
+    call, index = _bound_fk(model, config, backend)
+    outs = call(q, x0)
+    seconds = time.perf_counter() - t0
+    return pose_from_kernel(model, outs, index, q, config.tolerance, seconds, config.name)
+
+
 def forward_kinematics(
     model: Model,
     q: Sequence[float],
     solver: SolverConfig | None = None,
     guess: Sequence[float] | None = None,
+    *,
+    backend: str = "auto",
 ) -> PoseSolution:
     """Solve Φ(x, q; p) = 0 for the pose x.
 
     q: actuated joints, size nq (SI).  guess: initial pose, size nx (default:
     the home pose).  The answer is checked (:func:`assess`) before it is
     reported solved.
+
+    Newton (``SolverConfig("newton")``, with the options the kernels take:
+    abstol, abstolStep, max_iter): the kernel of the batch,
+    :func:`cpm_nlp.core.kernels.fk_kernel`, so a single solve and a batch
+    give the same statuses and values.  For a mechanism with a closed-form IK
+    it solves for the nq task coordinates through the IK from the first-order
+    guess and falls back to Newton on Φ from ``guess`` where that does not
+    settle the pose (``PoseSolution.path``).  backend: "auto" (compiled C when
+    a compiler is available, built once per machine), "compiled" or "map"
+    (CasADi's virtual machine).
     """
     config = solver or SolverConfig()
     c = model.closure
     qv = _vector(q, c.nq, "q")
-    x0 = model.x_home if guess is None else _vector(guess, c.nx, "guess")
+    x0 = None if guess is None else _vector(guess, c.nx, "guess")
+    if config.method == "newton" and batch_newton_supported(config):
+        return _kernel_forward(model, qv, x0, config, backend)
+    x0 = model.x_home if x0 is None else x0
     built = c.fk_solver(config)
     x, ok, iters, msg, sec = built.solve(x0, np.concatenate([qv, model.p]), model.x_lower, model.x_upper)
     if not ok:

@@ -60,6 +60,65 @@ DIMENSIONS: dict[str, Dimension] = {
 }
 
 
+#: unit text -> (factor to pint's root units, dimension), for the units of DIMENSIONS: the
+#: floats pint gives (Quantity(1.0, unit).to_root_units().magnitude; tests/test_units.py
+#: checks each against pint)
+FAST_UNITS: dict[str, tuple[float, str]] = {
+    "m": (1.0, "length"),
+    "mm": (0.001, "length"),
+    "um": (1e-06, "length"),
+    "µm": (1e-06, "length"),
+    "nm": (1e-09, "length"),
+    "cm": (0.01, "length"),
+    "rad": (1.0, "angle"),
+    "deg": (0.017453292519943295, "angle"),
+    "mrad": (0.001, "angle"),
+    "urad": (1e-06, "angle"),
+    "arcmin": (0.00029088820866572163, "angle"),
+    "arcsec": (4.84813681109536e-06, "angle"),
+    "Pa": (1000.0, "stress"),
+    "kPa": (1000000.0, "stress"),
+    "MPa": (1000000000.0, "stress"),
+    "GPa": (1000000000000.0, "stress"),
+    "N": (1000.0, "force"),
+    "mN": (1.0, "force"),
+    "kN": (1000000.0, "force"),
+    "kg": (1000.0, "mass"),
+    "g": (1.0, "mass"),
+    "mg": (0.001, "mass"),
+    "m^3": (1.0, "volume"),
+    "mm^3": (1e-09, "volume"),
+    "cm^3": (1.0000000000000002e-06, "volume"),
+    "um^3": (9.999999999999999e-19, "volume"),
+    "kg/m^3": (1000.0, "density"),
+    "g/cm^3": (999999.9999999999, "density"),
+    "s": (1.0, "time"),
+    "ms": (0.001, "time"),
+    "us": (1e-06, "time"),
+    "Hz": (1.0, "frequency"),
+    "kHz": (1000.0, "frequency"),
+    "N/m": (1000.0, "stiffness"),
+    "N/mm": (1000000.0, "stiffness"),
+    "N/um": (1000000000.0, "stiffness"),
+    "N*m/rad": (1000.0, "rotational_stiffness"),
+    "N*mm/rad": (1.0, "rotational_stiffness"),
+    "m/s^2": (1.0, "acceleration"),
+    "mm/s^2": (0.001, "acceleration"),
+    "%": (0.01, "dimensionless"),
+}
+
+
+def fast_dimension(value: Any) -> str | None:
+    """The dimension of a ``"<number> <unit>"`` string whose unit is in
+    :data:`FAST_UNITS` (else None): where a caller tries dimensions in turn, the
+    one to try first."""
+    if not isinstance(value, str):
+        return None
+    match = _NUMBER.match(value)
+    unit = FAST_UNITS.get(match.group(2)) if match else None
+    return unit[1] if unit else None
+
+
 _registry_lock = threading.Lock()
 _registry: Any = None
 
@@ -119,6 +178,13 @@ def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # no
         raise InputError(f"expected a finite number, got '{value}'", path=path)
     if not unit_text:
         return number
+    fast = FAST_UNITS.get(unit_text)
+    ref = FAST_UNITS.get(dim.si) if dim.si else (1.0, dimension)
+    if fast is not None and ref is not None and fast[1] == dimension == ref[1]:
+        si = number * fast[0] / ref[0]  # the same operations as the pint path below, on the same factors
+        if not math.isfinite(si):
+            raise InputError(f"{value!r} overflows", path=path)
+        return si
     try:
         unit = _ureg().parse_units(unit_text)
         factor, root = _root(unit)
@@ -147,6 +213,9 @@ def to_display(value: float, dimension: str) -> tuple[float, str]:
     dim = DIMENSIONS[dimension]
     if dim.display == dim.si:
         return value, dim.si
+    fast, fast_si = FAST_UNITS.get(dim.display), FAST_UNITS.get(dim.si)
+    if fast is not None and fast_si is not None:
+        return value * fast_si[0] / fast[0], dim.display
     f_disp, _ = _root(_ureg().parse_units(dim.display))
     f_si, _ = _root(_ureg().parse_units(dim.si))
     return value * f_si / f_disp, dim.display

@@ -14,9 +14,14 @@ joint limits and tolerance built in::
 
 Every Function takes numbers (numpy arrays) or CasADi symbols: MX for
 ``fk`` and ``ik`` (they contain a rootfinder), SX or MX for the others.  The
-FK is Newton's method from ``x0`` (CasADi ``fast_newton``); its ``status``
-output is 0 only where the pose passed every check of cpm_nlp
-(``cn.status_of(code)`` names it).  Nothing here prints or keeps global
+FK is the kernel of every Newton FK in cpm_nlp: for a mechanism with a
+closed-form IK, Newton on the task coordinates through the IK from the
+first-order guess about ``x0``, else (or where that does not settle the pose)
+Newton on Φ from ``x0`` (CasADi ``fast_newton``); its ``status`` output is 0
+only where the pose passed every check of cpm_nlp (``cn.status_of(code)``
+names it).  (Which formulation answered is reported by the solvers'
+``PoseSolution.path`` and ``BatchResult.path(i)``; the Function keeps the
+outputs it always had.)  Nothing here prints or keeps global
 state; the Functions may be called from several threads.
 """
 
@@ -28,7 +33,7 @@ import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError
-from ..core.kernels import bake, fk_kernel, ik_kernel, jacobian_kernel
+from ..core.kernels import FK_OUTPUTS, bake, fk_kernel, ik_kernel, jacobian_kernel
 from ..core.model import Model
 from ..core.solver import SolverConfig
 
@@ -80,7 +85,7 @@ def model_functions(model: Model, solver: SolverConfig | None = None) -> ModelFu
     return ModelFunctions(
         model=model,
         phi=_with_parameters(c.phi, model, f"{name}_phi"),
-        fk=bake(fk_kernel(c, config), model, config.tolerance),
+        fk=bake(fk_kernel(c, config), model, config.tolerance, outputs=FK_OUTPUTS),
         ik=bake(ik_kernel(c, config), model, config.tolerance),
         jacobian=bake(jacobian_kernel(c), model, config.tolerance),
         passive=_with_parameters(c.passive, model, f"{name}_passive") if c.passive is not None else None,

@@ -16,15 +16,20 @@ tolerance built in:
   and meaning, the parameter values built in, the status codes, and the
   CasADi version that wrote the files.
 
-The forward kinematics is Newton's method (CasADi ``fast_newton``, which
-generates C) from a given guess, followed by the same checks as every solve
-in cpm_nlp; its ``status`` output says whether the pose can be trusted.
+The forward kinematics is the kernel of every Newton FK in cpm_nlp
+(:func:`cpm_nlp.core.kernels.fk_kernel`): for a mechanism with a closed-form
+IK, Newton on the task coordinates through the IK from the first-order
+guess about x0, falling back to Newton on all of Φ (CasADi ``fast_newton``,
+which generates C) from x0; then the same checks as every solve in cpm_nlp.
+Its ``status`` output says whether the pose can be trusted, ``path`` which
+formulation answered.
 Files are written to a temporary directory and moved into place only when
 all of them are complete.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import hashlib
 import json
@@ -39,6 +44,8 @@ import numpy as np
 
 from ..core.errors import InputError, suggest
 from ..core.kernels import (
+    FK_OUTPUTS,
+    REDUCED_STEPS,
     ROUND_TRIP_FACTOR,
     SINGULAR_CONDITION,
     STATUSES,
@@ -190,9 +197,21 @@ _PURPOSE = {
 def exported_functions(
     model: Model, what: Sequence[str] = WHAT, solver: SolverConfig | None = None
 ) -> list[tuple[Kernel, ca.Function]]:
-    """The baked Functions (``<mechanism>_<what>``) and their kernels."""
+    """The baked Functions (``<mechanism>_<what>``) and their kernels.
+
+    The FK is the kernel of every Newton FK in cpm_nlp (through the closed-form
+    IK where the mechanism has one, with the full Newton as fallback); its
+    ``path`` output is left out, so that the exported signature (and every C
+    program written against it) stays as it was.
+    """
     config = solver or SolverConfig("newton")
-    return [(k, bake(k, model, config.tolerance)) for k in (kernel(model.closure, w, config) for w in parse_what(what))]
+    out = []
+    for w in parse_what(what):
+        k = kernel(model.closure, w, config)
+        if w == "fk":
+            k = dataclasses.replace(k, outputs=FK_OUTPUTS)
+        out.append((k, bake(k, model, config.tolerance)))
+    return out
 
 
 # -- C wrappers -------------------------------------------------------------------------------
@@ -294,7 +313,17 @@ def manifest(
             "home": {"x": model.x_home.tolist(), "q": model.q_home.tolist()},
         },
         "tolerance": {"value": config.tolerance, "unit": c.residual_unit, "meaning": "largest accepted max |Φ|"},
-        "newton": {**newton_options(config), "method": "CasADi fast_newton (full Newton steps, QR)"},
+        "newton": {
+            **newton_options(config),
+            "method": "CasADi fast_newton (full Newton steps, QR)"
+            + (
+                ""
+                if c.ik is None
+                else f"; first {REDUCED_STEPS} Newton steps on the task coordinates through the closed-form IK, "
+                "from the first-order guess t0 = x0[task] + J_home (q - q_ik(x0[task])) (J_home = dt/dq at home), "
+                "falling back to fast_newton on Φ from x0 where they do not settle the pose"
+            ),
+        },
         "status_codes": {str(k): {"status": s.value, "meaning": STATUS_TEXT[s]} for k, s in enumerate(STATUSES)},
         "functions": funcs,
         "files": files,

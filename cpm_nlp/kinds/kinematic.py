@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.assembly import AssemblyModes, assembly_modes
 from ..analysis.requirements import joint_requirements
 from ..core.batch import batch_forward_kinematics, batch_inverse_kinematics
 from ..core.errors import InputError
@@ -126,7 +127,7 @@ class ForwardKinematics(ProblemKind):
     plots = ("io", "mechanism", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
-        return actuator_options(model, "grid")
+        return actuator_options(model, "grid") + list(MODE_OPTIONS)
 
     def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
         raw = dict(raw) if isinstance(raw, Mapping) else raw
@@ -147,12 +148,22 @@ class ForwardKinematics(ProblemKind):
                 f"missing actuator input(s) {', '.join(missing)}; give every one of {', '.join(names)}", path=path
             )
         check_actuator_limits(model, inputs, path)
-        broadcast([inputs[n] for n in names], names, path)
+        _qs, batch = broadcast([inputs[n] for n in names], names, path)
+        if inputs.get("assembly_modes") == "all" and batch:
+            raise InputError(
+                "assembly_modes: all searches the modes of one actuator vector; give scalar actuator values",
+                path=path + ("assembly_modes",),
+            )
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         names = model.closure.q_names
         qs, batch = broadcast([inputs[n] for n in names], names, ("inputs",))
         guess = inputs.get("guess")
+        if inputs.get("assembly_modes") == "all":
+            found = assembly_modes(
+                model, qs[0], solver, starts=inputs["mode_starts"], seed=inputs["mode_seed"], guess=guess
+            )
+            return _modes_result(self.name, model, found, solver)
         if batch and batch_newton_supported(solver):  # one vectorized Newton over every point
             sols = batch_forward_kinematics(model, qs, solver, guess).solutions()
         else:
@@ -160,7 +171,91 @@ class ForwardKinematics(ProblemKind):
         return _result(self.name, model, sols, batch, solver)
 
     def output_names(self, model: Model) -> list[str]:
+        # the values of ``assembly_modes: all`` (:func:`mode_value_names`) are not listed: they
+        # would become columns (and change the fingerprint) of every forward_kinematics sweep
         return _pose_names(model)[0]
+
+
+#: inputs of the forward_kinematics kind that ask for every assembly mode
+MODE_OPTIONS = (
+    Option(
+        "assembly_modes",
+        "choice",
+        "'designated': the pose on the model's assembly branch; 'all': every distinct real solution that a "
+        "seeded multi-start Newton search finds (not a proof of completeness)",
+        default="designated",
+        choices=("designated", "all"),
+    ),
+    Option("mode_starts", "int", "Newton starts of the assembly-mode search", default=2000, lower=1, upper=1_000_000),
+    Option("mode_seed", "int", "seed of the assembly-mode search", default=0, lower=0, upper=2**32 - 1),
+)
+
+
+def mode_value_names(model: Model) -> list[str]:
+    """Values a forward_kinematics result with ``assembly_modes: all`` adds."""
+    c = model.closure
+    per_mode = [f"modes_{n}" for n in c.x_names + c.passive_names]
+    return [
+        "modes",
+        *per_mode,
+        "modes_status",
+        "modes_designated",
+        "modes_branch",
+        "modes_basin",
+        "nearest_mode",
+        "distance_length",
+        "distance_angle",
+        "mode_search",
+    ]
+
+
+def _modes_result(kind: str, model: Model, found: AssemblyModes, solver: SolverConfig) -> Result:
+    """A forward_kinematics result: the working mode as usual, every mode found beside it."""
+    c = model.closure
+    modes = found.modes
+    extra: dict[str, Any] = {"modes": found.count}
+    dims: dict[str, str] = {"modes": "dimensionless"}
+    for i, coord in enumerate(c.x):
+        extra[f"modes_{coord.name}"] = [float(m.x[i]) for m in modes]
+        dims[f"modes_{coord.name}"] = coord.kind
+    for coord in c.passive_coords:
+        extra[f"modes_{coord.name}"] = [m.passive.get(coord.name) for m in modes]
+        dims[f"modes_{coord.name}"] = coord.kind
+    extra["modes_status"] = [m.status.value for m in modes]
+    extra["modes_designated"] = [m.designated for m in modes]
+    extra["modes_branch"] = [m.branch.tolist() for m in modes]
+    extra["modes_basin"] = [m.basin for m in modes]
+    extra["nearest_mode"] = found.nearest
+    extra["distance_length"] = found.distance_length
+    extra["distance_angle"] = found.distance_angle
+    extra["mode_search"] = (
+        f"{found.starts} Newton starts in the search region, {found.converged} converged, "
+        f"{found.outside_region} outside the region dropped; {found.note}"
+    )
+    dims.update(
+        modes_status="text",
+        modes_designated="text",
+        modes_branch="matrix",
+        modes_basin="dimensionless",
+        nearest_mode="dimensionless",
+        distance_length="length",
+        distance_angle="angle",
+        mode_search="text",
+    )
+    res = _result(kind, model, [found.working_solution], False, solver, extra)
+    res.dimensions.update(dims)
+    res.units.update({k: _si(d) for k, d in dims.items()})
+    designated = sum(m.designated for m in modes)
+    summary = f"{found.count} assembly mode(s) found, {designated} on the designated branch"
+    if designated > 1:
+        summary += " (the branch indicators do not tell these apart)"
+    if found.nearest is not None:
+        summary += (
+            f"; nearest other mode: {found.distance_length:.6g} m and {found.distance_angle:.6g} rad away"
+            " (lengths and angles of the pose)"
+        )
+    res.message = f"{res.message}; {summary}; {found.note}"
+    return res
 
 
 class InverseKinematics(ProblemKind):

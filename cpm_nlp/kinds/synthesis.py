@@ -5,6 +5,11 @@ constraints), so the kind dispatches to the mechanism: a mechanism that
 supports it declares its formulation, a :class:`SynthesisFormulation`
 subclass, as the capability ``Mechanism.synthesis``.  The kind itself only looks the formulation
 up and hands it the validated model, inputs and solver.
+
+A mechanism that declares none gets the generic formulation,
+:class:`CuboidSynthesis`: the largest inscribed cuboid per unit of a declared
+footprint, with the chosen parameters as unknowns of the cuboid NLP
+(:mod:`cpm_nlp.analysis.synthesis`).
 """
 
 from __future__ import annotations
@@ -12,11 +17,16 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ..analysis.synthesis import cuboid_synthesis
+from ..core.errors import InputError, suggest
 from ..core.kind import ProblemKind, require_ipopt
 from ..core.model import Model
-from ..core.options import Option
-from ..core.result import Result
+from ..core.multistart import start_options
+from ..core.options import Option, validate_mapping
+from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
+from ..core.units import DIMENSIONS
+from .workspace import _volume_dimension
 
 
 class SynthesisFormulation(ProblemKind):
@@ -27,22 +37,215 @@ class SynthesisFormulation(ProblemKind):
     name = "synthesis"
 
 
+def _declared(model: Model) -> dict[str, Option]:
+    """The declared parameter options of a model's mechanism (by name)."""
+    return {o.name: o for o in model.mechanism.parameters} if model.mechanism is not None else {}
+
+
+def _dim(model: Model, name: str) -> str:
+    opt = _declared(model).get(name)
+    return opt.kind if opt is not None else model.dimensions.get(name, "dimensionless")
+
+
+class CuboidSynthesis(SynthesisFormulation):
+    """The generic synthesis of a mechanism without a paper formulation: the
+    parameters named in ``design`` vary within their bounds to maximise the
+    inscribed cuboid per unit of ``footprint`` (a product of parameter powers),
+    under the model's joint limits; multi-start, the optimum re-checked."""
+
+    description = (
+        "generic dimensional synthesis: the parameters as unknowns of the cuboid NLP, maximising the inscribed "
+        "cuboid per unit of a footprint (IPOPT, multi-start, optimum re-checked)"
+    )
+
+    def input_options(self, model: Model) -> list[Option]:
+        return start_options(default=4) + [
+            Option("samples_per_edge", "int", "sample points per box edge in the NLP", default=3, lower=2, upper=7),
+            Option(
+                "check_per_edge",
+                "int",
+                "points per box edge of the membership check of the optimum",
+                default=9,
+                lower=2,
+                upper=65,
+            ),
+        ]
+
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        raw = dict(raw) if isinstance(raw, Mapping) else raw
+        if not isinstance(raw, dict):
+            raise InputError(f"expected a mapping of inputs, got {raw!r}", path=path)
+        if "design" not in raw:
+            raise InputError(
+                "missing required input 'design' (the parameters to vary: a list of names, which vary within "
+                "their declared bounds, or a mapping name -> [low, high]; e.g. design: {L: [90 mm, 130 mm]}); "
+                f"parameters of {model.name}: {', '.join(model.closure.parameters)}",
+                path=path,
+            )
+        design = self._design(raw.pop("design"), model, path + ("design",))
+        footprint = self._footprint(raw.pop("footprint", None), model, path + ("footprint",))
+        inputs = validate_mapping(raw, self.input_options(model), path, what="input")
+        inputs["design"], inputs["footprint"] = design, footprint
+        for name, e in footprint.items():
+            low = design[name][0] if name in design else model.parameters[name]
+            if e != 0 and not low > 0:
+                raise InputError(
+                    f"the footprint takes the log of {name}; its lower bound must be positive, got {low:g}",
+                    path=path + ("design", name),
+                )
+        return inputs
+
+    def _name(self, name: Any, model: Model, path: tuple) -> str:
+        names = model.closure.parameters
+        if not isinstance(name, str) or name not in names:
+            raise InputError(
+                f"unknown parameter {name!r}; expected one of: {', '.join(names)}",
+                path=path,
+                suggestions=suggest(str(name), names),
+            )
+        return name
+
+    def _design(self, raw: Any, model: Model, path: tuple) -> dict[str, tuple[float, float]]:
+        declared = _declared(model)
+        if isinstance(raw, (list, tuple)) and raw:
+            out = {}
+            for k, n in enumerate(raw):
+                name = self._name(n, model, path + (k,))
+                opt = declared.get(name)
+                lo, hi = (opt.lower, opt.upper) if opt is not None else (None, None)
+                if lo is None or hi is None:
+                    raise InputError(
+                        f"parameter {name} declares no finite bounds; give them: design: {{{name}: [low, high]}}",
+                        path=path + (k,),
+                    )
+                out[name] = (float(lo), float(hi))
+            return out
+        if isinstance(raw, Mapping) and raw:
+            out = {}
+            for n, value in raw.items():
+                name = self._name(n, model, path + (n,))
+                opt = declared.get(name)
+                kind = opt.kind if opt is not None else _dim(model, name)
+                rng = Option(
+                    name,
+                    kind,
+                    f"bounds of {name}",
+                    shape="range",
+                    lower=opt.lower if opt else None,
+                    upper=opt.upper if opt else None,
+                )
+                out[name] = rng.parse(value, path + (n,))
+            return out
+        raise InputError(
+            f"expected a non-empty list of parameter names or a mapping name -> [low, high], got {raw!r}", path=path
+        )
+
+    def _footprint(self, raw: Any, model: Model, path: tuple) -> dict[str, float]:
+        if raw is None:
+            return {}
+        if not isinstance(raw, Mapping):
+            raise InputError(
+                f"expected a mapping parameter -> exponent (footprint = product of parameter powers, e.g. "
+                f"{{b: 2}}), got {raw!r}",
+                path=path,
+            )
+        out = {}
+        for n, e in raw.items():
+            name = self._name(n, model, path + (n,))
+            out[name] = Option(name, "dimensionless", "exponent", lower=-10.0, upper=10.0).parse(e, path + (n,))
+        return out
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        rep = cuboid_synthesis(
+            model,
+            inputs["design"],
+            inputs["footprint"],
+            solver,
+            starts=inputs["starts"],
+            seed=inputs["seed"],
+            samples_per_edge=inputs["samples_per_edge"],
+            check_per_edge=inputs["check_per_edge"],
+        )
+        names = self.output_names(model, inputs)
+        values: dict[str, Any] = dict.fromkeys(names)
+        dims = self._dims(model, inputs)
+        c = model.closure
+        if rep.found:
+            values.update({n: rep.parameters[n] for n in inputs["design"]})
+            for k, t in enumerate(c.task):
+                values[f"{t}_min"], values[f"{t}_max"] = float(rep.lower[k]), float(rep.upper[k])
+            values.update(
+                volume=rep.volume,
+                footprint=rep.footprint,
+                objective=rep.objective,
+                check_points=rep.check.points,
+                check_outside=rep.check.outside,
+                check_margin=rep.check.margin,
+                check_binding=rep.check.binding,
+                shrink=rep.shrink,
+            )
+        values.update(starts=rep.starts, starts_converged=rep.converged, starts_agreed=rep.agreed)
+        status = Status.SOLVED if rep.found else Status.INFEASIBLE if rep.infeasible else Status.NOT_CONVERGED
+        units = {k: (DIMENSIONS[v].si if v in DIMENSIONS else "") for k, v in dims.items()}
+        units["volume"] = _volume_dimension(model)[1]
+        return Result(
+            "synthesis",
+            status,
+            values,
+            units,
+            dims,
+            SolverInfo("ipopt", rep.iterations, rep.seconds),
+            rep.message,
+            None,
+            {"type": model.name, **dict(model.parameters)},
+        )
+
+    def _dims(self, model: Model, inputs: Mapping[str, Any] | None) -> dict[str, str]:
+        c = model.closure
+        dims = {n: _dim(model, n) for n in (inputs["design"] if inputs else c.parameters)}
+        for i in c.task_index:
+            dims[f"{c.x[i].name}_min"] = dims[f"{c.x[i].name}_max"] = c.x[i].kind
+        dims["volume"] = _volume_dimension(model)[0]
+        dims.update(
+            footprint="dimensionless",
+            objective="dimensionless",
+            check_points="dimensionless",
+            check_outside="dimensionless",
+            check_margin="si",
+            check_binding="text",
+            shrink="dimensionless",
+            starts="dimensionless",
+            starts_converged="dimensionless",
+            starts_agreed="dimensionless",
+        )
+        return dims
+
+    def output_names(self, model: Model, inputs: Mapping[str, Any] | None = None) -> list[str]:
+        return list(self._dims(model, inputs))
+
+
 def formulation(model: Model) -> SynthesisFormulation | None:
-    """The synthesis formulation of a model's mechanism, or None."""
+    """The synthesis formulation of a model's mechanism: its own (the paper's), else
+    the generic :class:`CuboidSynthesis`; None for a model built by hand."""
     mech = model.mechanism
-    if mech is None or mech.synthesis is None:
+    if mech is None:
         return None
+    if mech.synthesis is None:
+        return CuboidSynthesis()
     return mech.synthesis()
 
 
 class Synthesis(ProblemKind):
     name = "synthesis"
     plots = ("comparison", "design")
-    description = "dimensional synthesis by the mechanism's own formulation (IPOPT, multi-start)"
+    description = (
+        "dimensional synthesis by the mechanism's own formulation, else the generic one: the largest inscribed "
+        "cuboid per unit of footprint (IPOPT, multi-start)"
+    )
 
     def supports(self, model: Model) -> str | None:
         if formulation(model) is None:
-            return f"the mechanism '{model.name}' declares no synthesis formulation (Mechanism.synthesis)"
+            return f"the model '{model.name}' has no mechanism declaration (built by hand)"
         return None
 
     def input_options(self, model: Model) -> list[Option]:

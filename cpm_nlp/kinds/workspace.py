@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.certify import CERTIFICATE_NAMES, CERTIFY_OPTION, certificate_values
 from ..analysis.workspace import (
     ADDED_PER_ROUND,
     CHECK_OPTION,
@@ -103,6 +104,7 @@ class InscribedCuboid(ProblemKind):
                 upper=9,
             ),
             CHECK_OPTION,
+            CERTIFY_OPTION,
             Option(
                 "refinements",
                 "int",
@@ -147,6 +149,7 @@ class InscribedCuboid(ProblemKind):
             "check_outside",
             "check_margin",
             "check_binding",
+            *CERTIFICATE_NAMES,
         ]
         extras = _cuboid_extras(model)
         return names + (list(extras.value_names) if extras else [])
@@ -198,6 +201,11 @@ class InscribedCuboid(ProblemKind):
         dims.update(
             check_points="dimensionless", check_outside="dimensionless", check_margin="si", check_binding="text"
         )
+        cert_values, cert_dims = certificate_values(
+            model, res.lower if res.found else None, res.upper if res.found else None, inputs["certify"]
+        )
+        values.update(cert_values)
+        dims.update(cert_dims)
         extras = _cuboid_extras(model)
         if extras is not None and res.found:
             extra, extra_dims = extras.values(model, res.lower, res.upper, dict(inputs), solver)
@@ -214,6 +222,8 @@ class InscribedCuboid(ProblemKind):
                 f"; membership check: {chk.points} points of its faces, edges and interior, "
                 f"all inside (worst margin {chk.margin:.3g}, {chk.binding})"
             )
+            if values.get("certificate"):
+                message += f"; {values['certificate']}"
         units = {k: (vunit if d == "task volume" else _unit(d)) for k, d in dims.items()}
         return Result(
             self.name,

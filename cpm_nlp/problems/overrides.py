@@ -21,17 +21,17 @@ def parse_override(text: str) -> tuple[list[str | int], Any]:
         raise InputError(f"expected dotted.key=VALUE with a non-empty key, got {text!r}", path=("--set",))
     parts: list[str | int] = []
     for part in key.split("."):
-        while "[" in part and part.endswith("]"):
-            head, _, idx = part.partition("[")
-            if head:
-                parts.append(head)
+        head, bracket, rest = part.partition("[")
+        if head:
+            parts.append(int(head) if head.isdigit() else head)
+        if bracket:  # one or more list indices: name[i][j]
+            indices = ("[" + rest).split("]")[:-1]
+            if not indices or not part.endswith("]") or not all(i.startswith("[") for i in indices):
+                raise InputError(f"expected an integer list index in {text!r}", path=("--set",))
             try:
-                parts.append(int(idx[:-1]))
+                parts += [int(i[1:]) for i in indices]
             except ValueError:
                 raise InputError(f"expected an integer list index in {text!r}", path=("--set",)) from None
-            part = ""
-        if part:
-            parts.append(int(part) if part.isdigit() else part)
     try:
         value = load_yaml_text(raw) if raw.strip() else None
     except yaml.YAMLError:

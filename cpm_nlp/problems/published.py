@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..core.errors import InputError, unknown_key_error
-from ..core.units import DIMENSIONS, article, format_quantity, parse_quantity
+from ..core.units import DIMENSIONS, article, fast_dimension, format_quantity, parse_quantity
 
 ROW_KEYS = ("quantity", "source", "published", "value", "tolerance", "reason", "expect")
 VERDICTS = ("agrees", "differs", "not reproducible", "solve failed")
@@ -102,7 +102,9 @@ def parse_any_quantity(value: Any, path: tuple) -> tuple[float, str]:
         raise InputError(f"expected a number or a quantity, got {value!r}", path=path)
     if isinstance(value, (int, float)):
         return parse_quantity(value, "dimensionless", path), "dimensionless"
-    for name in DIMENSIONS:
+    first = fast_dimension(value)  # the unit's own dimension first: no pint registry for the usual units
+    # (each dimension has its own root units, so the dimension found is the same in any order)
+    for name in ([first] if first else []) + [n for n in DIMENSIONS if n != first]:
         try:
             return parse_quantity(value, name, path), name
         except InputError:

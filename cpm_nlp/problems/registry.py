@@ -21,31 +21,32 @@ from typing import Any
 
 from ..core.errors import CpmError, InputError, suggest
 from ..core.kind import ProblemKind
-from ..kinds.analysis import ActuatorWorkspace, Dynamics
-from ..kinds.kinematic import ForwardKinematics, InverseKinematics, Jacobian, JointRequirements
-from ..kinds.synthesis import Synthesis
-from ..kinds.workspace import InscribedCuboid, Workspace
 from ..mechanisms.registry import REGISTRY as MECHANISMS
 from ..mechanisms.registry import PluginError, mechanism_names, mechanism_type
 
 #: entry-point group of problem-kind plugins
 ENTRY_POINT_GROUP = "cpm_nlp.kinds"
 
-#: the generic kinds: they work on every mechanism that supports them
-GENERIC: dict[str, type[ProblemKind]] = {
-    k.name: k
-    for k in (
-        ForwardKinematics,
-        InverseKinematics,
-        Jacobian,
-        JointRequirements,
-        ActuatorWorkspace,
-        Dynamics,
-        InscribedCuboid,
-        Workspace,
-        Synthesis,
-    )
+#: the generic kinds, which work on every mechanism that supports them: name ->
+#: "module:class" under cpm_nlp.kinds, imported when first asked for (a solve loads
+#: only its own kind's module)
+GENERIC = {
+    "forward_kinematics": "kinematic:ForwardKinematics",
+    "inverse_kinematics": "kinematic:InverseKinematics",
+    "jacobian": "kinematic:Jacobian",
+    "joint_requirements": "kinematic:JointRequirements",
+    "actuator_workspace": "analysis:ActuatorWorkspace",
+    "dynamics": "analysis:Dynamics",
+    "inscribed_cuboid": "workspace:InscribedCuboid",
+    "workspace": "workspace:Workspace",
+    "synthesis": "synthesis:Synthesis",
 }
+
+
+def generic_kind(name: str) -> type[ProblemKind]:
+    """The class of a generic kind (imports its module of cpm_nlp.kinds)."""
+    module, _, cls = GENERIC[name].partition(":")
+    return getattr(importlib.import_module(f"cpm_nlp.kinds.{module}"), cls)
 
 
 class _Kinds:
@@ -75,8 +76,8 @@ def _add(table: dict, name: str, cls: Any, origin: str) -> None:
 
 def _collect() -> dict[str, tuple[type[ProblemKind], str]]:
     table: dict[str, tuple[type[ProblemKind], str]] = {}
-    for name, cls in GENERIC.items():
-        _add(table, name, cls, "cpm_nlp.kinds")
+    for name in GENERIC:
+        _add(table, name, generic_kind(name), "cpm_nlp.kinds")
     for mname in mechanism_names():
         mech = mechanism_type(mname)
         for name, cls in mech.kinds.items():
@@ -110,7 +111,7 @@ def kind_origin(name: str) -> str:
 def problem_kind(name: Any, path: tuple = ("problem",)) -> ProblemKind:
     """Look up a problem kind by name (with a "did you mean" if unknown)."""
     if isinstance(name, str) and name in GENERIC:  # no need to load every mechanism
-        return GENERIC[name]()
+        return generic_kind(name)()
     table = KINDS.table()
     if not isinstance(name, str) or name not in table:
         raise InputError(

@@ -1,0 +1,276 @@
+"""FK by Newton on the task coordinates through the closed-form IK (issue 15).
+
+The reduced formulation (nq unknowns, :func:`cpm_nlp.core.kernels.reduced_fk_kernel`)
+answers a pose only when it settles it as solved; every other pose goes to
+the full Newton on Φ (:func:`cpm_nlp.core.kernels.full_fk_kernel`).  Checked
+here: agreement with the full path on random poses of all four mechanisms,
+identical statuses on poses that are wrong-branch, out of reach, singular or
+outside the joint limits, the conditioning certificate against numpy, the
+first-order guess against central differences, and batch = single solves
+(issue 13).
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import cpm_nlp as cn
+from cpm_nlp.core.batch import _finish, evaluate, thread_pool
+from cpm_nlp.core.compiled import compiler_available
+from cpm_nlp.core.kernels import (
+    CERTIFY_DELTA,
+    PATHS,
+    full_fk_kernel,
+    linearization,
+    reduced_fk_kernel,
+    shared_values,
+)
+from cpm_nlp.core.result import Status
+
+from .conftest import PAPER_PRS3, central_difference
+
+NEWTON = cn.SolverConfig("newton")
+LIMITED = {"s": ["-2 mm", "2 mm"], "beta_m": ["-1.5 deg", "1.5 deg"]}
+#: prc3-li-2018.md Table 1 (kinematic part), as in test_prc3_kinematics.py
+TABLE1 = {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}
+
+
+def build(name, limited=True):
+    """The papers' models (with the papers' joint limits unless ``limited`` is false)."""
+    if name == "prs3":
+        return cn.build_model("prs3", PAPER_PRS3, LIMITED if limited else {})
+    if name == "prc3":
+        return cn.build_model("prc3", TABLE1, {"q": ["0 um", "15 um"]} if limited else {})
+    if name == "rpr":
+        return cn.build_model("rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"})
+    limits = {"psi_min": "1.49 rad", "psi_max": "1.65 rad", "phi_max": "0.0795 rad"}
+    return cn.build_model("pantograph", {"a": "20 mm", "b": "50 mm"}, limits if limited else {})
+
+
+#: half-widths of random task coordinates about home (SI), per mechanism: the papers' working ranges and beyond
+SPREAD = {
+    "prs3": [3e-3, math.radians(1.0), math.radians(1.0)],
+    "prc3": [4e-6, 4e-6, 4e-6],
+    "rpr": [0.2, 0.2, 8e-3],
+    "pantograph": [6e-3, 6e-3, 6e-3],
+}
+
+
+def full_only(model, q, x0=None):
+    """The batch as it was before the reduced path: Newton on Φ from x0 for every pose."""
+    c = model.closure
+    kern = full_fk_kernel(c, NEWTON)
+    x0 = model.x_home if x0 is None else x0
+    out = dict(zip(kern.outputs, evaluate(kern.function, [q, x0, *shared_values(kern, model, NEWTON.tolerance)])))
+    return _finish("forward_kinematics", model, out, q, NEWTON.tolerance, "map", 1, 0.0, "fast_newton")
+
+
+@pytest.mark.parametrize("name", ["prs3", "prc3", "rpr", "pantograph"])
+def test_reduced_agrees_with_full_on_random_poses(name):
+    """Random poses (from the closed-form IK of random task coordinates, and
+    random actuator vectors about home): the reduced path answers the poses it
+    settles with the pose of the full Newton (1e-12) and of the IK, and every
+    status equals the full path's."""
+    model = build(name, limited=False)
+    c = model.closure
+    rng = np.random.default_rng(150)
+    t = model.x_home[c.task_index] + rng.uniform(-1, 1, (300, c.nq)) * np.array(SPREAD[name])
+    ik = cn.batch_inverse_kinematics(model, t)
+    assert ik.ok.sum() >= 100, ik.counts()
+    q_home = model.q_home + rng.uniform(-1, 1, (200, c.nq)) * np.abs(ik.q[ik.ok] - model.q_home).max(axis=0)
+    q = np.vstack([ik.q[ik.ok], q_home])
+    res = cn.batch_forward_kinematics(model, q)
+    ref = full_only(model, q)
+    np.testing.assert_array_equal(res.status, ref.status)
+    paths = np.array([res.path(i) for i in range(len(res))])
+    assert set(paths) <= set(PATHS)
+    reduced = paths == "reduced"
+    assert reduced.mean() > 0.8, res.counts()
+    assert res.ok[reduced].all()  # the reduced path answers only what it settles as solved
+    both = res.ok & ref.ok
+    np.testing.assert_allclose(res.x[both], ref.x[both], rtol=0, atol=1e-12)
+    if c.passive is not None:
+        np.testing.assert_allclose(res.passive[both], ref.passive[both], rtol=0, atol=1e-12)
+    # FK against IK: the poses the IK made come back
+    n_ik = int(ik.ok.sum())
+    np.testing.assert_allclose(res.x[:n_ik][res.ok[:n_ik]], ik.x[ik.ok][res.ok[:n_ik]], rtol=0, atol=1e-12)
+
+
+def hard_cases(model, rng):
+    """(q rows, x0 rows) of the edge cases: out of the joint limits, out of
+    reach (no assembly: not_converged for an FK), a guess on the mirrored
+    assembly (wrong_branch), large strokes where Newton from home wanders off."""
+    inside = rng.uniform(-2.2e-3, 2.2e-3, (150, 3))  # in reach; some outside the +-2 mm stroke limits
+    far = np.array([[0.3, -0.3, 0.0], [0.0, 0.0, 0.2], [-0.1, 0.05, 0.08]])
+    large = rng.uniform(-0.05, 0.05, (100, 3))
+    q = np.vstack([inside, far, large])
+    x0 = np.tile(model.x_home, (q.shape[0], 1))
+    mirrored = model.x_home.copy()
+    mirrored[2] = -mirrored[2]  # below the actuator plane
+    x0[::7] = mirrored
+    return q, x0
+
+
+def test_edge_cases_have_the_statuses_of_the_full_path():
+    """wrong_branch, out of reach (not_converged), singular and
+    outside_joint_limits poses get exactly the status the full path gives
+    them, and the full path is the one that answers them."""
+    model = build("prs3")
+    rng = np.random.default_rng(151)
+    q, x0 = hard_cases(model, rng)
+    res = cn.batch_forward_kinematics(model, q, guess=x0)
+    ref = full_only(model, q, x0)
+    np.testing.assert_array_equal(res.status, ref.status)
+    statuses = set(res.statuses)
+    assert {Status.SOLVED, Status.WRONG_BRANCH, Status.NOT_CONVERGED, Status.OUTSIDE_JOINT_LIMITS} <= statuses
+    for i in np.flatnonzero(~res.ok):
+        assert res.path(i) == "full" and res.message(i) == ref.message(i)
+    # singular: nearly flat legs (type II); the second model is refined to solved by the 2-norm condition number
+    for alpha0, expected in (("1e-7 deg", Status.SINGULAR), ("1e-6 deg", Status.SOLVED)):
+        flat = cn.build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": alpha0})
+        qs = np.vstack([np.zeros(3), rng.uniform(-1e-6, 1e-6, (20, 3))])
+        res = cn.batch_forward_kinematics(flat, qs)
+        ref = full_only(flat, qs)
+        np.testing.assert_array_equal(res.status, ref.status)
+        assert res.statuses[0] is expected and res.path(0) == "full"
+        assert res.message(0) == ref.message(0)
+
+
+def test_reduced_kernel_never_settles_a_pose_the_full_path_rejects():
+    """The reduced kernel on its own: on every edge case it reports solved only where the full path does."""
+    model = build("prs3")
+    q, x0 = hard_cases(model, np.random.default_rng(152))
+    kern = reduced_fk_kernel(model.closure, NEWTON)
+    out = dict(zip(kern.outputs, evaluate(kern.function, [q, x0, *shared_values(kern, model, NEWTON.tolerance)])))
+    settled = out["status"].ravel() == 0
+    ref = full_only(model, q, x0)
+    assert settled.sum() >= 10 and ref.ok.sum() == settled.sum()  # all the solved poses settle here
+    assert ref.ok[settled].all()
+    np.testing.assert_allclose(out["x"][settled], ref.x[settled], rtol=0, atol=1e-12)
+
+
+def test_conditioning_certificate_bounds_the_condition_number():
+    """cond1 of the reduced path is an upper bound of κ₁(Φ_x) (induced 1-norm,
+    numpy), from Φ_x⁻¹ at home and no inverse at the pose; +inf where the
+    preconditioned residual exceeds CERTIFY_DELTA."""
+    model = cn.build_model("prs3", PAPER_PRS3)
+    c = model.closure
+    rng = np.random.default_rng(153)
+    q = np.vstack([rng.uniform(-2.3e-3, 2.3e-3, (100, 3)), rng.uniform(-0.03, 0.03, (100, 3))])
+    kern = reduced_fk_kernel(c, NEWTON)
+    out = dict(zip(kern.outputs, evaluate(kern.function, [q, model.x_home, *shared_values(kern, model, 1e-10)])))
+    b = linearization(model)["Phi_x_home_inv"].reshape(c.nx, c.nx, order="F")
+    np.testing.assert_allclose(b @ np.asarray(c.phi_x(model.x_home, model.q_home, model.p)), np.eye(c.nx), atol=1e-12)
+    finite = 0
+    for i in range(q.shape[0]):
+        x = out["x"][i]
+        if not np.all(np.isfinite(x)):
+            continue
+        a = np.asarray(c.phi_x(x, q[i], model.p))
+        delta = np.abs(np.eye(c.nx) - a @ b).sum(axis=0).max()
+        bound = out["cond1"][i, 0]
+        if delta <= CERTIFY_DELTA * (1 - 1e-9):
+            exact = np.linalg.cond(a, 1)
+            assert exact <= bound * (1 + 1e-12)
+            assert bound <= exact * np.linalg.cond(b, 1) / (1 - delta) * 1.01  # not vacuous either
+            finite += 1
+        elif delta > CERTIFY_DELTA * (1 + 1e-9):
+            assert bound == np.inf
+    assert finite >= 100
+
+
+def test_first_order_guess_is_the_ad_jacobian_at_home():
+    """J_home (dt/dq at home, AD) equals central differences of the FK's task
+    coordinates, and the first-order guess is second-order accurate."""
+    model = cn.build_model("prs3", PAPER_PRS3)
+    c = model.closure
+    jac = linearization(model)["J_home"].reshape(c.nq, c.nq, order="F")
+
+    def task_of_q(q):
+        return cn.forward_kinematics(model, q, NEWTON).x[c.task_index]
+
+    np.testing.assert_allclose(jac, central_difference(task_of_q, model.q_home, 1e-7), rtol=1e-6, atol=1e-9)
+    direction = np.array([1.0, -0.4, 0.7])
+    errors = []
+    for h in (1e-3, 0.5e-3):
+        q = model.q_home + h * direction
+        t0 = model.x_home[c.task_index] + jac @ (q - model.q_home)
+        errors.append(np.max(np.abs(t0 - task_of_q(q))))
+    assert errors[0] / errors[1] == pytest.approx(4.0, rel=0.05)  # error O(|q - q_home|²)
+
+
+def hard_batch(model, rng, n=240):
+    """>= 200 random actuator vectors, incl. hard ones: outside the limits, out
+    of reach, large strokes (wrong branch or no convergence from home)."""
+    q = rng.uniform(-2.2e-3, 2.2e-3, (n, 3))
+    q[::8] = rng.uniform(-0.05, 0.05, (q[::8].shape[0], 3))
+    q[::25] = [0.3, -0.3, 0.0]
+    return q
+
+
+@pytest.mark.parametrize("backend", ["map", "compiled"])
+def test_batch_equals_single_solves_on_hard_poses(backend):
+    """Issue 13: the same statuses, messages, paths and values in a batch as in
+    single Newton solves, over 240 random poses incl. hard ones (same kernel,
+    same initial-guess rule, same checks)."""
+    if backend == "compiled" and not compiler_available():
+        pytest.skip("no C compiler")
+    model = cn.build_model("prs3", PAPER_PRS3, {"s": ["-2 mm", "2 mm"]})
+    q = hard_batch(model, np.random.default_rng(154))
+    res = cn.batch_forward_kinematics(model, q, backend=backend)
+    counts = res.counts()
+    assert counts["solved"] >= 50 and counts["outside_joint_limits"] >= 20, counts
+    assert counts.get("not_converged", 0) + counts.get("wrong_branch", 0) >= 10, counts
+    for k in range(len(q)):
+        single = cn.forward_kinematics(model, q[k], NEWTON, backend=backend)
+        assert res.statuses[k] is single.status, (k, single.message, res.message(k))
+        assert res.message(k) == single.message
+        assert res.path(k) == single.path
+        if single.ok:
+            np.testing.assert_allclose(res.x[k], single.x, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(res.passive[k], single.passive, rtol=0, atol=1e-12)
+
+
+def test_single_solve_says_which_path_answered():
+    model = build("prs3")
+    sol = cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3], NEWTON)
+    assert sol.ok and sol.path == "reduced" and sol.solver == "newton"
+    np.testing.assert_allclose(sol.x, cn.inverse_kinematics(model, sol.x[model.closure.task_index]).x, atol=1e-13)
+    far = cn.forward_kinematics(model, [0.3, -0.3, 0.0], NEWTON)
+    assert far.status is Status.NOT_CONVERGED and far.path == "full"
+    assert far.message.startswith("Newton stopped at max |Φ| = ")
+    # IPOPT keeps its own path
+    assert cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3]).path == ""
+
+
+def test_exported_code_has_the_reduced_path(tmp_path):
+    model = build("prs3")
+    data = cn.export_kinematics(model, tmp_path / "c", what="fk", fmt="c")
+    source = (tmp_path / "c" / "prs3_kinematics.c").read_text()
+    assert "prs3_fk_reduced" in source and "prs3_fk_full" in source
+    assert "task coordinates through the closed-form IK" in data["newton"]["method"]
+
+
+def test_the_thread_pool_is_kept_between_batches():
+    model = build("prs3")
+    q = np.random.default_rng(155).uniform(-2e-3, 2e-3, (1000, 3))
+    cn.batch_forward_kinematics(model, q, threads=2)
+    pool = thread_pool(2)
+    one = cn.batch_forward_kinematics(model, q, threads=1)
+    two = cn.batch_forward_kinematics(model, q, threads=2)
+    assert thread_pool(2) is pool
+    np.testing.assert_array_equal(one.x, two.x)
+
+
+def test_auto_backend_falls_back_to_the_virtual_machine_when_compiling_fails(tmp_path, monkeypatch, caplog):
+    """A single Newton solve never fails for want of a working C compiler."""
+    monkeypatch.setenv("CPM_NLP_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("CC", "false")  # a "compiler" that always fails
+    model = build("prs3")
+    with caplog.at_level("WARNING", logger="cpm_nlp"):
+        sol = cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3], NEWTON)
+    assert sol.ok and sol.path == "reduced"
+    assert "backend 'auto' uses 'map'" in caplog.text
+    ref = cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3], NEWTON, backend="map")
+    np.testing.assert_array_equal(sol.x, ref.x)
