@@ -407,3 +407,117 @@ print("exit", main(["solve", {fk!r}, "-q", "--plot", {html!r}]))
         "(pip install 'cpm_nlp[plot]')"
     )
     assert list(tmp_path.iterdir()) == []
+
+
+# -- a plot of every kind, from real solves ------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def solved():
+    """Results of the shipped problem files, solved once for this module."""
+    import cpm_nlp as cn
+
+    from .conftest import PROBLEMS
+
+    cache = {}
+
+    def get(name):
+        if name not in cache:
+            problem = cn.load_problem(PROBLEMS / f"{name}.yaml")
+            data = figures.from_result(cn.solve(problem))
+            data.live = problem.model
+            cache[name] = data
+        return cache[name]
+
+    return get
+
+
+def test_dynamics_plot_frequencies_are_the_eigenvalues_of_K_and_M(solved):
+    """prc3-li-2018.md eq 28-41: the bars are sqrt(eig(K, M)) / 2 pi of the result's matrices,
+    which the kind reports as f1..f3; the printed values are compared beside them."""
+    data = solved("prc3_dynamics")
+    fig, kind = figures.figure(data)
+    assert kind == "dynamics"
+    bars = [p.get_height() for p in fig.axes[0].patches]
+    assert bars == pytest.approx([data.values[f"f{i}"] for i in (1, 2, 3)], rel=1e-9)
+    assert any("paper (printed)" in ax.get_xlabel() for ax in fig.axes)
+    assert_figure_readable(fig)
+
+
+def test_amplifier_plot_slope_is_A2(solved):
+    data = solved("prc3_amplifier")
+    fig, kind = figures.figure(data)
+    line = fig.axes[0].lines[0]
+    slope = np.polyfit(line.get_xdata(), line.get_ydata(), 1)[0]
+    assert kind == "amplifier" and slope == pytest.approx(data.values["A2"], rel=1e-9)  # eq 2: d = A2 q, both in µm
+    assert_figure_readable(fig)
+
+
+def test_twists_as_arrows_on_the_mechanism(solved):
+    """rpr-2rpu-upr-zhang-2022.md eq 45: one rotation and one translation arrow per actuator that moves them."""
+    data = solved("rpr_twists")
+    fig, kind = figures.figure(data)
+    T = np.asarray(data.values["T"])
+    n = sum(np.linalg.norm(T[:3, j]) > 0 for j in range(3)) + sum(np.linalg.norm(T[3:, j]) > 0 for j in range(3))
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert kind == "twists" and sum(lab.startswith(("ω of", "v of")) for lab in labels) == n
+    assert_figure_readable(fig)
+    html, _ = figures.figure(data, interactive=True)
+    assert sum(t.name.startswith(("ω of", "v of")) for t in html.data) == n
+
+
+def test_compliance_matrices_with_their_entries(solved):
+    data = solved("rpr_compliance")
+    fig, kind = figures.figure(data)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert kind == "matrices" and "$C$" in titles and "$C_{in}$" in titles
+    C = fig.axes[titles.index("$C$")]
+    entries = [float(t.get_text()) for t in C.texts]
+    assert entries == pytest.approx(
+        [v if abs(v) > 1e-12 * np.abs(data.values["C"]).max() else 0 for v in np.ravel(data.values["C"])], rel=5e-3
+    )
+    assert_figure_readable(fig)
+
+
+def test_joint_design_and_synthesis_against_their_references(solved):
+    data = solved("rpr_joint_design")
+    fig, kind = figures.figure(data)
+    assert kind == "comparison"
+    names = [t.get_text() for t in fig.axes[0].get_yticklabels()]
+    assert names == ["$f_{R}$", r"$\theta_{max,R}$", "$f_{U}$", r"$\theta_{max,U}$"]
+    bar = fig.axes[0].patches[0]  # f_R: the compared design's over ours, from 1
+    assert 1 + bar.get_width() == pytest.approx(data.values["f_R_compare"] / data.values["f_R"])
+    assert_figure_readable(fig)
+    syn = solved("pantograph_synthesis")
+    fig, kind = figures.figure(syn)
+    assert kind == "comparison" and "multi-start: starts 6" in fig.axes[-1].get_title()
+    assert_figure_readable(fig)
+    fig, kind = figures.figure(syn, "design")  # the designed pantograph drawn at home
+    assert kind == "design" and f"a = {syn.values['a'] * 1e3:.4g} mm" in fig._suptitle.get_text()
+    assert_figure_readable(fig)
+
+
+def test_jacobian_plot_mechanism_and_conditioning_slice(solved):
+    data = solved("prs3_jacobian")
+    fig, kind = figures.figure(data)
+    assert kind == "jacobian"
+    cond_ax = next(ax for ax in fig.axes if ax.get_title().startswith("cond at"))
+    assert cond_ax.get_legend().get_title().get_text() == f"cond = {data.values['cond']:.4g}"
+    star = next(ln for ln in cond_ax.lines if ln.get_marker() == "*")
+    assert star.get_xdata()[0] == pytest.approx(data.values["pz"] * 1e3)  # the pose, in mm
+    mesh = cond_ax.collections[0].get_array()
+    assert np.nanmin(mesh) >= 1.0  # condition numbers
+    assert_figure_readable(fig)
+    fig, kind = figures.figure(data, "matrices")
+    assert kind == "matrices" and "$J_{task}$" in [ax.get_title() for ax in fig.axes]
+
+
+def test_mechanism_plot_of_a_pose_and_its_html(solved, tmp_path):
+    data = solved("pantograph_forward_kinematics")
+    fig, kind = figures.figure(data)
+    assert kind == "mechanism" and "pantograph at px = 101 mm" in fig._suptitle.get_text()
+    assert_figure_readable(fig)
+    html, kind = figures.figure(data, interactive=True)
+    assert kind == "mechanism" and {"link", "revolute joint (R)"} <= {t.name for t in html.data}
+    save(html, tmp_path / "m.html")
+    assert (tmp_path / "m.html").stat().st_size > 1_000_000
