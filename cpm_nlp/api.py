@@ -27,13 +27,15 @@ from .core.kinematics import (
     passive_joints,
     residual,
 )
-from .core.mechanism import CuboidExtras, DynamicsModel, Mechanism, declare
+from .core.mechanism import CuboidExtras, DynamicsModel, JointStiffness, Mechanism, declare
 from .core.model import Coordinate, LoopClosure, Model
 from .core.result import Result, SolverInfo, Status
 from .core.solver import SolverConfig
 from .core.version import __version__
 from .io.embed import ModelFunctions, model_functions
 from .io.export import export_kinematics, load_exported
+from .mechanisms import described as _described
+from .mechanisms.described.spec import ClosedFormIK, Description, Joint, Leg, Parameter, Platform, Quantity
 from .mechanisms.registry import build_model, mechanism_names, mechanism_type, register, unregister
 from .problems.file import Problem, load_problem, problem_from_dict, solve
 from .problems.overrides import apply_overrides
@@ -55,6 +57,20 @@ def functions(source: Model | str | os.PathLike, solver: SolverConfig | None = N
     return model_functions(source, solver)
 
 
+def describe_mechanism(description: Description, *, register: bool = True) -> Mechanism:
+    """A mechanism from a :class:`Description` built in code (the dataclasses of a mechanism
+    file: :class:`Parameter`, :class:`Platform`, :class:`Leg`, :class:`Joint` ...), generated
+    and checked like a file; registered under its name unless ``register`` is false."""
+    mech = _described.mechanism(description)
+    return register_mechanism(mech, replace=True) if register else mech
+
+
+def load_mechanism_file(path: str | os.PathLike, *, register: bool = True) -> Mechanism:
+    """The mechanism a mechanism file describes (registered under its name unless ``register`` is false)."""
+    mech = _described.load_file(path)
+    return register_mechanism(mech, replace=True) if register else mech
+
+
 #: a mechanism declared in code, with "did you mean" for a misspelt part
 declare_mechanism = declare
 #: add a mechanism declared in code to the registry
@@ -68,6 +84,15 @@ __all__ = [
     "assembly_modes",
     "Certificate",
     "certify_box",
+    "ClosedFormIK",
+    "Description",
+    "Joint",
+    "Leg",
+    "Parameter",
+    "Platform",
+    "Quantity",
+    "describe_mechanism",
+    "load_mechanism_file",
     "BatchJacobians",
     "BatchResult",
     "Comparison",
@@ -76,6 +101,7 @@ __all__ = [
     "CuboidExtras",
     "CuboidResult",
     "DynamicsModel",
+    "JointStiffness",
     "InputError",
     "JacobianReport",
     "LoopClosure",

@@ -255,7 +255,9 @@ def test_plot_bad_input(cli, tmp_path):
     assert run.code == 2
     assert run.err == "error: a map of a single result needs --x, --y and --value naming three of its lists\n"
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "heatmap")
-    assert run.err.startswith("error: --type: unknown plot type 'heatmap'; expected one of: amplifier, comparison")
+    assert run.err.startswith(
+        "error: --type: unknown plot type 'heatmap'; expected one of: amplifier, comparison, design"
+    )
     assert run.err.endswith("did you mean 'map'?\n")
     run = cli("plot", str(out), "-o", str(tmp_path / "x.jpg"))
     assert run.err == (

@@ -21,6 +21,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from ..core.errors import CpmError, InputError
+from ..core.version import __version__
 from ..io.atomic import check_output_path, write_atomic
 
 TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
@@ -61,6 +62,8 @@ def _fmt_list(value: list, dim: str | None) -> str:
             return text + (f", {nulls} null" if nulls else "")
 
         def cell(x: Any) -> str:
+            if isinstance(x, list):  # a batch of matrices: one row per point
+                return "[" + ", ".join(cell(v) for v in x) + "]"
             return "—" if x is None else str(x) if isinstance(x, bool) else f"{x:.6g}"
 
         return "matrix " + "; ".join("[" + ", ".join(cell(x) for x in row) + "]" for row in flat)
@@ -311,21 +314,35 @@ def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
     return EXIT_OK
 
 
+def _category_cell(r: Any) -> str:
+    text = r.category.replace("_", " ")
+    return text + (", echo" if r.echoes else "")
+
+
 def render_reproduce(rows: Sequence[Any]) -> str:
-    """The reproduction table, reasons numbered once below it."""
+    """The reproduction table, reasons numbered once below it.  The "what" column
+    says what the published value is (its category) and ", echo" when the
+    computed value is an input given back."""
     from ..core.units import format_quantity
 
-    header = ("paper", "quantity", "source", "published", "computed", "rel. error", "verdict")
+    header = ("paper", "quantity", "source", "what", "published", "computed", "rel. error", "verdict")
     table = []
     reasons: dict[str, int] = {}
+
+    def note(text: str) -> str:
+        return f" [{reasons.setdefault(text, len(reasons) + 1)}]"
+
     for r in rows:
         comp = "—" if r.computed is None else format_quantity(r.computed, r.dimension, 5)
         rel = "—" if r.rel_error is None else f"{r.rel_error * 100:.2f} %"
         verdict = r.verdict + ("" if r.expected else "  [UNEXPECTED]")
         if r.reason:
-            n = reasons.setdefault(r.reason, len(reasons) + 1)
-            verdict += f" [{n}]"
-        table.append((r.paper, r.quantity, r.source, r.published_text, comp, rel, verdict))
+            verdict += note(r.reason)
+        if r.tolerance_reason:
+            verdict += note("tolerance: " + r.tolerance_reason)
+        if r.echoes:
+            verdict += note("computed value echoes an input: " + r.echoes)
+        table.append((r.paper, r.quantity, r.source, _category_cell(r), r.published_text, comp, rel, verdict))
     widths = [max(len(str(x)) for x in col) for col in zip(header, *table)]
 
     def line(cells: Sequence[Any]) -> str:
@@ -337,19 +354,36 @@ def render_reproduce(rows: Sequence[Any]) -> str:
     return "\n".join(out)
 
 
+def render_reproduce_summary(summary: dict[str, Any]) -> str:
+    """Independent agreements apart from those that are not; the last line is
+    "N figures, M unexpected"."""
+    parts = [f"{n} {c.replace('_', ' ')}" for c, n in summary["agree_not_independent_by_category"].items()]
+    if summary["agree_echoing_an_input"]:
+        parts.append(f"{summary['agree_echoing_an_input']} echo an input")
+    lines = [
+        f"agree, independently: {summary['agree_independent']} (a printed figure, computed from other inputs)",
+        f"agree, not independently: {summary['agree_not_independent']}" + (f" ({', '.join(parts)})" if parts else ""),
+        f"differ, as explained: {summary['differ'] - summary['unexpected_differ']}; "
+        f"not reproducible: {summary['not_reproducible']}",
+        f"{summary['figures']} figures, {summary['unexpected']} unexpected",
+    ]
+    return "\n".join(lines)
+
+
 def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
+    from ..problems.published import summarize
     from ..problems.reproduce import reproduce
 
     check_output_path(args.output)
     rows = reproduce(args.paths or None)
+    summary = summarize(rows)
+    document = json.dumps({"figures": [r.to_dict() for r in rows], "summary": summary}, indent=2) + "\n"
     if args.json:
-        out.write(json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+        out.write(document)
     else:
-        out.write(render_reproduce(rows) + "\n")
-        bad = [r for r in rows if not r.expected]
-        out.write(f"\n{len(rows)} figures, {len(bad)} unexpected\n")
+        out.write(render_reproduce(rows) + "\n\n" + render_reproduce_summary(summary) + "\n")
     if args.output:
-        write_atomic(args.output, json.dumps([r.to_dict() for r in rows], indent=2) + "\n")
+        write_atomic(args.output, document)
     return EXIT_OK if all(r.expected for r in rows) else EXIT_FAILED
 
 
@@ -364,6 +398,19 @@ def cmd_export(args: argparse.Namespace, out: TextIO) -> int:
     data = export_kinematics(problem.model, args.out, what, args.format, problem.solver, source=args.file)
     for f in [*data["files"], "manifest.json"]:
         out.write(f"{Path(args.out) / f}\n")
+    return EXIT_OK
+
+
+def cmd_examples(args: argparse.Namespace, out: TextIO) -> int:
+    from ..problems.shipped import copy_examples
+
+    written = copy_examples(args.dir, force=args.force)
+    n_problems = sum(1 for f in written if f.parent.name != "configs")
+    out.write(
+        f"{args.dir}: {n_problems} problem files in problems/, {len(written) - n_problems} solver presets in "
+        f"configs/\n(edit them, then e.g. cd {args.dir} && cpm-nlp solve problems/prs3_forward_kinematics.yaml "
+        "or cpm-nlp reproduce)\n"
+    )
     return EXIT_OK
 
 
@@ -396,6 +443,11 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:
         out.write(f"  {o.name:<8} {o.description}\n")
     caps = mt.capabilities()
     out.write("capabilities: " + (", ".join(caps) if caps else "none beyond the required parts") + "\n")
+    if mt.stiffness is not None:  # the default hinges of the compliance kinds
+        out.write(f"joint stiffness ({mt.stiffness.source}):\n")
+        for hname, spec in mt.stiffness.hinges.items():
+            text = ", ".join(f"{k}: {v}" for k, v in spec.items())
+            out.write(f"  {hname:<10} {text}\n")
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
     return EXIT_OK
@@ -410,6 +462,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Kinematics and design of compliant parallel mechanisms (CasADi + IPOPT).",
         epilog="Exit status: 0 solved, 1 solve failed, 2 bad input.",
     )
+    parser.add_argument("--version", action="store_true", help="print the version of cpm_nlp and exit")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="log progress to stderr (-vv: debug)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -484,6 +537,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file")
     p.set_defaults(func=cmd_export)
 
+    p = sub.add_parser(
+        "examples",
+        help="copy the shipped problem files and solver presets into a directory, to edit",
+        description="Copy the shipped problem files into DIR/problems and the solver presets into DIR/configs "
+        "(where cpm-nlp looks for them when run in DIR). Existing files are left alone unless --force.",
+    )
+    p.add_argument("dir", metavar="DIR", help="directory to copy into (created if missing)")
+    p.add_argument("--force", action="store_true", help="overwrite files of the same name")
+    p.set_defaults(func=cmd_examples)
+
     p = sub.add_parser("describe", help="list mechanisms and problem kinds, or describe one")
     p.add_argument("name", nargs="?")
     p.set_defaults(func=cmd_describe)
@@ -516,6 +579,9 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse already printed the usage message
         return int(exc.code) if isinstance(exc.code, int) else EXIT_INPUT
+    if args.version:
+        out.write(f"cpm-nlp {__version__}\n")
+        return EXIT_OK
     if args.command is None:
         parser.print_help(out)
         return EXIT_INPUT

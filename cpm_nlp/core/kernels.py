@@ -480,11 +480,14 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         r = reduced(q, x0, *shared)
         names = ("x", "passive", *_STATUS_OUTPUTS)
         # the Switch's branches share one signature: (q, x0, p, lower, upper, tol, reduced outputs)
-        ins = [ca.MX.sym(n, s.sparsity()) for n, s in zip(["q", "x0", *SHARED_INPUTS], [q, x0, *shared[:4]])]
-        r_in = [ca.MX.sym(f"reduced_{n}", reduced.sparsity_out(k)) for k, n in enumerate(names)]
+        in_names = ["q", "x0", *SHARED_INPUTS][: 2 + len(shared[:4])]
+        ins = [ca.MX.sym(n, s.sparsity()) for n, s in zip(in_names, [q, x0, *shared[:4]])]
+        r_names = [f"reduced_{n}" for n in names]
+        r_in = [ca.MX.sym(n, reduced.sparsity_out(k)) for k, n in enumerate(r_names)]
         # outputs: (x, passive, checks..., path, status): status stays last
         out_names = [*names[:-1], "path", "status"]
-        io = ([n.name() for n in ins + r_in], out_names)
+        # names from the lists, not the symbols: a symbol of size 0 (no passive joints) is a constant
+        io = (in_names + r_names, out_names)
         keep = ca.Function(f"{c.name}_fk_keep", ins + r_in, r_in[:-1] + [ca.MX(0), r_in[-1]], *io)
         f = list(full(*ins))
         fallback = ca.Function(f"{c.name}_fk_fallback", ins + r_in, f[:-1] + [ca.MX(1), f[-1]], *io)

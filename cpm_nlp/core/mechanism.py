@@ -28,9 +28,10 @@ Optional capabilities
 ---------------------
 See the fields of :class:`Mechanism`: cross-value checks, a synthesis
 formulation, extra inscribed-cuboid inputs and values, a closed-form
-workspace membership from the paper, a dynamics model, problem kinds of its
-own, the problem files that reproduce its paper's figures, and a drawing of
-the mechanism at a pose (``geometry``: base, legs, joints, platform).
+workspace membership from the paper, a dynamics model, default joint
+stiffnesses and flexure hinges, problem kinds of its own, the problem files
+that reproduce its paper's figures, and a drawing of the mechanism at a pose
+(``geometry``: base, legs, joints, platform).
 """
 
 from __future__ import annotations
@@ -129,6 +130,29 @@ class Drawing:
 
 
 @dataclass(frozen=True, kw_only=True)
+class JointStiffness:
+    """The compliant joints of a mechanism as its paper gives them (the
+    ``stiffness`` capability), used by the compliance kinds as defaults that a
+    problem file may override hinge by hinge (``inputs.hinges``).
+
+    hinges: hinge name -> the same mapping a problem file gives under
+        ``inputs.hinges``: ``joints`` (a coordinate or family name of x, q or the
+        passive joints, or a mapping axis -> name with axes bend, bend2, torsion,
+        axial), ``k`` (N*m/rad on angles, N/m on lengths; one value or one per
+        axis), and optionally a flexure ``type`` with its dimensions (see
+        :data:`cpm_nlp.analysis.compliance.HINGE_TYPES`) for the stresses and the
+        stiffness of the axes k does not give.
+    material: the hinge material, a name of :data:`cpm_nlp.analysis.flexure.MATERIALS`
+        or an inline mapping ``{name, E, nu, density, yield_strength, allowable}``.
+    source: where the paper gives them (file, section, table).
+    """
+
+    hinges: Mapping[str, Mapping[str, Any]]
+    material: Any = None
+    source: str = ""
+
+
+@dataclass(frozen=True, kw_only=True)
 class Mechanism:
     """A mechanism type: required parts and optional capabilities.
 
@@ -166,6 +190,8 @@ class Mechanism:
     #: ``(model, x (nx,), q (nq,)) -> Drawing``: the mechanism at a pose (base, legs,
     #: joints, platform) for the plots, from its kinematic functions
     geometry: Callable[[Any, Any, Any], Drawing] | None = None
+    #: default joint stiffnesses and flexure hinges, for the compliance kinds
+    stiffness: JointStiffness | None = None
     #: problem kinds of its own: kind name -> ProblemKind subclass
     kinds: Mapping[str, type] = field(default_factory=dict)
     #: its shipped problem files: examples of its kinds, and (those with a ``reproduce:``
@@ -207,6 +233,7 @@ CAPABILITIES = (
     "paper_membership",
     "dynamics",
     "geometry",
+    "stiffness",
     "kinds",
     "problem_files",
 )
@@ -244,6 +271,13 @@ def validate(mech: Mechanism) -> None:  # noqa: C901 - one flat check per declar
         _fail(mech, "cuboid", "a CuboidExtras or None")
     if mech.dynamics is not None and not isinstance(mech.dynamics, DynamicsModel):
         _fail(mech, "dynamics", "a DynamicsModel or None")
+    if mech.stiffness is not None:
+        if not isinstance(mech.stiffness, JointStiffness):
+            _fail(mech, "stiffness", "a JointStiffness or None")
+        if not isinstance(mech.stiffness.hinges, Mapping) or not all(
+            isinstance(k, str) and isinstance(v, Mapping) for k, v in mech.stiffness.hinges.items()
+        ):
+            _fail(mech, "stiffness", "a JointStiffness whose hinges map names to hinge mappings")
     if not isinstance(mech.kinds, Mapping):
         _fail(mech, "kinds", "a mapping of kind name -> ProblemKind subclass")
     for kname, cls in mech.kinds.items():

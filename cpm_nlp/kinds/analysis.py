@@ -24,6 +24,7 @@ from ..core.options import Option, validate_mapping
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
+from .compliance import STRESS_LIMIT_OPTION, split_stress_limit
 from .kinematic import _model_info, _si
 
 
@@ -45,11 +46,18 @@ class ActuatorWorkspace(ProblemKind):
     description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
     plots = ("workspace",)  # its points (inputs.points: true): the images of the stroke grid
 
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        raw, limited = split_stress_limit(raw, model, path)  # hinge stress limits -> joint limits
+        inputs = super().parse_inputs(raw, limited or model, path)
+        inputs["stress_limited_model"] = limited
+        return inputs
+
     def input_options(self, model: Model) -> list[Option]:
         return [
             Option("samples", "int", "grid points per actuator over its stroke (ends included)", 11, 2, 101),
             Option("quadrature", "int", "Gauss-Legendre points per actuator for the volume", 4, 1, 20),
             Option("points", "bool", "also return every sampled point (a large list)", False),
+            STRESS_LIMIT_OPTION,
         ]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
@@ -78,6 +86,7 @@ class ActuatorWorkspace(ProblemKind):
         return dims
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        model = inputs.get("stress_limited_model") or model
         c = model.closure
         rep = reachable_workspace(model, inputs["samples"], inputs["quadrature"], solver)
         dims = self._dims(model)

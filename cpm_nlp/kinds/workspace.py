@@ -36,6 +36,7 @@ from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
+from .compliance import STRESS_LIMIT_OPTION, split_stress_limit
 from .kinematic import _model_info
 
 
@@ -92,6 +93,12 @@ class InscribedCuboid(ProblemKind):
     description = "largest axis-aligned box of task coordinates inside the reachable workspace (IPOPT, multi-start)"
     plots = ("workspace",)
 
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        raw, limited = split_stress_limit(raw, model, path)  # hinge stress limits -> joint limits
+        inputs = super().parse_inputs(raw, limited or model, path)
+        inputs["stress_limited_model"] = limited
+        return inputs
+
     def input_options(self, model: Model) -> list[Option]:
         rounds = EXTRA_SLOTS // ADDED_PER_ROUND
         opts = start_options() + [
@@ -125,7 +132,7 @@ class InscribedCuboid(ProblemKind):
         opts += _region_options(model)
         extras = _cuboid_extras(model)
         opts += list(extras.options) if extras else []
-        return opts
+        return opts + [STRESS_LIMIT_OPTION]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _region(inputs, model, path)
@@ -155,6 +162,7 @@ class InscribedCuboid(ProblemKind):
         return names + (list(extras.value_names) if extras else [])
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        model = inputs.get("stress_limited_model") or model
         require_ipopt(solver, self.name)
         c = model.closure
         res = inscribed_cuboid(
@@ -243,6 +251,12 @@ class Workspace(ProblemKind):
     description = "membership of given points and a seeded point cloud of the reachable workspace"
     plots = ("workspace",)
 
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        raw, limited = split_stress_limit(raw, model, path)  # hinge stress limits -> joint limits
+        inputs = super().parse_inputs(raw, limited or model, path)
+        inputs["stress_limited_model"] = limited
+        return inputs
+
     def input_options(self, model: Model) -> list[Option]:
         c = model.closure
         opts = [
@@ -253,7 +267,7 @@ class Workspace(ProblemKind):
             Option("samples", "int", "points drawn for the point cloud (0: none)", default=0, lower=0, upper=200_000),
             Option("seed", "int", "seed of the point cloud", default=0, lower=0, upper=2**32 - 1),
         ]
-        return opts + _region_options(model)
+        return opts + _region_options(model) + [STRESS_LIMIT_OPTION]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _region(inputs, model, path)
@@ -276,6 +290,7 @@ class Workspace(ProblemKind):
         )
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        model = inputs.get("stress_limited_model") or model
         c = model.closure
         task = list(c.task)
         values: dict[str, Any] = {}

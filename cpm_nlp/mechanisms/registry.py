@@ -27,11 +27,13 @@ import re
 import threading
 from collections.abc import Mapping
 from importlib import metadata
+from pathlib import Path
 from typing import Any
 
 from ..core.errors import CpmError, InputError, suggest
 from ..core.mechanism import PARTS, Mechanism, MechanismDeclarationError, validate
 from ..core.model import LoopClosure, Model
+from . import described
 
 log = logging.getLogger(__name__)
 
@@ -73,6 +75,12 @@ class _Registry:
                     )
                     continue
                 specs[ep.name] = (ep.value, origin)
+            for path in described.shipped_files():
+                name = _file_mechanism_name(path)
+                if name is None or name in specs:
+                    log.warning("mechanism file %s ignored: no valid name, or the name is taken", path)
+                    continue
+                specs[name] = (f"file:{path}", f"file {path}")
             self._specs = specs
         return self._specs
 
@@ -138,8 +146,19 @@ class _Registry:
 _UNEXPECTED = re.compile(r"unexpected keyword argument '(\w+)'")
 
 
+def _file_mechanism_name(path: Any) -> str | None:
+    try:
+        data = described.read_yaml(path)
+    except CpmError:
+        return None
+    name = data.get("name") if isinstance(data, Mapping) else None
+    return name if isinstance(name, str) and name.isidentifier() else None
+
+
 def _load(name: str, target: str, origin: str) -> Mechanism:
     """Import and validate one declaration; every failure names its origin."""
+    if target.startswith("file:"):
+        return described.load_file(target[len("file:") :])
     module, _, attr = target.partition(":")
     try:
         obj: Any = importlib.import_module(module)
@@ -197,6 +216,56 @@ def mechanism_type(name: Any, path: tuple = ("mechanism", "type")) -> Mechanism:
             suggestions=suggest(str(name), names),
         )
     return REGISTRY.get(name)
+
+
+def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
+    """Register a mechanism read from a file (or described inline) under its name, replacing
+    an earlier description of that name; a built-in or plugin of that name is an error."""
+    with REGISTRY._lock:
+        current = REGISTRY._discover().get(mech.name)
+        if current is not None and not current[1].startswith(("file ", "described")):
+            raise InputError(
+                f"the described mechanism's name {mech.name!r} is taken by a {current[1]} mechanism; rename it",
+                path=path + ("name",),
+            )
+        if REGISTRY._loaded.get(mech.name) is not mech:
+            REGISTRY.register(mech, replace=True)
+    return mech
+
+
+#: keys of a problem file's mechanism section
+SECTION_KEYS = ("type", "file", "description", "parameters", "limits")
+
+
+def section_type(section: Mapping[str, Any], base_dir: Any = None, path: tuple = ("mechanism",)) -> str:
+    """The mechanism type a problem file's ``mechanism:`` section names: ``type`` (registered),
+    ``file`` (a mechanism file, relative to the problem file) or ``description`` (inline)."""
+    given = [k for k in ("type", "file", "description") if section.get(k) is not None]
+    if len(given) != 1:
+        raise InputError(
+            "expected exactly one of 'type' (e.g. prs3), 'file' (a mechanism file) or 'description' "
+            f"(a mechanism described inline); got {', '.join(given) or 'none'}",
+            path=path,
+        )
+    if given[0] == "type":
+        return section["type"]
+    if given[0] == "file":
+        raw = section["file"]
+        if not isinstance(raw, str) or not raw.strip():
+            raise InputError(f"expected the path of a mechanism file, got {raw!r}", path=path + ("file",))
+        target = Path(raw) if Path(raw).is_absolute() or base_dir is None else Path(base_dir) / raw
+        if not target.is_file():
+            raise InputError(f"mechanism file not found: {target}", path=path + ("file",))
+        try:
+            mech = described.load_file(target)
+        except InputError as exc:  # the message names the mechanism file, the problem file names the key
+            raise InputError(f"in the mechanism file {exc.render()}", path=path + ("file",)) from None
+        return use_described(mech, path).name
+    try:
+        mech = described.from_dict(section["description"], base_dir=Path(base_dir) if base_dir else None)
+    except InputError as exc:
+        raise exc.at(prefix=path + ("description",)) from None
+    return use_described(mech, path).name
 
 
 def closure_of(mech: Mechanism) -> LoopClosure:

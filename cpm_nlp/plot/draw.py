@@ -1024,3 +1024,76 @@ def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, 
         if isinstance(value, (int, float)):
             a.legend(fontsize="x-small", title=f"{name} = {value:.4g}", title_fontsize="x-small", loc="upper right")
     return fig
+
+
+# -- (d) compliance ellipsoid and mode shapes -------------------------------------------------------
+
+
+def ellipsoid_figure(C: Any, names: Sequence[str], *, title: str = "") -> Any:
+    """The compliance ellipsoid {C f : |f| = 1} of a 2x2 or 3x3 translational
+    compliance block C (m/N): the deflections a unit force in any direction
+    causes, in 3-D (or 2-D) with its principal axes listed."""
+    Figure = _figure_class()
+    Cm = np.asarray(C, dtype=float)
+    n = Cm.shape[0]
+    if n not in (2, 3) or Cm.shape != (n, n):
+        raise InputError(f"a compliance ellipsoid needs a 2x2 or 3x3 block, got {Cm.shape}")
+    S = 0.5 * (Cm + Cm.T)
+    w, V = np.linalg.eigh(S)
+    peak = float(np.max(np.abs(w))) if w.size else 0.0
+    f, unit = display_unit("length", [peak])
+    fig = Figure(figsize=(7, 6), layout="constrained")
+    text = ", ".join(f"{_number(abs(v) * f)} {unit}/N" for v in w[::-1])
+    if n == 3:
+        ax = fig.add_subplot(1, 1, 1, projection="3d")
+        u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
+        dirs = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
+        pts = dirs @ S.T * f
+        ax.plot_surface(pts[..., 0], pts[..., 1], pts[..., 2], alpha=0.35, color="tab:blue")
+        for k in range(3):
+            a = V[:, k] * w[k] * f
+            ax.plot([-a[0], a[0]], [-a[1], a[1]], [-a[2], a[2]], color="tab:red", lw=2)
+        ax.set_zlabel(axis_label(names[2], unit + "/N"))
+    else:
+        ax = fig.add_subplot(1, 1, 1)
+        t = np.linspace(0, 2 * np.pi, 200)
+        pts = np.stack([np.cos(t), np.sin(t)], axis=-1) @ S.T * f
+        ax.plot(pts[:, 0], pts[:, 1], color="tab:blue")
+        ax.set_aspect("equal")
+        ax.grid(True, alpha=0.3)
+    ax.set_xlabel(axis_label(names[0], unit + "/N"))
+    ax.set_ylabel(axis_label(names[1], unit + "/N"))
+    ax.set_title(f"principal compliances: {text}", fontsize="small")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def modes_figure(
+    points: Any, shapes: Sequence[Any], frequencies: Sequence[float], names: Sequence[str], *, title: str = ""
+) -> Any:
+    """Mode shapes as arrows: one panel per mode, an arrow at each point (N x 3,
+    SI) along its displacement in that mode (N x 3, normalized to the largest)."""
+    Figure = _figure_class()
+    P = np.asarray(points, dtype=float).reshape(-1, 3)
+    f, unit = display_unit("length", P)
+    n = len(shapes)
+    if n == 0:
+        raise InputError("no mode to draw")
+    span = float(np.ptp(P, axis=0).max()) if len(P) > 1 else float(np.abs(P).max() or 1.0)
+    span = span or 1.0
+    fig = Figure(figsize=(4.5 * min(n, 3), 4.2 * math.ceil(n / 3)), layout="constrained")
+    for k, (shape, freq) in enumerate(zip(shapes, frequencies)):
+        D = np.asarray(shape, dtype=float).reshape(-1, 3)
+        peak = float(np.abs(D).max()) or 1.0
+        D = D / peak * 0.3 * span
+        ax = fig.add_subplot(math.ceil(n / 3), min(n, 3), k + 1, projection="3d")
+        ax.scatter(P[:, 0] * f, P[:, 1] * f, P[:, 2] * f, color="k", s=12)
+        ax.quiver(P[:, 0] * f, P[:, 1] * f, P[:, 2] * f, D[:, 0] * f, D[:, 1] * f, D[:, 2] * f, color="tab:red")
+        ax.set_title(f"mode {k + 1}: {_number(freq)} Hz", fontsize="small")
+        ax.set_xlabel(axis_label(names[0], unit))
+        ax.set_ylabel(axis_label(names[1], unit))
+        ax.set_zlabel(axis_label(names[2], unit))
+    if title:
+        fig.suptitle(title)
+    return fig

@@ -57,9 +57,11 @@ from .draw import (
     design_map_figure,
     display_unit,
     dynamics_figure,
+    ellipsoid_figure,
     jacobian_figure,
     matrices_figure,
     mechanism_figure,
+    modes_figure,
     panels_figure,
     pretty,
 )
@@ -1010,8 +1012,89 @@ def amplifier_plot(data: ResultData, options: PlotOptions) -> Any:
 #: plot types with an interactive (.html) 3-D figure
 INTERACTIVE = ("workspace", "mechanism", "design", "jacobian", "twists")
 
+
+def forces_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Actuator forces and hinge stresses along a motion (actuator_forces over a
+    list of inputs; prs3-ruiz.md Table 2 extended to a curve), against the input
+    that varies most."""
+    _flat_only(options, "forces")
+    if data.sweep:
+        raise NotApplicable("'forces' plots one actuator_forces result; for a sweep use 'lines'")
+    c = _closure(data)
+    inputs = c.q_names + [_pose_name(data, c, t) for t in c.task]
+    forces = [f"F{j + 1}" for j in range(c.nq)]
+    stresses = sorted(k for k in data.values if k.startswith("stress_") and not k.endswith("_loaded"))
+    _require_lists(data, forces + inputs, "a forces plot (give the motion as lists)")
+    cols = {n: as_floats(data.values[n]) for n in inputs}
+    spread = {n: np.nanmax(v) - np.nanmin(v) if np.isfinite(v).any() else 0.0 for n, v in cols.items()}
+    x = max(inputs, key=lambda n: spread[n])
+    if spread[x] <= 0:
+        raise NotApplicable("no input varies over the motion")
+    order = np.argsort(cols[x])
+    panels = [Panel("actuator force", "force", {f: [data.values[f][i] for i in order] for f in forces})]
+    if stresses and isinstance(data.values[stresses[0]], list):
+        panels.append(Panel("hinge stress", "stress", {s: [data.values[s][i] for i in order] for s in stresses}))
+    return panels_figure(
+        cols[x][order],
+        panels,
+        xname=x,
+        xdimension=_dims(data, x),
+        title=f"Actuator forces and hinge stresses ({data.model.get('type')})",
+        ncols=len(panels),
+    )
+
+
+def _translational(c: Any) -> list[int]:
+    return [i for i, x in enumerate(c.x) if x.kind == "length"][:3]
+
+
+def ellipsoid_plot(data: ResultData, options: PlotOptions) -> Any:
+    """The compliance ellipsoid of the platform: the translational block of C."""
+    _flat_only(options, "ellipsoid")
+    if data.sweep or not isinstance(data.values.get("C"), list):
+        raise NotApplicable("'ellipsoid' plots the output compliance C of one platform_compliance result")
+    c = _closure(data)
+    idx = _translational(c)
+    if len(idx) < 2:
+        raise NotApplicable("the platform has fewer than two translational coordinates")
+    C = np.asarray(data.values["C"], dtype=float)[np.ix_(idx, idx)]
+    return ellipsoid_figure(
+        C, [c.x_names[i] for i in idx], title=f"Compliance ellipsoid of the platform ({data.model.get('type')})"
+    )
+
+
+def modes_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Mode shapes as arrows at the platform point (the translational pose
+    coordinates) and at each actuator, one panel per mode."""
+    _flat_only(options, "modes")
+    if data.sweep or not isinstance(data.values.get("modes_x"), list):
+        raise NotApplicable("'modes' plots the mode shapes of one natural_frequencies result")
+    c = _closure(data)
+    idx = _translational(c)
+    platform = np.zeros(3)
+    platform[: len(idx)] = [data.values[c.x_names[i]] for i in idx]
+    pts = [platform]
+    for j in range(c.nq):  # the actuators, spread on a circle around the platform for display
+        a = 2 * np.pi * j / max(c.nq, 1)
+        r = max(float(np.abs(platform).max()), 1e-3)
+        pts.append(platform + r * np.array([np.cos(a), np.sin(a), -1.0]))
+    shapes = []
+    for mq, mx in zip(data.values["modes_q"], data.values["modes_x"]):
+        d = np.zeros((1 + c.nq, 3))
+        d[0, : len(idx)] = [mx[i] for i in idx]
+        for j in range(c.nq):
+            d[1 + j, 2] = mq[j]
+        shapes.append(d)
+    freqs = [data.values[f"f{k + 1}"] for k in range(len(shapes))]
+    names = [c.x_names[i] for i in idx] + ["z"] * (3 - len(idx))
+    return modes_figure(np.array(pts), shapes, freqs, names, title=f"Mode shapes ({data.model.get('type')})")
+
+
 #: plot type -> function(data, options) -> Figure
 PLOTS = {
+    "forces": forces_plot,
+    "ellipsoid": ellipsoid_plot,
+    "modes": modes_plot,
     "workspace": workspace_plot,
     "map": map_plot,
     "requirements": requirements_plot,

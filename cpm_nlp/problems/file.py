@@ -31,7 +31,7 @@ from ..core.kind import ProblemKind
 from ..core.model import Model
 from ..core.result import Result
 from ..core.solver import SolverConfig
-from ..mechanisms.registry import build_model
+from ..mechanisms.registry import SECTION_KEYS, build_model, section_type
 from .overrides import apply_overrides
 from .published import parse_reproduce
 from .reader import read_yaml
@@ -93,11 +93,9 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
             path=("mechanism",),
         )
     for key in mech:
-        if key not in ("type", "parameters", "limits"):
-            raise unknown_key_error(str(key), ("type", "parameters", "limits"), ("mechanism",), "mechanism key")
-    if "type" not in mech:
-        raise InputError("missing required key 'type' (the mechanism, e.g. prs3)", path=("mechanism",))
-    model = build_model(mech["type"], mech.get("parameters"), mech.get("limits"))
+        if key not in SECTION_KEYS:
+            raise unknown_key_error(str(key), SECTION_KEYS, ("mechanism",), "mechanism key")
+    model = build_model(section_type(mech, base_dir), mech.get("parameters"), mech.get("limits"))
     reason = kind.supports(model)
     if reason:
         raise InputError(

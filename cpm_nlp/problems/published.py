@@ -22,22 +22,59 @@ section::
 explained by ``reason``; a row that disagrees without it is a regression.
 
 Published values are typed in (they are the paper's); computed values are
-always obtained by solving the file.
+always obtained by solving the file.  What the "published" value is, and how
+independent an agreement with it is, each row says:
+
+* ``category`` (default ``published``): where the value comes from --
+  ``published`` a number printed in the paper; ``derived`` not printed, but
+  evaluated by hand from printed formulas and numbers; ``read_off_matrix`` a
+  geometry read off the printed matrix the row is compared with;
+  ``consistency`` a check whose inputs were read from (or fitted to) the figure
+  it is compared with; ``claim`` a statement of the paper written as a
+  number (an approximation taken as exact: 0, "lies inside": 0 points
+  outside); ``not_printed`` the paper prints no such number (a plot, an
+  assumed input).  Only a ``published`` row that agrees and does not
+  echo an input is an independent agreement (:func:`summarize`).
+* ``echoes``: the computed value is an input given back (an active bound, a
+  parameter held fixed), named by this text.
+* ``tolerance_reason``: required when the tolerance is wider than half a unit
+  of the last digit of the published text (:func:`printed_half_unit`).
 """
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..core.errors import InputError, unknown_key_error
+from ..core.errors import InputError, suggest, unknown_key_error
 from ..core.units import DIMENSIONS, article, fast_dimension, format_quantity, parse_quantity
 
-ROW_KEYS = ("quantity", "source", "published", "value", "tolerance", "reason", "expect")
+ROW_KEYS = (
+    "quantity",
+    "source",
+    "published",
+    "category",
+    "value",
+    "tolerance",
+    "tolerance_reason",
+    "echoes",
+    "reason",
+    "expect",
+)
 VERDICTS = ("agrees", "differs", "not reproducible", "solve failed")
+
+#: what a row's "published" value is (its ``category``), as shown beside it
+CATEGORIES = {
+    "published": "printed in the paper",
+    "derived": "not printed: evaluated from the paper's printed formulas and numbers",
+    "read_off_matrix": "not printed: a geometry read off the printed matrix it is compared with",
+    "consistency": "a consistency check: its inputs were read from, or fitted to, the figure it is compared with",
+    "claim": "not printed: a statement of the paper (an approximation, 'lies inside') written as a number",
+    "not_printed": "the paper prints no such number",
+}
 
 
 @dataclass(frozen=True)
@@ -54,6 +91,9 @@ class PublishedFigure:
     tolerance: float | None
     reason: str
     expect: str  # "agree" | "differ"
+    category: str = "published"
+    echoes: str = ""  # the input the computed value gives back, if it does
+    tolerance_reason: str = ""
 
 
 @dataclass(frozen=True)
@@ -78,22 +118,81 @@ class Comparison:
     verdict: str
     reason: str
     expected: bool  # the verdict is the one the file expects
+    category: str = "published"
+    echoes: str = ""
+    tolerance_reason: str = ""
+
+    @property
+    def agrees(self) -> bool:
+        return self.verdict.startswith("agrees")
+
+    @property
+    def independent(self) -> bool:
+        """An agreement with a printed number that is not an input given back."""
+        return self.agrees and self.category == "published" and not self.echoes
 
     def to_dict(self) -> dict[str, Any]:
+        def num(x: Any) -> float | None:
+            return None if x is None else float(x)
+
         return {
             "file": self.file,
             "paper": self.paper,
             "quantity": self.quantity,
             "source": self.source,
-            "published": self.published,
+            "category": self.category,
+            "published": num(self.published),
             "published_text": self.published_text,
-            "computed": self.computed,
+            "computed": num(self.computed),
             "unit": DIMENSIONS[self.dimension].si if self.dimension in DIMENSIONS else "",
-            "rel_error": self.rel_error,
+            "rel_error": num(self.rel_error),
             "verdict": self.verdict,
+            "echoes_input": self.echoes or None,
+            "independent": bool(self.independent),
             "reason": self.reason,
-            "expected": self.expected,
+            "tolerance_reason": self.tolerance_reason or None,
+            "expected": bool(self.expected),
         }
+
+
+def summarize(rows: Iterable[Comparison]) -> dict[str, Any]:
+    """Counts of a reproduction table: independent agreements apart from the
+    agreements that are not (by category, and inputs echoed back)."""
+    rows = list(rows)
+    agree = [r for r in rows if r.agrees]
+    dependent = [r for r in agree if not r.independent]
+    by_category = {c: sum(1 for r in dependent if r.category == c and not r.echoes) for c in CATEGORIES}
+    return {
+        "figures": len(rows),
+        "unexpected": sum(1 for r in rows if not r.expected),
+        "agree_independent": sum(1 for r in agree if r.independent),
+        "agree_not_independent": len(dependent),
+        "agree_not_independent_by_category": {c: n for c, n in by_category.items() if n},
+        "agree_echoing_an_input": sum(1 for r in dependent if r.echoes),
+        "differ": sum(1 for r in rows if r.verdict.startswith("differs")),
+        "unexpected_differ": sum(1 for r in rows if r.verdict.startswith("differs") and not r.expected),
+        "not_reproducible": sum(1 for r in rows if r.verdict == "not reproducible"),
+        "solve_failed": sum(1 for r in rows if r.verdict == "solve failed"),
+        "categories": {c: sum(1 for r in rows if r.category == c) for c in CATEGORIES},
+    }
+
+
+_NUMBER = re.compile(r"\s*[-+]?(\d*)(?:\.(\d*))?(?:[eE]([-+]?\d+))?")
+
+
+def printed_half_unit(text: str, dimension: str, path: tuple = ()) -> float | None:
+    """Half a unit of the last printed digit of ``text`` ("1.78e-6 m^3",
+    "0.0795 rad", "21.875"), in SI units; None if ``text`` starts with no number."""
+    m = _NUMBER.match(text)
+    if m is None or not (m.group(1) or m.group(2)):
+        return None
+    decimals = len(m.group(2) or "")
+    exponent = int(m.group(3) or 0)
+    half = 0.5 * 10.0 ** (exponent - decimals)
+    rest = text[m.end() :].strip()
+    if not rest:
+        return half
+    return parse_quantity(f"{half!r} {rest}", dimension, path)
 
 
 def parse_any_quantity(value: Any, path: tuple) -> tuple[float, str]:
@@ -136,33 +235,18 @@ def _text(row: Mapping, key: str, path: tuple, required: bool = True) -> str:
     return v.strip()
 
 
-def _parse_row(row: Any, path: tuple) -> PublishedFigure:  # noqa: C901 - one rule per key of a row
-    if not isinstance(row, Mapping):
-        raise InputError(f"expected a mapping with keys {', '.join(ROW_KEYS)}", path=path)
-    for key in row:
-        if key not in ROW_KEYS:
-            raise unknown_key_error(str(key), ROW_KEYS, path, "row key")
-    quantity = _text(row, "quantity", path)
-    source = _text(row, "source", path)
-    reason = _text(row, "reason", path, required=False)
-    expect = row.get("expect", "agree")
-    if expect not in ("agree", "differ"):
-        raise InputError(f"expected 'agree' or 'differ', got {expect!r}", path=path + ("expect",))
-    if "published" not in row:
-        raise InputError("missing required key 'published' (the paper's figure)", path=path)
-    value = row.get("value")
-    published_raw = row["published"]
-    if value is None:
-        if not reason:
-            raise InputError("a figure the model does not compute (value: null) needs a 'reason'", path=path)
-        return PublishedFigure(
-            quantity, source, str(published_raw), None, "dimensionless", None, None, None, reason, "differ"
-        )
-    if not isinstance(value, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*", value):
+def _category(row: Mapping, path: tuple) -> str:
+    category = row.get("category", "published")
+    if not isinstance(category, str) or category not in CATEGORIES:
         raise InputError(
-            f"expected the name of a result value, e.g. s_min or dz[0], got {value!r}", path=path + ("value",)
+            f"expected one of {', '.join(CATEGORIES)}, got {category!r}",
+            path=path + ("category",),
+            suggestions=suggest(str(category), CATEGORIES),
         )
-    published, dim = parse_any_quantity(published_raw, path + ("published",))
+    return category
+
+
+def _tolerance(row: Mapping, dim: str, path: tuple) -> tuple[str, float]:
     tol_raw = row.get("tolerance")
     if tol_raw is None:
         raise InputError("missing required key 'tolerance' ('5 %' relative, or an absolute quantity)", path=path)
@@ -179,9 +263,77 @@ def _parse_row(row: Any, path: tuple) -> PublishedFigure:  # noqa: C901 - one ru
         )
     if not tol > 0:
         raise InputError(f"expected a positive tolerance, got {tol_raw!r}", path=path + ("tolerance",))
+    return kind, tol
+
+
+def _check_tolerance_reason(row: Mapping, fig: PublishedFigure, path: tuple) -> None:
+    """A tolerance wider than the printed rounding needs a ``tolerance_reason``."""
+    half = printed_half_unit(fig.published_text, fig.dimension, path + ("published",))
+    if half is None or fig.published is None or fig.tolerance is None:
+        return
+    width = fig.tolerance * abs(fig.published) if fig.tolerance_kind == "rel" else fig.tolerance
+    if width > half * (1 + 1e-9) and not fig.tolerance_reason:
+        raise InputError(
+            f"tolerance {row.get('tolerance')} is wider than the printed rounding of "
+            f"{fig.published_text!r} (half a unit of its last digit: "
+            f"{format_quantity(half, fig.dimension, 3)}); say why in 'tolerance_reason'",
+            path=path + ("tolerance",),
+        )
+
+
+def _parse_row(row: Any, path: tuple) -> PublishedFigure:  # noqa: C901 - one rule per key of a row
+    if not isinstance(row, Mapping):
+        raise InputError(f"expected a mapping with keys {', '.join(ROW_KEYS)}", path=path)
+    for key in row:
+        if key not in ROW_KEYS:
+            raise unknown_key_error(str(key), ROW_KEYS, path, "row key")
+    quantity = _text(row, "quantity", path)
+    source = _text(row, "source", path)
+    reason = _text(row, "reason", path, required=False)
+    category = _category(row, path)
+    echoes = _text(row, "echoes", path, required=False)
+    tolerance_reason = _text(row, "tolerance_reason", path, required=False)
+    expect = row.get("expect", "agree")
+    if expect not in ("agree", "differ"):
+        raise InputError(f"expected 'agree' or 'differ', got {expect!r}", path=path + ("expect",))
+    if "published" not in row:
+        raise InputError("missing required key 'published' (the paper's figure)", path=path)
+    value = row.get("value")
+    published_raw = row["published"]
+    if value is None:
+        if not reason:
+            raise InputError("a figure the model does not compute (value: null) needs a 'reason'", path=path)
+        for key in ("tolerance", "tolerance_reason", "echoes"):
+            if key in row:
+                raise InputError(f"a figure the model does not compute (value: null) has no {key!r}", path=path)
+        return PublishedFigure(
+            quantity, source, str(published_raw), None, "dimensionless", None, None, None, reason, "differ", category
+        )
+    if not isinstance(value, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*", value):
+        raise InputError(
+            f"expected the name of a result value, e.g. s_min or dz[0], got {value!r}", path=path + ("value",)
+        )
+    published, dim = parse_any_quantity(published_raw, path + ("published",))
+    kind, tol = _tolerance(row, dim, path)
     if expect == "differ" and not reason:
         raise InputError("a row expected to differ needs a 'reason'", path=path)
-    return PublishedFigure(quantity, source, str(published_raw), published, dim, value, kind, tol, reason, expect)
+    fig = PublishedFigure(
+        quantity,
+        source,
+        str(published_raw),
+        published,
+        dim,
+        value,
+        kind,
+        tol,
+        reason,
+        expect,
+        category,
+        echoes,
+        tolerance_reason,
+    )
+    _check_tolerance_reason(row, fig, path)
+    return fig
 
 
 def _lookup(values: Mapping[str, Any], ref: str) -> Any:
@@ -202,18 +354,21 @@ def compare(spec: ReproduceSpec, result: Any, file: str) -> list[Comparison]:
 
         def row(computed, dim, rel, verdict, reason, expected, fig=fig):
             return Comparison(
-                file,
-                spec.paper,
-                fig.quantity,
-                fig.source,
-                fig.published_text,
-                fig.published,
-                computed,
-                dim,
-                rel,
-                verdict,
-                reason,
-                expected,
+                file=file,
+                paper=spec.paper,
+                quantity=fig.quantity,
+                source=fig.source,
+                published_text=fig.published_text,
+                published=fig.published,
+                computed=computed,
+                dimension=dim,
+                rel_error=None if rel is None else float(rel),
+                verdict=verdict,
+                reason=reason,
+                expected=bool(expected),
+                category=fig.category,
+                echoes=fig.echoes,
+                tolerance_reason=fig.tolerance_reason,
             )
 
         if fig.value is None:

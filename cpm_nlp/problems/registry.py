@@ -40,6 +40,9 @@ GENERIC = {
     "inscribed_cuboid": "workspace:InscribedCuboid",
     "workspace": "workspace:Workspace",
     "synthesis": "synthesis:Synthesis",
+    "actuator_forces": "compliance:ActuatorForces",
+    "platform_compliance": "compliance:PlatformCompliance",
+    "natural_frequencies": "compliance:NaturalFrequencies",
 }
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from pathlib import Path
 
+from ..core.errors import InputError
 from ..mechanisms.registry import mechanism_names, mechanism_type
 from .file import load_problem, solve
 from .published import Comparison, compare
@@ -14,12 +15,13 @@ from .shipped import shipped_problems_dir
 
 
 def problem_files(paths: Iterable[str | Path]) -> list[Path]:
-    """YAML files under the given files/directories, sorted."""
+    """YAML files under the given files/directories (and their subdirectories,
+    e.g. problems/mechanisms/), sorted."""
     out: list[Path] = []
     for p in paths:
         p = Path(p)
         if p.is_dir():
-            out += sorted(p.glob("*.yaml"))
+            out += sorted(p.rglob("*.yaml"))
         else:
             out.append(p)
     return out
@@ -46,10 +48,19 @@ def plugin_problem_files() -> list[Path]:
 
 def reproduce(paths: Iterable[str | Path] | None = None) -> list[Comparison]:
     """Solve every problem file with a ``reproduce`` section; all rows.  Without
-    paths: the shipped problem files, and those of mechanism plugins."""
-    files = (
-        problem_files(paths) if paths is not None else problem_files(default_problem_dirs()) + plugin_problem_files()
-    )
+    paths: the shipped problem files, and those of mechanism plugins.  Comparing
+    nothing is bad input (:class:`InputError`, naming what was given): no
+    problem files, or none with a ``reproduce`` section."""
+    given = [str(p) for p in paths] if paths is not None else None
+    if given is not None:
+        files = problem_files(given)
+        what = ", ".join(given) if given else "no paths"
+    else:
+        dirs = default_problem_dirs()
+        files = problem_files(dirs) + plugin_problem_files()
+        what = ", ".join(str(d) for d in dirs) if dirs else "the shipped problems/ (not found)"
+    if not files:
+        raise InputError(f"no problem files (*.yaml) to compare in {what}")
     rows: list[Comparison] = []
     for f in files:
         problem = load_problem(f)
@@ -57,4 +68,10 @@ def reproduce(paths: Iterable[str | Path] | None = None) -> list[Comparison]:
             continue
         result = solve(problem)
         rows += compare(problem.reproduce, result, str(f))
+    if not rows:
+        names = ", ".join(str(f) for f in files[:3]) + (f" and {len(files) - 3} more" if len(files) > 3 else "")
+        raise InputError(
+            f"nothing compared: {names} {'has' if len(files) == 1 else 'have'} no 'reproduce' section",
+            hint="a problem file that reproduces published figures carries 'reproduce: {paper, rows}'",
+        )
     return rows

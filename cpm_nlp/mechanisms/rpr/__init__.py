@@ -6,9 +6,22 @@
 * :mod:`.kinds` -- its own problem kinds (``rpr_*``) and its synthesis formulation.
 """
 
-from ...core.mechanism import Mechanism
+from ...core.mechanism import JointStiffness, Mechanism
 from . import kinematics
 from .kinds import Compliance, JointDesign, ScrewJacobian, Synthesis, TransmissionMap, Twists
+
+#: Table 1's flexure joints as circular notches (the reading of problems/rpr_compliance.yaml):
+#: R joints one notch r 4 mm, t 0.4 mm, 12 mm wide; each axis of a U joint one notch r 1 mm,
+#: t 0.4 mm in the 12 mm square rod; Al 7075 (section 5, the FEA's material).  Stiffness and
+#: stresses from the hinge formulas (the paper prints no joint stiffness).
+STIFFNESS = JointStiffness(
+    hinges={
+        "R": {"joints": "theta_R", "type": "circular_notch", "r": "4 mm", "t": "0.4 mm", "w": "12 mm"},
+        "U": {"joints": "theta_U", "type": "circular_notch", "r": "1 mm", "t": "0.4 mm", "w": "12 mm"},
+    },
+    material="Al 7075-T6",
+    source="rpr-2rpu-upr-zhang-2022.md Table 1 (joint dimensions) and section 5 (Al-7075)",
+)
 
 MECHANISM = Mechanism(
     name="rpr",
@@ -23,6 +36,7 @@ MECHANISM = Mechanism(
     build=kinematics.build,
     synthesis=Synthesis,
     geometry=kinematics.geometry,
+    stiffness=STIFFNESS,
     kinds={k.name: k for k in (ScrewJacobian, Twists, TransmissionMap, JointDesign, Compliance)},
     problem_files=(
         "rpr_forward_kinematics.yaml",

@@ -59,6 +59,7 @@ import casadi as ca
 import numpy as np
 from scipy.stats import qmc
 
+from ...analysis import compliance as cm
 from ...analysis import flexure
 from ...analysis import flexure_compliance as fc
 from ...analysis.flexure import Material
@@ -345,6 +346,24 @@ def passive_rates(model: Model, x: Sequence[float]) -> tuple[np.ndarray, np.ndar
     return G, dj @ G
 
 
+def mechanism_stiffness(model: Model, x: Sequence[float], k_J: Sequence[float]) -> np.ndarray:
+    """K' of eq 40 as an instance of the generic pseudo-rigid-body method
+    (:mod:`cpm_nlp.analysis.compliance`): hinges of stiffness k_J on the passive
+    joints, undeflected at the home pose, give the input stiffness K_q, the Hessian of
+    the strain energy along the loop closures.  At the home pose (the paper's initial
+    pose, where eq 40 is evaluated) it equals G_pᵀ K_J G_p exactly; away from it K_q
+    also holds the terms of the hinges' preload (the energy's gradient times the
+    curvature of the passive angles), which eq 40 leaves out."""
+    c = model.closure
+    xv = np.asarray(x, dtype=float)
+    q = np.asarray(c.ik(xv, model.p)[1]).ravel()
+    names = cm.joint_names(c)
+    k = np.zeros(len(names))
+    k[c.nx + c.nq :] = np.asarray(k_J, dtype=float)
+    hs = cm.HingeSet(names, [], k, cm.joint_vector(model, model.x_home, model.q_home), [])
+    return cm.static_point(model, hs, xv, q).K_q
+
+
 def compliance_model(
     model: Model, x: Sequence[float], *, l1: float, l2: float, c_r: float, c_t: float, k_J: Sequence[float]
 ) -> dict[str, Any]:
@@ -352,7 +371,7 @@ def compliance_model(
     displacement per input force) with every intermediate matrix."""
     G, G_p = passive_rates(model, x)
     K_J = np.diag(np.asarray(k_J, dtype=float))
-    K = G_p.T @ K_J @ G_p  # eq 40
+    K = mechanism_stiffness(model, x, k_J)  # eq 40, by the generic energy method
     A = amplifier_matrices(l1, l2, c_r, c_t)
     M = np.linalg.solve(np.eye(3) + A["A22"] @ K, A["A21"])  # D_out = M F_in (eq 36, 40)
     C = G @ M  # eq 43

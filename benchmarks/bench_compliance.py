@@ -1,0 +1,95 @@
+"""Speed of the compliance method (issue 12): per pose, on the 3-PRS with the
+hinges of prs3-ruiz.md section 5.
+
+    python benchmarks/bench_compliance.py [--repeats 200] [--json benchmarks/bench_compliance.json]
+
+* **forces** -- actuator forces, K_q and hinge stresses at one solved pose
+  (:func:`cpm_nlp.analysis.compliance.static_point`); target <= 1 ms;
+* **compliance** -- the same plus the 6x6 output compliance J (K_q + K_a)⁻¹ Jᵀ;
+  target <= 2 ms;
+* **compliant_fk** -- the loaded pose under a 1 N load by IPOPT (warm, the
+  solver built); target <= 20 ms.
+
+Each figure is the median of ``repeats`` calls; the baseline in the same run is
+one rigid forward kinematics by Newton (the cheapest solve the toolkit does at a
+pose), so the ratios stay comparable when the machine is loaded.  The load
+average (os.getloadavg) is recorded beside each figure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from cpm_nlp.analysis import compliance as cm  # noqa: E402
+from cpm_nlp.core.kinematics import forward_kinematics  # noqa: E402
+from cpm_nlp.core.solver import SolverConfig  # noqa: E402
+from cpm_nlp.mechanisms.registry import build_model  # noqa: E402
+
+TARGETS = {"forces": 1e-3, "compliance": 2e-3, "compliant_fk": 20e-3}
+
+
+def _median(fn, repeats: int) -> tuple[float, tuple[float, float, float]]:
+    fn()
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times), os.getloadavg()
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=200)
+    ap.add_argument("--json", default=str(ROOT / "benchmarks" / "bench_compliance.json"))
+    args = ap.parse_args(argv)
+    m = build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"})
+    hs = cm.hinge_set(m, None)
+    newton = SolverConfig(method="newton")
+    q = np.array([0.9e-3, -0.4e-3, 0.6e-3])
+    sol = forward_kinematics(m, q, newton)
+    ka = np.zeros(3)
+    f = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+    sp = cm.static_point(m, hs, sol.x, sol.q)
+    cases = {
+        "baseline_fk_newton": lambda: forward_kinematics(m, q, newton),
+        "forces": lambda: cm.static_point(m, hs, sol.x, sol.q),
+        "compliance": lambda: cm.output_compliance(cm.static_point(m, hs, sol.x, sol.q), ka),
+        "compliant_fk": lambda: cm.compliant_fk(m, hs, sol.x, sol.q, sp.F, f, ka),
+    }
+    out = {}
+    for name, fn in cases.items():
+        reps = max(5, args.repeats // 10) if name == "compliant_fk" else args.repeats
+        sec, load = _median(fn, reps)
+        out[name] = {"seconds": sec, "load": list(load)}
+    base = out["baseline_fk_newton"]["seconds"]
+    print(f"{'case':<20} {'median':>10} {'/ FK':>8} {'target':>8}  load")
+    for name, rec in out.items():
+        rec["ratio_to_baseline"] = rec["seconds"] / base
+        target = TARGETS.get(name)
+        if target:
+            rec["target_seconds"] = target
+            rec["met"] = rec["seconds"] <= target
+        t = f"{target * 1e3:.0f} ms" if target else ""
+        print(
+            f"{name:<20} {rec['seconds'] * 1e3:8.3f} ms {rec['ratio_to_baseline']:8.2f} {t:>8}  "
+            + ", ".join(f"{v:.2f}" for v in rec["load"])
+        )
+    Path(args.json).write_text(json.dumps(out, indent=2))
+    print("written:", args.json)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

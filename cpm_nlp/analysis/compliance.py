@@ -1,0 +1,688 @@
+"""Compliance, stiffness and strength of any mechanism by the pseudo-rigid-body
+energy method.
+
+Every compliant joint coordinate θ_j of a mechanism -- a pose coordinate x, an
+actuator q or a passive joint angle of its closure (``passive_coords``) -- may
+carry a hinge of stiffness k_j.  The hinges store the strain energy
+
+    U(x, q) = ½ Σ_j k_j (θ_j(x, q) - θ_j0)²,
+
+with θ_j0 the joint values at the mechanism's home pose (the undeflected
+configuration).  On the loop closures Φ(x, q; p) = 0 the pose is a function
+x(q) whose derivative is dx/dq = J = -Φ_x⁻¹ Φ_q (implicit function theorem), so
+
+* the actuator forces that hold a pose against the hinges and against a
+  generalized load f on the pose coordinates (force on a length, moment on an
+  angle, conjugate to that coordinate) are the reduced gradient
+  F = ∂V/∂q + Jᵀ ∂V/∂x of V = U - fᵀx (virtual work: Fᵀδq = δU - fᵀδx);
+* the input stiffness is its total derivative K_q = ∂F/∂q + ∂F/∂x J, the
+  Hessian of V(x(q), q), exact by algorithmic differentiation (the geometric
+  stiffness of the load included);
+* the output compliance with actuators of stiffness K_a (0: the actuator forces
+  held; rigid: the positions held) is C_x = J (K_q + K_a)⁻¹ Jᵀ;
+* the compliant forward kinematics minimises V + ½ (q - q_c)ᵀ K_a (q - q_c) - F_cᵀ (q - q_c)
+  over (x, q) subject to Φ = 0 (IPOPT), F_c the actuator forces of the unloaded
+  commanded pose, so that the commanded pose is the equilibrium without load.
+
+This is a pseudo-rigid-body model: only the joint coordinates the kinematics
+moves store energy, with the hinge's stiffness about that axis.  The other
+five axes of each flexure (the 6-axis compliances of
+:mod:`cpm_nlp.analysis.flexure_compliance`) would need the position and frame
+of every hinge in space, which a loop closure does not carry; they supply the
+stiffness of an axis only when a coordinate moves about it (e.g. the torsion
+of a spherical flexure).  With the actuators rigidly held the model is a rigid
+structure (no deflection); the platform compliance it gives is that of the
+actuated directions.
+
+Hinge stresses follow from the hinge moments M = k (θ - θ0) by the formulas of
+:data:`HINGE_TYPES` (nominal stresses at the thinnest section, each with its
+source), combined by von Mises where a hinge carries bending and torsion.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ..core.errors import InputError, suggest
+from ..core.kernels import FastFunction
+from ..core.model import LoopClosure, Model
+from ..core.options import Option, validate_mapping
+from ..core.units import parse_quantity
+from .flexure import Material, circular_notch_stiffness_exact, material
+from .flexure_compliance import circular_notch_compliances, rectangle_torsion_constant
+
+#: the axes of a hinge a joint coordinate may turn (or stretch) it about
+AXES = ("bend", "bend2", "torsion", "axial")
+AXIS_TEXT = {
+    "bend": "bending about the hinge's compliant axis",
+    "bend2": "bending about the second (out-of-plane) axis",
+    "torsion": "torsion about the hinge's length",
+    "axial": "stretch along the hinge's length (a length coordinate)",
+}
+
+
+def rectangle_torsion_stress(T, a, c):
+    """Largest shear stress of an a x c rectangle (a >= c) under torsion T,
+    τ = 3T/(8 A B²) [1 + 0.6095 (B/A) + 0.8865 (B/A)² - 1.8023 (B/A)³ + 0.9100 (B/A)⁴]
+    with 2A = a, 2B = c (W. C. Young, R. G. Budynas, Roark's Formulas for Stress
+    and Strain, 7th ed., Table 10.7, case 4)."""
+    a, c = max(a, c), min(a, c)
+    A, B = a / 2.0, c / 2.0
+    ratio = B / A
+    return 3.0 * T / (8.0 * A * B**2) * (1 + 0.6095 * ratio + 0.8865 * ratio**2 - 1.8023 * ratio**3 + 0.91 * ratio**4)
+
+
+def _von_mises(sigma: float, tau: float) -> float:
+    return math.sqrt(sigma**2 + 3.0 * tau**2)
+
+
+def _rect_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
+    """Nominal stress at the thinnest section t x w of a rectangular hinge:
+    σ = K_t (6|M_bend|/(w t²) + 6|M_bend2|/(t w²) + |F|/(w t)), τ from Roark's
+    rectangle torsion, combined by von Mises."""
+    t, w = d["t"], d["w"]
+    sigma = 6.0 * abs(loads.get("bend", 0.0)) / (w * t**2) + 6.0 * abs(loads.get("bend2", 0.0)) / (t * w**2)
+    sigma += abs(loads.get("axial", 0.0)) / (w * t)
+    tau = rectangle_torsion_stress(abs(loads.get("torsion", 0.0)), w, t)
+    return d.get("Kt", 1.0) * _von_mises(sigma, tau)
+
+
+def _rod_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
+    """Round neck of diameter d: σ = K_t (32 |M|/(π d³) + 4|F|/(π d²)) with M the
+    resultant of both bending moments, τ = 16 T/(π d³), von Mises (Euler-Bernoulli
+    and Saint-Venant torsion of a circular section)."""
+    dia = d["d"]
+    m = math.hypot(loads.get("bend", 0.0), loads.get("bend2", 0.0))
+    sigma = 32.0 * m / (math.pi * dia**3) + 4.0 * abs(loads.get("axial", 0.0)) / (math.pi * dia**2)
+    tau = 16.0 * abs(loads.get("torsion", 0.0)) / (math.pi * dia**3)
+    return d.get("Kt", 1.0) * _von_mises(sigma, tau)
+
+
+def _notch_stiffness(E, G, d) -> dict[str, float]:
+    if G is None:  # without Poisson's ratio only the bending stiffness (Paros-Weisbord exact)
+        return {"bend": float(circular_notch_stiffness_exact(E, d["w"], d["t"], d["r"]))}
+    c = circular_notch_compliances(E, G, d["w"], d["t"], d["r"])
+    return {"bend": 1 / c["rz"], "bend2": 1 / c["ry"], "torsion": 1 / c["rx"], "axial": 1 / c["x"]}
+
+
+def _rod_stiffness(E, G, d) -> dict[str, float]:
+    dia, length = d["d"], d["l"]
+    inertia = math.pi * dia**4 / 64.0
+    out = {"bend": E * inertia / length, "bend2": E * inertia / length, "axial": E * math.pi * dia**2 / 4 / length}
+    if G is not None:
+        out["torsion"] = G * 2.0 * inertia / length
+    return out
+
+
+def _leaf_stiffness(E, G, d) -> dict[str, float]:
+    t, w, length = d["t"], d["w"], d["l"]
+    out = {"bend": E * w * t**3 / 12 / length, "bend2": E * t * w**3 / 12 / length, "axial": E * w * t / length}
+    if G is not None:
+        out["torsion"] = G * float(rectangle_torsion_constant(max(w, t), min(w, t))) / length
+    return out
+
+
+@dataclass(frozen=True)
+class HingeType:
+    """A flexure hinge geometry: its dimensions, its stiffness about each axis
+    ``(E, G, dims) -> {axis: k}`` (G None when the material gives no Poisson's
+    ratio) and its largest stress ``(dims, loads) -> σ``."""
+
+    dims: tuple[str, ...]
+    stiffness: Any
+    stress: Any
+    source: str
+
+
+HINGE_TYPES: dict[str, HingeType] = {
+    "circular_notch": HingeType(
+        ("t", "r", "w"),
+        _notch_stiffness,
+        _rect_stress,
+        "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance), Paros-Weisbord exact without nu; "
+        "stress: nominal 6M/(w t^2) at the thinnest section (the stress of pantograph-3d-elgammal-2016.md eq 38), "
+        "times Kt (default 1)",
+    ),
+    "circular_rod": HingeType(
+        ("d", "l"),
+        _rod_stiffness,
+        _rod_stress,
+        "stiffness: E I/l, G J/l, E A/l of a round neck of diameter d and length l (fillets ignored: stiffer); "
+        "stress: 32M/(pi d^3), 16T/(pi d^3), von Mises, times Kt (default 1)",
+    ),
+    "leaf_spring": HingeType(
+        ("t", "l", "w"),
+        _leaf_stiffness,
+        _rect_stress,
+        "stiffness: E w t^3/(12 l) (Euler-Bernoulli), G J/l with Roark's rectangle J; "
+        "stress: 6M/(w t^2), Roark Table 10.7 torsion, von Mises",
+    ),
+}
+
+DIM_OPTIONS = {
+    "t": Option("t", "length", "thickness at the thinnest section", lower=0.0, strict=True),
+    "r": Option("r", "length", "notch radius", lower=0.0, strict=True),
+    "w": Option("w", "length", "hinge width (along its compliant axis)", lower=0.0, strict=True),
+    "d": Option("d", "length", "neck diameter", lower=0.0, strict=True),
+    "l": Option("l", "length", "hinge length", lower=0.0, strict=True),
+}
+HINGE_KEYS = ("joints", "type", "k", "material", "Kt", "r_fillet", *DIM_OPTIONS)
+
+
+def check_geometry(kind: str, d: Mapping[str, float], path: tuple) -> None:
+    """Reject a hinge that cannot exist (t >= 2r for a circular notch: the two
+    notches would not leave a thinnest section narrower than the blank)."""
+    if kind == "circular_notch" and d["t"] >= 2.0 * d["r"]:
+        raise InputError(
+            f"impossible circular notch: thickness t = {d['t'] * 1e3:g} mm must be below twice the notch radius "
+            f"2r = {2 * d['r'] * 1e3:g} mm",
+            path=path + ("t",),
+        )
+
+
+@dataclass
+class Hinge:
+    """One flexure of the mechanism: the joint coordinates it carries (axis ->
+    index in (x, q, passive)), its stiffness per axis and its stress formula."""
+
+    name: str
+    group: str
+    kind: str | None
+    dims: dict[str, float]
+    axes: dict[str, int]
+    k: dict[str, float]
+    material: Material | None
+    source: str = ""
+    #: the hinge formula's stiffness per axis (where type and material give it), beside k
+    k_formula: dict[str, float] = field(default_factory=dict)
+
+    def stress(self, deflection: Mapping[str, float]) -> float | None:
+        """Largest stress for the axis deflections (θ - θ0); None without geometry."""
+        if self.kind is None:
+            return None
+        loads = {a: self.k[a] * deflection[a] for a in self.axes}
+        return float(HINGE_TYPES[self.kind].stress(self.dims, loads))
+
+    def angle_limit(self, axis: str, sigma_allow: float) -> float | None:
+        """The deflection about one axis alone at which the hinge reaches sigma_allow."""
+        if self.kind is None:
+            return None
+        unit = self.stress({a: (1.0 if a == axis else 0.0) for a in self.axes})
+        return sigma_allow / unit if unit > 0 else None
+
+
+@dataclass
+class HingeSet:
+    """The hinges of one model: stiffness k and rest values θ0 over the joint
+    vector (x, q, passive), and the hinges for the stresses."""
+
+    names: list[str]
+    dims: list[str]
+    k: np.ndarray
+    theta0: np.ndarray
+    hinges: list[Hinge]
+    sigma_allow: float | None = None
+    sources: list[str] = field(default_factory=list)
+
+    def moments(self, theta: np.ndarray) -> np.ndarray:
+        return self.k * (np.asarray(theta, dtype=float) - self.theta0)
+
+    def stresses(self, theta: np.ndarray) -> dict[str, float | None]:
+        dev = np.asarray(theta, dtype=float) - self.theta0
+        return {h.name: h.stress({a: float(dev[i]) for a, i in h.axes.items()}) for h in self.hinges}
+
+
+def joint_names(closure: LoopClosure) -> list[str]:
+    return closure.x_names + closure.q_names + closure.passive_names
+
+
+def _members(closure: LoopClosure, name: str, path: tuple) -> list[int]:
+    coords = list(closure.x) + list(closure.q) + list(closure.passive_coords)
+    exact = [i for i, c in enumerate(coords) if c.name == name]
+    if exact:
+        return exact
+    fam = [i for i, c in enumerate(coords) if c.family == name]
+    if fam:
+        return fam
+    known = sorted({c.name for c in coords} | {c.family for c in coords if c.family})
+    raise InputError(
+        f"unknown joint {name!r}; expected a coordinate or a family of {closure.name}: {', '.join(known)}",
+        path=path,
+        suggestions=suggest(name, known),
+    )
+
+
+def _stiffness_value(raw: Any, kind: str, path: tuple) -> float:
+    dim = "rotational_stiffness" if kind == "angle" else "stiffness"
+    value = parse_quantity(raw, dim, path)
+    if not value > 0:
+        raise InputError(f"expected a positive stiffness, got {raw!r}", path=path)
+    return value
+
+
+def _parse_hinge(  # noqa: C901 - one flat check per key of a hinge entry
+    closure: LoopClosure, gname: str, spec: Any, default_material: Material | None, path: tuple
+) -> list[Hinge]:
+    if not isinstance(spec, Mapping):
+        raise InputError(f"expected a hinge mapping {{joints, type, k, ...}}, got {spec!r}", path=path)
+    for key in spec:
+        if key not in HINGE_KEYS:
+            raise InputError(
+                f"unknown hinge key {key!r}; expected some of: {', '.join(HINGE_KEYS)}",
+                path=path + (str(key),),
+                suggestions=suggest(str(key), HINGE_KEYS),
+            )
+    joints = spec.get("joints")
+    if isinstance(joints, str):
+        joints = {"bend": joints}
+    if not isinstance(joints, Mapping) or not joints:
+        raise InputError(
+            f"expected joints: a coordinate or family name, or a mapping axis -> name (axes: {', '.join(AXES)}), "
+            f"got {joints!r}",
+            path=path + ("joints",),
+        )
+    axes: dict[str, list[int]] = {}
+    for axis, jname in joints.items():
+        if axis not in AXES:
+            raise InputError(
+                f"unknown hinge axis {axis!r}; expected one of: {', '.join(AXES)}",
+                path=path + ("joints", str(axis)),
+                suggestions=suggest(str(axis), AXES),
+            )
+        axes[axis] = _members(closure, str(jname), path + ("joints", axis))
+    counts = {len(v) for v in axes.values()}
+    if len(counts) != 1:
+        raise InputError(
+            "the joints of one hinge must have as many members each, got "
+            + ", ".join(f"{a}: {len(v)}" for a, v in axes.items()),
+            path=path + ("joints",),
+        )
+    coords = list(closure.x) + list(closure.q) + list(closure.passive_coords)
+    kind = spec.get("type")
+    if kind is not None and kind not in HINGE_TYPES:
+        raise InputError(
+            f"unknown hinge type {kind!r}; expected one of: {', '.join(HINGE_TYPES)}",
+            path=path + ("type",),
+            suggestions=suggest(str(kind), HINGE_TYPES),
+        )
+    dims: dict[str, float] = {}
+    if kind is not None:
+        need = HINGE_TYPES[kind].dims
+        extra = [d for d in DIM_OPTIONS if d not in need and spec.get(d) is not None]
+        if extra:
+            raise InputError(
+                f"hinge type {kind} has no dimension {', '.join(extra)} (it takes {', '.join(need)})", path=path
+            )
+        dims = validate_mapping(
+            {d: spec.get(d) for d in need}, [DIM_OPTIONS[d] for d in need], path, what="hinge dimension"
+        )
+        check_geometry(kind, dims, path)
+        kt = spec.get("Kt")
+        dims["Kt"] = 1.0 if kt is None else Option("Kt", "dimensionless", "", lower=1.0).parse(kt, path + ("Kt",))
+    mat = default_material
+    if spec.get("material") is not None:
+        mat = material(spec["material"], path + ("material",))
+    # stiffness: given per axis (or one value for a one-axis hinge), else the hinge formula
+    raw_k = spec.get("k")
+    given: dict[str, Any] = {}
+    if isinstance(raw_k, Mapping):
+        for a in raw_k:
+            if a not in axes:
+                raise InputError(
+                    f"stiffness given for axis {a!r}, which this hinge does not use (its axes: {', '.join(axes)})",
+                    path=path + ("k", str(a)),
+                )
+        given = dict(raw_k)
+    elif raw_k is not None:
+        if len(axes) != 1:
+            raise InputError(
+                f"this hinge has {len(axes)} axes ({', '.join(axes)}); give k per axis, e.g. k: {{bend: ...}}",
+                path=path + ("k",),
+            )
+        given = {next(iter(axes)): raw_k}
+    formula: dict[str, float] = {}
+    if kind is not None and any(a not in given for a in axes) and mat is None:
+        raise InputError(
+            f"hinge {gname}: its stiffness needs a material (or k for every axis)", path=path + ("material",)
+        )
+    if kind is not None and mat is not None and mat.E is not None:
+        G = mat.G if mat.nu is not None else None
+        formula = {a: float(v) for a, v in HINGE_TYPES[kind].stiffness(mat.E, G, dims).items()}
+    out: list[Hinge] = []
+    n = counts.pop()
+    for m in range(n):
+        idx = {a: v[m] for a, v in axes.items()}
+        k: dict[str, float] = {}
+        for a, i in idx.items():
+            if a in given:
+                sub = path + ("k", a) if isinstance(raw_k, Mapping) else path + ("k",)
+                k[a] = _stiffness_value(given[a], coords[i].kind, sub)
+            elif a in formula:
+                k[a] = float(formula[a])
+            else:
+                why = "a hinge type (and material)" if kind is None else "nu in the material"
+                raise InputError(
+                    f"hinge {gname}: no stiffness about {a} ({AXIS_TEXT[a]}); give k.{a} or {why}", path=path
+                )
+        name = gname if n == 1 else f"{gname}{m + 1}"
+        src = HINGE_TYPES[kind].source if kind else "given k"
+        out.append(Hinge(name, gname, kind, dims, idx, k, mat, src, {a: formula[a] for a in idx if a in formula}))
+    return out
+
+
+def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hinge
+    model: Model,
+    hinges: Mapping[str, Any] | None,
+    material_spec: Any = None,
+    sigma_allow: float | None = None,
+    path: tuple = ("inputs",),
+) -> HingeSet:
+    """The hinges of a model: the mechanism's declared defaults (its ``stiffness``
+    capability) merged, hinge by hinge and key by key, with ``hinges`` from the
+    problem file; ``material_spec`` overrides the default material."""
+    c = model.closure
+    mech = model.mechanism
+    decl = getattr(mech, "stiffness", None) if mech is not None else None
+    merged: dict[str, dict] = {k: dict(v) for k, v in (decl.hinges.items() if decl else ())}
+    if hinges is not None and not isinstance(hinges, Mapping):
+        raise InputError(f"expected a mapping of hinges (name -> {{joints, type, k, ...}}), got {hinges!r}", path=path)
+    for name, spec in (hinges or {}).items():
+        if isinstance(spec, Mapping):
+            merged[str(name)] = {**merged.get(str(name), {}), **spec}
+        elif spec is None:  # null removes a default hinge
+            merged.pop(str(name), None)
+        else:
+            merged[str(name)] = spec
+    if not merged:
+        raise InputError(
+            f"mechanism {model.name} declares no joint stiffness; give inputs.hinges "
+            "(name -> {joints: <coordinate or family>, k: ... or a hinge type with its dimensions})",
+            path=path + ("hinges",),
+        )
+    mat = None
+    if material_spec is not None:
+        mat = material(material_spec, path + ("material",))
+    elif decl is not None and decl.material is not None:
+        mat = material(decl.material, ("mechanism", "stiffness", "material"))
+    names = joint_names(c)
+    coords = list(c.x) + list(c.q) + list(c.passive_coords)
+    k = np.zeros(len(names))
+    out: list[Hinge] = []
+    for gname, spec in merged.items():
+        hpath = path + ("hinges", gname) if hinges and gname in hinges else ("mechanism", "stiffness", gname)
+        for h in _parse_hinge(c, gname, spec, mat, hpath):
+            for a, i in h.axes.items():
+                if k[i] != 0.0:
+                    raise InputError(f"joint {names[i]} carries two hinges", path=hpath + ("joints", a))
+                k[i] = h.k[a]
+            out.append(h)
+    theta0 = joint_vector(model, model.x_home, model.q_home)
+    return HingeSet(names, [co.kind for co in coords], k, theta0, out, sigma_allow, [decl.source] if decl else [])
+
+
+def allowable(hs: HingeSet, sigma_allow: float | None, safety_factor: float, path: tuple) -> float:
+    """σ_allow: sigma_allow / safety_factor when given; else, with a safety factor above 1,
+    the hinge material's yield strength / safety_factor; else the material's allowable
+    (design) stress, which already holds its source's safety factor, or its yield strength.
+    The smallest over the hinge materials."""
+    if sigma_allow is not None:
+        return sigma_allow / safety_factor
+    mats = {h.material.name: h.material for h in hs.hinges if h.material is not None and h.kind is not None}
+    if not mats:
+        raise InputError("a stress limit needs sigma_allow or a hinge material", path=path + ("sigma_allow",))
+    values = []
+    why = "a stress limit needs it (or give sigma_allow)"
+    for m in mats.values():
+        if safety_factor > 1 or m.allowable is None:
+            values.append(m.require("yield_strength", path + ("material",), why) / safety_factor)
+        else:
+            values.append(m.allowable)
+    return min(values)
+
+
+def joint_vector(model: Model, x: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """(x, q, passive) at one pose."""
+    c = model.closure
+    parts = [np.asarray(x, dtype=float).ravel(), np.asarray(q, dtype=float).ravel()]
+    if c.passive is not None:
+        parts.append(np.asarray(c.passive(x, q, model.p), dtype=float).ravel())
+    return np.concatenate(parts)
+
+
+# -- CasADi functions, built once per mechanism type --------------------------------------------------
+
+
+@functools.lru_cache(maxsize=16)
+def energy_function(closure: LoopClosure) -> ca.Function:
+    """``("pseudo_rigid_body", [x, q, p, k, theta0, f], [V, F, K_q, J, theta])``: the
+    energy V = U - fᵀx, the actuator forces F, the input stiffness K_q, the
+    forward Jacobian J and the joint vector θ = (x, q, passive), all symbolic
+    (the reference :func:`static_point` is checked against; slower, as the
+    symbolic Φ_x⁻¹ grows the expression)."""
+    c = closure
+    x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
+    n = c.nx + c.nq + len(c.passive_coords)
+    k, th0, f = ca.SX.sym("k", n), ca.SX.sym("theta0", n), ca.SX.sym("f", c.nx)
+    theta = _theta(c, x, q, p)
+    d = theta - th0
+    V = 0.5 * ca.dot(k, d * d) - ca.dot(f, x)
+    J = c.jacobian(x, q, p)
+    F = ca.gradient(V, q) + J.T @ ca.gradient(V, x)
+    Kq = ca.jacobian(F, q) + ca.jacobian(F, x) @ J
+    return ca.Function(
+        "pseudo_rigid_body",
+        [x, q, p, k, th0, f],
+        [V, F, Kq, J, theta],
+        ["x", "q", "p", "k", "theta0", "f"],
+        ["V", "F", "K_q", "J", "theta"],
+    )
+
+
+def _theta(c: LoopClosure, x: Any, q: Any, p: Any) -> Any:
+    return ca.vertcat(*([x, q] + ([c.passive(x, q, p)] if c.passive is not None else [])))
+
+
+@functools.lru_cache(maxsize=16)
+def energy_parts(closure: LoopClosure) -> Any:
+    """The derivatives the reduced quantities need, over z = (x, q):
+    ``("pseudo_rigid_body_parts", [x, q, p, k, theta0, f], [V, dV, d2V, dPhi, d2Phi, theta])``
+    with d2Phi the Hessians of the nx residuals stacked.  With λ = Φ_x⁻ᵀ V_x (adjoint),
+    F = V_q - Φ_qᵀ λ and K_q = Zᵀ (∇²V - Σ λ_i ∇²Φ_i) Z, Z = [J; I] (the reduced
+    Hessian of V(x(q), q)); the small linear algebra is done in numpy.  Wrapped for
+    fast calls (:class:`~cpm_nlp.core.kernels.FastFunction`)."""
+    c = closure
+    x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
+    n = c.nx + c.nq + len(c.passive_coords)
+    k, th0, f = ca.SX.sym("k", n), ca.SX.sym("theta0", n), ca.SX.sym("f", c.nx)
+    z = ca.vertcat(x, q)
+    theta = _theta(c, x, q, p)
+    d = theta - th0
+    V = 0.5 * ca.dot(k, d * d) - ca.dot(f, x)
+    dV, d2V = ca.gradient(V, z), ca.hessian(V, z)[0]
+    phi = c.phi(x, q, p)
+    dphi = ca.jacobian(phi, z)
+    d2phi = ca.vertcat(*[ca.hessian(phi[i], z)[0] for i in range(c.nx)])
+    fn = ca.Function(
+        "pseudo_rigid_body_parts",
+        [x, q, p, k, th0, f],
+        [ca.densify(e) for e in (V, dV, d2V, dphi, d2phi, theta)],
+        ["x", "q", "p", "k", "theta0", "f"],
+        ["V", "dV", "d2V", "dPhi", "d2Phi", "theta"],
+    )
+    return FastFunction(fn)
+
+
+@dataclass
+class StaticPoint:
+    """Actuator forces, input stiffness and hinge stresses at one pose."""
+
+    x: np.ndarray
+    q: np.ndarray
+    F: np.ndarray
+    K_q: np.ndarray
+    J: np.ndarray
+    theta: np.ndarray
+    energy: float
+    stresses: dict[str, float | None]
+
+    @property
+    def stress_max(self) -> float | None:
+        vals = [s for s in self.stresses.values() if s is not None]
+        return max(vals) if vals else None
+
+
+def static_point(model: Model, hs: HingeSet, x, q, f=None) -> StaticPoint:
+    """Forces, stiffness and stresses at a solved pose (x, q) under the load f (nx)."""
+    c = model.closure
+    nx, nq = c.nx, c.nq
+    nz = nx + nq
+    load = np.zeros(nx) if f is None else np.asarray(f, dtype=float)
+    V, dV, d2V, dphi, d2phi, theta = energy_parts(c)(x, q, model.p, hs.k, hs.theta0, load)
+    d2V = d2V.reshape(nz, nz, order="F")
+    dphi = dphi.reshape(nx, nz, order="F")
+    # the stacked Hessians, (nx nz) x nz column-major: flat index i*nz + a + b*nx*nz -> [b, a, i]
+    d2phi = d2phi.reshape(nz, nx, nz).transpose(0, 2, 1)
+    phi_x, phi_q = dphi[:, :nx], dphi[:, nx:]
+    inv = np.linalg.inv(phi_x)
+    J = -inv @ phi_q
+    lam = inv.T @ dV[:nx]
+    F = dV[nx:] - phi_q.T @ lam
+    H = d2V - d2phi @ lam  # Hessians are symmetric, so [b, a] = [a, b]
+    Z = np.empty((nz, nq))
+    Z[:nx], Z[nx:] = J, np.eye(nq)
+    Kq = Z.T @ H @ Z
+    return StaticPoint(
+        np.asarray(x, dtype=float),
+        np.asarray(q, dtype=float),
+        F,
+        0.5 * (Kq + Kq.T),
+        J,
+        theta,
+        float(V[0]),
+        hs.stresses(theta),
+    )
+
+
+def output_compliance(sp: StaticPoint, k_actuator: np.ndarray | None) -> np.ndarray:
+    """C_x = J (K_q + K_a)⁻¹ Jᵀ (nx x nx); k_actuator None: positions held (C = 0)."""
+    nx = sp.J.shape[0]
+    if k_actuator is None:
+        return np.zeros((nx, nx))
+    K = sp.K_q + np.diag(k_actuator)
+    if np.linalg.cond(K) > 1e12:
+        raise np.linalg.LinAlgError("K_q + K_a is singular")
+    return sp.J @ np.linalg.solve(K, sp.J.T)
+
+
+@functools.lru_cache(maxsize=16)
+def compliant_fk_solver(closure: LoopClosure) -> ca.Function:
+    """IPOPT: min_{x,q} U - fᵀx + ½ Σ ka (q - qc)² - Fcᵀ(q - qc) s.t. Φ(x, q; p) = 0,
+    with parameters (qc, p, k, theta0, f, ka, Fc); scaled by ``scale`` (a stiffness)."""
+    c = closure
+    x, q = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq)
+    p = ca.SX.sym("p", c.np)
+    n = c.nx + c.nq + len(c.passive_coords)
+    k, th0, f = ca.SX.sym("k", n), ca.SX.sym("theta0", n), ca.SX.sym("f", c.nx)
+    qc, ka, Fc = ca.SX.sym("qc", c.nq), ca.SX.sym("ka", c.nq), ca.SX.sym("Fc", c.nq)
+    scale = ca.SX.sym("scale")
+    theta = ca.vertcat(*([x, q] + ([c.passive(x, q, p)] if c.passive is not None else [])))
+    d = theta - th0
+    dq = q - qc
+    V = 0.5 * ca.dot(k, d * d) - ca.dot(f, x) + 0.5 * ca.dot(ka, dq * dq) - ca.dot(Fc, dq)
+    nlp = {
+        "x": ca.vertcat(x, q),
+        "p": ca.vertcat(qc, p, k, th0, f, ka, Fc, scale),
+        "f": V / scale,
+        "g": c.phi(x, q, p),
+    }
+    opts = {
+        "ipopt.print_level": 0,
+        "print_time": False,
+        "ipopt.sb": "yes",
+        "ipopt.tol": 1e-12,
+        "ipopt.constr_viol_tol": 1e-13,
+        "ipopt.hessian_approximation": "exact",
+    }
+    return ca.nlpsol(f"{c.name}_compliant_fk", "ipopt", nlp, opts)
+
+
+@dataclass
+class CompliantPose:
+    ok: bool
+    x: np.ndarray
+    q: np.ndarray
+    message: str
+    iterations: int
+
+
+def compliant_fk(
+    model: Model, hs: HingeSet, x_c, q_c, F_c, f, k_actuator: np.ndarray | None, tol: float = 1e-10
+) -> CompliantPose:
+    """The loaded pose from the unloaded commanded pose (x_c, q_c) whose actuator
+    forces are F_c; k_actuator None holds the positions."""
+    c = model.closure
+    solver = compliant_fk_solver(c)
+    ka = np.zeros(c.nq) if k_actuator is None else np.asarray(k_actuator, dtype=float)
+    scale = max(float(np.max(hs.k)), 1e-300)
+    # no bounds: the loaded pose stays next to the commanded one (checked on the branch
+    # afterwards), and without inequalities IPOPT runs as a plain Newton-SQP (no barrier)
+    lbx = np.full(c.nx + c.nq, -np.inf)
+    ubx = np.full(c.nx + c.nq, np.inf)
+    if k_actuator is None:
+        lbx[c.nx :] = ubx[c.nx :] = q_c
+    par = np.concatenate([q_c, model.p, hs.k, hs.theta0, f, ka, F_c, [scale]])
+    sol = solver(x0=np.concatenate([x_c, q_c]), p=par, lbx=lbx, ubx=ubx, lbg=0.0, ubg=0.0)
+    stats = solver.stats()
+    z = np.asarray(sol["x"], dtype=float).ravel()
+    x, q = z[: c.nx], z[c.nx :]
+    res = float(np.max(np.abs(np.asarray(c.phi(x, q, model.p), dtype=float)))) if c.nx else 0.0
+    ok = bool(stats.get("success", False)) and res <= tol
+    msg = stats.get("return_status", "") + (f"; residual {res:.3g}" if res > tol else "")
+    if ok and c.branch is not None:
+        g = np.asarray(c.branch(x, q, model.p), dtype=float).ravel()
+        if not np.all(g > 0):
+            ok, msg = False, msg + "; the loaded pose left the assembly branch"
+    return CompliantPose(ok, x, q, msg, int(stats.get("iter_count", 0)))
+
+
+# -- stress limits as joint limits ----------------------------------------------------------------
+
+
+def stress_angle_limits(hs: HingeSet, sigma_allow: float) -> dict[str, tuple[float, float]]:
+    """Joint limits from a stress limit: for each joint coordinate carried by a hinge
+    with a geometry, θ0 ± δ, δ the deflection about that axis alone at which the hinge
+    reaches sigma_allow (the smallest over the hinges on that joint).  The minimal
+    generalization of pantograph-3d-elgammal-2016.md eq 31 (ψ = π/2 ∓ δ_max): deflections
+    about several axes of one hinge at once add up, which per-axis limits do not see."""
+    out: dict[str, tuple[float, float]] = {}
+    for h in hs.hinges:
+        for axis, i in h.axes.items():
+            delta = h.angle_limit(axis, sigma_allow)
+            if delta is None:
+                continue
+            name = hs.names[i]
+            lo, hi = hs.theta0[i] - delta, hs.theta0[i] + delta
+            if name in out:
+                lo, hi = max(lo, out[name][0]), min(hi, out[name][1])
+            out[name] = (float(lo), float(hi))
+    return out
+
+
+def with_limits(model: Model, limits: Mapping[str, tuple[float, float]]) -> Model:
+    """A copy of the model with extra joint limits (each intersected with any it has)."""
+    merged = dict(model.limits)
+    coords = {c.name: c for c in list(model.closure.x) + list(model.closure.q) + list(model.closure.passive_coords)}
+    for name, (lo, hi) in limits.items():
+        old = model.limit_of(coords[name])
+        if old is not None:
+            lo, hi = max(lo, old[0]), min(hi, old[1])
+        merged[name] = (lo, hi)
+    return dataclasses.replace(model, limits=merged)

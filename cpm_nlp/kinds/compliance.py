@@ -1,0 +1,628 @@
+"""Problem kinds of compliance, stiffness and strength, for any mechanism whose
+joints carry hinges (declared by the mechanism's ``stiffness`` capability or
+given under ``inputs.hinges``); the method is :mod:`cpm_nlp.analysis.compliance`.
+
+* ``actuator_forces`` -- the actuator forces, input stiffness K_q and hinge
+  stresses along a motion (actuator inputs, or poses through IK), and the motion
+  at which the first hinge reaches the allowable stress;
+* ``platform_compliance`` -- the 6x6 (nx x nx) output compliance at a pose and the
+  compliant forward kinematics under a load;
+* ``natural_frequencies`` -- frequencies and mode shapes, linearized Lagrange at
+  a pose, from masses and inertias on the coordinates and the hinge stiffness.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+
+from ..analysis import compliance as cm
+from ..analysis.dynamics import parse_mass
+from ..core.errors import InputError, unknown_key_error
+from ..core.kind import (
+    ProblemKind,
+    actuator_options,
+    broadcast,
+    check_actuator_limits,
+    given,
+    task_options,
+    task_values,
+)
+from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics
+from ..core.model import Model
+from ..core.options import Option, validate_mapping
+from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
+from ..core.solver import SolverConfig
+from ..core.units import parse_quantity
+from .kinematic import _model_info, _pose_names, _pose_values, _si
+
+#: inputs parsed by hand (mappings), declared for ``describe``
+_SPECIAL = ("hinges", "material", "load", "masses")
+
+
+def _hinge_options() -> list[Option]:
+    return [
+        Option(
+            "hinges",
+            "str",
+            "hinges over the mechanism's defaults: name -> {joints: <coordinate or family, or axis -> name>, "
+            "k: <N*m/rad or N/m, or axis -> value>, type: circular_notch|circular_rod|leaf_spring, t, r, w, d, l, "
+            "Kt, material}; null removes a default hinge",
+            default=None,
+        ),
+        Option("material", "str", "the hinge material (a name or inline {E, nu, yield_strength, ...})", default=None),
+    ]
+
+
+def _load_option(model: Model) -> Option:
+    names = ", ".join(f"{x.name} ({'force' if x.kind == 'length' else 'moment'})" for x in model.closure.x)
+    return Option(
+        "load",
+        "str",
+        f"external load on the platform, conjugate to the pose coordinates: a mapping over {names}",
+        default=None,
+    )
+
+
+def _pose_inputs(model: Model) -> list[Option]:
+    return task_options(model, "grid") + actuator_options(model, "grid")
+
+
+def _split(raw: Any, path: tuple) -> tuple[dict, dict]:
+    if raw is None:
+        raw = {}
+    if not isinstance(raw, Mapping):
+        raise InputError(f"expected a mapping of inputs, got {type(raw).__name__} {raw!r}", path=path)
+    special = {k: raw[k] for k in _SPECIAL if k in raw}
+    rest = {k: v for k, v in raw.items() if k not in _SPECIAL}
+    return rest, special
+
+
+def parse_load(raw: Any, model: Model, path: tuple) -> np.ndarray:
+    """A load mapping (pose coordinate -> force on a length, moment on an angle) as an nx vector."""
+    c = model.closure
+    f = np.zeros(c.nx)
+    if raw is None:
+        return f
+    if not isinstance(raw, Mapping):
+        raise InputError(
+            f"expected a load mapping such as {{{c.x_names[0]}: 1 N}}, got {type(raw).__name__} {raw!r}", path=path
+        )
+    for key, value in raw.items():
+        if key not in c.x_names:
+            raise unknown_key_error(str(key), c.x_names, path, "pose coordinate")
+        i = c.x_names.index(key)
+        dim = "force" if c.x[i].kind == "length" else "moment"
+        f[i] = parse_quantity(value, dim, path + (key,))
+    return f
+
+
+def _solve_poses(model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> tuple[list[PoseSolution], bool]:
+    c = model.closure
+    if given(inputs, c.q_names):
+        qs, batch = broadcast([inputs[n] for n in c.q_names], c.q_names, ("inputs",))
+        return [forward_kinematics(model, q, solver) for q in qs], batch
+    ts, batch = broadcast(task_values(inputs, model, ("inputs",)), list(c.task), ("inputs",))
+    return [inverse_kinematics(model, t, solver) for t in ts], batch
+
+
+def _check_pose_inputs(model: Model, inputs: Mapping[str, Any], path: tuple, required: bool = True) -> None:
+    c = model.closure
+    pose_keys = given(inputs, [o.name for o in task_options(model, "grid")])
+    act_keys = given(inputs, c.q_names)
+    if pose_keys and act_keys:
+        raise InputError(
+            f"give either the pose ({', '.join(pose_keys)}) or the actuators ({', '.join(act_keys)}), not both",
+            path=path,
+        )
+    if act_keys:
+        if len(act_keys) != c.nq:
+            raise InputError(f"give every actuator: {', '.join(c.q_names)}", path=path)
+        check_actuator_limits(model, inputs, path)
+        broadcast([inputs[n] for n in c.q_names], c.q_names, path)
+    elif pose_keys or required:
+        broadcast(task_values(inputs, model, path), list(c.task), path)
+
+
+def _summary(sols: list[PoseSolution], batch: bool) -> tuple[Status, str, list[Status] | None]:
+    statuses = [s.status for s in sols]
+    bad = [(k, s) for k, s in enumerate(sols) if not s.ok]
+    if not bad:
+        return Status.SOLVED, f"{len(sols)} pose(s) solved", statuses if batch else None
+    k, s = bad[0]
+    msg = f"{len(bad)} of {len(sols)} poses not solved; first, point {k}: {STATUS_TEXT[s.status]}" + (
+        f" ({s.message})" if s.message else ""
+    )
+    return worst_status(statuses), msg, statuses if batch else None
+
+
+class _HingeKind(ProblemKind):
+    """Shared input handling: pose or actuator inputs, hinges, material, load."""
+
+    def supports(self, model: Model) -> str | None:
+        c = model.closure
+        if c.nx == 0:  # pragma: no cover - every closure has a pose
+            return "it has no pose coordinates"
+        return None
+
+    def extra_options(self, model: Model) -> list[Option]:
+        return []
+
+    def input_options(self, model: Model) -> list[Option]:
+        return _pose_inputs(model) + _hinge_options() + [_load_option(model)] + self.extra_options(model)
+
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        rest, special = _split(raw, path)
+        opts = [o for o in self.input_options(model) if o.name not in _SPECIAL]
+        inputs = validate_mapping(rest, opts, path, what="input")
+        sigma = inputs.get("sigma_allow")
+        inputs["hinge_set"] = cm.hinge_set(model, special.get("hinges"), special.get("material"), sigma, path)
+        inputs["load"] = parse_load(special.get("load"), model, path + ("load",))
+        inputs["masses_raw"] = special.get("masses")
+        self.check_inputs(inputs, model, path)
+        return inputs
+
+
+def _stress_values(hs: cm.HingeSet, points: list[cm.StaticPoint | None], batch: bool) -> tuple[dict, dict]:
+    groups = sorted({h.group for h in hs.hinges if h.kind is not None})
+    values: dict[str, Any] = {}
+    dims: dict[str, str] = {}
+    cols: dict[str, list] = {"stress_max": []}
+    cols.update({f"stress_{g}": [] for g in groups})
+    for sp in points:
+        if sp is None:
+            for v in cols.values():
+                v.append(None)
+            continue
+        cols["stress_max"].append(sp.stress_max)
+        for g in groups:
+            vals = [s for h, s in zip(hs.hinges, sp.stresses.values()) if h.group == g and s is not None]
+            cols[f"stress_{g}"].append(max(vals) if vals else None)
+    for k, v in cols.items():
+        values[k] = v if batch else v[0]
+        dims[k] = "stress"
+    return values, dims
+
+
+class ActuatorForces(_HingeKind):
+    name = "actuator_forces"
+    description = (
+        "actuator forces (gradient of the hinge strain energy, AD through the kinematics, plus a platform load), "
+        "input stiffness K_q and hinge stresses along a motion; the motion where the first hinge reaches sigma_allow"
+    )
+    plots = ("forces",)
+
+    def extra_options(self, model: Model) -> list[Option]:
+        return [
+            Option(
+                "stress_limit",
+                "bool",
+                "also find the motion (along the ray from home through the last point) at which the first hinge "
+                "reaches the allowable stress, on the nonlinear kinematics, and its linear extrapolation",
+                default=False,
+            ),
+            Option(
+                "sigma_allow",
+                "stress",
+                "allowable stress (default: the hinge material's allowable, else its yield strength / safety_factor)",
+                default=None,
+                lower=0.0,
+                strict=True,
+            ),
+            Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
+        ]
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        _check_pose_inputs(model, inputs, path)
+        if inputs["stress_limit"]:
+            hs = inputs["hinge_set"]
+            if not any(h.kind is not None for h in hs.hinges):
+                raise InputError(
+                    "a stress limit needs hinges with a flexure type and dimensions (the stiffness alone gives "
+                    "no stress)",
+                    path=path + ("stress_limit",),
+                )
+            inputs["sigma"] = cm.allowable(hs, inputs.get("sigma_allow"), inputs["safety_factor"], path)
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        c = model.closure
+        hs: cm.HingeSet = inputs["hinge_set"]
+        f = inputs["load"]
+        sols, batch = _solve_poses(model, inputs, solver)
+        points = [cm.static_point(model, hs, s.x, s.q, f) if s.ok else None for s in sols]
+        status, message, statuses = _summary(sols, batch)
+        names, dims = _pose_names(model)
+        values = _pose_values(model, sols, batch)
+        units = {n: _si(dims[n]) for n in names}
+        for j in range(c.nq):
+            col = [None if sp is None else float(sp.F[j]) for sp in points]
+            values[f"F{j + 1}"] = col if batch else col[0]
+            dims[f"F{j + 1}"] = "force" if c.q[j].kind == "length" else "moment"
+            units[f"F{j + 1}"] = "N" if c.q[j].kind == "length" else "N*m"
+        sv, sd = _stress_values(hs, points, batch)
+        values.update(sv)
+        dims.update(sd)
+        units.update({k: "Pa" for k in sd})
+        kq = [None if sp is None else sp.K_q.tolist() for sp in points]
+        energy = [None if sp is None else sp.energy for sp in points]
+        values.update(K_q=kq if batch else kq[0], energy=energy if batch else energy[0])
+        dims.update(K_q="matrix", energy="energy")
+        units.update(K_q=f"N/m or N*m/rad (rows and columns {', '.join(c.q_names)})", energy="J")
+        seen: set[str] = set()
+        for h in hs.hinges:
+            if h.group in seen:
+                continue
+            seen.add(h.group)
+            for a, kf in h.k_formula.items():
+                kind = [model.closure.x, model.closure.q, model.closure.passive_coords]
+                coord = (list(kind[0]) + list(kind[1]) + list(kind[2]))[h.axes[a]]
+                values[f"k_formula_{h.group}_{a}"] = kf
+                dims[f"k_formula_{h.group}_{a}"] = "rotational_stiffness" if coord.kind == "angle" else "stiffness"
+                units[f"k_formula_{h.group}_{a}"] = "N*m/rad" if coord.kind == "angle" else "N/m"
+        if inputs["stress_limit"]:
+            last = sols[-1]
+            lim_values, lim_dims, lim_msg = (
+                self._limit(model, hs, inputs, last, solver)
+                if last.ok
+                else ({}, {}, "no stress limit: the last point was not solved")
+            )
+            values.update(lim_values)
+            dims.update(lim_dims)
+            units.update({k: _si(d) for k, d in lim_dims.items()})
+            message += "; " + lim_msg
+        info = SolverInfo(
+            "+".join(sorted({s.solver for s in sols if s.solver})) or solver.name,
+            sum(s.iterations for s in sols),
+            sum(s.seconds for s in sols),
+        )
+        return Result(self.name, status, values, units, dims, info, message, statuses, _model_info(model))
+
+    def _limit(self, model: Model, hs: cm.HingeSet, inputs: Mapping[str, Any], end: PoseSolution, solver):  # noqa: C901 - bracket, root, then one value family per coordinate kind
+        """The scale λ of the ray home -> end at which the largest stress reaches σ_allow."""
+        c = model.closure
+        sigma = inputs["sigma"]
+        by_actuators = bool(given(inputs, c.q_names))
+        t_home, t_end = model.task_of(model.x_home), model.task_of(end.x)
+
+        def pose(lam: float) -> PoseSolution:
+            if by_actuators:
+                return forward_kinematics(model, model.q_home + lam * (end.q - model.q_home), solver)
+            return inverse_kinematics(model, t_home + lam * (t_end - t_home), solver)
+
+        def excess(lam: float) -> float:
+            sol = pose(lam)
+            if not sol.ok:
+                raise _OutOfReach(lam, sol)
+            sp = cm.static_point(model, hs, sol.x, sol.q, inputs["load"])
+            return (sp.stress_max or 0.0) - sigma
+
+        s_end = excess(1.0) + sigma
+        lam_lin = sigma / s_end if s_end > 0 else None
+        lam_hi = 1.0
+        try:
+            while excess(lam_hi) < 0:
+                lam_hi *= 2.0
+                if lam_hi > 1e6:
+                    return {}, {}, "the stresses never reach sigma_allow along this motion"
+            lam = scipy.optimize.brentq(excess, 0.0 if lam_hi == 1.0 else lam_hi / 2, lam_hi, xtol=1e-12, rtol=1e-12)
+        except _OutOfReach as exc:
+            return (
+                {},
+                {},
+                f"the motion leaves the reachable poses (scale {exc.lam:g}: {exc.sol.status.value}) before a hinge "
+                f"reaches sigma_allow",
+            )
+        sol = pose(lam)
+        values: dict[str, Any] = {"sigma_allow": sigma, "scale_at_allowable": lam, "scale_at_allowable_linear": lam_lin}
+        dims: dict[str, str] = {"sigma_allow": "stress", "scale_at_allowable": "dimensionless"}
+        dims["scale_at_allowable_linear"] = "dimensionless"
+        for k, i in enumerate(c.task_index):
+            name = c.x[i].name
+            values[f"{name}_at_allowable"] = float(sol.x[i])
+            values[f"{name}_at_allowable_linear"] = float(t_home[k] + lam_lin * (t_end[k] - t_home[k]))
+            dims[f"{name}_at_allowable"] = dims[f"{name}_at_allowable_linear"] = c.x[i].kind
+        for off, target in c.offsets.items():
+            i = c.x_names.index(target)
+            values[f"{off}_at_allowable"] = float(sol.x[i] - model.x_home[i])
+            values[f"{off}_at_allowable_linear"] = values[f"{target}_at_allowable_linear"] - float(model.x_home[i])
+            dims[f"{off}_at_allowable"] = dims[f"{off}_at_allowable_linear"] = c.x[i].kind
+        for j, qn in enumerate(c.q_names):
+            values[f"{qn}_at_allowable"] = float(sol.q[j])
+            dims[f"{qn}_at_allowable"] = c.q[j].kind
+        return values, dims, f"first hinge at sigma_allow = {sigma / 1e6:.6g} MPa at scale {lam:.6g} of the motion"
+
+    def output_names(self, model: Model) -> list[str]:
+        c = model.closure
+        names = _pose_names(model)[0] + [f"F{j + 1}" for j in range(c.nq)] + ["stress_max", "K_q", "energy"]
+        names += ["sigma_allow", "scale_at_allowable", "scale_at_allowable_linear"]
+        for i in c.task_index:
+            names += [f"{c.x[i].name}_at_allowable", f"{c.x[i].name}_at_allowable_linear"]
+        for off in c.offsets:
+            names += [f"{off}_at_allowable", f"{off}_at_allowable_linear"]
+        names += [f"{q}_at_allowable" for q in c.q_names]
+        decl = getattr(model.mechanism, "stiffness", None) if model.mechanism is not None else None
+        if decl is not None:
+            names += [f"stress_{g}" for g in decl.hinges]
+        return names
+
+
+class _OutOfReach(Exception):
+    def __init__(self, lam: float, sol: PoseSolution) -> None:
+        super().__init__(f"scale {lam}")
+        self.lam, self.sol = lam, sol
+
+
+def _k_actuator(raw: Any, model: Model, path: tuple) -> np.ndarray | None:
+    if raw is None or raw == "rigid":
+        return None
+    values = raw if isinstance(raw, list) else [raw] * model.closure.nq
+    if len(values) != model.closure.nq:
+        raise InputError(f"expected one actuator stiffness or {model.closure.nq}, got {len(values)}", path=path)
+    out = []
+    for k, (v, q) in enumerate(zip(values, model.closure.q)):
+        dim = "stiffness" if q.kind == "length" else "rotational_stiffness"
+        val = parse_quantity(v, dim, path + ((k,) if isinstance(raw, list) else ()))
+        if val < 0:
+            raise InputError(f"expected a stiffness >= 0, got {v!r}", path=path)
+        out.append(val)
+    return np.array(out)
+
+
+class PlatformCompliance(_HingeKind):
+    name = "platform_compliance"
+    description = (
+        "output compliance C = J (K_q + K_a)^-1 J^T at a pose and the compliant forward kinematics under a load "
+        "(minimum potential energy on the loop closures, IPOPT): deflection, linear deflection C f, hinge stresses"
+    )
+    plots = ("ellipsoid",)
+
+    def extra_options(self, model: Model) -> list[Option]:
+        return [
+            Option(
+                "k_actuator",
+                "str",
+                "actuator stiffness: 'rigid' (positions held: with rigid links the pseudo-rigid-body model then has "
+                "no deflection), 0 N/m (the actuator forces held, the load case of a FEM with forces at the "
+                "actuators), or a stiffness (one, or one per actuator)",
+                default="rigid",
+            )
+        ]
+
+    def input_options(self, model: Model) -> list[Option]:
+        return (
+            task_options(model, "scalar")
+            + actuator_options(model, "scalar")
+            + super().input_options(model)[len(_pose_inputs(model)) :]
+        )
+
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        raw = dict(raw) if isinstance(raw, Mapping) else raw
+        ka = raw.pop("k_actuator", None) if isinstance(raw, dict) else None
+        inputs = super().parse_inputs(raw, model, path)
+        inputs["k_actuator"] = _k_actuator(ka, model, path + ("k_actuator",))
+        return inputs
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        _check_pose_inputs(model, inputs, path, required=False)
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        c = model.closure
+        hs: cm.HingeSet = inputs["hinge_set"]
+        f, ka = inputs["load"], inputs["k_actuator"]
+        if given(inputs, c.q_names) or given(inputs, [o.name for o in task_options(model, "scalar")]):
+            sol = _solve_poses(model, inputs, solver)[0][0]
+        else:
+            sol = inverse_kinematics(model, model.task_of(model.x_home), solver)
+        names, dims = _pose_names(model)
+        units = {n: _si(dims[n]) for n in names}
+        values = _pose_values(model, [sol], False)
+        info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
+        if not sol.ok:
+            return Result(self.name, sol.status, values, units, dims, info, sol.message, None, _model_info(model))
+        sp = cm.static_point(model, hs, sol.x, sol.q)
+        try:
+            C = cm.output_compliance(sp, ka)
+        except np.linalg.LinAlgError:
+            msg = (
+                "K_q + K_a is singular: the hinges and actuators leave a motion without stiffness "
+                "(give a positive k_actuator, or more hinges)"
+            )
+            return Result(self.name, Status.SINGULAR, values, units, dims, info, msg, None, _model_info(model))
+        lin = C @ f
+        loaded = cm.compliant_fk(model, hs, sol.x, sol.q, sp.F, f, ka)
+        xs = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
+        values.update(C=C.tolist(), deflection_linear=lin.tolist())
+        dims.update(C="matrix", deflection_linear="vector")
+        units.update(C=f"rows and columns {xs}; m/N, rad/(N*m) and mixed", deflection_linear=xs)
+        for i, x in enumerate(c.x):
+            values[f"C_{x.name}"] = float(C[i, i])
+            dims[f"C_{x.name}"] = "compliance" if x.kind == "length" else "rotational_compliance"
+            units[f"C_{x.name}"] = "m/N" if x.kind == "length" else "rad/(N*m)"
+        status, message = Status.SOLVED, "compliant forward kinematics by IPOPT (" + loaded.message + ")"
+        if not np.any(f):
+            message = "no load: the output compliance only"
+        if loaded.ok:
+            d = loaded.x - sol.x
+            values["deflection"] = d.tolist()
+            dims["deflection"] = "vector"
+            units["deflection"] = xs
+            for i, x in enumerate(c.x):
+                values[f"d_{x.name}"] = float(d[i])
+                dims[f"d_{x.name}"] = x.kind
+                units[f"d_{x.name}"] = _si(x.kind)
+            spl = cm.static_point(model, hs, loaded.x, loaded.q)
+            sv, sd = _stress_values(hs, [spl], False)
+            values.update({k + "_loaded": v for k, v in sv.items()})
+            dims.update({k + "_loaded": v for k, v in sd.items()})
+            units.update({k + "_loaded": "Pa" for k in sd})
+            values["q_loaded"] = loaded.q.tolist()
+            dims["q_loaded"] = "vector"
+            units["q_loaded"] = ", ".join(f"{q.name} [{_si(q.kind)}]" for q in c.q)
+        else:
+            status = Status.NOT_CONVERGED
+        if ka is None:
+            message += "; actuators rigidly held: a pseudo-rigid-body model with rigid links does not deflect"
+        info = SolverInfo("ipopt", sol.iterations + loaded.iterations, sol.seconds)
+        return Result(self.name, status, values, units, dims, info, message, None, _model_info(model))
+
+    def output_names(self, model: Model) -> list[str]:
+        c = model.closure
+        names = _pose_names(model)[0] + ["C", "deflection_linear", "deflection", "q_loaded", "stress_max_loaded"]
+        names += [f"C_{x.name}" for x in c.x] + [f"d_{x.name}" for x in c.x]
+        return names
+
+
+class NaturalFrequencies(_HingeKind):
+    name = "natural_frequencies"
+    description = (
+        "natural frequencies and mode shapes at a pose: linearized Lagrange with M = J^T M_x J + M_q from masses "
+        "and inertias on the coordinates and K = K_q, the hinge energy's Hessian along the loop closures"
+    )
+    plots = ("modes",)
+
+    def input_options(self, model: Model) -> list[Option]:
+        opts = task_options(model, "scalar") + actuator_options(model, "scalar") + _hinge_options()
+        opts.append(
+            Option(
+                "masses",
+                "str",
+                "mass (on a length coordinate: '12 g', or a block {length, width, height} of the material) or "
+                "inertia (on an angle coordinate, kg*m^2) per pose or actuator coordinate: "
+                + ", ".join(model.closure.x_names + model.closure.q_names),
+            )
+        )
+        return opts
+
+    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        if isinstance(raw, Mapping) and "load" in raw:
+            raise unknown_key_error("load", [o.name for o in self.input_options(model)], path, "input")
+        inputs = super().parse_inputs(raw, model, path)
+        c = model.closure
+        masses = inputs.pop("masses_raw")
+        if not isinstance(masses, Mapping) or not masses:
+            raise InputError(
+                f"expected masses: a mapping of coordinate -> mass or inertia over {', '.join(c.x_names + c.q_names)}",
+                path=path + ("masses",),
+            )
+        hs: cm.HingeSet = inputs["hinge_set"]
+        mat = next((h.material for h in hs.hinges if h.material is not None), None)
+        mx, mq = np.zeros(c.nx), np.zeros(c.nq)
+        for key, value in masses.items():
+            names = c.x_names + c.q_names
+            if key not in names:
+                raise unknown_key_error(str(key), names, path + ("masses",), "coordinate")
+            coord = (list(c.x) + list(c.q))[names.index(key)]
+            if coord.kind == "length":
+                m = parse_mass(value, mat.density if mat else None, mat.name if mat else "?", path + ("masses", key))
+            else:
+                m = parse_quantity(value, "inertia", path + ("masses", key))
+                if not m > 0:
+                    raise InputError(f"expected a positive inertia, got {value!r}", path=path + ("masses", key))
+            if key in c.x_names:
+                mx[c.x_names.index(key)] = m
+            else:
+                mq[c.q_names.index(key)] = m
+        inputs["M_x"], inputs["M_q"] = mx, mq
+        return inputs
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        _check_pose_inputs(model, inputs, path, required=False)
+
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+        c = model.closure
+        hs: cm.HingeSet = inputs["hinge_set"]
+        if given(inputs, c.q_names) or given(inputs, [o.name for o in task_options(model, "scalar")]):
+            sol = _solve_poses(model, inputs, solver)[0][0]
+        else:
+            sol = inverse_kinematics(model, model.task_of(model.x_home), solver)
+        names, dims = _pose_names(model)
+        units = {n: _si(dims[n]) for n in names}
+        values = _pose_values(model, [sol], False)
+        info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
+        if not sol.ok:
+            return Result(self.name, sol.status, values, units, dims, info, sol.message, None, _model_info(model))
+        sp = cm.static_point(model, hs, sol.x, sol.q)
+        M = sp.J.T @ np.diag(inputs["M_x"]) @ sp.J + np.diag(inputs["M_q"])
+        K = 0.5 * (sp.K_q + sp.K_q.T)
+        try:
+            lam, modes = scipy.linalg.eigh(K, M)
+        except np.linalg.LinAlgError:
+            return Result(
+                self.name,
+                Status.SINGULAR,
+                values,
+                units,
+                dims,
+                info,
+                "the mass matrix J^T M_x J + M_q is singular: give masses that move every actuated direction",
+                None,
+                _model_info(model),
+            )
+        freq = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
+        for k in range(c.nq):
+            values[f"f{k + 1}"] = float(freq[k])
+            dims[f"f{k + 1}"] = "frequency"
+            units[f"f{k + 1}"] = "Hz"
+        shapes = (sp.J @ modes).T
+        values.update(M=M.tolist(), K=K.tolist(), modes_q=modes.T.tolist(), modes_x=shapes.tolist())
+        dims.update(M="matrix", K="matrix", modes_q="matrix", modes_x="matrix")
+        units.update(
+            M=f"kg or kg*m^2 (generalized coordinates {', '.join(c.q_names)})",
+            K="N/m or N*m/rad",
+            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized)",
+            modes_x=f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)",
+        )
+        msg = "frequencies from |K_q - (2 pi f)^2 M| = 0 at the pose"
+        return Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+
+    def output_names(self, model: Model) -> list[str]:
+        c = model.closure
+        return _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)] + ["M", "K", "modes_q", "modes_x"]
+
+
+# -- stress limits for the workspace kinds ---------------------------------------------------------
+
+#: the input the workspace kinds (workspace, inscribed_cuboid, actuator_workspace) accept
+STRESS_LIMIT_OPTION = Option(
+    "stress_limit",
+    "str",
+    "hinge stress limits in place of angle limits: true (the mechanism's hinges and material) or a mapping "
+    "{sigma_allow, safety_factor, hinges, material}; each hinge's deflection about each axis alone at sigma_allow "
+    "becomes a limit of its joint (generalizing eq 31 of pantograph-3d-elgammal-2016.md)",
+    default=None,
+)
+_STRESS_KEYS = ("sigma_allow", "safety_factor", "hinges", "material")
+
+
+def split_stress_limit(raw: Any, model: Model, path: tuple) -> tuple[Any, Model | None]:
+    """The inputs without ``stress_limit``, and the model with the joint limits it sets
+    (None when not given)."""
+    if not isinstance(raw, Mapping) or raw.get("stress_limit") in (None, False):
+        if isinstance(raw, Mapping) and "stress_limit" in raw:
+            raw = {k: v for k, v in raw.items() if k != "stress_limit"}
+        return raw, None
+    spec = raw["stress_limit"]
+    rest = {k: v for k, v in raw.items() if k != "stress_limit"}
+    sub = path + ("stress_limit",)
+    if spec is True:
+        spec = {}
+    if not isinstance(spec, Mapping):
+        keys = ", ".join(_STRESS_KEYS)
+        raise InputError(f"expected stress_limit: true or a mapping {{{keys}}}, got {spec!r}", path=sub)
+    for key in spec:
+        if key not in _STRESS_KEYS:
+            raise unknown_key_error(str(key), _STRESS_KEYS, sub, "stress_limit key")
+    opts = [
+        Option("sigma_allow", "stress", "allowable stress", default=None, lower=0.0, strict=True),
+        Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
+    ]
+    vals = validate_mapping({k: spec.get(k) for k in ("sigma_allow", "safety_factor")}, opts, sub, what="key")
+    hs = cm.hinge_set(model, spec.get("hinges"), spec.get("material"), None, sub)
+    if not any(h.kind is not None for h in hs.hinges):
+        raise InputError("a stress limit needs hinges with a flexure type and dimensions", path=sub + ("hinges",))
+    sigma = cm.allowable(hs, vals["sigma_allow"], vals["safety_factor"], sub)
+    return rest, cm.with_limits(model, cm.stress_angle_limits(hs, sigma))

@@ -1,0 +1,201 @@
+"""Mechanisms described in files (or built in code from the same dataclasses).
+
+:func:`load_file` reads a mechanism file, :func:`from_dict` a parsed mapping
+(inline under ``mechanism:`` in a problem file) and :func:`mechanism` a
+:class:`~.spec.Description` built in code; each returns a
+:class:`~cpm_nlp.core.mechanism.Mechanism` with its symbolic closure, ready to
+register.  A description is generated once per content (SHA-256 of the file's
+text, or of the description) and kept in memory; compiled kernels are cached
+on disk by their source like the built-ins'.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import threading
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...core.errors import InputError
+from ...core.mechanism import Mechanism
+from ...core.model import LoopClosure, Model
+from ...io.yamlfile import load_yaml_text, read_yaml
+from .generate import closure_parts, parameter_options
+from .spec import Description, description_from_dict
+
+log = logging.getLogger(__name__)
+
+__all__ = ["Description", "load_file", "from_dict", "mechanism", "shipped_files", "read_yaml", "load_yaml_text"]
+
+#: the shipped mechanism files
+SHIPPED_DIR = Path(__file__).resolve().parents[3] / "problems" / "mechanisms"
+
+_LOCK = threading.Lock()
+#: content hash -> Mechanism (code, not problem data: one per distinct description)
+_CACHE: dict[str, Mechanism] = {}
+
+
+def shipped_files() -> list[Path]:
+    """The mechanism files shipped in ``problems/mechanisms/``."""
+    return sorted(SHIPPED_DIR.glob("*.yaml")) if SHIPPED_DIR.is_dir() else []
+
+
+def load_file(path: str | Path) -> Mechanism:
+    """The mechanism a file describes (errors name the file and the key path)."""
+    path = Path(path)
+    text_key = _file_key(path)
+    data = read_yaml(path)
+    return _cached(text_key, lambda: from_dict(data, file=str(path), base_dir=path.resolve().parent))
+
+
+def _file_key(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes() + str(path.resolve()).encode()).hexdigest()
+    except OSError:
+        return "missing:" + str(path)
+
+
+def _cached(key: str, make: Any) -> Mechanism:
+    with _LOCK:
+        mech = _CACHE.get(key)
+    if mech is None:
+        mech = make()
+        with _LOCK:
+            _CACHE[key] = mech
+    return mech
+
+
+def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Mechanism:
+    """The mechanism a parsed mapping describes."""
+    try:
+        d = description_from_dict(data, file=file)
+    except InputError as exc:
+        raise exc.at(file=file) from None
+    return mechanism(d, base_dir=base_dir)
+
+
+def mechanism(d: Description, *, base_dir: Path | None = None) -> Mechanism:
+    """A :class:`Mechanism` from a description built in code or read from a file."""
+    try:
+        return _mechanism(d, base_dir)
+    except InputError as exc:
+        raise exc.at(file=d.file) from None
+
+
+def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
+    gen, fns = closure_parts(d)
+    closure = LoopClosure(
+        d.name,
+        x=gen.x_coords,
+        q=gen.q_coords,
+        parameters=[p.name for p in d.parameters],
+        phi=fns["phi"],
+        task=d.platform.task,
+        home=lambda p: tuple(np.asarray(v, dtype=float).ravel() for v in fns["home"](p)),
+        bounds=lambda p: tuple(np.asarray(v, dtype=float).ravel() for v in fns["extras"](p)[:2]),
+        ik=fns["ik"],
+        passive=fns["passive"],
+        passive_coords=[r.coord for r in gen.reported],
+        branch=fns["branch"],
+        offsets=d.platform.offsets,
+    )
+    params = parameter_options(d)
+    limits = gen.limit_options()
+    examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)
+    derived_names = [(n, dim) for n, _sx, dim in gen.derived]
+
+    def build(closure_: LoopClosure, parameters: dict, lims: dict) -> Model:
+        return _build(closure_, parameters, lims, fns, derived_names, d)
+
+    mech = Mechanism(
+        name=d.name,
+        title=d.title,
+        paper=d.paper,
+        parameters=params,
+        limits=limits,
+        closure=lambda: closure,
+        build=build,
+        problem_files=examples,
+        origin=f"file {d.file}" if d.file else "described in code",
+    )
+    if all(not p.required for p in params):  # check the reference configuration now, with the defaults
+        model = mech.model(closure, {}, {}, ())
+        log.debug("%s: reference configuration checked (%d coordinates)", d.name, len(model.x_home))
+    return mech
+
+
+def _build(
+    closure: LoopClosure, parameters: dict, limits: dict, fns: dict, derived_names: list, d: Description
+) -> Model:
+    p = np.array([float(parameters[n]) for n in closure.parameters])
+    values = fns["extras"](p)
+    length = float(values[2])
+    derived_vals = np.asarray(values[3], dtype=float).ravel()
+    dims = {par.name: par.dimension for par in d.parameters}
+    dims.update({n: dim for n, dim in derived_names})
+    model = Model(
+        closure,
+        parameters={n: parameters[n] for n in closure.parameters},
+        limits={k: v for k, v in limits.items() if v is not None},
+        derived={n: float(v) for (n, _), v in zip(derived_names, derived_vals)},
+        dimensions=dims,
+        characteristic_length=length if length > 0 else 1.0,
+    )
+    for (what, path), value in zip(fns["requirements"], np.asarray(values[4], dtype=float).ravel()):
+        if not abs(value) < 1e-9:
+            raise InputError(
+                f"the reference configuration does not assemble: {what} (deviation {value:.3e})", path=path
+            )
+    check_reference(model, fns["row_names"])
+    return model
+
+
+def check_reference(model: Model, row_names: list[str]) -> None:
+    """The reference configuration assembles, and the closures determine the pose there (rank of Φ_x)."""
+    c = model.closure
+    res = np.asarray(c.phi(model.x_home, model.q_home, model.p), dtype=float).ravel()
+    scale = max(model.characteristic_length, 1e-12)
+    worst = int(np.argmax(np.abs(res)))
+    if not np.all(np.isfinite(res)) or abs(res[worst]) > 1e-9 * scale:
+        raise InputError(
+            f"the reference configuration does not assemble: residual {res[worst]:.3e} "
+            f"({c.residual_unit}) in {row_names[worst]}; max |Φ| = {np.max(np.abs(res)):.3e}",
+            path=("platform", "home"),
+            hint="check the joints' locations against the home pose",
+        )
+    if c.branch is not None:
+        g = np.asarray(c.branch(model.x_home, model.q_home, model.p), dtype=float).ravel()
+        if not np.all(g > 0):
+            raise InputError(f"branch indicators not positive at the reference configuration: {g}", path=("legs",))
+    J = np.asarray(c.phi_x(model.x_home, model.q_home, model.p), dtype=float)
+    s = np.linalg.svd(J, compute_uv=False)
+    tol = max(J.shape) * np.finfo(float).eps * max(s[0], 1.0) * 1e3
+    rank = int(np.sum(s > tol))
+    if rank < c.nx:
+        _u, _s, vt = np.linalg.svd(J)
+        free = vt[-1]
+        names = [c.x_names[k] for k in np.argsort(-np.abs(free)) if abs(free[k]) > 1e-6 * np.max(np.abs(free))]
+        raise InputError(
+            f"wrong mobility: with the actuators locked the closures leave {c.nx - rank} free motion(s) of the "
+            f"platform at the reference configuration (rank Φ_x = {rank} < {c.nx}); free: {', '.join(names)} "
+            "(under-constrained: fix these coordinates under platform.fixed, or add a leg); or two equations "
+            "repeat each other (over-constrained in the others)",
+            path=("platform", "coordinates"),
+        )
+    Jq = np.asarray(c.phi_q(model.x_home, model.q_home, model.p), dtype=float)
+    if np.linalg.matrix_rank(Jq) < c.nq:
+        raise InputError(
+            f"an actuator does not move the platform at the reference configuration (rank Φ_q < {c.nq})",
+            path=("legs",),
+        )
+
+
+def read_description(path: str | Path) -> Description:
+    """The description in a mechanism file (no generation)."""
+    try:
+        return description_from_dict(read_yaml(path), file=str(path))
+    except InputError as exc:
+        raise exc.at(file=str(path)) from None

@@ -1,0 +1,375 @@
+"""Expressions of mechanism files, parsed safely into CasADi.
+
+An expression is a string such as ``"b + L*cos(alpha0)"`` or
+``"[a*cos(g), a*sin(g), 0]"`` over declared symbols (parameters, derived
+values, pose and actuator coordinates).  It is parsed with Python's
+:mod:`ast` and walked with a strict whitelist -- numbers, names, ``+ - * / **``
+(``^`` is read as a power), unary minus, calls of the functions in
+:data:`FUNCTIONS`, ``[a, b, c]`` vectors and ``v[0]`` indexing -- and never
+evaluated by Python: every other construct (attributes, comparisons,
+lambdas, keywords, strings ...) is an error that names its column.
+
+Each value carries a physical dimension, the exponents of length and of
+angle, so that an angle where a length is expected ("[a, 0, alpha0]" as a
+location) is an error, not a silent mix.  Plain numbers adapt to their
+context (a bare number is SI).  Angles and plain numbers may be added
+(radians are dimensionless in SI); lengths may not be added to either.
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import casadi as ca
+
+from ...core.errors import suggest
+
+#: dimension of a value: (length exponent, angle exponent); None for a plain number that adapts
+Dim = tuple[float, float] | None
+
+LENGTH: Dim = (1.0, 0.0)
+ANGLE: Dim = (0.0, 1.0)
+NUMBER: Dim = (0.0, 0.0)
+#: dimension names of mechanism files and declared options -> Dim
+DIMENSION_OF = {"length": LENGTH, "angle": ANGLE, "dimensionless": NUMBER}
+
+
+class ExpressionError(Exception):
+    """A bad expression: the message, and the 1-based column in the string as written."""
+
+    def __init__(self, message: str, column: int) -> None:
+        self.message, self.column = message, column
+        super().__init__(f"column {column}: {message}")
+
+
+def describe(dim: Dim) -> str:
+    if dim is None:
+        return "a plain number"
+    length, angle = dim
+    if length == 0:
+        return "an angle" if angle else "a plain number"
+    if length == 1 and angle == 0:
+        return "a length"
+    return f"a quantity of dimension length^{length:g}" + (f" angle^{angle:g}" if angle else "")
+
+
+def compatible(a: Dim, b: Dim) -> bool:
+    """Dimensions that may be added or compared: equal length exponents (angles are radians)."""
+    return a is None or b is None or a[0] == b[0]
+
+
+@dataclass(frozen=True)
+class Value:
+    """A CasADi expression (scalar or column vector) and its dimension."""
+
+    sx: ca.SX
+    dim: Dim
+
+    @property
+    def size(self) -> int:
+        return int(self.sx.numel())
+
+
+def _mul(a: Dim, b: Dim, sign: float = 1.0) -> Dim:
+    if a is None:
+        return b if sign > 0 or b is None else (-b[0], -b[1])
+    if b is None:
+        return a
+    return (a[0] + sign * b[0], a[1] + sign * b[1])
+
+
+def _same(name: str, args: list[Value], col: int) -> Dim:
+    dims = [a.dim for a in args if a.dim is not None]
+    for d in dims[1:]:
+        if not compatible(dims[0], d):
+            raise ExpressionError(
+                f"{name}() needs arguments of one dimension, got {describe(dims[0])} and {describe(d)}", col
+            )
+    return dims[0] if dims else None
+
+
+def _trig(name: str, args: list[Value], col: int) -> Dim:
+    d = args[0].dim
+    if d is not None and d[0] != 0:
+        raise ExpressionError(f"{name}() takes an angle or a plain number, got {describe(d)}", col)
+    return NUMBER
+
+
+def _inverse_trig(name: str, args: list[Value], col: int) -> Dim:
+    _trig(name, args, col)
+    return ANGLE
+
+
+def _atan2(name: str, args: list[Value], col: int) -> Dim:
+    _same(name, args, col)
+    return ANGLE
+
+
+def _sqrt(_name: str, args: list[Value], _col: int) -> Dim:
+    d = args[0].dim
+    return None if d is None else (d[0] / 2, d[1] / 2)
+
+
+def _product(_name: str, args: list[Value], _col: int) -> Dim:
+    return _mul(args[0].dim, args[1].dim)
+
+
+def _unitless(_name: str, _args: list[Value], _col: int) -> Dim:
+    return NUMBER
+
+
+def _first(_name: str, args: list[Value], _col: int) -> Dim:
+    return args[0].dim
+
+
+def _select(i, *values):
+    return values[int(i) - 1]
+
+
+#: name -> (number of arguments (None: any >= 1), CasADi implementation, dimension rule, vector arguments)
+FUNCTIONS: dict[str, tuple[int | None, Callable, Callable, bool]] = {
+    "sin": (1, ca.sin, _trig, False),
+    "cos": (1, ca.cos, _trig, False),
+    "tan": (1, ca.tan, _trig, False),
+    "asin": (1, ca.asin, _inverse_trig, False),
+    "acos": (1, ca.acos, _inverse_trig, False),
+    "atan": (1, ca.atan, _inverse_trig, False),
+    "atan2": (2, ca.atan2, _atan2, False),
+    "sqrt": (1, ca.sqrt, _sqrt, False),
+    "exp": (1, ca.exp, _trig, False),
+    "log": (1, ca.log, _trig, False),
+    "abs": (1, ca.fabs, _first, False),
+    "min": (2, ca.fmin, _same, False),
+    "max": (2, ca.fmax, _same, False),
+    "hypot": (2, lambda a, b: ca.sqrt(a**2 + b**2), _same, False),
+    "norm": (1, ca.norm_2, _first, True),
+    "dot": (2, ca.dot, _product, True),
+    "cross": (2, ca.cross, _product, True),
+    "unit": (1, lambda v: v / ca.norm_2(v), _unitless, True),
+}
+#: constants every expression knows
+CONSTANTS = {"pi": math.pi}
+#: the names an expression may not use for a symbol of its own
+RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"select"}
+
+
+def _translate(text: str) -> tuple[str, list[int]]:
+    """``^`` -> ``**``, and the map from columns of the result to columns of the text."""
+    out, cols = [], []
+    for i, ch in enumerate(text):
+        if ch == "^":
+            out.append("**")
+            cols += [i, i]
+        else:
+            out.append(ch)
+            cols.append(i)
+    cols.append(len(text))
+    return "".join(out), cols
+
+
+class _Evaluator:
+    def __init__(self, symbols: Mapping[str, Value], cols: list[int]) -> None:
+        self.symbols = symbols
+        self.cols = cols
+
+    def col(self, node: ast.AST) -> int:
+        off = getattr(node, "col_offset", 0) or 0
+        return self.cols[min(off, len(self.cols) - 1)] + 1
+
+    def fail(self, node: ast.AST, message: str) -> ExpressionError:
+        return ExpressionError(message, self.col(node))
+
+    def eval(self, node: ast.AST) -> Value:
+        method = getattr(self, "_" + type(node).__name__, None)
+        if method is None:
+            raise self.fail(node, f"{_construct(node)} is not allowed in an expression")
+        return method(node)
+
+    def _Expression(self, node: ast.Expression) -> Value:
+        return self.eval(node.body)
+
+    def _Constant(self, node: ast.Constant) -> Value:
+        if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
+            raise self.fail(node, f"expected a number, got {node.value!r}")
+        return Value(ca.SX(float(node.value)), None)
+
+    def _Name(self, node: ast.Name) -> Value:
+        if node.id in self.symbols:
+            return self.symbols[node.id]
+        if node.id in CONSTANTS:
+            return Value(ca.SX(CONSTANTS[node.id]), NUMBER)
+        known = list(self.symbols) + list(CONSTANTS)
+        hint = suggest(node.id, known)
+        more = f"; did you mean {' or '.join(repr(h) for h in hint)}?" if hint else ""
+        raise self.fail(node, f"unknown symbol {node.id!r}{more}")
+
+    def _UnaryOp(self, node: ast.UnaryOp) -> Value:
+        v = self.eval(node.operand)
+        if isinstance(node.op, ast.USub):
+            return Value(-v.sx, v.dim)
+        if isinstance(node.op, ast.UAdd):
+            return v
+        raise self.fail(node, f"the operator {_construct(node.op)} is not allowed")
+
+    def _BinOp(self, node: ast.BinOp) -> Value:  # noqa: C901 - one branch per operator
+        a, b = self.eval(node.left), self.eval(node.right)
+        op = node.op
+        if isinstance(op, (ast.Add, ast.Sub)):
+            if not compatible(a.dim, b.dim):
+                word = "add" if isinstance(op, ast.Add) else "subtract"
+                raise self.fail(node, f"cannot {word} {describe(a.dim)} and {describe(b.dim)}")
+            if a.size != b.size and 1 not in (a.size, b.size):
+                raise self.fail(node, f"vectors of sizes {a.size} and {b.size} do not add")
+            dim = a.dim if a.dim is not None else b.dim
+            return Value(a.sx + b.sx if isinstance(op, ast.Add) else a.sx - b.sx, dim)
+        if isinstance(op, (ast.Mult, ast.Div)):
+            if a.size > 1 and b.size > 1:
+                raise self.fail(node, "a product of two vectors: use dot() or cross()")
+            if isinstance(op, ast.Div) and b.size > 1:
+                raise self.fail(node, "division by a vector")
+            if isinstance(op, ast.Mult):
+                return Value(a.sx * b.sx, _mul(a.dim, b.dim))
+            return Value(a.sx / b.sx, _mul(a.dim, b.dim, -1.0))
+        if isinstance(op, ast.Pow):
+            if not (isinstance(node.right, ast.Constant) or _is_negated_constant(node.right)):
+                raise self.fail(node.right, "an exponent must be a plain number")
+            e = float(ca.DM(b.sx))
+            if b.dim is not None and b.dim != NUMBER:
+                raise self.fail(node.right, "an exponent must be a plain number")
+            dim = None if a.dim is None else (a.dim[0] * e, a.dim[1] * e)
+            if a.size > 1:
+                raise self.fail(node, "a power of a vector")
+            return Value(a.sx**e, dim)
+        raise self.fail(node, f"the operator {_construct(op)} is not allowed (use + - * / ^)")
+
+    def _List(self, node: ast.List | ast.Tuple) -> Value:
+        if not node.elts:
+            raise self.fail(node, "an empty vector")
+        items = [self.eval(e) for e in node.elts]
+        dim: Dim = None
+        for e, v in zip(node.elts, items):
+            if v.size != 1:
+                raise self.fail(e, "a vector's elements must be scalars")
+            if not compatible(dim, v.dim):
+                raise self.fail(e, f"a vector mixes {describe(dim)} and {describe(v.dim)}")
+            dim = dim if dim is not None else v.dim
+        return Value(ca.vertcat(*[v.sx for v in items]), dim)
+
+    _Tuple = _List
+
+    def _Subscript(self, node: ast.Subscript) -> Value:
+        v = self.eval(node.value)
+        index = node.slice
+        if not isinstance(index, ast.Constant) or not isinstance(index.value, int) or isinstance(index.value, bool):
+            raise self.fail(index, "an index must be a whole number (v[0] is the first element)")
+        if not 0 <= index.value < v.size:
+            raise self.fail(index, f"index {index.value} out of range for a vector of {v.size}")
+        return Value(v.sx[index.value], v.dim)
+
+    def _Call(self, node: ast.Call) -> Value:
+        if not isinstance(node.func, ast.Name):
+            raise self.fail(node, "only calls of named functions are allowed")
+        name = node.func.id
+        if node.keywords or any(isinstance(a, ast.Starred) for a in node.args):
+            raise self.fail(node, f"{name}() takes plain arguments only")
+        if name == "select":
+            return self._select(node)
+        if name not in FUNCTIONS:
+            hint = suggest(name, list(FUNCTIONS) + ["select"])
+            more = f"; did you mean {' or '.join(repr(h) for h in hint)}?" if hint else ""
+            raise self.fail(node.func, f"unknown function {name!r}{more}")
+        nargs, impl, rule, vector = FUNCTIONS[name]
+        if len(node.args) != nargs:
+            raise self.fail(node, f"{name}() takes {nargs} argument(s), got {len(node.args)}")
+        args = [self.eval(a) for a in node.args]
+        for a, arg in zip(node.args, args):
+            if vector and arg.size != 3 and name == "cross":
+                raise self.fail(a, "cross() takes vectors of 3 elements")
+            if not vector and arg.size != 1:
+                raise self.fail(a, f"{name}() takes scalars; got a vector of {arg.size}")
+        dim = rule(name, args, self.col(node))
+        return Value(impl(*[a.sx for a in args]), dim)
+
+    def _select(self, node: ast.Call) -> Value:
+        """select(i, a, b, ...): the i-th (from 1) of the values, i a plain number known when the file is read."""
+        if len(node.args) < 2:
+            raise self.fail(node, "select(i, a, b, ...) needs an index and at least one value")
+        i = self.eval(node.args[0])
+        if not i.sx.is_constant():
+            raise self.fail(node.args[0], "select()'s index must be known when the file is read (a leg index)")
+        k = float(ca.DM(i.sx))
+        if not k.is_integer() or not 1 <= k <= len(node.args) - 1:
+            raise self.fail(node.args[0], f"select() index {k:g} is not in 1..{len(node.args) - 1}")
+        return self.eval(node.args[int(k)])
+
+
+def _is_negated_constant(node: ast.AST) -> bool:
+    return isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub) and isinstance(node.operand, ast.Constant)
+
+
+def _construct(node: ast.AST) -> str:
+    names = {
+        "Attribute": "an attribute (a.b)",
+        "Compare": "a comparison",
+        "BoolOp": "'and'/'or'",
+        "Lambda": "a lambda",
+        "IfExp": "'if ... else'",
+        "Dict": "a mapping",
+        "Set": "a set",
+        "ListComp": "a comprehension",
+        "GeneratorExp": "a comprehension",
+        "NamedExpr": "':='",
+        "Starred": "'*'",
+        "JoinedStr": "a string",
+        "BitXor": "'^'",
+        "FloorDiv": "'//'",
+        "Mod": "'%'",
+        "MatMult": "'@'",
+        "Not": "'not'",
+        "Invert": "'~'",
+    }
+    return names.get(type(node).__name__, f"'{type(node).__name__}'")
+
+
+def parse(text: object, symbols: Mapping[str, Value]) -> Value:
+    """The CasADi value of an expression (a string, or a plain number)."""
+    if isinstance(text, bool):
+        raise ExpressionError(f"expected an expression or a number, got {text!r}", 1)
+    if isinstance(text, (int, float)):
+        if not math.isfinite(text):
+            raise ExpressionError(f"expected a finite number, got {text!r}", 1)
+        return Value(ca.SX(float(text)), None)
+    if isinstance(text, list):
+        text = "[" + ", ".join(str(t) for t in text) + "]"
+    if not isinstance(text, str) or not text.strip():
+        raise ExpressionError(f"expected an expression (a string such as 'b + L*cos(alpha0)'), got {text!r}", 1)
+    if len(text) > 2000:
+        raise ExpressionError(f"an expression of {len(text)} characters; at most 2000", 1)
+    source, cols = _translate(text)
+    try:
+        tree = ast.parse(source.strip(), mode="eval")
+    except SyntaxError as exc:
+        lead = len(source) - len(source.lstrip())
+        off = max((exc.offset or 1) - 1 + lead, 0)
+        raise ExpressionError(f"syntax error ({exc.msg})", cols[min(off, len(cols) - 1)] + 1) from None
+    except (ValueError, RecursionError, MemoryError) as exc:
+        raise ExpressionError(f"cannot parse the expression ({type(exc).__name__})", 1) from None
+    lead = len(source) - len(source.lstrip())
+    try:
+        return _Evaluator(symbols, cols[lead:]).eval(tree)
+    except RecursionError:
+        raise ExpressionError("the expression is nested too deeply", 1) from None
+
+
+def names_in(text: object) -> set[str]:
+    """The symbol names an expression uses (for dependency order); empty when it does not parse."""
+    if not isinstance(text, str):
+        return set()
+    try:
+        tree = ast.parse(_translate(text)[0].strip(), mode="eval")
+    except (SyntaxError, ValueError, RecursionError):
+        return set()
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - RESERVED

@@ -1,0 +1,695 @@
+"""From a :class:`~.spec.Description` to a :class:`~cpm_nlp.core.model.LoopClosure`
+and a :class:`~cpm_nlp.core.mechanism.Mechanism`, symbolically in CasADi.
+
+Each leg is a serial chain given at the reference configuration (product of
+exponentials: a joint's variable is its displacement from there).  Its closure
+with the platform is written without the passive joints' variables, by
+eliminating them from the platform end (the classical leg constraints):
+
+* the last joint is a point joint (S; planar R) at B: the leg's side must put B
+  where the platform does,
+* before it, an R (spatial) at c with axis w: B stays on a circle about the
+  axis, 2 equations (axial offset, radius),
+* before it, a U, an S or a planar R at c (or a ``distance`` joint): B stays on
+  a sphere (circle) about c, 1 equation,
+* before it, a C: B stays on a cylinder, 1 equation,
+* before it, a P along c->B after a U, S or planar R at c: |cB| = its length,
+  1 equation,
+* the joints left before those (the proximal chain) must be actuated: they
+  move c by known amounts.
+
+The eliminated joints' values (the passive joint angles) are recovered from
+the chain afterwards, and each elimination gives an assembly-branch indicator:
+the cosine of the eliminated link's angle to its reference direction, positive
+on the reference configuration's branch (plus the length of a P leg).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+
+from ...analysis import flexure
+from ...core.errors import InputError, format_key_path
+from ...core.model import Coordinate
+from ...core.options import Option, validate_mapping
+from ...core.units import parse_quantity
+from . import expr as ex
+from .spec import Description, Joint, Leg
+
+POINT_JOINTS = {"S", "planar_R"}
+SPHERE_JOINTS = {"U", "S", "planar_R"}
+JOINT_DIMS = {"P": "length", "planar_P": "length", "R": "angle", "planar_R": "angle", "U": "angle", "S": "angle"}
+
+
+def _rot(axis: Any, angle: Any) -> ca.SX:
+    """Rotation by ``angle`` about a unit axis (Rodrigues), or about "x", "y", "z"."""
+    if isinstance(axis, str):
+        axis = ca.DM([1.0 if axis == a else 0.0 for a in "xyz"])
+    k = ca.SX(axis)
+    K = ca.skew(k)
+    return ca.SX.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
+
+
+def _xyz_angles(M: ca.SX) -> list[ca.SX]:
+    """(a, b, c) with M = Rx(a) Ry(b) Rz(c)."""
+    return [ca.atan2(-M[1, 2], M[2, 2]), ca.asin(ca.fmin(ca.fmax(M[0, 2], -1), 1)), ca.atan2(-M[0, 1], M[0, 0])]
+
+
+@dataclass
+class _Joint:
+    """A joint resolved to CasADi: location, axis, variable."""
+
+    spec: Joint
+    at: ca.SX | None = None
+    to: ca.SX | None = None
+    axis: ca.SX | None = None
+    axes: list = field(default_factory=list)
+    value: ca.SX | None = None  # displacement from the reference configuration, when known
+    home: list = field(default_factory=list)
+    #: elementary motions ("P" | "R", axis, displacement) of a joint in the proximal chain
+    motions: list = field(default_factory=list)
+
+    @property
+    def type(self) -> str:
+        return self.spec.type
+
+
+@dataclass
+class _Reported:
+    coord: Coordinate
+    value: ca.SX
+    limit: tuple | None = None
+    path: tuple = ()
+
+
+class Generator:
+    """Builds the symbolic closure of one description (errors carry key paths)."""
+
+    def __init__(self, d: Description) -> None:
+        self.d = d
+        self.p = ca.SX.sym("p", len(d.parameters))
+        self.env: dict[str, ex.Value] = {}
+        for k, par in enumerate(d.parameters):
+            if par.name in ex.RESERVED:
+                raise InputError(f"{par.name!r} is a function or constant name", path=("parameters", par.name))
+            self.env[par.name] = ex.Value(self.p[k], ex.DIMENSION_OF[par.dimension])
+        self.derived: list[tuple[str, ca.SX, str]] = []
+        for q in d.derived:
+            v = self.value(q.value, ("derived", q.name), self.env, q.dimension)
+            self._bind(self.env, q.name, v, ("derived", q.name))
+            self.derived.append((q.name, v.sx, q.dimension or _dim_name(v.dim)))
+        self.reported: list[_Reported] = []
+        self.rows: list[tuple[ca.SX, str]] = []
+        self.branch: list[ca.SX] = []
+        self.q_coords: list[Coordinate] = []
+        self.q_syms: list[ca.SX] = []
+        self.q_home: list[ca.SX] = []
+        self.q_limits: dict[str, tuple] = {}
+        self.platform_radius: list[ca.SX] = []
+        #: (quantity that must vanish at the reference configuration, what it means, key path)
+        self.requirements: list[tuple[ca.SX, str, tuple]] = []
+        #: passive joints of the proximal chains: (coordinate, symbol, home value, limit, key path)
+        self.extra: list[tuple] = []
+        self.extra_limits: dict[str, tuple] = {}
+
+    # -- expressions -----------------------------------------------------------------------
+    def value(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ex.Value:
+        try:
+            v = ex.parse(text, env)
+        except ex.ExpressionError as exc:
+            shown = "[" + ", ".join(str(t) for t in text) + "]" if isinstance(text, list) else str(text)
+            hint = None
+            if "never closed" in exc.message:
+                hint = "inside a YAML [list] or {mapping}, quote an expression that contains a comma"
+            raise InputError(f"in {shown!r}: column {exc.column}: {exc.message}", path=path, hint=hint) from None
+        if dimension is not None and not ex.compatible(v.dim, ex.DIMENSION_OF[dimension]):
+            raise InputError(
+                f"expected {ex.describe(ex.DIMENSION_OF[dimension])}, got {ex.describe(v.dim)} in {text!r}", path=path
+            )
+        return v
+
+    def scalar(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ca.SX:
+        v = self.value(text, path, env, dimension)
+        if v.size != 1:
+            raise InputError(f"expected a scalar, got a vector of {v.size} in {text!r}", path=path)
+        return v.sx
+
+    def vector(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None) -> ca.SX:
+        v = self.value(text, path, env, dimension)
+        n = 2 if self.d.platform.planar else 3
+        if v.size != n:
+            raise InputError(f"expected a vector of {n} elements, got {v.size} in {text!r}", path=path)
+        return ca.vertcat(v.sx, 0) if n == 2 else v.sx
+
+    @staticmethod
+    def _bind(env: dict, name: str, v: ex.Value, path: tuple) -> None:
+        if name in env or name in ex.RESERVED:
+            raise InputError(f"the name {name!r} is already taken (a parameter, coordinate or function)", path=path)
+        env[name] = v
+
+    # -- platform ----------------------------------------------------------------------------
+    def platform(self) -> None:
+        pf = self.d.platform
+        for t in pf.task:
+            if t in pf.fixed:
+                raise InputError(f"{t!r} is both a task coordinate and fixed", path=("platform", "task"))
+        self.x_names = [c for c in pf.coordinates if c not in pf.fixed]
+        self.x_coords = [
+            Coordinate(n, pf.coordinates[n], pf.descriptions.get(n, "platform coordinate")) for n in self.x_names
+        ]
+        self.x = ca.SX.sym("x", len(self.x_names))
+        self.xenv = dict(self.env)
+        for k, name in enumerate(self.x_names):
+            self._bind(
+                self.xenv,
+                name,
+                ex.Value(self.x[k], ex.DIMENSION_OF[pf.coordinates[name]]),
+                ("platform", "coordinates", name),
+            )
+        for name, text in pf.fixed.items():
+            v = self.value(text, ("platform", "fixed", name), self.env, pf.coordinates[name])
+            self._bind(self.xenv, name, v, ("platform", "fixed", name))
+        self.P = self.vector(pf.position, ("platform", "position"), self.xenv, "length")
+        R = ca.SX.eye(3)
+        for k, (axis, angle) in enumerate(pf.rotation):
+            if pf.planar and axis != "z":
+                raise InputError("a planar platform turns about z only", path=("platform", "rotation", k))
+            R = R @ _rot(axis, self.scalar(angle, ("platform", "rotation", k, 1), self.xenv, "angle"))
+        self.R = R
+        home = []
+        for name in self.x_names:
+            text = pf.home.get(name, 0)
+            home.append(self.scalar(text, ("platform", "home", name), self.env, pf.coordinates[name]))
+        self.x_home = ca.vertcat(*home)
+        self.P_home = ca.substitute(self.P, self.x, self.x_home)
+        self.R_home = ca.substitute(self.R, self.x, self.x_home)
+
+    def platform_point(self, B0: ca.SX) -> ca.SX:
+        """The platform point that is at B0 at the reference pose, at the pose x."""
+        self.platform_radius.append(ca.norm_2(B0 - self.P_home))
+        return self.P + self.R @ self.R_home.T @ (B0 - self.P_home)
+
+    # -- actuators -------------------------------------------------------------------------
+    def actuator(self, j: Joint, env: Mapping[str, ex.Value]) -> ca.SX:
+        name = j.actuated
+        if name in [c.name for c in self.q_coords]:
+            raise InputError(f"actuator {name!r} drives two joints", path=j.path + ("actuated",))
+        dim = JOINT_DIMS.get(j.type)
+        if j.type not in ("P", "R", "planar_P", "planar_R"):
+            raise InputError(
+                f"a {j.type} joint cannot be actuated (P, R, planar_P, planar_R can)", path=j.path + ("actuated",)
+            )
+        fam = j.limit or (re.sub(r"\d+$", "", name) or name)
+        self.q_coords.append(Coordinate(name, dim, f"actuator of the {j.type} joint at {_where(j.path)}", fam))
+        sym = ca.SX.sym(name)
+        self.q_syms.append(sym)
+        home = j.home[0] if j.home else 0
+        qh = self.scalar(home, j.path + ("home",), env, dim)
+        self.q_home.append(qh)
+        gain = self.scalar(j.gain, j.path + ("gain",), env)
+        if j.range is not None and fam not in self.q_limits:
+            self.q_limits[fam] = (dim, j.range, j.path + ("range",))
+        return gain * (sym - qh)
+
+    # -- legs ------------------------------------------------------------------------------
+    def leg(self, leg: Leg) -> None:
+        env = dict(self.env)
+        if leg.index is not None:
+            self._bind(env, leg.index, ex.Value(ca.SX(float(leg.values[0])), None), leg.path + ("repeat", "index"))
+        for name, text in leg.let.items():
+            self._bind(env, name, self.value(text, leg.path + ("let", name), env), leg.path + ("let", name))
+        turn = ca.SX.eye(3)
+        if leg.rotate is not None:
+            turn = _rot(leg.rotate_axis, self.scalar(leg.rotate, leg.path + ("repeat", "rotate"), env, "angle"))
+        joints = [self.resolve(j, env, turn) for j in leg.joints]
+        self.close(leg, joints)
+
+    def resolve(self, j: Joint, env: Mapping[str, ex.Value], turn: ca.SX) -> _Joint:  # noqa: C901 - one rule per joint part
+        out = _Joint(j)
+        planar = self.d.platform.planar
+        allowed = ("planar_R", "planar_P", "distance") if planar else ("P", "R", "C", "U", "S", "distance")
+        if j.type not in allowed:
+            other = {"R": "planar_R", "P": "planar_P", "planar_R": "R", "planar_P": "P"}.get(j.type)
+            raise InputError(
+                f"a {'planar' if planar else 'spatial'} mechanism takes {', '.join(allowed)} joints, got {j.type}",
+                path=j.path + ("type",),
+                suggestions=[other] if other else (),
+            )
+        if j.at is None:
+            raise InputError(f"a {j.type} joint needs its location 'at'", path=j.path)
+        out.at = turn @ self.vector(j.at, j.path + ("at",), env, "length")
+        if j.type == "distance":
+            if j.to is None:
+                raise InputError("a distance joint needs 'to' (the point on the distal body)", path=j.path)
+            out.to = turn @ self.vector(j.to, j.path + ("to",), env, "length")
+        elif j.to is not None:
+            raise InputError("only a distance joint has 'to'", path=j.path + ("to",))
+        if j.type in ("P", "R", "C", "planar_P"):
+            if j.axis is None:
+                raise InputError(f"a {j.type} joint needs its 'axis'", path=j.path)
+            a = turn @ self.vector(j.axis, j.path + ("axis",), env, None)
+            out.axis = a / ca.norm_2(a)
+        elif j.type == "planar_R":
+            out.axis = ca.SX(ca.DM([0.0, 0.0, 1.0]))
+        for k, a in enumerate(j.axes):
+            v = turn @ self.vector(a, j.path + ("axes", k), env, None)
+            out.axes.append(v / ca.norm_2(v))
+        need = {"U": 2, "S": 3}.get(j.type)
+        if j.axes and (need is None or len(j.axes) != need):
+            raise InputError(f"a {j.type} joint takes {need or 'no'} axes, got {len(j.axes)}", path=j.path + ("axes",))
+        if j.type == "U" and not j.axes:
+            raise InputError("a U joint needs its two 'axes'", path=j.path)
+        dof = {"P": 1, "R": 1, "planar_R": 1, "planar_P": 1, "C": 2, "U": 2, "S": 3, "distance": 0}[j.type]
+        if j.coordinates and len(j.coordinates) != dof:
+            raise InputError(
+                f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}", path=j.path + ("coordinates",)
+            )
+        if j.actuated is not None:
+            out.value = self.actuator(j, env)
+        elif j.home:
+            dim = JOINT_DIMS.get(j.type)
+            out.home = [self.scalar(h, j.path + ("home", k), env, dim) for k, h in enumerate(j.home)]
+        return out
+
+    def close(self, leg: Leg, joints: list[_Joint]) -> None:  # noqa: C901 - one branch per leg ending
+        last = joints[-1]
+        if last.type == "distance":
+            tip, elim = last.to, _Joint(Joint("S", path=last.spec.path), at=last.at)
+            before = joints[:-1]
+        elif last.type in POINT_JOINTS and (last.type == "S") != self.d.platform.planar:
+            tip = last.at
+            before = joints[:-1]
+            elim = None
+            if before and before[-1].value is None and before[-1].type in ("R", "C", *SPHERE_JOINTS):
+                elim = before.pop()
+        else:
+            want = "planar_R" if self.d.platform.planar else "S"
+            raise InputError(
+                f"leg {leg.name}: it must reach the platform through a point joint ({want}) or a distance joint; "
+                f"its last joint is {last.type}",
+                path=last.spec.path + ("type",),
+            )
+        slide = None
+        if elim is None and before and before[-1].type in ("P", "planar_P") and len(before) >= 2:
+            if before[-2].value is None and before[-2].type in SPHERE_JOINTS | {"R"}:
+                slide, elim = before.pop(), before.pop()
+        for k, j in enumerate(before):
+            if j.value is None:
+                self.unknowns(j, leg, k)
+        Rm, tm = self.chain(before)
+        B = self.platform_point(tip)
+        R_rel = self.R @ self.R_home.T
+        rows = 2 if self.d.platform.planar else 3
+        if elim is None:
+            v = B - (Rm @ tip + tm)
+            for k in range(rows):
+                self.rows.append((v[k], f"leg {leg.name}: point {'xyz'[k]}"))
+            self.report_tip(last, Rm, R_rel, leg.name)
+            return
+        c = Rm @ elim.at + tm
+        u0 = tip - elim.at
+        u = Rm @ u0
+        v = B - c
+        r = ca.norm_2(u0)
+        Rb = Rm
+        if slide is not None:
+            if slide.value is None:
+                raise InputError(
+                    f"leg {leg.name}: a passive P between two point joints constrains nothing", path=slide.spec.path
+                )
+            self.requirements.append(
+                (
+                    ca.norm_2(ca.cross(slide.axis, u0)) / r,
+                    "the P joint's axis is not along the leg (c -> B)",
+                    slide.spec.path,
+                )
+            )
+            self.rows.append((ca.norm_2(v) - (r + slide.value), f"leg {leg.name}: length"))
+            self.branch.append((r + slide.value) / r)
+            self.branch.append(ca.dot(u, v) / (r * ca.norm_2(v)))
+            if elim.type == "R":  # R-P-S: the leg also stays in the plane normal to the R axis
+                w = Rm @ elim.axis
+                self.rows.append((ca.dot(v, w) - ca.dot(u0, elim.axis), f"leg {leg.name}: plane of the R joint"))
+                theta = ca.atan2(ca.dot(w, ca.cross(u, v)), ca.dot(u, v))
+                self.report(elim, [theta], leg.name)
+                Rb = _rot(w, theta) @ Rm
+            else:
+                Rb = self.report_sphere(elim, Rm, u0, v, leg)
+        elif elim.type == "R":
+            w = Rm @ elim.axis
+            h = ca.dot(u0, elim.axis)
+            up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
+            self.rows.append((ca.dot(v, w) - h, f"leg {leg.name}: plane of the R joint"))
+            self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: radius about the R joint"))
+            self.branch.append(ca.dot(up, vp) / ca.dot(up, up))
+            theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
+            self.report(elim, [theta], leg.name)
+            Rb = _rot(w, theta) @ Rm
+        elif elim.type == "C":
+            w = Rm @ elim.axis
+            up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
+            rp = ca.norm_2(u0 - ca.dot(u0, elim.axis) * elim.axis)
+            self.rows.append(((ca.dot(vp, vp) - rp**2) / (2 * rp), f"leg {leg.name}: cylinder of the C joint"))
+            self.branch.append(ca.dot(up, vp) / ca.dot(up, up))
+            theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
+            self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0, elim.axis)], leg.name)
+            Rb = _rot(w, theta) @ Rm
+        else:
+            self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: distance"))
+            self.branch.append(ca.dot(u, v) / ca.dot(u0, u0))
+            Rb = self.report_sphere(elim, Rm, u0, v, leg)
+        self.report_tip(last, Rb, R_rel, leg.name)
+
+    def chain(self, joints: list[_Joint]) -> tuple[ca.SX, ca.SX]:
+        """The motion y -> Rm y + tm of the proximal chain's last body (product of exponentials)."""
+        Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
+        for j in joints:
+            motions = j.motions or [("P" if j.type in ("P", "planar_P") else "R", j.axis, j.value)]
+            for kind, axis, value in motions:
+                if kind == "P":
+                    Rk, tk = ca.SX.eye(3), value * axis
+                else:  # a rotation about the axis through j.at
+                    Rk = _rot(axis, value)
+                    tk = j.at - Rk @ j.at
+                Rm, tm = Rm @ Rk, Rm @ tk + tm
+        return Rm, tm
+
+    def unknowns(self, j: _Joint, leg: Leg, k: int) -> None:
+        """A passive joint of the proximal chain: its values become pose unknowns (dependent coordinates)."""
+        if j.type == "distance":
+            raise InputError(f"leg {leg.name}: a distance joint must be the last of its leg", path=j.spec.path)
+        e = [ca.DM([1.0, 0, 0]), ca.DM([0, 1.0, 0]), ca.DM([0, 0, 1.0])]
+        elementary = {
+            "P": [("P", j.axis)],
+            "planar_P": [("P", j.axis)],
+            "R": [("R", j.axis)],
+            "planar_R": [("R", j.axis)],
+            "C": [("R", j.axis), ("P", j.axis)],
+            "U": [("R", a) for a in j.axes],
+            "S": [("R", a) for a in (j.axes or e)],
+        }[j.type]
+        names = j.spec.coordinates or tuple(f"{leg.name}_j{k + 1}_{n + 1}" for n in range(len(elementary)))
+        for n, ((kind, axis), name) in enumerate(zip(elementary, names)):
+            dim = "length" if kind == "P" else "angle"
+            sym = ca.SX.sym(name)
+            home = j.home[n] if n < len(j.home) else ca.SX(0)
+            fam = j.spec.limit or re.sub(r"\d+$", "", name) or name
+            coord = Coordinate(name, dim, f"passive {j.type} joint of leg {leg.name} (an unknown of the loops)", fam)
+            self.extra.append((coord, sym, home, self._limit(j, dim), j.spec.path))
+            j.motions.append((kind, axis, sym - home))
+
+    def report(self, j: _Joint, values: list, leg: str) -> None:
+        names = j.spec.coordinates
+        if not names:
+            return
+        for k, (name, val) in enumerate(zip(names, values)):
+            home = j.home[k] if k < len(j.home) else 0
+            dim = "length" if (j.type == "C" and k == 1) or j.type in ("P", "planar_P") else "angle"
+            fam = j.spec.limit or re.sub(r"\d+$", "", name) or name
+            desc = f"{j.type} joint of leg {leg}" + (f", axis {k + 1}" if len(names) > 1 else "")
+            self.reported.append(
+                _Reported(Coordinate(name, dim, desc, fam), home + val, self._flexure_range(j, dim, home), j.spec.path)
+            )
+
+    def _flexure_range(self, j: _Joint, dim: str, home: Any) -> tuple | None:
+        """The joint's limits; a flexure's are a deflection about the reference value."""
+        lim = self._limit(j, dim)
+        if lim is None or j.spec.flexure is None or (isinstance(home, (int, float)) and home == 0):
+            return lim
+        home_sx = ca.SX(home)
+        if not home_sx.is_constant():
+            raise InputError(
+                "a flexure hinge limits the deflection from the reference configuration, and this joint's "
+                "reference value depends on the parameters; report the deflection (home 0) or give its range",
+                path=j.spec.path + ("flexure",),
+            )
+        h = float(ca.DM(home_sx))
+        return (h + lim[0], h + lim[1])
+
+    def report_sphere(self, elim: _Joint, Rm: ca.SX, u0: ca.SX, v: ca.SX, leg: Leg) -> ca.SX | None:
+        """The angles of a U (or planar R) whose link is eliminated, and the link's rotation (None: not determined)."""
+        if elim.type == "planar_R":
+            u = Rm @ u0
+            theta = ca.atan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1])
+            self.report(elim, [theta], leg.name)
+            return _rot("z", theta) @ Rm
+        if elim.type == "U":
+            a1, a2 = elim.axes
+            F = ca.horzcat(a1, a2, ca.cross(a1, a2))
+            self.requirements.append((ca.dot(a1, a2), "the U joint's axes are not perpendicular", elim.spec.path))
+            self.requirements.append(
+                (
+                    ca.norm_2(ca.cross(F[:, 2], u0)) / ca.norm_2(u0),
+                    "the U joint's link is not normal to both axes",
+                    elim.spec.path,
+                )
+            )
+            w = F.T @ Rm.T @ v
+            theta2 = ca.atan2(w[0], ca.sqrt(w[1] ** 2 + w[2] ** 2))
+            theta1 = ca.atan2(-w[1], w[2])
+            self.report(elim, [theta1, theta2], leg.name)
+            return Rm @ F @ _rot("x", theta1) @ _rot("y", theta2) @ F.T
+        if elim.spec.coordinates:
+            raise InputError(
+                f"leg {leg.name}: the spin of a link between two spherical joints is not determined; "
+                "report no coordinates for this S (or use a U)",
+                path=elim.spec.path + ("coordinates",),
+            )
+        return None
+
+    def report_tip(self, last: _Joint, Rb: ca.SX | None, R_rel: ca.SX, leg_name: str) -> None:
+        names = last.spec.coordinates
+        if not names or last.type == "distance":
+            return
+        if Rb is None:
+            raise InputError(
+                "the rotation of this joint is not determined (the link before it may spin); report no coordinates",
+                path=last.spec.path + ("coordinates",),
+            )
+        if last.type == "planar_R":
+            M = Rb.T @ R_rel
+            self.report(last, [ca.atan2(M[1, 0], M[0, 0])], leg_name)
+            return
+        F = ca.horzcat(*last.axes) if last.axes else ca.SX.eye(3)
+        self.report(last, _xyz_angles(F.T @ Rb.T @ R_rel @ F), leg_name)
+
+    def _limit(self, j: _Joint, dim: str) -> tuple | None:
+        if j.spec.flexure is not None:
+            path = j.spec.path + ("flexure",)
+            values = validate_mapping(j.spec.flexure.values, flexure.HINGE_LIMIT_OPTIONS, path, what="flexure key")
+            if values.get("hinge") is None:
+                raise InputError(f"missing key 'hinge' (one of: {', '.join(flexure.HINGES)})", path=path)
+            rot = flexure.hinge_rotation(values, path)
+            return (-rot, rot)
+        if j.spec.range is not None:
+            rng = tuple(parse_quantity(v, dim, j.spec.path + ("range", k)) for k, v in enumerate(j.spec.range))
+            if not rng[0] < rng[1]:
+                raise InputError(f"expected low < high, got {list(j.spec.range)}", path=j.spec.path + ("range",))
+            return rng
+        return None
+
+    # -- the whole closure -----------------------------------------------------------------------
+    def build(self) -> dict[str, Any]:  # noqa: C901 - one step per section of the description
+        d = self.d
+        self.platform()
+        for leg in d.legs:
+            self.leg(leg)
+        for name, (dim, home) in d.actuators.items():
+            if name not in [c.name for c in self.q_coords]:
+                self.q_coords.append(Coordinate(name, dim, "actuator", re.sub(r"\d+$", "", name) or name))
+                self.q_syms.append(ca.SX.sym(name))
+                self.q_home.append(self.scalar(home, ("actuators", name, "home"), self.env, dim))
+        if not self.q_coords:
+            raise InputError("no actuators: mark joints 'actuated: name' (or declare 'actuators')", path=("legs",))
+        q = ca.vertcat(*self.q_syms)
+        full = dict(self.xenv)
+        for c, s in zip(self.q_coords, self.q_syms):
+            self._bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("actuators", c.name))
+        for k, text in enumerate(d.closures):
+            self.rows.append((self.scalar(text, ("closures", k), full), f"closures[{k}]"))
+        for k, text in enumerate(d.branch):
+            self.branch.append(self.scalar(text, ("branch", k), full))
+        families = list(dict.fromkeys(r.coord.group for r in self.reported))
+        self.reported.sort(key=lambda r: families.index(r.coord.group))  # alpha1..3, beta1..3, as the papers list them
+        for qty in d.passive:
+            v = self.value(qty.value, ("passive", qty.name), full, qty.dimension)
+            dim = qty.dimension or _dim_name(v.dim)
+            fam = qty.family or re.sub(r"\d+$", "", qty.name) or qty.name
+            self.reported.append(
+                _Reported(Coordinate(qty.name, dim, qty.description, fam), v.sx, None, ("passive", qty.name))
+            )
+        self.add_unknowns()
+        nx, nrows = len(self.x_names), len(self.rows)
+        if nrows != nx:
+            what = "over" if nrows > nx else "under"
+            raise InputError(
+                f"wrong mobility: the legs and closures give {nrows} equation(s) for {nx} pose coordinate(s) "
+                f"({', '.join(self.x_names)}): {what}-constrained; equations: {'; '.join(r[1] for r in self.rows)}",
+                path=("platform", "coordinates"),
+                hint="declare the coordinates the structure fixes under platform.fixed, or add legs",
+            )
+        if len(d.platform.task) != len(self.q_coords):
+            raise InputError(
+                f"{len(d.platform.task)} task coordinate(s) for {len(self.q_coords)} actuator(s) "
+                f"({', '.join(c.name for c in self.q_coords)}); they must be as many",
+                path=("platform", "task"),
+            )
+        return self.functions(q)
+
+    def add_unknowns(self) -> None:
+        if not self.extra:
+            return
+        self.x = ca.vertcat(self.x, *[e[1] for e in self.extra])
+        self.x_home = ca.vertcat(self.x_home, *[e[2] for e in self.extra])
+        for coord, _sym, _home, limit, path in self.extra:
+            if coord.name in self.x_names or coord.name in [c.name for c in self.q_coords]:
+                raise InputError(f"the coordinate name {coord.name!r} is used twice", path=path + ("coordinates",))
+            self.x_names.append(coord.name)
+            self.x_coords.append(coord)
+            self.extra_limits[coord.group] = (coord.kind, limit, coord.description)
+
+    def functions(self, q: ca.SX) -> dict[str, Any]:
+        x, p = self.x, self.p
+        io = ["x", "q", "p"]
+        phi = ca.Function("phi", [x, q, p], [ca.vertcat(*[r[0] for r in self.rows])], io, ["phi"])
+        branch = ca.Function("branch", [x, q, p], [ca.vertcat(*self.branch)], io, ["g"]) if self.branch else None
+        passive = None
+        if self.reported:
+            passive = ca.Function("passive", [x, q, p], [ca.vertcat(*[r.value for r in self.reported])], io, ["j"])
+        home = ca.Function("home", [p], [self.x_home, ca.vertcat(*self.q_home)], ["p"], ["x", "q"])
+        radius = ca.mmax(ca.vertcat(*self.platform_radius)) if self.platform_radius else ca.SX(0)
+        if self.d.characteristic_length is not None:
+            radius = self.scalar(self.d.characteristic_length, ("characteristic_length",), self.env, "length")
+        lo, hi = self.bounds(radius)
+        req = ca.vertcat(*[r[0] for r in self.requirements]) if self.requirements else ca.SX(0, 1)
+        extras = ca.Function(
+            "described_values",
+            [p],
+            [lo, hi, radius, ca.vertcat(*[dv[1] for dv in self.derived]) if self.derived else ca.SX(0, 1), req],
+            ["p"],
+            ["lower", "upper", "length", "derived", "requirements"],
+        )
+        return {
+            "phi": phi,
+            "branch": branch,
+            "passive": passive,
+            "home": home,
+            "extras": extras,
+            "ik": self.closed_form_ik(),
+            "row_names": [r[1] for r in self.rows],
+            "requirements": [(r[1], r[2]) for r in self.requirements],
+        }
+
+    def bounds(self, radius: ca.SX) -> tuple[ca.SX, ca.SX]:
+        pf = self.d.platform
+        lo, hi = [], []
+        span = 2 * ca.fmax(radius, ca.norm_2(self.P_home))
+        for k, coord in enumerate(self.x_coords):
+            name, dim = coord.name, coord.kind
+            if name in pf.bounds:
+                a, b = pf.bounds[name]
+                lo.append(self.scalar(a, ("platform", "bounds", name, 0), self.env, dim))
+                hi.append(self.scalar(b, ("platform", "bounds", name, 1), self.env, dim))
+            elif dim == "angle":
+                half = math.pi / 3 if name in pf.coordinates else math.pi / 2
+                lo.append(self.x_home[k] - half)
+                hi.append(self.x_home[k] + half)
+            else:
+                lo.append(self.x_home[k] - span)
+                hi.append(self.x_home[k] + span)
+        return ca.vertcat(*lo), ca.vertcat(*hi)
+
+    def closed_form_ik(self) -> ca.Function | None:  # noqa: C901 - one check per part of the ik section
+        ik = self.d.ik
+        if ik is None:
+            return None
+        pf = self.d.platform
+        t = ca.SX.sym("t", len(pf.task))
+        env = dict(self.env)
+        for k, name in enumerate(pf.task):
+            env[name] = ex.Value(t[k], ex.DIMENSION_OF[pf.coordinates[name]])
+        for name in pf.fixed:
+            env[name] = self.xenv[name]
+        for name, text in ik.let.items():
+            self._bind(env, name, self.value(text, ("ik", "let", name), env), ("ik", "let", name))
+        xs = []
+        for name in self.x_names:
+            if name in pf.task:
+                xs.append(env[name].sx)
+            elif name in ik.pose:
+                dim = self.x_coords[self.x_names.index(name)].kind
+                xs.append(self.scalar(ik.pose[name], ("ik", "pose", name), env, dim))
+            else:
+                raise InputError(
+                    f"missing the dependent coordinate {name!r} (an expression of the task coordinates)",
+                    path=("ik", "pose"),
+                )
+        qs = []
+        for c in self.q_coords:
+            if c.name not in ik.actuators:
+                raise InputError(f"missing the actuator {c.name!r}", path=("ik", "actuators"))
+            qs.append(self.scalar(ik.actuators[c.name], ("ik", "actuators", c.name), env, c.kind))
+        if ik.reach is None:
+            raise InputError("missing 'reach': an expression < 0 where the pose cannot be assembled", path=("ik",))
+        reach = self.scalar(ik.reach, ("ik", "reach"), env)
+        return ca.Function(
+            "ik", [t, self.p], [ca.vertcat(*xs), ca.vertcat(*qs), reach], ["t", "p"], ["x", "q", "reach"]
+        )
+
+    # -- declared options -----------------------------------------------------------------------
+    def limit_options(self) -> tuple[Option, ...]:
+        seen: dict[str, Option] = {}
+        for fam, (dim, rng, path) in self.q_limits.items():
+            lim = tuple(parse_quantity(v, dim, path + (k,)) for k, v in enumerate(rng))
+            seen[fam] = Option(fam, dim, f"range [low, high] of every actuator {fam}*", default=lim, shape="range")
+        for c in self.q_coords:
+            if c.group not in seen:
+                seen[c.group] = Option(
+                    c.group, c.kind, f"range [low, high] of every actuator {c.group}*", default=None, shape="range"
+                )
+        for fam, (dim, lim, desc) in self.extra_limits.items():
+            if fam not in seen:
+                seen[fam] = Option(fam, dim, f"range [low, high] of every {fam}* ({desc})", default=lim, shape="range")
+        for r in self.reported:
+            fam = r.coord.group
+            if fam not in seen:
+                seen[fam] = Option(
+                    fam,
+                    r.coord.kind,
+                    f"range [low, high] of every {fam}* ({r.coord.description})",
+                    default=r.limit,
+                    shape="range",
+                )
+        return tuple(seen.values())
+
+
+def _where(path: tuple) -> str:
+    return format_key_path(path)
+
+
+def _dim_name(dim: ex.Dim) -> str:
+    if dim is None or dim[0] == 0:
+        return "angle" if dim is not None and dim[1] else "dimensionless"
+    return "length"
+
+
+def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
+    g = Generator(d)
+    return g, g.build()
+
+
+def parameter_options(d: Description) -> tuple[Option, ...]:
+    """The declared parameters as options (validated like a built-in mechanism's)."""
+    return tuple(
+        Option(p.name, p.dimension, p.description or p.name, default=p.default, lower=p.lower, upper=p.upper)
+        for p in d.parameters
+    )
+
+
+__all__ = ["Generator", "closure_parts", "parameter_options"]

@@ -1,0 +1,573 @@
+"""The description of a mechanism: dataclasses (the Python builder API) and
+their reading from a mapping (a mechanism file).
+
+A mechanism file::
+
+    name: my_stage                     # the type name (an identifier)
+    title: one line
+    parameters:                        # declared like the built-ins' options
+      b: {dimension: length, default: 47.91 mm, bounds: [0 mm, 1 m], description: ...}
+    derived:                           # named expressions of the parameters
+      a: b + L*cos(alpha0)
+    platform:
+      coordinates: {px: length, ..., psi: angle}
+      position: [px, py, pz]           # P, an expression over the coordinates
+      rotation: [[y, theta], [x, psi], [z, phi]]   # R = Ry(theta) Rx(psi) Rz(phi)
+      task: [pz, psi, theta]           # nq of them; the others are dependent (reported)
+      fixed: {}                        # coordinates fixed by the structure: name -> value
+      home: {pz: L*sin(alpha0)}        # the reference pose (others 0)
+    legs:
+      - name: leg
+        repeat: {index: i, values: [1, 2, 3], rotate: 2*pi*(i-1)/3}
+        joints:                        # base -> platform, at the reference pose
+          - {type: P, at: [a, 0, 0], axis: [-1, 0, 0], actuated: "s{i}"}
+          - {type: R, at: [a, 0, 0], axis: [0, -1, 0], coordinates: ["alpha{i}"], home: [alpha0]}
+          - {type: S, at: [b, 0, L*sin(alpha0)], coordinates: ["bm{i}", "bn{i}", "bl{i}"]}
+
+Every location and axis is a vector expression in the parameters, in the base
+frame at the reference configuration (the home pose).  See the README for the
+full list of keys.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from ...core.errors import InputError, suggest, unknown_key_error
+from ...core.options import REQUIRED
+from ...core.units import parse_quantity
+
+#: joint types -> (degrees of freedom, description)
+JOINT_TYPES = {
+    "P": (1, "prismatic (spatial)"),
+    "R": (1, "revolute (spatial)"),
+    "C": (2, "cylindrical: a revolute and a prismatic on one axis"),
+    "U": (2, "universal: two revolutes, axes[0] on the proximal body, axes[1] on the distal one"),
+    "S": (3, "spherical"),
+    "planar_R": (1, "revolute of a planar mechanism (axis z)"),
+    "planar_P": (1, "prismatic of a planar mechanism (axis in the plane)"),
+    "distance": (0, "rigid distance between two points (an S-S strut or a parallelogram's link)"),
+}
+DIMENSIONS = ("length", "angle", "dimensionless")
+AXES = ("x", "y", "z")
+
+Expr = Any  # an expression: a string, a number, or a list of them (a vector)
+
+
+@dataclass
+class Parameter:
+    """A geometry parameter (declared like a built-in mechanism's options)."""
+
+    name: str
+    dimension: str = "length"
+    default: Any = REQUIRED
+    lower: float | None = None
+    upper: float | None = None
+    description: str = ""
+
+
+@dataclass
+class Quantity:
+    """A named expression with its dimension (derived values, reported passive coordinates)."""
+
+    name: str
+    value: Expr
+    dimension: str | None = None
+    description: str = ""
+    family: str = ""
+
+
+@dataclass
+class Flexure:
+    """A flexure hinge that sets a joint's limits: hinge type, dimensions, material
+    (the keys of :data:`cpm_nlp.analysis.flexure.HINGE_LIMIT_OPTIONS`)."""
+
+    values: dict[str, Any]
+
+
+@dataclass
+class Joint:
+    """One joint of a leg, base side first.
+
+    at: its location (vector expression, base frame, reference configuration);
+    for ``distance`` the point on the proximal body, ``to`` the one on the distal.
+    axis: its axis (R, P, C, planar_P); axes: the two axes of a U, the three
+    axes an S reports its angles about (default x, y, z).
+    actuated: the actuator coordinate driving it (a name), with ``gain``
+    (displacement per actuator unit) and ``home`` (the actuator value at the
+    reference configuration).
+    coordinates: names of its reported joint values (one per degree of freedom),
+    ``home`` their values at the reference configuration.
+    limit: the limit family of its coordinates (default: the name without digits).
+    """
+
+    type: str
+    at: Expr = None
+    to: Expr = None
+    axis: Expr = None
+    axes: tuple[Expr, ...] = ()
+    actuated: str | None = None
+    gain: Expr = 1
+    home: tuple[Expr, ...] = ()
+    coordinates: tuple[str, ...] = ()
+    limit: str | None = None
+    range: tuple[Any, Any] | None = None
+    flexure: Flexure | None = None
+    body: str | None = None  # the body it carries (distal side); optional, for connectivity checks
+    path: tuple = ()
+
+
+@dataclass
+class Leg:
+    """A serial chain from the base to the platform, optionally repeated: the
+    ``index`` symbol takes each of ``values`` and every vector of the leg is
+    turned by ``rotate`` (an angle expression in the index) about ``rotate_axis``."""
+
+    name: str
+    joints: list[Joint]
+    index: str | None = None
+    values: tuple[Any, ...] = ()
+    rotate: Expr = None
+    rotate_axis: str = "z"
+    path: tuple = ()
+    #: definitions of the leg (name -> expression, in order; may use the index)
+    let: dict[str, Expr] = field(default_factory=dict)
+
+
+@dataclass
+class Platform:
+    coordinates: dict[str, str]
+    position: Expr
+    rotation: list[tuple[str, Expr]]
+    task: tuple[str, ...]
+    fixed: dict[str, Expr] = field(default_factory=dict)
+    home: dict[str, Expr] = field(default_factory=dict)
+    bounds: dict[str, tuple[Expr, Expr]] = field(default_factory=dict)
+    descriptions: dict[str, str] = field(default_factory=dict)
+    planar: bool = False
+    offsets: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass
+class ClosedFormIK:
+    """A closed-form inverse kinematics: ``let`` definitions in order, the
+    dependent coordinates and the actuators as expressions of the task
+    coordinates, and ``reach`` (< 0 when the pose cannot be assembled)."""
+
+    let: dict[str, Expr]
+    pose: dict[str, Expr]
+    actuators: dict[str, Expr]
+    reach: Expr = None
+
+
+@dataclass
+class Description:
+    """A whole mechanism, as a file describes it (also built in code)."""
+
+    name: str
+    title: str
+    parameters: list[Parameter]
+    platform: Platform
+    legs: list[Leg] = field(default_factory=list)
+    derived: list[Quantity] = field(default_factory=list)
+    #: actuators declared without joints: name -> (dimension, value at the reference configuration)
+    actuators: dict[str, tuple[str, Expr]] = field(default_factory=dict)
+    closures: list[Expr] = field(default_factory=list)
+    branch: list[Expr] = field(default_factory=list)
+    passive: list[Quantity] = field(default_factory=list)
+    ik: ClosedFormIK | None = None
+    characteristic_length: Expr = None
+    paper: str = ""
+    examples: tuple[str, ...] = ()
+    file: str | None = None
+
+
+# -- reading a mapping ---------------------------------------------------------------------------
+
+TOP = {
+    "name": "the mechanism type name (an identifier)",
+    "title": "a one-line title",
+    "paper": "where the mechanism comes from",
+    "parameters": "name -> {dimension, default, bounds, description}",
+    "derived": "name -> expression (or {value, dimension, description})",
+    "platform": "{coordinates, position, rotation, task, fixed, home, bounds}",
+    "legs": "list of {name, repeat, joints}",
+    "actuators": "name -> dimension or {dimension, home} (for closures written as expressions)",
+    "branch": "assembly-branch indicators as expressions, positive on the working branch",
+    "closures": "list of closure equations as expressions (an escape hatch)",
+    "passive": "name -> {value, dimension, family, description}: extra reported joint values",
+    "ik": "{let, pose, actuators, reach}: a closed-form inverse kinematics",
+    "characteristic_length": "length expression for conditioning measures",
+    "examples": "problem files that use the mechanism (relative to this file)",
+}
+
+
+def _mapping(value: Any, path: tuple, what: str, allowed: Mapping[str, str] | None = None) -> dict:
+    if not isinstance(value, Mapping):
+        raise InputError(f"expected {what}, got {type(value).__name__} {value!r:.60}", path=path)
+    if allowed is not None:
+        for key in value:
+            if key not in allowed:
+                raise unknown_key_error(str(key), allowed, path, "key")
+    return dict(value)
+
+
+def _list(value: Any, path: tuple, what: str) -> list:
+    if not isinstance(value, list):
+        raise InputError(f"expected {what}, got {type(value).__name__} {value!r:.60}", path=path)
+    return value
+
+
+def _name(value: Any, path: tuple, what: str) -> str:
+    if not isinstance(value, str) or not value.isidentifier():
+        raise InputError(f"expected {what} (a name such as 'alpha1'), got {value!r}", path=path)
+    return value
+
+
+def _text(value: Any, path: tuple) -> str:
+    if value is None:
+        return ""
+    if not isinstance(value, str):
+        raise InputError(f"expected free text, got {value!r:.60}", path=path)
+    return value
+
+
+def _dimension(value: Any, path: tuple) -> str:
+    if value not in DIMENSIONS:
+        raise InputError(
+            f"expected a dimension, one of: {', '.join(DIMENSIONS)}; got {value!r}",
+            path=path,
+            suggestions=suggest(str(value), DIMENSIONS),
+        )
+    return value
+
+
+PARAMETER_KEYS = {"dimension": "", "default": "", "bounds": "", "description": ""}
+
+
+def _parameter(name: str, raw: Any, path: tuple) -> Parameter:
+    if isinstance(raw, str) and raw in DIMENSIONS:
+        raw = {"dimension": raw}
+    raw = _mapping(raw, path, "{dimension, default, bounds, description}", PARAMETER_KEYS)
+    dim = _dimension(raw.get("dimension", "length"), path + ("dimension",))
+    lower = upper = None
+    if raw.get("bounds") is not None:
+        b = raw["bounds"]
+        if not isinstance(b, list) or len(b) != 2:
+            raise InputError(f"expected [low, high] (null for none), got {b!r}", path=path + ("bounds",))
+        lower, upper = (None if v is None else parse_quantity(v, dim, path + ("bounds", k)) for k, v in enumerate(b))
+    default = REQUIRED if raw.get("default") is None else parse_quantity(raw["default"], dim, path + ("default",))
+    return Parameter(name, dim, default, lower, upper, _text(raw.get("description"), path + ("description",)))
+
+
+QUANTITY_KEYS = {"value": "", "dimension": "", "description": "", "family": ""}
+
+
+def _quantity(name: str, raw: Any, path: tuple) -> Quantity:
+    if not isinstance(raw, Mapping):
+        return Quantity(name, raw)
+    raw = _mapping(raw, path, "{value, dimension, description}", QUANTITY_KEYS)
+    if "value" not in raw:
+        raise InputError("missing key 'value' (an expression)", path=path)
+    dim = None if raw.get("dimension") is None else _dimension(raw["dimension"], path + ("dimension",))
+    fam = raw.get("family") or ""
+    return Quantity(name, raw["value"], dim, _text(raw.get("description"), path + ("description",)), fam)
+
+
+PLATFORM_KEYS = {
+    "coordinates": "name -> dimension (or {dimension, description})",
+    "position": "P as an expression of the coordinates",
+    "rotation": "[[axis, angle], ...]: R as a product of rotations",
+    "task": "the task coordinates",
+    "fixed": "coordinates fixed by the structure: name -> value",
+    "home": "the reference pose: name -> value",
+    "bounds": "name -> [low, high]: the box IPOPT keeps the pose in",
+    "planar": "true for a planar mechanism (P in the plane, R about z)",
+    "offsets": "name -> coordinate: inputs/outputs measured from the home pose (dz: pz)",
+}
+
+
+def _platform(raw: Any, path: tuple) -> Platform:  # noqa: C901 - one check per key
+    raw = _mapping(raw, path, "a mapping {coordinates, position, rotation, task ...}", PLATFORM_KEYS)
+    coords, descs = {}, {}
+    for name, spec in _mapping(raw.get("coordinates"), path + ("coordinates",), "name -> dimension").items():
+        p = path + ("coordinates", name)
+        _name(name, p, "a coordinate name")
+        if isinstance(spec, Mapping):
+            spec = _mapping(spec, p, "{dimension, description}", {"dimension": "", "description": ""})
+            descs[name] = _text(spec.get("description"), p + ("description",))
+            spec = spec.get("dimension")
+        coords[name] = _dimension(spec, p)
+    for key in ("position", "task"):
+        if key not in raw:
+            raise InputError(f"missing key {key!r} ({PLATFORM_KEYS[key]})", path=path)
+    rotation = []
+    for k, item in enumerate(_list(raw.get("rotation") or [], path + ("rotation",), "[[axis, angle], ...]")):
+        if not isinstance(item, list) or len(item) != 2 or item[0] not in AXES:
+            raise InputError(f"expected [axis, angle] with axis x, y or z; got {item!r}", path=path + ("rotation", k))
+        rotation.append((item[0], item[1]))
+    task = _list(raw["task"], path + ("task",), "a list of coordinate names")
+    for k, t in enumerate(task):
+        if t not in coords:
+            raise InputError(
+                f"unknown coordinate {t!r}; declared: {', '.join(coords)}",
+                path=path + ("task", k),
+                suggestions=suggest(str(t), coords),
+            )
+    fixed = _mapping(raw.get("fixed") or {}, path + ("fixed",), "name -> value")
+    home = _mapping(raw.get("home") or {}, path + ("home",), "name -> value")
+    bounds = {}
+    for name, b in _mapping(raw.get("bounds") or {}, path + ("bounds",), "name -> [low, high]").items():
+        if not isinstance(b, list) or len(b) != 2:
+            raise InputError(f"expected [low, high], got {b!r}", path=path + ("bounds", name))
+        bounds[name] = (b[0], b[1])
+    for section, names in (("fixed", fixed), ("home", home), ("bounds", bounds)):
+        for name in names:
+            if name not in coords:
+                raise InputError(
+                    f"unknown coordinate {name!r}; declared: {', '.join(coords)}",
+                    path=path + (section, name),
+                    suggestions=suggest(str(name), coords),
+                )
+    planar = raw.get("planar", False)
+    if not isinstance(planar, bool):
+        raise InputError(f"expected true or false, got {planar!r}", path=path + ("planar",))
+    offsets = _mapping(raw.get("offsets") or {}, path + ("offsets",), "name -> coordinate")
+    for name, target in offsets.items():
+        _name(name, path + ("offsets", name), "an offset name")
+        if target not in coords or target in fixed:
+            raise InputError(f"expected a pose coordinate, got {target!r}", path=path + ("offsets", name))
+    return Platform(coords, raw["position"], rotation, tuple(task), fixed, home, bounds, descs, planar, offsets)
+
+
+JOINT_KEYS = {
+    "type": "one of " + ", ".join(JOINT_TYPES),
+    "at": "location (vector expression)",
+    "to": "the distal point of a distance joint",
+    "axis": "axis (vector expression)",
+    "axes": "the axes of a U (2) or of an S's reported angles (3)",
+    "actuated": "the actuator coordinate's name",
+    "gain": "displacement per actuator unit (expression)",
+    "home": "values at the reference configuration (list)",
+    "coordinates": "names of its reported joint values",
+    "limit": "limit family of its coordinates",
+    "range": "[low, high] default limits",
+    "flexure": "{hinge, t, r, l, material, E, sigma_all}",
+    "body": "the body it carries (distal side)",
+}
+
+
+def _joint(raw: Any, path: tuple, template: dict) -> Joint:  # noqa: C901 - one check per key
+    raw = _mapping(raw, path, "a joint {type, at, axis, ...}", JOINT_KEYS)
+    kind = raw.get("type")
+    if kind not in JOINT_TYPES:
+        raise InputError(
+            f"unknown joint type {kind!r}; expected one of: {', '.join(JOINT_TYPES)}",
+            path=path + ("type",),
+            suggestions=suggest(str(kind), JOINT_TYPES),
+        )
+    actuated = raw.get("actuated")
+    if actuated is not None:
+        actuated = _name(_fill(actuated, template, path + ("actuated",)), path + ("actuated",), "an actuator name")
+    coords = tuple(
+        _name(_fill(c, template, path + ("coordinates", k)), path + ("coordinates", k), "a coordinate name")
+        for k, c in enumerate(_list(raw.get("coordinates") or [], path + ("coordinates",), "a list of names"))
+    )
+    home = raw.get("home")
+    home = tuple(home) if isinstance(home, list) else (() if home is None else (home,))
+    axes = raw.get("axes") or []
+    if not isinstance(axes, list):
+        raise InputError(f"expected a list of vectors, got {axes!r:.60}", path=path + ("axes",))
+    rng = raw.get("range")
+    if rng is not None and (not isinstance(rng, list) or len(rng) != 2):
+        raise InputError(f"expected [low, high], got {rng!r}", path=path + ("range",))
+    flex = raw.get("flexure")
+    if flex is not None:
+        flex = Flexure(_mapping(flex, path + ("flexure",), "{hinge, t, r, l, material}"))
+    limit = raw.get("limit")
+    if limit is not None:
+        limit = _name(limit, path + ("limit",), "a limit family name")
+    return Joint(
+        kind,
+        raw.get("at"),
+        raw.get("to"),
+        raw.get("axis"),
+        tuple(axes),
+        actuated,
+        raw.get("gain", 1),
+        home,
+        coords,
+        limit,
+        None if rng is None else tuple(rng),
+        flex,
+        None
+        if raw.get("body") is None
+        else _name(_fill(raw["body"], template, path + ("body",)), path + ("body",), "a body name"),
+        path,
+    )
+
+
+_PLACEHOLDER = re.compile(r"\{(\w+)\}")
+
+
+def _fill(text: Any, template: dict, path: tuple) -> Any:
+    """``"s{i}"`` with i = 2 -> ``"s2"``."""
+    if not isinstance(text, str):
+        return text
+
+    def sub(m: re.Match) -> str:
+        if m.group(1) not in template:
+            raise InputError(
+                f"unknown placeholder {{{m.group(1)}}} in {text!r}; the leg's index is "
+                + (", ".join(template) or "not declared (repeat: {index: i, values: [...]})"),
+                path=path,
+            )
+        v = template[m.group(1)]
+        return f"{v:g}" if isinstance(v, float) else str(v)
+
+    return _PLACEHOLDER.sub(sub, text)
+
+
+LEG_KEYS = {
+    "name": "the leg's name",
+    "repeat": "{index, values, rotate, axis}",
+    "let": "definitions of the leg: name -> expression (in order; may use the index)",
+    "joints": "base -> platform",
+}
+REPEAT_KEYS = {"index": "symbol", "values": "its values", "rotate": "angle expression", "axis": "x, y or z"}
+
+
+def _legs(raw: Any, path: tuple) -> list[Leg]:
+    legs = []
+    for k, item in enumerate(_list(raw, path, "a list of legs")):
+        p = path + (k,)
+        item = _mapping(item, p, "a leg {name, repeat, joints}", LEG_KEYS)
+        name = _name(item.get("name", f"leg{k + 1}"), p + ("name",), "a leg name")
+        rep = item.get("repeat")
+        if rep is None:
+            variants = [({}, None, None, "z")]
+        else:
+            rep = _mapping(rep, p + ("repeat",), "{index, values, rotate}", REPEAT_KEYS)
+            index = _name(rep.get("index", "i"), p + ("repeat", "index"), "an index symbol")
+            values = _list(rep.get("values"), p + ("repeat", "values"), "a list of index values")
+            for j, v in enumerate(values):
+                if isinstance(v, bool) or not isinstance(v, (int, float)):
+                    raise InputError(f"expected a number, got {v!r}", path=p + ("repeat", "values", j))
+            axis = rep.get("axis", "z")
+            if axis not in AXES:
+                raise InputError(f"expected x, y or z, got {axis!r}", path=p + ("repeat", "axis"))
+            variants = [({index: v}, index, rep.get("rotate"), axis) for v in values]
+        joints_raw = _list(item.get("joints"), p + ("joints",), "a list of joints, base -> platform")
+        if not joints_raw:
+            raise InputError("a leg needs at least one joint", path=p + ("joints",))
+        for template, index, rotate, axis in variants:
+            suffix = "" if index is None else str(template[index])
+            joints = [_joint(j, p + ("joints", n), template) for n, j in enumerate(joints_raw)]
+            let = _mapping(item.get("let") or {}, p + ("let",), "name -> expression")
+            legs.append(Leg(name + suffix, joints, index, tuple(template.values()), rotate, axis, p, let))
+    return legs
+
+
+def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a chain can break
+    """Each leg is a serial chain base -> bodies -> platform: a joint carries the next body (its
+    ``body``, default the leg's own next link, the platform for the last joint)."""
+    owner: dict[str, str] = {}
+    for leg in legs:
+        prev, seen = "base", set()
+        for n, j in enumerate(leg.joints):
+            last = n == len(leg.joints) - 1
+            body = j.body or ("platform" if last else f"{leg.name}.link{n + 1}")
+            where = j.path + ("body",)
+            if body == "base":
+                raise InputError(f"a joint cannot carry the base (it joins {prev!r} to the base)", path=where)
+            if body == prev or body in seen:
+                raise InputError(
+                    f"two joints on the body {body!r} with no loop between them: this joint joins {prev!r} "
+                    f"to {body!r} again (a leg is a serial chain; name the body each joint carries)",
+                    path=where,
+                )
+            if last and body != "platform":
+                raise InputError(
+                    f"leg {leg.name} does not reach the platform: its last joint carries {body!r}", path=where
+                )
+            if not last and body == "platform":
+                rest = ", ".join(k.type for k in leg.joints[n + 1 :])
+                raise InputError(
+                    f"leg {leg.name} reaches the platform at joint {n + 1}; the joints after it ({rest}) "
+                    "hang on the platform with no loop",
+                    path=where,
+                )
+            if body != "platform" and owner.get(body, leg.name) != leg.name:
+                raise InputError(
+                    f"the body {body!r} is in legs {owner[body]} and {leg.name}: legs are serial chains that "
+                    "share only the base and the platform",
+                    path=where,
+                )
+            owner[body] = leg.name
+            seen.add(body)
+            prev = body
+
+
+IK_KEYS = {"let": "definitions in order", "pose": "dependent coordinates", "actuators": "", "reach": ""}
+
+
+def description_from_dict(data: Any, file: str | None = None) -> Description:  # noqa: C901 - one step per section
+    """Read a mechanism description from a parsed mechanism file (errors carry key paths)."""
+    data = _mapping(data, (), "a mechanism description (a mapping with name, parameters, platform, legs)", TOP)
+    for key in ("name", "platform"):
+        if key not in data:
+            raise InputError(f"missing required key {key!r} ({TOP[key]})")
+    name = _name(data["name"], ("name",), "a mechanism type name")
+    params = [
+        _parameter(_name(n, ("parameters", n), "a parameter name"), v, ("parameters", n))
+        for n, v in _mapping(data.get("parameters") or {}, ("parameters",), "name -> {dimension, default}").items()
+    ]
+    derived = [
+        _quantity(_name(n, ("derived", n), "a name"), v, ("derived", n))
+        for n, v in _mapping(data.get("derived") or {}, ("derived",), "name -> expression").items()
+    ]
+    passive = [
+        _quantity(_name(n, ("passive", n), "a name"), v, ("passive", n))
+        for n, v in _mapping(data.get("passive") or {}, ("passive",), "name -> {value, dimension}").items()
+    ]
+    actuators = {}
+    for n, v in _mapping(data.get("actuators") or {}, ("actuators",), "name -> dimension").items():
+        path = ("actuators", n)
+        _name(n, path, "an actuator name")
+        if isinstance(v, Mapping):
+            v = _mapping(v, path, "{dimension, home}", {"dimension": "", "home": ""})
+            actuators[n] = (_dimension(v.get("dimension"), path + ("dimension",)), v.get("home", 0))
+        else:
+            actuators[n] = (_dimension(v, path), 0)
+    ik = None
+    if data.get("ik") is not None:
+        raw = _mapping(data["ik"], ("ik",), "{let, pose, actuators, reach}", IK_KEYS)
+        ik = ClosedFormIK(
+            _mapping(raw.get("let") or {}, ("ik", "let"), "name -> expression"),
+            _mapping(raw.get("pose") or {}, ("ik", "pose"), "name -> expression"),
+            _mapping(raw.get("actuators") or {}, ("ik", "actuators"), "name -> expression"),
+            raw.get("reach"),
+        )
+    examples = _list(data.get("examples") or [], ("examples",), "a list of problem files")
+    legs = _legs(data.get("legs") or [], ("legs",))
+    check_bodies(legs)
+    return Description(
+        name=name,
+        title=_text(data.get("title"), ("title",)) or name,
+        parameters=params,
+        platform=_platform(data["platform"], ("platform",)),
+        legs=legs,
+        derived=derived,
+        actuators=actuators,
+        closures=list(_list(data.get("closures") or [], ("closures",), "a list of expressions")),
+        branch=list(_list(data.get("branch") or [], ("branch",), "a list of expressions")),
+        passive=passive,
+        ik=ik,
+        characteristic_length=data.get("characteristic_length"),
+        paper=_text(data.get("paper"), ("paper",)),
+        examples=tuple(str(e) for e in examples),
+        file=file,
+    )
