@@ -255,7 +255,8 @@ def test_bad_solver_option_value(cli, tmp_path):
         cli,
         tmp_path,
         GOOD + "solver: {options: {ipopt.tol: small}}\n",
-        "solver.options.ipopt.tol: CasADi rejected the value 'small' of option 'ipopt.tol' (type mismatch)",
+        "solver.options.ipopt.tol: expected a dimensionless number such as '0.5' or a bare SI number, got 'small' "
+        "(write a number first, then the unit)",
     )
 
 
@@ -306,6 +307,6 @@ def test_solver_option_given_a_mapping(cli, tmp_path):
     expect_input_error(
         cli,
         tmp_path,
-        GOOD + "solver: {options: {ipopt.tol: {a: 1}}}\n",
-        "solver.options.ipopt.tol: CasADi rejected the value {'a': 1} of option 'ipopt.tol' (type mismatch)",
+        GOOD + "solver: {options: {ipopt.mu_min: {a: 1}}}\n",
+        "solver.options.ipopt.mu_min: CasADi rejected the value {'a': 1} of option 'ipopt.mu_min' (type mismatch)",
     )

@@ -253,7 +253,7 @@ def test_plot_bad_input(cli, tmp_path):
     assert cli("solve", fk, "-o", str(out), "-q").code == 0
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "map")
     assert run.code == 2
-    assert run.err == "error: a map of a single result needs --x, --y and --value naming three of its lists\n"
+    assert run.err == f"error: {out}: a map of a single result needs --x, --y and --value naming three of its lists\n"
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "heatmap")
     assert run.err.startswith(
         "error: --type: unknown plot type 'heatmap'; expected one of: amplifier, comparison, design"

@@ -341,7 +341,11 @@ def test_interrupted_cli_sweep_says_how_to_resume(cli, tmp_path, monkeypatch):
     out = tmp_path / "r.csv"
     run = cli("sweep", str(SWEEP_FILE), "-o", str(out))
     assert run.code == 130
-    assert run.err == (f"\ninterrupted: the points solved so far are in {out}; run the same command to resume\n")
+    assert run.err == f"\ninterrupted before any point was solved; nothing was written ({out} does not exist)\n"
+    out.write_text("# cpm_nlp sweep {}\n")  # a file with points of this sweep
+    run = cli("sweep", str(SWEEP_FILE), "-o", str(out))
+    assert run.code == 130
+    assert run.err == f"\ninterrupted: the points solved so far are in {out}; run the same command to resume\n"
 
 
 def test_progress_bar_redraws_in_place_on_a_terminal():

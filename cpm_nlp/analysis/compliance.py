@@ -390,7 +390,7 @@ def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hi
     problem file; ``material_spec`` overrides the default material."""
     c = model.closure
     mech = model.mechanism
-    decl = getattr(mech, "stiffness", None) if mech is not None else None
+    decl = mech.stiffness if mech is not None else None
     merged: dict[str, dict] = {k: dict(v) for k, v in (decl.hinges.items() if decl else ())}
     if hinges is not None and not isinstance(hinges, Mapping):
         raise InputError(f"expected a mapping of hinges (name -> {{joints, type, k, ...}}), got {hinges!r}", path=path)

@@ -42,7 +42,7 @@ import numpy as np
 from ..core.errors import InputError, suggest
 from ..core.model import LoopClosure, Model
 from ..core.multistart import AGREEMENT, best_and_agreement, uniform_starts
-from ..core.solver import SolverConfig
+from ..core.solver import SolverConfig, run_nlp
 from .workspace import (
     CUBOID_IPOPT,
     NLP_MARGIN,
@@ -148,15 +148,7 @@ class SynthesisNLP:
         self._solver = ca.nlpsol(f"{c.name}_synthesis_{N}_{k}", "ipopt", nlp, opts)
 
     def solve(self, z0, params, lbx, ubx, lbg, ubg) -> tuple[np.ndarray, bool, str, int]:
-        try:
-            out = self._solver(x0=z0, p=params, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
-        except RuntimeError as exc:  # an evaluation error: a failed start, not a crash
-            log.debug("synthesis NLP raised: %s", exc)
-            return np.full(len(z0), np.nan), False, f"solver error: {exc}".splitlines()[0], 0
-        stats = self._solver.stats()
-        z = np.asarray(out["x"]).ravel()
-        ok = bool(stats.get("success", False)) and bool(np.all(np.isfinite(z)))
-        return z, ok, str(stats.get("return_status", "")), int(stats.get("iter_count", 0))
+        return run_nlp(self._solver, "synthesis NLP", x0=z0, p=params, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
 
 
 def _check_names(names: Sequence[str], closure: LoopClosure, path: tuple) -> None:

@@ -60,7 +60,7 @@ from ..core.model import LoopClosure, Model
 from ..core.multistart import AGREEMENT, best_and_agreement
 from ..core.options import Option
 from ..core.result import Status, worst_status
-from ..core.solver import SolverConfig
+from ..core.solver import SolverConfig, run_nlp
 from .cuboid_ik import ClosedFormCuboid
 from .requirements import full_factorial
 
@@ -495,15 +495,7 @@ class CuboidNLP:
         self._solver = ca.nlpsol(f"{c.name}_cuboid_{N}", "ipopt", nlp, opts)
 
     def solve(self, z0, params, lbx, ubx, lbg, ubg) -> tuple[np.ndarray, bool, str, int]:
-        try:
-            out = self._solver(x0=z0, p=params, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
-        except RuntimeError as exc:  # an evaluation error: a failed start, not a crash
-            log.debug("cuboid NLP raised: %s", exc)
-            return np.full(len(z0), np.nan), False, f"solver error: {exc}".splitlines()[0], 0
-        stats = self._solver.stats()
-        z = np.asarray(out["x"]).ravel()
-        ok = bool(stats.get("success", False)) and bool(np.all(np.isfinite(z)))
-        return z, ok, str(stats.get("return_status", "")), int(stats.get("iter_count", 0))
+        return run_nlp(self._solver, "cuboid NLP", x0=z0, p=params, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
 
 
 def cuboid_nlp(model: Model, n_samples: int, config: SolverConfig) -> CuboidNLP:

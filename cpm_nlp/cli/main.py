@@ -13,16 +13,21 @@ problem kinds, Matplotlib, Dask), so ``cpm-nlp --help`` loads none of them.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import ctypes
 import json
 import logging
+import os
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
+from ..core import progress
 from ..core.errors import CpmError, InputError
 from ..core.version import __version__
 from ..io.atomic import check_output_path, write_atomic
+from ..io.inputs import inputs_scope
 
 TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
 if TYPE_CHECKING:
@@ -121,14 +126,47 @@ def render_result(result: Result, title: str = "") -> str:
 # -- subcommands --------------------------------------------------------------------------------
 
 
+def _flush_c_stdio() -> None:
+    """Flush the C library's stdout buffer (IPOPT and CasADi print through it)."""
+    with contextlib.suppress(OSError, AttributeError, TypeError):
+        ctypes.CDLL(None).fflush(None)
+
+
+@contextlib.contextmanager
+def solver_output_to_stderr(active: bool) -> Iterator[None]:
+    """While active: whatever is written to file descriptor 1 (IPOPT's log, its
+    option documentation, CasADi's messages) goes to stderr, so that stdout
+    carries exactly the one JSON document of ``--json``."""
+    if not active:
+        yield
+        return
+    try:
+        sys.stdout.flush()
+        saved = os.dup(1)
+    except (OSError, ValueError):  # no file descriptor 1 (embedded use): nothing to protect
+        yield
+        return
+    try:
+        _flush_c_stdio()
+        os.dup2(2, 1)
+        yield
+    finally:
+        with contextlib.suppress(OSError, ValueError):
+            sys.stdout.flush()
+        _flush_c_stdio()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     from ..mechanisms.registry import mechanism_type
     from ..problems.file import load_problem, solve
 
-    check_output_path(args.output)
-    _check_plot_args(args)
-    problem = load_problem(args.file, args.set or [])
-    result = solve(problem)
+    check_output_path(args.output, [args.file])
+    _check_plot_args(args, [args.file, args.output])
+    with solver_output_to_stderr(args.json), progress.reporting(_batch_progress(args)):
+        problem = load_problem(args.file, args.set or [])
+        result = solve(problem)
     # the result first: a plot that cannot be drawn never takes it away
     if args.json:
         out.write(result.to_json() + "\n")
@@ -136,7 +174,7 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
         title = mechanism_type(problem.model.name).title
         out.write(render_result(result, title) + "\n")
     if args.output:
-        write_atomic(args.output, result.to_json() + "\n")
+        write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])
     status = EXIT_OK if result.ok else EXIT_FAILED
     if args.plot:
         fig = _result_figure(args, result, problem)
@@ -144,6 +182,19 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
             return EXIT_FAILED
         _save_figure(args, fig, out)
     return status
+
+
+def _batch_progress(args: argparse.Namespace) -> progress.Callback | None:
+    """On a terminal (stderr), a progress bar for a batch solved pose by pose."""
+    if args.quiet or not getattr(args.err, "isatty", lambda: False)():
+        return None
+    bars: dict[str, ProgressBar] = {}
+
+    def show(what: str, done: int, total: int) -> None:
+        bar = bars.setdefault(what, ProgressBar(args.err, label=what, unit="poses"))
+        bar(done, total)
+
+    return show
 
 
 # -- plots ------------------------------------------------------------------------------------
@@ -155,12 +206,13 @@ def _plot_options(args: argparse.Namespace) -> Any:
     return PlotOptions(value=args.value, x=getattr(args, "x", None), y=getattr(args, "y", None), best=args.best)
 
 
-def _check_plot_args(args: argparse.Namespace) -> None:
-    """Before solving: the figure can be written, and its library is there."""
+def _check_plot_args(args: argparse.Namespace, inputs: Sequence[str | None] = ()) -> None:
+    """Before solving: the figure can be written (not over an input or the
+    results), and its plotting library is there."""
     if getattr(args, "plot", None):
         from ..plot.draw import check_figure_path, require_backend
 
-        check_figure_path(args.plot, "--plot")
+        check_figure_path(args.plot, "--plot", inputs=[f for f in inputs if f])
         require_backend(args.plot)
 
 
@@ -192,7 +244,7 @@ def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: T
     from ..plot.draw import save
 
     fig, kind = fig_and_type
-    save(fig, args.plot)
+    save(fig, args.plot, option="--plot")
     if not args.quiet and not getattr(args, "json", False):
         out.write(f"plot    : {args.plot} ({kind})\n")
 
@@ -201,11 +253,15 @@ def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
     from ..plot.draw import check_figure_path, require_backend, save
     from ..plot.figures import figure, load
 
-    check_figure_path(args.output)
+    check_figure_path(args.output, inputs=[args.result])
     require_backend(args.output)
-    data = load(args.result)
-    fig, kind = figure(data, args.type, _plot_options(args), interactive=_interactive(args.output))
-    save(fig, args.output)
+    try:
+        data = load(args.result)
+        fig, kind = figure(data, args.type, _plot_options(args), interactive=_interactive(args.output))
+    except InputError as exc:  # every message about the result names the file plotted
+        about_a_flag = bool(exc.path) and str(exc.path[0]).startswith("-")
+        raise (exc if exc.file or about_a_flag else exc.at(file=args.result)) from None
+    save(fig, args.output, inputs=[args.result])
     out.write(f"{args.output}: {kind} plot of {args.result}\n")
     return EXIT_OK
 
@@ -214,11 +270,11 @@ def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
 
 
 class ProgressBar:
-    """Points done of a sweep, on stderr: redrawn in place on a terminal, a
-    line per tenth otherwise (logs)."""
+    """Points done of a sweep (or poses of a batch), on stderr: redrawn in
+    place on a terminal, a line per tenth otherwise (logs)."""
 
-    def __init__(self, stream: TextIO, width: int = 30) -> None:
-        self.stream, self.width = stream, width
+    def __init__(self, stream: TextIO, width: int = 30, label: str = "sweep", unit: str = "points") -> None:
+        self.stream, self.width, self.label, self.unit = stream, width, label, unit
         self.tty = bool(getattr(stream, "isatty", lambda: False)())
         self.t0 = time.monotonic()
         self.first: int | None = None
@@ -235,7 +291,7 @@ class ProgressBar:
         eta = ""
         if 0 < new and done < total:
             eta = f", about {elapsed / new * (total - done):.0f} s left"
-        text = f"sweep: {done}/{total} points ({frac:.0%}), {elapsed:.1f} s{eta}"
+        text = f"{self.label}: {done}/{total} {self.unit} ({frac:.0%}), {elapsed:.1f} s{eta}"
         if self.tty:
             if done < total and now - self.last_draw < 0.1:
                 return
@@ -271,7 +327,8 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
 
     output = args.output or f"{Path(args.file).stem}.parquet"
     results_format(output)
-    _check_plot_args(args)
+    check_output_path(output, [args.file])
+    _check_plot_args(args, [args.file, output])
     if args.workers is not None and args.workers < 1:
         raise InputError(f"expected a positive number of workers, got {args.workers}", path=("--workers",))
     if args.chunk is not None and args.chunk < 1:
@@ -290,11 +347,11 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
             progress=progress,
         )
     except KeyboardInterrupt:
-        args.err.write(f"\ninterrupted: the points solved so far are in {output}; run the same command to resume\n")
+        args.err.write("\n" + _interrupted_message(output) + "\n")
         return 130
     if not args.quiet:
         out.write(render_sweep(summary, args, problem) + "\n")
-    if args.plot:
+    if args.plot:  # the sweep ran: a plot that cannot be drawn is a failure (exit 1), not bad input
         from ..plot.figures import figure, load
 
         try:
@@ -304,6 +361,15 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
             return EXIT_FAILED
         _save_figure(args, drawn, out)
     return EXIT_OK if summary.ok else EXIT_FAILED
+
+
+def _interrupted_message(output: str) -> str:
+    """What a Ctrl-C during a sweep leaves: the results so far, or nothing."""
+    from ..io.results import journal_path
+
+    if Path(output).exists() or journal_path(Path(output)).exists():
+        return f"interrupted: the points solved so far are in {output}; run the same command to resume"
+    return f"interrupted before any point was solved; nothing was written ({output} does not exist)"
 
 
 def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
@@ -374,8 +440,9 @@ def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
     from ..problems.published import summarize
     from ..problems.reproduce import reproduce
 
-    check_output_path(args.output)
-    rows = reproduce(args.paths or None)
+    check_output_path(args.output, args.paths)
+    with solver_output_to_stderr(args.json):
+        rows = reproduce(args.paths or None)
     summary = summarize(rows)
     document = json.dumps({"figures": [r.to_dict() for r in rows], "summary": summary}, indent=2) + "\n"
     if args.json:
@@ -383,7 +450,7 @@ def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
     else:
         out.write(render_reproduce(rows) + "\n\n" + render_reproduce_summary(summary) + "\n")
     if args.output:
-        write_atomic(args.output, document)
+        write_atomic(args.output, document, inputs=args.paths)
     return EXIT_OK if all(r.expected for r in rows) else EXIT_FAILED
 
 
@@ -393,9 +460,11 @@ def cmd_export(args: argparse.Namespace, out: TextIO) -> int:
 
     what = parse_what(args.what)
     check_format(args.format)
-    check_out_dir(args.out)
+    check_out_dir(args.out, inputs=[args.file])
     problem = load_problem(args.file, args.set or [])
-    data = export_kinematics(problem.model, args.out, what, args.format, problem.solver, source=args.file)
+    data = export_kinematics(
+        problem.model, args.out, what, args.format, problem.solver, source=args.file, inputs=[args.file]
+    )
     for f in [*data["files"], "manifest.json"]:
         out.write(f"{Path(args.out) / f}\n")
     return EXIT_OK
@@ -593,7 +662,8 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
     func: Callable[[argparse.Namespace, TextIO], int] = args.func
     args.err = err
     try:
-        return func(args, out)
+        with inputs_scope():
+            return func(args, out)
     except InputError as exc:
         err.write(f"error: {exc}\n")
         return EXIT_INPUT

@@ -40,6 +40,18 @@ def suggest(word: str, candidates: Iterable[str], n: int = 3) -> list[str]:
     return [lowered[h] for h in hits[:n]]
 
 
+#: Longest message part of an error (a message quoting a large input is cut).
+MAX_MESSAGE = 400
+
+
+def _shorten(text: str, limit: int) -> str:
+    """``text`` cut to about ``limit`` characters, saying how much was left out."""
+    text = str(text)
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]}... ({len(text) - limit} more characters)"
+
+
 class CpmError(Exception):
     """Base class of every exception raised by cpm_nlp on purpose."""
 
@@ -80,15 +92,16 @@ class InputError(CpmError):
 
     def render(self) -> str:
         where = []
+        message = _shorten(self.message, MAX_MESSAGE)
         if self.file:
-            where.append(str(self.file))
+            where.append(_shorten(str(self.file), 200))
         if self.path:
-            where.append(format_key_path(self.path))
-        text = ": ".join(where + [self.message]) if where else self.message
+            where.append(_shorten(format_key_path(self.path), 200))
+        text = ": ".join(where + [message]) if where else message
         if self.suggestions:
-            text += "; did you mean " + " or ".join(f"'{s}'" for s in self.suggestions) + "?"
+            text += "; did you mean " + " or ".join(f"'{_shorten(s, 80)}'" for s in self.suggestions[:3]) + "?"
         if self.hint:
-            text += f" ({self.hint})"
+            text += f" ({_shorten(self.hint, 300)})"
         # one message, one line: control characters from the input are escaped
         return "".join(ch if ch.isprintable() else repr(ch)[1:-1] for ch in text)
 

@@ -69,6 +69,8 @@ class Option:
         return base + (f" {bounds}" if bounds else "")
 
     def format_value(self, v: float) -> str:
+        if self.kind == "int":
+            return f"{int(v)}"
         if self.kind in DIMENSIONS and self.kind != "dimensionless":
             return format_quantity(v, self.kind)
         return f"{v:g}"
@@ -162,6 +164,13 @@ class Option:
 
     def _check_bounds(self, number: float, raw: Any, path: tuple) -> None:
         lo, hi = self.lower, self.upper
+        limit = DIMENSIONS[self.kind].limit if self.kind in DIMENSIONS else math.inf
+        if abs(number) > limit and not (lo is not None and hi is not None and lo >= -limit and hi <= limit):
+            raise InputError(
+                f"{raw!r} is beyond the sanity limit of {self.format_value(limit)} for "
+                f"{article(self.kind.replace('_', ' '))}; expected {self.expectation()}",
+                path=path,
+            )
         bad = (lo is not None and (number < lo or (self.strict and number == lo))) or (
             hi is not None and (number > hi or (self.strict and number == hi))
         )

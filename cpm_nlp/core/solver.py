@@ -22,6 +22,7 @@ import casadi as ca
 import numpy as np
 
 from .errors import InputError, suggest
+from .options import Option
 
 log = logging.getLogger(__name__)
 
@@ -44,35 +45,149 @@ DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
     },
 }
 
-#: Commonly used IPOPT option names, for "did you mean" (CasADi does the validation).
-_COMMON_IPOPT = (
-    "tol",
-    "max_iter",
-    "print_level",
-    "acceptable_tol",
-    "acceptable_iter",
-    "constr_viol_tol",
-    "dual_inf_tol",
-    "compl_inf_tol",
-    "mu_strategy",
-    "mu_init",
-    "linear_solver",
-    "hessian_approximation",
-    "nlp_scaling_method",
-    "bound_push",
-    "bound_frac",
-    "warm_start_init_point",
-    "max_cpu_time",
-    "max_wall_time",
-    "sb",
-    "print_timing_statistics",
-    "derivative_test",
-    "fixed_variable_treatment",
-    "bound_relax_factor",
-    "honor_original_bounds",
-    "check_derivatives_for_naninf",
-    "output_file",
-)
+#: Largest integer an option of IPOPT or CasADi takes (a C int).
+MAX_INT = 2**31 - 1
+
+
+def _real(name: str, description: str, lower: float = 0.0, strict: bool = True, upper: float | None = None) -> Option:
+    return Option(name, "dimensionless", description, default=None, lower=lower, upper=upper, strict=strict)
+
+
+def _count(name: str, description: str, lower: int = 0, upper: int = MAX_INT) -> Option:
+    return Option(name, "int", description, default=None, lower=lower, upper=upper)
+
+
+def _yes_no(name: str, description: str) -> Option:
+    return Option(name, "choice", description, default=None, choices=("yes", "no"))
+
+
+#: The IPOPT options checked by type and range before IPOPT sees them (names
+#: without the ``ipopt.`` prefix; https://coin-or.github.io/Ipopt/OPTIONS.html).
+#: An option not listed here is passed to IPOPT, which checks its name.
+IPOPT_OPTIONS: dict[str, Option] = {
+    o.name: o
+    for o in (
+        _real("tol", "desired convergence tolerance (relative)"),
+        _count("max_iter", "maximum number of iterations"),
+        _count("print_level", "output verbosity level", upper=12),
+        _real("acceptable_tol", "'acceptable' convergence tolerance (relative)"),
+        _count("acceptable_iter", "number of 'acceptable' iterates before stopping"),
+        _real("constr_viol_tol", "desired threshold for the constraint violation (absolute)"),
+        _real("acceptable_constr_viol_tol", "'acceptance' threshold for the constraint violation"),
+        _real("dual_inf_tol", "desired threshold for the dual infeasibility"),
+        _real("compl_inf_tol", "desired threshold for the complementarity conditions"),
+        Option("mu_strategy", "choice", "barrier parameter update", None, choices=("monotone", "adaptive")),
+        _real("mu_init", "initial value for the barrier parameter"),
+        Option(
+            "linear_solver",
+            "choice",
+            "linear solver used for step computations",
+            None,
+            choices=("mumps", "ma27", "ma57", "ma77", "ma86", "ma97", "pardiso", "pardisomkl", "spral", "wsmp"),
+        ),
+        Option(
+            "hessian_approximation",
+            "choice",
+            "what Hessian information is to be used",
+            None,
+            choices=("exact", "limited-memory"),
+        ),
+        Option(
+            "nlp_scaling_method",
+            "choice",
+            "technique used for scaling the problem",
+            None,
+            choices=("none", "user-scaling", "gradient-based", "equilibration-based"),
+        ),
+        _real("bound_push", "desired minimum absolute distance from the initial point to bound"),
+        _real("bound_frac", "desired minimum relative distance from the initial point to bound", upper=0.5),
+        _real("bound_relax_factor", "factor for initial relaxation of the bounds", strict=False),
+        _yes_no("warm_start_init_point", "warm-start for the initial point"),
+        _real("max_cpu_time", "maximum number of CPU seconds"),
+        _real("max_wall_time", "maximum number of wall-clock seconds"),
+        _yes_no("sb", "suppress the IPOPT banner"),
+        _yes_no("print_timing_statistics", "print timing statistics at the end"),
+        Option(
+            "derivative_test",
+            "choice",
+            "derivative checker",
+            None,
+            choices=("none", "first-order", "second-order", "only-second-order"),
+        ),
+        Option(
+            "fixed_variable_treatment",
+            "choice",
+            "how fixed variables are handled",
+            None,
+            choices=("make_parameter", "make_parameter_nodual", "make_constraint", "relax_bounds"),
+        ),
+        _yes_no("honor_original_bounds", "project the final point into the original bounds"),
+        _yes_no("check_derivatives_for_naninf", "check the derivative matrices for NaN and Inf"),
+    )
+}
+
+#: The options of CasADi's Newton rootfinder (casadi.rootfinder_options("newton"))
+#: and of every rootfinder, checked by type and range; any other name is refused.
+NEWTON_OPTIONS: dict[str, Option] = {
+    o.name: o
+    for o in (
+        _real("abstol", "stopping criterion tolerance on the residual max-norm"),
+        _real("abstolStep", "stopping criterion tolerance on the step size"),
+        _count("max_iter", "maximum number of Newton iterations", lower=1),
+        Option("line_search", "bool", "enable the line search", None),
+        Option("print_iteration", "bool", "print information about each iteration", None),
+        Option("error_on_fail", "bool", "raise an error when the iteration fails", None),
+    )
+}
+
+#: Options of every CasADi function, for either method.
+COMMON_OPTIONS: dict[str, Option] = {
+    o.name: o
+    for o in (
+        Option("print_time", "bool", "print the time spent in the solver", None),
+        Option("verbose", "bool", "verbose evaluation (debugging)", None),
+    )
+}
+
+
+def run_nlp(solver: ca.Function, what: str, **args: Any) -> tuple[np.ndarray, bool, str, int]:
+    """One call of an IPOPT ``nlpsol``: ``(x, converged, return status, iterations)``.
+    An evaluation error inside the NLP (a NaN in a start far from home) is a failed
+    start, reported as such, not a crash."""
+    try:
+        out = solver(**args)
+    except RuntimeError as exc:
+        log.debug("%s raised: %s", what, exc)
+        return np.full(len(np.atleast_1d(args["x0"])), np.nan), False, f"solver error: {exc}".splitlines()[0], 0
+    stats = solver.stats()
+    z = np.asarray(out["x"]).ravel()
+    ok = bool(stats.get("success", False)) and bool(np.all(np.isfinite(z)))
+    return z, ok, str(stats.get("return_status", "")), int(stats.get("iter_count", 0))
+
+
+def check_options(method: str, options: Mapping[str, Any]) -> dict[str, Any]:
+    """The options checked by type and range where they are known; the
+    checked values (an integer written ``50.0`` becomes ``50``).  An unknown
+    Newton option, or an IPOPT option given to Newton, is refused with a
+    "did you mean" among Newton's options."""
+    out: dict[str, Any] = {}
+    for key, value in options.items():
+        path = ("solver", "options", key)
+        rule = COMMON_OPTIONS.get(key)
+        if method == "ipopt" and key.startswith("ipopt."):
+            rule = IPOPT_OPTIONS.get(key[len("ipopt.") :])
+        elif method == "newton" and rule is None:
+            rule = NEWTON_OPTIONS.get(key)
+            if rule is None:
+                known = sorted({*NEWTON_OPTIONS, *COMMON_OPTIONS})
+                what = "an IPOPT option" if key.startswith("ipopt.") else "not an option of this solver"
+                raise InputError(
+                    f"'{key}' is {what}; the newton method takes: {', '.join(known)}",
+                    path=path,
+                    suggestions=suggest(key.rpartition(".")[2], known),
+                )
+        out[key] = value if rule is None else rule.parse(value, path)
+    return out
 
 
 @dataclass(frozen=True)
@@ -112,8 +227,10 @@ class SolverConfig:
         return merged
 
     def validate(self) -> None:
-        """Let CasADi check the options now (on a one-variable problem), so that
-        a bad option is reported while the problem file is read."""
+        """Check the options by type and range (:func:`check_options`), then let
+        CasADi check them (on a one-variable problem), so that a bad option is
+        reported while the problem file is read."""
+        check_options(self.method, self.options)
         items = tuple(sorted(self.options.items(), key=lambda kv: kv[0]))
         try:
             hash(items)
@@ -175,7 +292,7 @@ def translate_casadi_error(exc: Exception, options: Mapping[str, Any]) -> InputE
         return InputError(
             f"IPOPT has no option '{name}'",
             path=("solver", "options", f"ipopt.{name}"),
-            suggestions=[f"ipopt.{s}" for s in suggest(name, _COMMON_IPOPT)],
+            suggestions=[f"ipopt.{s}" for s in suggest(name, IPOPT_OPTIONS)],
             hint="see https://coin-or.github.io/Ipopt/OPTIONS.html",
         )
     m = re.search(r"Unknown option: (\S+)", text)

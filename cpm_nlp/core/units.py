@@ -37,30 +37,35 @@ class Dimension:
     display: str
     example: str
     common_units: tuple[str, ...]
+    #: largest magnitude (SI) a declared option of this dimension accepts
+    #: unless it declares its own bounds: far beyond any mechanism of this
+    #: toolkit, it only stops absurd values (1e30 rad) from being "solved"
+    limit: float = math.inf
 
 
 DIMENSIONS: dict[str, Dimension] = {
     d.name: d
     for d in (
-        Dimension("length", "m", "mm", "47.91 mm", ("m", "mm", "um", "µm", "nm", "cm")),
-        Dimension("angle", "rad", "deg", "0.2 deg", ("rad", "deg", "mrad", "urad", "arcmin", "arcsec")),
-        Dimension("stress", "Pa", "MPa", "400 MPa", ("Pa", "kPa", "MPa", "GPa")),
-        Dimension("force", "N", "N", "20 N", ("N", "mN", "kN")),
-        Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg")),
-        Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3")),
-        Dimension("density", "kg/m^3", "kg/m^3", "2810 kg/m^3", ("kg/m^3", "g/cm^3")),
-        Dimension("time", "s", "s", "5 ms", ("s", "ms", "us")),
-        Dimension("frequency", "Hz", "Hz", "93.8 Hz", ("Hz", "kHz")),
-        Dimension("stiffness", "N/m", "N/um", "2 N/um", ("N/m", "N/mm", "N/um")),
-        Dimension("rotational_stiffness", "N*m/rad", "N*m/rad", "98.37 N*m/rad", ("N*m/rad", "N*mm/rad")),
-        Dimension("moment", "N*m", "N*m", "0.1 N*m", ("N*m", "N*mm")),
-        Dimension("inertia", "kg*m^2", "kg*m^2", "1e-4 kg*m^2", ("kg*m^2", "g*mm^2")),
-        Dimension("compliance", "m/N", "um/N", "15 um/N", ("m/N", "um/N")),
-        Dimension("rotational_compliance", "rad/(N*m)", "rad/(N*m)", "0.01 rad/(N*m)", ("rad/(N*m)",)),
-        Dimension("energy", "J", "J", "1 mJ", ("J", "mJ")),
-        Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "um^3", "cm^3")),
-        Dimension("acceleration", "m/s^2", "m/s^2", "9.81 m/s^2", ("m/s^2", "mm/s^2")),
-        Dimension("dimensionless", "", "", "0.5", ("", "%")),
+        Dimension("length", "m", "mm", "47.91 mm", ("m", "mm", "um", "µm", "nm", "cm"), 1e3),
+        Dimension(
+            "angle", "rad", "deg", "0.2 deg", ("rad", "deg", "mrad", "urad", "arcmin", "arcsec"), 4 * math.pi
+        ),  # two turns: crank angles of a 3-RRR reach 380 deg
+        Dimension("stress", "Pa", "MPa", "400 MPa", ("Pa", "kPa", "MPa", "GPa"), 1e13),
+        Dimension("force", "N", "N", "20 N", ("N", "mN", "kN"), 1e7),
+        Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg"), 1e4),
+        Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3"), 1e3),
+        Dimension("density", "kg/m^3", "kg/m^3", "2810 kg/m^3", ("kg/m^3", "g/cm^3"), 1e5),
+        Dimension("time", "s", "s", "5 ms", ("s", "ms", "us"), 1e7),
+        Dimension("frequency", "Hz", "Hz", "93.8 Hz", ("Hz", "kHz"), 1e12),
+        Dimension("stiffness", "N/m", "N/um", "2 N/um", ("N/m", "N/mm", "N/um"), 1e12),
+        Dimension("rotational_stiffness", "N*m/rad", "N*m/rad", "98.37 N*m/rad", ("N*m/rad", "N*mm/rad"), 1e9),
+        Dimension("moment", "N*m", "N*m", "0.1 N*m", ("N*m", "N*mm"), 1e7),
+        Dimension("inertia", "kg*m^2", "kg*m^2", "1e-4 kg*m^2", ("kg*m^2", "g*mm^2"), 1e6),
+        Dimension("compliance", "m/N", "um/N", "15 um/N", ("m/N", "um/N"), 1e6),
+        Dimension("rotational_compliance", "rad/(N*m)", "rad/(N*m)", "0.01 rad/(N*m)", ("rad/(N*m)",), 1e9),
+        Dimension("energy", "J", "J", "1 mJ", ("J", "mJ"), 1e9),
+        Dimension("acceleration", "m/s^2", "m/s^2", "9.81 m/s^2", ("m/s^2", "mm/s^2"), 1e6),
+        Dimension("dimensionless", "", "", "0.5", ("", "%"), 1e15),
     )
 }
 

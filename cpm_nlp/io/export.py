@@ -61,6 +61,7 @@ from ..core.result import STATUS_TEXT
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
 from ..core.version import __version__
+from .atomic import check_output_path
 
 WHAT = ("fk", "ik", "jacobian")
 FORMATS = ("casadi", "c")
@@ -344,15 +345,27 @@ def manifest(
     return out
 
 
-def check_out_dir(out_dir: str | os.PathLike, path: tuple = ("--out",)) -> Path:
+def check_out_dir(
+    out_dir: str | os.PathLike, path: tuple = ("--out",), inputs: Sequence[str | os.PathLike] = ()
+) -> Path:
+    """The output directory, after checking (nothing created) that it can be
+    written: an existing directory or a new one in an existing directory, no
+    file written there replacing an input or anything but a regular file."""
     target = Path(out_dir)
     if target.exists() and not target.is_dir():
         raise InputError(f"{target} is a file; expected a directory", path=path)
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
         raise InputError(f"directory {parent} does not exist", path=path)
-    if not os.access(target if target.exists() else parent, os.W_OK):
-        raise InputError(f"{target if target.exists() else parent} is not writable", path=path)
+    where = target if target.exists() else parent
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".cpm_nlp_check_", dir=where)
+    except OSError as exc:
+        raise InputError(f"cannot write in {where} ({exc.strerror or exc.__class__.__name__})", path=path) from None
+    os.close(fd)
+    os.unlink(tmp)
+    if (target / MANIFEST).exists() or (target / MANIFEST).is_symlink():  # always written: replaceable?
+        check_output_path(str(target / MANIFEST), inputs, option=path[0] if path else "--out")
     return target
 
 
@@ -363,6 +376,7 @@ def export_kinematics(
     fmt: str = "casadi",
     solver: SolverConfig | None = None,
     source: str | None = None,
+    inputs: Sequence[str | os.PathLike] = (),
 ) -> dict[str, Any]:
     """Write the exported functions and ``manifest.json`` into ``out_dir``
     (created if missing); returns the manifest.
@@ -372,7 +386,7 @@ def export_kinematics(
     """
     check_format(fmt)
     names = parse_what(what)
-    target = check_out_dir(out_dir)
+    target = check_out_dir(out_dir, inputs=inputs)
     config = solver or SolverConfig("newton")
     exported = exported_functions(model, names, config)
     parent = target.parent if str(target.parent) else Path(".")
@@ -388,9 +402,16 @@ def export_kinematics(
         files = {f: _sha256(folder / f) for f in written}
         data = manifest(model, exported, fmt, config, files, source)
         (folder / MANIFEST).write_text(json.dumps(data, indent=2, allow_nan=False) + "\n")
-        target.mkdir(exist_ok=True)
-        for f in [*written, MANIFEST]:
-            os.replace(folder / f, target / f)
+        if target.is_dir():  # no file of the export replaces an input or a special file
+            for f in [*written, MANIFEST]:
+                check_output_path(str(target / f), inputs, option="--out")
+        try:
+            target.mkdir(exist_ok=True)
+            for f in [*written, MANIFEST]:
+                os.replace(folder / f, target / f)
+        except OSError as exc:
+            why = exc.strerror or exc.__class__.__name__
+            raise InputError(f"cannot write in {target} ({why})", path=("--out",)) from None
     return data
 
 

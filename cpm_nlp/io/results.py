@@ -37,6 +37,7 @@ from typing import Any
 
 from ..core.errors import InputError
 from .atomic import check_output_path, replace_atomically
+from .inputs import MAX_RESULTS_BYTES, check_input_file, read_input_text
 
 META_PREFIX = "# cpm_nlp sweep "
 FORMATS = (".parquet", ".csv")
@@ -103,11 +104,16 @@ def _uncell(text: str) -> Any:
     return text
 
 
-def _decode_row(raw: Mapping[str, str]) -> dict[str, Any]:
+def _decode_row(raw: Mapping[str, str], path: Path, line: int) -> dict[str, Any]:
     row: dict[str, Any] = {}
     for name, text in raw.items():
         if name == "point":
-            row[name] = int(text)
+            try:
+                row[name] = int(text)
+            except (TypeError, ValueError):
+                raise InputError(
+                    f"line {line}: expected a point number in column 'point', got {str(text)[:40]!r}", file=str(path)
+                ) from None
         elif name in TEXT_COLUMNS:
             row[name] = text
         else:
@@ -197,9 +203,8 @@ class CsvStore(_Store):
         super().__init__(path, meta, columns, overwrite)
         self.resumed = path.exists() and not overwrite
         if self.resumed:
-            _read_meta_line(path)  # a file of ours, before anything is changed in it
+            self._adopt(read_csv(path))  # a file of ours and of this sweep, before anything is changed in it
             _truncate_partial_line(path)
-            self._adopt(read_csv(path))
 
     def _head(self) -> str:
         buf = io.StringIO()
@@ -246,11 +251,12 @@ class ParquetStore(_Store):
         self._dirty = False  # rows not yet in the Parquet file
         if not overwrite and (path.exists() or self.journal.exists()):
             table = read_parquet(path)
-            self._adopt(table)
+            if table.meta or path.exists():  # else: a journal cut short in its first line (nothing solved)
+                self._adopt(table)
             self.rows = {r["point"]: r for r in table.rows}
             if self.journal.exists():
                 _truncate_partial_line(self.journal)
-                self._dirty = True  # a run that stopped before writing its Parquet file
+                self._dirty = bool(table.rows)  # a run that stopped before writing its Parquet file
         self._last = time.monotonic()
         self._cost = 0.0
 
@@ -296,6 +302,8 @@ def open_store(path: str | os.PathLike, meta: dict[str, Any], columns: list[str]
     target = Path(path)
     fmt = results_format(target)
     check_output_path(str(target))
+    if fmt == ".parquet":  # the journal is appended to: a regular file too, never an input
+        check_output_path(str(journal_path(target)))
     meta = json.loads(json.dumps(meta))  # a copy: the store adds units as it learns them
     if fmt == ".csv":
         return CsvStore(target, meta, columns, overwrite)
@@ -305,25 +313,35 @@ def open_store(path: str | os.PathLike, meta: dict[str, Any], columns: list[str]
 # -- reading ------------------------------------------------------------------------------------
 
 
-def _read_meta_line(path: Path) -> dict[str, Any]:
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        first = fh.readline()
+def _meta_of(first: str, path: Path) -> dict[str, Any]:
     if not first.startswith(META_PREFIX):
         raise InputError(
-            f"{path} is not a cpm_nlp sweep results file (its first line is not '{META_PREFIX.strip()} ...')"
+            f"the file is not a cpm_nlp sweep results file (its first line is not '{META_PREFIX.strip()} ...')",
+            file=str(path),
         )
     try:
-        return json.loads(first[len(META_PREFIX) :])
+        meta = json.loads(first[len(META_PREFIX) :])
     except ValueError:
-        raise InputError(f"{path}: the metadata line of the results file is damaged") from None
+        meta = None
+    if not isinstance(meta, dict):
+        raise InputError("the metadata line (line 1) of the results file is damaged", file=str(path))
+    return meta
 
 
 def read_csv(path: Path) -> SweepTable:
-    meta = _read_meta_line(path)
-    with open(path, encoding="utf-8", newline="") as fh:
-        fh.readline()
-        reader = csv.DictReader(fh)
-        rows = [_decode_row(raw) for raw in reader if None not in raw.values()]  # a line cut short is skipped
+    """Rows of a CSV results file; a last line cut short by a crash (no newline) is dropped."""
+    text = read_input_text(path, MAX_RESULTS_BYTES, record=False)
+    text = text[: text.rfind("\n") + 1]  # every record ends with a newline
+    first, _, body = text.partition("\n")
+    meta = _meta_of(first, path)
+    reader = csv.DictReader(io.StringIO(body, newline=""))
+    rows = []
+    for raw in reader:
+        if None in raw.values() or None in raw:
+            raise InputError(
+                f"line {reader.line_num + 1}: expected {len(reader.fieldnames or ())} columns", file=str(path)
+            )
+        rows.append(_decode_row(raw, path, reader.line_num + 1))
     return SweepTable(str(path), meta, rows)
 
 
@@ -341,6 +359,7 @@ def read_parquet(path: Path) -> SweepTable:  # noqa: C901 - one message per way 
     meta: dict[str, Any] = {}
     rows: dict[int, dict[str, Any]] = {}
     if path.exists():
+        check_input_file(path, None)
         try:
             table = pq.read_table(path)
         except Exception as exc:  # pyarrow raises ArrowInvalid, OSError ... for a file that is not Parquet
@@ -357,19 +376,24 @@ def read_parquet(path: Path) -> SweepTable:  # noqa: C901 - one message per way 
             rows[r["point"]] = r
     journal = journal_path(path)
     if journal.exists():
-        with open(journal, encoding="utf-8") as fh:
-            lines = fh.read().split("\n")
-        if lines and lines[0]:
-            head = json.loads(lines[0])
+        text = read_input_text(journal, MAX_RESULTS_BYTES, record=False)
+        lines = text[: text.rfind("\n") + 1].split("\n")[:-1]  # a last line cut short by a crash is dropped
+        if lines:
+            try:
+                head = json.loads(lines[0])
+            except ValueError:
+                head = None
+            if not isinstance(head, dict):
+                raise InputError("the journal's first line (the sweep's metadata) is damaged", file=str(journal))
             meta = meta or head
             if head.get("fingerprint") != meta.get("fingerprint"):
                 raise InputError(f"{journal} belongs to another sweep than {path}; remove one of them")
-        for line in lines[1:]:
+        for n, line in enumerate(lines[1:], start=2):
             try:
                 r = json.loads(line)
-            except ValueError:  # the last line, cut short by a crash, or empty
-                continue
-            rows[r["point"]] = r
+                rows[int(r["point"])] = r
+            except (ValueError, TypeError, KeyError):
+                raise InputError(f"line {n} of the journal is damaged", file=str(journal)) from None
     meta.pop("json_columns", None)
     return SweepTable(str(path), meta, [rows[k] for k in sorted(rows)])
 
@@ -405,6 +429,8 @@ def read_results(path: str | os.PathLike) -> SweepTable:
     """Read a sweep results file (``.parquet`` or ``.csv``)."""
     p = Path(path)
     if not p.exists() and not journal_path(p).exists():
+        if p.is_symlink():
+            raise InputError("a symbolic link to a file that does not exist", file=str(path))
         raise InputError("file not found", file=str(path))
     if results_format(p) == ".csv":
         return read_csv(p)

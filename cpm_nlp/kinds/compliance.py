@@ -344,9 +344,13 @@ class ActuatorForces(_HingeKind):
         for off in c.offsets:
             names += [f"{off}_at_allowable", f"{off}_at_allowable_linear"]
         names += [f"{q}_at_allowable" for q in c.q_names]
-        decl = getattr(model.mechanism, "stiffness", None) if model.mechanism is not None else None
+        decl = model.mechanism.stiffness if model.mechanism is not None else None
         if decl is not None:
             names += [f"stress_{g}" for g in decl.hinges]
+            for g, spec in decl.hinges.items():  # stiffness from the hinge formula, where a geometry is given
+                if spec.get("type"):
+                    joints = spec.get("joints")
+                    names += [f"k_formula_{g}_{a}" for a in (joints if isinstance(joints, Mapping) else ("bend",))]
         return names
 
 

@@ -30,6 +30,7 @@ from ..core.kind import (
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
 from ..core.model import Model
 from ..core.options import Option, validate_mapping
+from ..core.progress import track
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
@@ -167,7 +168,7 @@ class ForwardKinematics(ProblemKind):
         if batch and batch_newton_supported(solver):  # one vectorized Newton over every point
             sols = batch_forward_kinematics(model, qs, solver, guess).solutions()
         else:
-            sols = [forward_kinematics(model, q, solver, guess) for q in qs]
+            sols = [forward_kinematics(model, q, solver, guess) for q in track(qs, "forward kinematics")]
         return _result(self.name, model, sols, batch, solver)
 
     def output_names(self, model: Model) -> list[str]:
@@ -287,7 +288,7 @@ class InverseKinematics(ProblemKind):
         if batch and model.closure.ik is not None and inputs["method"] != "solve":  # closed form, vectorized
             sols = batch_inverse_kinematics(model, ts, solver).solutions()
         else:
-            sols = [inverse_kinematics(model, t, solver, inputs["method"]) for t in ts]
+            sols = [inverse_kinematics(model, t, solver, inputs["method"]) for t in track(ts, "inverse kinematics")]
         return _result(self.name, model, sols, batch, solver)
 
     def output_names(self, model: Model) -> list[str]:

@@ -154,16 +154,14 @@ def value_text(v: float, digits: int = 5) -> str:
 # -- saving -----------------------------------------------------------------------------------
 
 
-def check_figure_path(path: str | os.PathLike, option: str = "-o") -> None:
-    """Fail early (an :class:`InputError`) if a figure cannot be written there."""
+def check_figure_path(path: str | os.PathLike, option: str = "-o", inputs: Sequence[str | os.PathLike] = ()) -> None:
+    """Fail early (an :class:`InputError`) if a figure cannot be written there
+    (or would replace one of ``inputs``)."""
     if Path(path).suffix.lower() not in FIGURE_FORMATS:
         raise InputError(
             f"expected a figure file ending in {', '.join(FIGURE_FORMATS)}, got {str(path)!r}", path=(option,)
         )
-    try:
-        check_output_path(str(path))
-    except InputError as exc:
-        raise InputError(exc.message, path=(option,)) from None
+    check_output_path(str(path), inputs, option=option)
 
 
 def require_backend(path: str | os.PathLike) -> None:
@@ -177,14 +175,22 @@ def require_backend(path: str | os.PathLike) -> None:
         require("matplotlib", "plot", "plotting")
 
 
-def save(fig: Any, path: str | os.PathLike) -> None:
+def save(fig: Any, path: str | os.PathLike, option: str = "-o", inputs: Sequence[str | os.PathLike] = ()) -> None:
     """Write a figure (format from the suffix) all at once; .html: a Plotly figure,
     self-contained (plotly.js embedded: it opens without a network)."""
     fmt = Path(path).suffix.lower().lstrip(".")
     if fmt == "html":
-        replace_atomically(path, lambda tmp: fig.write_html(tmp, include_plotlyjs=True, full_html=True), suffix=".html")
+        replace_atomically(
+            path,
+            lambda tmp: fig.write_html(tmp, include_plotlyjs=True, full_html=True),
+            suffix=".html",
+            inputs=inputs,
+            option=option,
+        )
         return
-    replace_atomically(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=150), suffix=f".{fmt}")
+    replace_atomically(
+        path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=150), suffix=f".{fmt}", inputs=inputs, option=option
+    )
 
 
 # -- (a) workspace -------------------------------------------------------------------------------

@@ -44,6 +44,7 @@ from ..analysis.workspace import membership, probe_region, sample_workspace
 from ..core.errors import InputError, suggest
 from ..core.kinematics import jacobians, passive_joints
 from ..core.units import DIMENSIONS
+from ..io.inputs import MAX_RESULTS_BYTES, read_input_text
 from ..io.results import FORMATS, read_results
 from ..mechanisms.registry import build_model, closure_of, mechanism_type
 from ..problems.registry import kind_names, problem_kind
@@ -143,8 +144,8 @@ def _dimension_of_unit(unit: Any) -> str | None:
 
 def from_result(result: Any, source: str = "") -> ResultData:
     """A :class:`~cpm_nlp.core.result.Result` or its JSON dict."""
-    d = result if isinstance(result, Mapping) else result.to_dict()
-    if not isinstance(d.get("values"), Mapping) or not isinstance(d.get("problem"), str):
+    d = result if isinstance(result, Mapping) or not hasattr(result, "to_dict") else result.to_dict()
+    if not isinstance(d, Mapping) or not isinstance(d.get("values"), Mapping) or not isinstance(d.get("problem"), str):
         raise InputError("expected a cpm-nlp result (JSON with problem, status, values, units)", file=source or None)
     dims = {k: dim for k, u in (d.get("units") or {}).items() if (dim := _dimension_of_unit(u))}
     return ResultData(
@@ -188,12 +189,7 @@ def load(path: str | os.PathLike) -> ResultData:
     p = Path(path)
     if p.suffix.lower() in FORMATS:
         return from_table(read_results(p))
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError("file not found", file=str(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read the file ({exc.__class__.__name__})", file=str(path)) from None
+    text = read_input_text(p, MAX_RESULTS_BYTES)
     try:
         data = json.loads(text)
     except ValueError:

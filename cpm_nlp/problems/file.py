@@ -111,10 +111,24 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
     reproduce = None
     if data.get("reproduce") is not None:
         reproduce = parse_reproduce(data["reproduce"], ("reproduce",))
+        _check_reproduced_values(data["reproduce"], reproduce, outputs or kind.output_names(model))
     sweep = None
     if data.get("sweep") is not None:
         sweep = parse_sweep(data["sweep"], data, kind, model, base_dir)
     return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data, sweep)
+
+
+def _check_reproduced_values(raw: Any, spec: Any, names: list[str]) -> None:
+    """Every compared value is one the problem gives (a typo is bad input, not a failed row)."""
+    for i, fig in enumerate(spec.rows):
+        name = (fig.value or "").split("[")[0]
+        if name and name not in names:
+            where = ("reproduce", "rows", i, "value") if isinstance(raw.get("rows"), list) else ("reproduce",)
+            raise InputError(
+                f"unknown value '{name}'; this problem gives: {', '.join(names)}",
+                path=where,
+                suggestions=suggest(name, names),
+            )
 
 
 def _parse_outputs(raw: Any, names: list[str]) -> list[str] | None:

@@ -15,13 +15,14 @@ from .shipped import shipped_problems_dir
 
 
 def problem_files(paths: Iterable[str | Path]) -> list[Path]:
-    """YAML files under the given files/directories (and their subdirectories,
-    e.g. problems/mechanisms/), sorted."""
+    """Problem files under the given files/directories (and their subdirectories),
+    sorted; a directory's ``mechanisms/`` subfolders hold mechanism descriptions, not
+    problems, and are left out."""
     out: list[Path] = []
     for p in paths:
         p = Path(p)
         if p.is_dir():
-            out += sorted(p.rglob("*.yaml"))
+            out += sorted(f for f in p.rglob("*.yaml") if "mechanisms" not in f.relative_to(p).parts[:-1])
         else:
             out.append(p)
     return out

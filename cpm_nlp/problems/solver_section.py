@@ -10,7 +10,7 @@ from typing import Any
 
 from ..core.errors import InputError, suggest
 from ..core.options import Option, validate_mapping
-from ..core.solver import METHODS, SolverConfig
+from ..core.solver import METHODS, SolverConfig, check_options
 from .reader import read_yaml
 from .shipped import shipped_configs_dir
 
@@ -116,6 +116,7 @@ def parse_solver(raw: Any, base_dir: Path | None, path: tuple = ("solver",)) -> 
     if merged["tolerance"] is not None:
         kwargs["tolerance"] = float(merged["tolerance"])
     try:
+        kwargs["options"] = check_options(merged["method"] or "ipopt", merged["options"])  # typed: 50.0 -> 50
         config = SolverConfig(**kwargs)
         config.validate()
     except InputError as exc:

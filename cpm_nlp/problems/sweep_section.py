@@ -221,7 +221,12 @@ def _axis(
     option, solver_key = _resolve(key, kind, model, path)
     dimension = option.kind if option is not None and option.kind in DIMENSIONS else None
     if isinstance(spec, Mapping) and "random" in spec:
-        return _random_axis(key, spec, option, dimension, path)
+        axis = _random_axis(key, spec, option, dimension, path)
+        if solver_key:  # a drawn value must be one the solver takes (not a method name, not an integer)
+            for u in (0.0, 0.3183098861837907, 1.0):
+                value = axis.low + u * (axis.high - axis.low)
+                _check_solver_value(key, value, data, base_dir, path)
+        return axis
     if isinstance(spec, Mapping) and solver_key is None and option is not None and option.shape != "range":
         scalar = dataclasses.replace(option, shape="scalar")
         for end in ("from", "to"):  # the ends as written, with the bounds of the value they override

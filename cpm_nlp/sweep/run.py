@@ -36,13 +36,15 @@ Dask nor pyarrow.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import logging
 import math
 import os
+import signal
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -226,6 +228,15 @@ LOCAL_CLUSTER_CONFIG = {
 }
 
 
+#: Environment of the local cluster's worker processes: Dask's own log at
+#: level error (cancelling the tasks of an interrupted sweep logs a warning
+#: per task; a point that fails is recorded in the results file, not logged).
+WORKER_ENVIRON = {"DASK_LOGGING__DISTRIBUTED": "error"}
+
+#: How long a sweep tries to reach a scheduler given by --scheduler (Dask's default is 30 s).
+CONNECT_SECONDS = 5.0
+
+
 def dask_config() -> Any:
     """The settings under which a sweep starts its local cluster (a context)."""
     import dask
@@ -249,13 +260,16 @@ class _Connection:
         distributed = require("distributed", "sweep", "running a sweep")
         if self.scheduler:
             try:
-                self.client = distributed.Client(self.scheduler)  # waits distributed.comm.timeouts.connect
+                self.client = distributed.Client(self.scheduler, timeout=CONNECT_SECONDS)
             except (OSError, TimeoutError, ValueError) as exc:
+                detail = " ".join(str(exc).split())[:200] or exc.__class__.__name__
                 raise InputError(
-                    f"cannot connect to the Dask scheduler {self.scheduler}: {exc}", path=("--scheduler",)
+                    f"cannot connect to the Dask scheduler {self.scheduler} within {CONNECT_SECONDS:g} s ({detail}); "
+                    "is it running, and is the address tcp://HOST:PORT?",
+                    path=("--scheduler",),
                 ) from None
             return self.client
-        with dask_config():
+        with dask_config(), _ctrl_c_ignored():  # the worker processes inherit "ignore SIGINT"
             self.cluster = distributed.LocalCluster(
                 n_workers=self.workers or default_workers(),
                 threads_per_worker=1,
@@ -267,10 +281,50 @@ class _Connection:
         return self.client
 
     def __exit__(self, *exc: Any) -> None:
-        if self.given is None and self.client is not None:
-            self.client.close()
-        if self.cluster is not None:
-            self.cluster.close()
+        interrupted = exc[0] is not None and issubclass(exc[0], KeyboardInterrupt)
+        with _quiet_dask() if interrupted else contextlib.nullcontext():  # closing after Ctrl-C: no log of it
+            if self.given is None and self.client is not None:
+                self.client.close()
+            if self.cluster is not None:
+                self.cluster.close()
+
+
+@contextlib.contextmanager
+def _ctrl_c_ignored() -> Iterator[None]:
+    """Ignore SIGINT while the local cluster starts its processes: a process
+    started with SIGINT ignored keeps ignoring it (and Python then installs no
+    KeyboardInterrupt handler), so a Ctrl-C reaches the sweep's own process
+    only, which stops the cluster; no worker prints a traceback."""
+    env = {k: os.environ.get(k) for k in WORKER_ENVIRON}
+    os.environ.update(WORKER_ENVIRON)
+    try:
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread: signals are not ours to change
+        previous = None
+    try:
+        yield
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+        for k, v in env.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+@contextlib.contextmanager
+def _quiet_dask() -> Iterator[None]:
+    """Dask's loggers silenced (closing a cluster after Ctrl-C logs lost workers and cancelled tasks)."""
+    loggers = [logging.getLogger(n) for n in ("distributed", "tornado", "asyncio")]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels):
+            lg.setLevel(level)
 
 
 def run_sweep(
