@@ -357,7 +357,7 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
         try:
             drawn = figure(load(output), args.type, _plot_options(args), interactive=_interactive(args.plot))
         except InputError as exc:  # the results file is written: a plot that cannot be drawn is a failure, exit 1
-            args.err.write(f"error: --plot: no plot written: {exc.message}\n")
+            args.err.write(f"error: no plot written: {exc.at(prefix=('--plot',))}\n")
             return EXIT_FAILED
         _save_figure(args, drawn, out)
     return EXIT_OK if summary.ok else EXIT_FAILED
