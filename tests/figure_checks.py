@@ -27,3 +27,45 @@ def assert_svg_drawn(path, min_paths=50):
     assert root.tag == f"{SVG}svg"
     n = sum(1 for _ in root.iter(f"{SVG}path")) + sum(1 for _ in root.iter(f"{SVG}use"))
     assert n >= min_paths, n
+
+
+def _labels(fig):
+    """The texts a reader must see whole: titles, axis labels, legends, tick labels
+    of 2-D axes within their view limits."""
+    out = [fig._suptitle] if fig._suptitle is not None else []
+    for legend in fig.legends:
+        out += [*legend.get_texts(), legend.get_title()]
+    for ax in fig.axes:
+        out += [ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label]
+        if hasattr(ax, "zaxis"):
+            out.append(ax.zaxis.label)
+        else:
+            for axis in (ax.xaxis, ax.yaxis):
+                lo, hi = sorted(axis.get_view_interval())
+                out += [t.label1 for t in axis.get_major_ticks() if lo <= t.get_loc() <= hi]
+        if ax.get_legend() is not None:
+            out += [*ax.get_legend().get_texts(), ax.get_legend().get_title()]
+    return out
+
+
+def assert_figure_readable(fig):
+    """Every title, label and legend text of a Matplotlib figure lies inside the
+    figure (nothing clipped at its edges), and no legend holds a template placeholder."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    width, height = fig.bbox.width, fig.bbox.height
+    for t in _labels(fig):
+        if t is None or not t.get_visible() or not t.get_text().strip():
+            continue
+        box = t.get_window_extent(renderer)
+        assert box.x0 >= -1 and box.y0 >= -1 and box.x1 <= width + 1 and box.y1 <= height + 1, (
+            f"text {t.get_text()!r} is clipped: {box} outside the figure {width} x {height}"
+        )
+    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+    for legend in legends:
+        for t in legend.get_texts():
+            text = t.get_text()
+            assert not any(c in text.replace("$", "") for c in "<>`"), f"legend holds a placeholder: {text!r}"

@@ -17,7 +17,7 @@ from cpm_nlp.plot.figures import PlotOptions, figure, from_result, from_table, l
 from cpm_nlp.sweep.run import columns, job_of, metadata, solve_points
 
 from .conftest import PROBLEMS
-from .figure_checks import assert_png_drawn, assert_svg_drawn
+from .figure_checks import assert_figure_readable, assert_png_drawn, assert_svg_drawn
 
 matplotlib = pytest.importorskip("matplotlib")
 
@@ -131,7 +131,8 @@ def test_workspace_with_its_inscribed_cuboid(tmp_path):
     assert rect.get_width() == pytest.approx(2 * half[0] * 1e3) and rect.get_height() == pytest.approx(
         2 * half[1] * 1e3
     )
-    assert ax3.get_legend().get_texts()[1].get_text() == "maximal inscribed cuboid (3.46 × 2.31 × 1.15 mm)"
+    assert fig.legends[0].get_texts()[1].get_text() == "maximal inscribed cuboid (3.46 × 2.31 × 1.15 mm)"
+    assert_figure_readable(fig)
     save(fig, tmp_path / "c.png")
     assert len(ax3.collections[1].get_paths()) == 6  # six faces, projected when drawn
     rgb = assert_png_drawn(tmp_path / "c.png")
@@ -242,7 +243,7 @@ def test_nothing_solved_is_said_not_drawn(cli, tmp_path):
         str(fig),
     )
     assert run.code == 1
-    assert run.err == "warning: no plot written: no point of the result is solved; there is nothing to plot\n"
+    assert run.err == ("error: --plot: no plot written: no point of the result is solved; there is nothing to plot\n")
     assert out.exists() and not fig.exists()
 
 
@@ -250,30 +251,40 @@ def test_plot_bad_input(cli, tmp_path):
     fk = str(PROBLEMS / "prs3_forward_kinematics.yaml")
     out = tmp_path / "fk.json"
     assert cli("solve", fk, "-o", str(out), "-q").code == 0
-    run = cli("plot", str(out), "-o", str(tmp_path / "x.png"))
+    run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "map")
     assert run.code == 2
-    assert run.err == (
-        f"error: {out}: no plot fits this result (io: an output/input plot needs per-point lists of s1, s2, s3, "
-        "px, py, dz, psi, theta, phi (solve a batch, without an outputs selection); workspace: a workspace cloud needs "
-        "per-point lists of dz, psi, theta (solve a batch, without an outputs selection))\n"
-    )
+    assert run.err == f"error: {out}: a map of a single result needs --x, --y and --value naming three of its lists\n"
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "heatmap")
-    assert run.err == (
-        "error: --type: unknown plot type 'heatmap'; expected one of: ellipsoid, forces, io, lines, map, modes, "
-        "requirements, workspace; "
-        "did you mean 'map'?\n"
+    assert run.err.startswith(
+        "error: --type: unknown plot type 'heatmap'; expected one of: amplifier, comparison, design"
     )
+    assert run.err.endswith("did you mean 'map'?\n")
     run = cli("plot", str(out), "-o", str(tmp_path / "x.jpg"))
-    assert run.err == f"error: -o: expected a figure file ending in .png, .svg, .pdf, got '{tmp_path / 'x.jpg'}'\n"
+    assert run.err == (
+        f"error: -o: expected a figure file ending in .png, .svg, .pdf, .html, got '{tmp_path / 'x.jpg'}'\n"
+    )
     run = cli("plot", fk, "-o", str(tmp_path / "x.png"))
     assert run.code == 2 and run.err == (
         f"error: {fk}: expected a JSON result written by 'cpm-nlp solve -o' or a sweep results file (.parquet, .csv)\n"
     )
-    run = cli("solve", fk, "-o", str(tmp_path / "y.json"), "--plot", str(tmp_path / "y.png"))
-    assert run.code == 2 and run.err.startswith("error: --plot: no plot fits this result (io: ")
     run = cli("solve", fk, "-q", "--plot", str(tmp_path / "y.gif"))
-    assert run.err == f"error: --plot: expected a figure file ending in .png, .svg, .pdf, got '{tmp_path / 'y.gif'}'\n"
+    assert run.err == (
+        f"error: --plot: expected a figure file ending in .png, .svg, .pdf, .html, got '{tmp_path / 'y.gif'}'\n"
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fk.json"]  # bad input wrote nothing
+
+
+def test_solve_plot_never_discards_the_result(cli, tmp_path):
+    """A plot that does not fit the result: the result is printed and written first,
+    then a clear message, exit 1 (issue 14)."""
+    fk = str(PROBLEMS / "prs3_forward_kinematics.yaml")
+    out = tmp_path / "fk.json"
+    run = cli("solve", fk, "-o", str(out), "--plot", str(tmp_path / "y.png"), "--type", "requirements")
+    assert run.code == 1
+    assert "platform" in run.out.lower() or "px" in run.out  # the table is printed
+    assert json.loads(out.read_text())["status"] == "solved"  # and written
+    assert run.err.startswith("error: --plot: no plot written: the requirements plot needs per-point lists")
+    assert not (tmp_path / "y.png").exists()
 
 
 def test_display_units_and_symbols():
@@ -301,26 +312,43 @@ def test_sweep_table_and_result_views(map_file, requirements):
 # -- the kinds of the pantograph and the RPR ----------------------------------------------------
 
 
-def test_pantograph_cuboid_in_its_workspace_like_fig_13(cli, tmp_path):
-    """pantograph-3d-elgammal-2016.md, Fig. 13: the maximal cuboid in the reachable workspace."""
-    out, png = tmp_path / "c.json", tmp_path / "c.png"
-    path = PROBLEMS / "pantograph_cuboid.yaml"
-    run = cli("solve", str(path), "-q", "-o", str(out), "--plot", str(png))
-    assert run.code == 0, run.err
-    assert_png_drawn(png)
-    v = json.loads(out.read_text())["values"]
-    data = load(out)
-    data.live = cn.load_problem(path).model  # as solve --plot has it
+def test_pantograph_printed_eq34c_box_beside_ours_in_the_workspace(tmp_path):
+    """pantograph-3d-elgammal-2016.md, Fig. 13 and eq 32-34: the maximal cuboid in the
+    workspace, its boundary drawn around it, and the box of eq 34c as printed beside it:
+    that box leaves the workspace (544 of 1663 check points, problems/pantograph_cuboid_eq34_printed.yaml)
+    at its near face px = k, where the phi planes (eq 18) bind."""
+    from matplotlib.path import Path as MplPath
+
+    problem = cn.load_problem(PROBLEMS / "pantograph_cuboid_eq34_printed.yaml")
+    result = cn.solve(problem)
+    v = result.values
+    data = from_result(result)
+    data.live = problem.model  # as solve --plot has it
     fig, kind = figure(data)
     assert kind == "workspace"
-    assert len(fig.axes[0].collections[0].get_offsets()) > 1000  # the cloud sampled from the model
-    rect = fig.axes[1].patches[0]  # px-py projection, in mm
-    assert rect.get_width() == pytest.approx((v["px_max"] - v["px_min"]) * 1e3)
-    assert rect.get_height() == pytest.approx((v["py_max"] - v["py_min"]) * 1e3)
-    assert fig.axes[1].get_xlabel() == "$px$ (mm)" and fig.axes[1].get_ylabel() == "$py$ (mm)"
-    assert_cloud_covers_cuboid(fig, v, ("px", "py", "pz"), 1e3)
-    alone, _ = figure(load(out))  # from the JSON alone: the cuboid, and how to see it in its workspace
-    assert len(alone.axes[0].collections[0].get_offsets()) == 0 and len(alone.axes[1].patches) == 1
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any(t.startswith("paper's eq 32-34 box, 544 of 1663 check points outside") for t in legend), legend
+    assert any(t.startswith("workspace boundary") for t in legend)
+    xz = fig.axes[2]  # px-pz projection, the boundary slice at py = 0, in mm
+    ours, paper = xz.patches
+    assert ours.get_width() == pytest.approx((v["px_max"] - v["px_min"]) * 1e3)
+    assert paper.get_x() == pytest.approx(v["paper_k"] * 1e3) and paper.get_linestyle() == "--"
+    assert paper.get_height() == pytest.approx(2 * v["paper_z_hat"] * 1e3)
+    boundary = [MplPath(ln.get_xydata()) for ln in xz.lines if len(ln.get_xdata()) > 10]
+    assert boundary
+
+    def inside(px, pz):
+        return any(b.contains_point((px * 1e3, pz * 1e3)) for b in boundary)
+
+    # our box's near-face corner is inside (just), the printed box's is not
+    k, z = v["px_min"], v["pz_max"]
+    assert inside(k + 0.02 * (v["px_max"] - k), 0.98 * z)
+    assert not inside(v["paper_k"] + 0.02 * (v["paper_x_hat"] - v["paper_k"]), v["paper_z_hat"])
+    assert_figure_readable(fig)
+    save(fig, tmp_path / "c.png")
+    assert_png_drawn(tmp_path / "c.png")
+    alone, _ = figure(from_result(result.to_dict()))  # from the JSON alone: the boxes, and how to see the workspace
+    assert len(alone.axes[1].patches) == 2 and not alone.axes[0].collections[1:]
     assert "`cpm-nlp solve FILE --plot` draws the workspace around it" in alone._suptitle.get_text()
 
 
@@ -389,8 +417,10 @@ def test_pantograph_outputs_against_dx_like_fig_20(tmp_path):
     )
     fig, kind = figure(from_result(cn.solve(cn.load_problem(path))))
     assert kind == "io" and fig.axes[0].get_xlabel() == "$d_{x}$ (mm)"
-    px, py, pz = (fig.axes[i].lines[0] for i in range(3))
+    px = fig.axes[0].lines[0]
     slope = np.polyfit(px.get_xdata(), px.get_ydata(), 1)[0]
     assert slope == pytest.approx(3.5, rel=1e-6)
-    assert not np.any(py.get_ydata()) and not np.any(pz.get_ydata())  # exact zeros shown as zero
-    assert fig.axes[1].get_ylabel() == "$py$ (mm)"
+    # no parasitic motion: py, pz and phi are exact zeros, said in the title, not drawn as flat panels
+    assert "constant over the batch: py = 0 mm, pz = 0 mm, phi = 0 deg" in fig._suptitle.get_text().replace("\n", " ")
+    assert [ax.get_ylabel() for ax in fig.axes] == ["$px$ (mm)", r"$\theta_{1}$ (deg)", r"$\theta_{2}$ (deg)"]
+    assert_figure_readable(fig)

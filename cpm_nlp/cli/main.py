@@ -167,7 +167,7 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     with solver_output_to_stderr(args.json), progress.reporting(_batch_progress(args)):
         problem = load_problem(args.file, args.set or [])
         result = solve(problem)
-    fig = _result_figure(args, result, problem.model) if args.plot else None  # a bad --plot writes nothing
+    # the result first: a plot that cannot be drawn never takes it away
     if args.json:
         out.write(result.to_json() + "\n")
     elif not args.quiet:
@@ -175,9 +175,13 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
         out.write(render_result(result, title) + "\n")
     if args.output:
         write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])
-    if fig is not None:
+    status = EXIT_OK if result.ok else EXIT_FAILED
+    if args.plot:
+        fig = _result_figure(args, result, problem)
+        if fig is None:
+            return EXIT_FAILED
         _save_figure(args, fig, out)
-    return EXIT_OK if result.ok else EXIT_FAILED
+    return status
 
 
 def _batch_progress(args: argparse.Namespace) -> progress.Callback | None:
@@ -204,28 +208,36 @@ def _plot_options(args: argparse.Namespace) -> Any:
 
 def _check_plot_args(args: argparse.Namespace, inputs: Sequence[str | None] = ()) -> None:
     """Before solving: the figure can be written (not over an input or the
-    results), and Matplotlib is there."""
+    results), and its plotting library is there."""
     if getattr(args, "plot", None):
-        from ..core.extras import require
-        from ..plot.draw import check_figure_path
+        from ..plot.draw import check_figure_path, require_backend
 
         check_figure_path(args.plot, "--plot", inputs=[f for f in inputs if f])
-        require("matplotlib", "plot", "plotting")
+        require_backend(args.plot)
 
 
-def _result_figure(args: argparse.Namespace, result: Result, model: Any) -> Any:
-    """The figure of a solved result; None (with a warning) if no point solved."""
-    from ..plot.figures import NothingSolved, figure, from_result
+def _result_figure(args: argparse.Namespace, result: Result, problem: Any) -> Any:
+    """The figure of a solved result, or None (with a message on stderr) if it
+    cannot be drawn: no point solved, or no plot fits the result."""
+    from ..plot.figures import figure, from_result
 
     data = from_result(result)
-    data.live = model
+    data.live = problem.model
+    if problem.reproduce is not None:
+        data.published = [
+            (row.value, row.published, f"published ({row.source})")
+            for row in problem.reproduce.rows
+            if row.value and row.published is not None
+        ]
     try:
-        return figure(data, args.type, _plot_options(args))
-    except NothingSolved as exc:  # an honest failed solve is not bad input: exit 1, the result is written
-        args.err.write(f"warning: no plot written: {exc.message}\n")
+        return figure(data, args.type, _plot_options(args), interactive=_interactive(args.plot))
+    except InputError as exc:  # the result is out already: a plot that cannot be drawn is a failure, exit 1
+        args.err.write(f"error: --plot: no plot written: {exc.message}\n")
         return None
-    except InputError as exc:
-        raise exc.at(prefix=("--plot",)) from None
+
+
+def _interactive(path: str) -> bool:
+    return str(path).lower().endswith(".html")
 
 
 def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: TextIO) -> None:
@@ -238,15 +250,14 @@ def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: T
 
 
 def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
-    from ..core.extras import require
-    from ..plot.draw import check_figure_path, save
+    from ..plot.draw import check_figure_path, require_backend, save
     from ..plot.figures import figure, load
 
     check_figure_path(args.output, inputs=[args.result])
-    require("matplotlib", "plot", "plotting")
+    require_backend(args.output)
     try:
         data = load(args.result)
-        fig, kind = figure(data, args.type, _plot_options(args))
+        fig, kind = figure(data, args.type, _plot_options(args), interactive=_interactive(args.output))
     except InputError as exc:  # every message about the result names the file plotted
         about_a_flag = bool(exc.path) and str(exc.path[0]).startswith("-")
         raise (exc if exc.file or about_a_flag else exc.at(file=args.result)) from None
@@ -344,10 +355,11 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
         from ..plot.figures import figure, load
 
         try:
-            _save_figure(args, figure(load(output), args.type, _plot_options(args)), out)
-        except InputError as exc:
+            drawn = figure(load(output), args.type, _plot_options(args), interactive=_interactive(args.plot))
+        except InputError as exc:  # the results file is written: a plot that cannot be drawn is a failure, exit 1
             args.err.write(f"error: no plot written: {exc.at(prefix=('--plot',))}\n")
             return EXIT_FAILED
+        _save_figure(args, drawn, out)
     return EXIT_OK if summary.ok else EXIT_FAILED
 
 
@@ -631,11 +643,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _add_plot_arguments(p: argparse.ArgumentParser, flag: str | None) -> None:
     if flag:
-        p.add_argument(flag, metavar="FIGURE", help="also plot the result to FIGURE (.png, .svg or .pdf)")
+        p.add_argument(
+            flag,
+            metavar="FIGURE",
+            help="also plot the result to FIGURE (.png, .svg, .pdf; .html: interactive 3-D, Plotly)",
+        )
     p.add_argument(
         "--type",
         metavar="TYPE",
-        help="plot type: workspace, map, requirements, io or lines (default: chosen from the result)",
+        help="plot type: workspace, map, requirements, io, lines, mechanism, jacobian, twists, comparison, matrices, "
+        "dynamics or amplifier (default: chosen from the result)",
     )
     p.add_argument("--value", metavar="NAME", help="the value to plot (map colour, curves)")
     p.add_argument("--best", choices=("max", "min"), help="map: mark the largest or smallest value")

@@ -29,8 +29,9 @@ Optional capabilities
 See the fields of :class:`Mechanism`: cross-value checks, a synthesis
 formulation, extra inscribed-cuboid inputs and values, a closed-form
 workspace membership from the paper, a dynamics model, default joint
-stiffnesses and flexure hinges, problem kinds of its
-own, and the problem files that reproduce its paper's figures.
+stiffnesses and flexure hinges, problem kinds of its own, the problem files
+that reproduce its paper's figures, and a drawing of the mechanism at a pose
+(``geometry``: base, legs, joints, platform).
 """
 
 from __future__ import annotations
@@ -58,11 +59,15 @@ class CuboidExtras:
         no cuboid was found).
     values: ``(model, lower, upper, inputs, solver) -> (values, dimensions)``
         for a found box ``lower <= t <= upper`` (SI, task coordinates).
+    paper_box: optional ``(values) -> (lower, upper, label) | None``: the box of
+        the paper's own formulation read from a result's values, drawn beside
+        the found one by the workspace plot (None when the result has none).
     """
 
     options: tuple[Option, ...] = ()
     value_names: tuple[str, ...] = ()
     values: Callable[..., tuple[dict, dict]]
+    paper_box: Callable[[Mapping[str, Any]], Any] | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -84,6 +89,44 @@ class DynamicsModel:
     lagrangian: Callable[[], Any]
     values: Callable[..., dict] | None = None
     dimensions: Mapping[str, str] = field(default_factory=dict)
+
+
+#: parts a :class:`Drawing` may join or fill, in the order they are drawn
+DRAWING_PARTS = ("base", "actuator", "link", "leg", "platform")
+#: joint letters a :class:`Drawing` may mark (prismatic, revolute, universal, spherical, cylindrical)
+JOINT_TYPES = ("P", "R", "U", "S", "C")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Drawing:
+    """The mechanism drawn at one pose, for plots: named 3-D points (SI, fixed
+    frame) and what joins them.
+
+    points: name -> (x, y, z).
+    segments: ``(from, to, part)``: a straight link between two points; part
+        is one of :data:`DRAWING_PARTS` (a rail or a lever is ``actuator``).
+    faces: ``(part, (names ...))``: a filled polygon (the base, the platform).
+    joints: point name -> joint letter (:data:`JOINT_TYPES`), marked on the drawing.
+    note: what the drawing leaves out or where it departs from scale (shown with it).
+    """
+
+    points: Mapping[str, Any]
+    segments: tuple[tuple[str, str, str], ...] = ()
+    faces: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    joints: Mapping[str, str] = field(default_factory=dict)
+    note: str = ""
+
+    def __post_init__(self) -> None:
+        names = set(self.points)
+        for a, b, part in self.segments:
+            if a not in names or b not in names or part not in DRAWING_PARTS:
+                raise ValueError(f"drawing: segment ({a!r}, {b!r}, {part!r}) names an unknown point or part")
+        for part, corners in self.faces:
+            if part not in DRAWING_PARTS or not set(corners) <= names or len(corners) < 3:
+                raise ValueError(f"drawing: face {part!r} {corners!r} names an unknown point or part")
+        for name, letter in self.joints.items():
+            if name not in names or letter not in JOINT_TYPES:
+                raise ValueError(f"drawing: joint {name!r}: {letter!r} names an unknown point or joint type")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -144,6 +187,9 @@ class Mechanism:
     paper_membership: Callable[[Any, Any], tuple[Any, dict]] | None = None
     #: a Lagrange model for the ``dynamics`` kind
     dynamics: DynamicsModel | None = None
+    #: ``(model, x (nx,), q (nq,)) -> Drawing``: the mechanism at a pose (base, legs,
+    #: joints, platform) for the plots, from its kinematic functions
+    geometry: Callable[[Any, Any, Any], Drawing] | None = None
     #: default joint stiffnesses and flexure hinges, for the compliance kinds
     stiffness: JointStiffness | None = None
     #: problem kinds of its own: kind name -> ProblemKind subclass
@@ -186,6 +232,7 @@ CAPABILITIES = (
     "cuboid",
     "paper_membership",
     "dynamics",
+    "geometry",
     "stiffness",
     "kinds",
     "problem_files",
@@ -217,7 +264,7 @@ def validate(mech: Mechanism) -> None:  # noqa: C901 - one flat check per declar
     for name in ("closure", "build"):
         if not callable(getattr(mech, name)):
             _fail(mech, name, "callable")
-    for name in ("check_parameters", "check_limits", "synthesis", "paper_membership"):
+    for name in ("check_parameters", "check_limits", "synthesis", "paper_membership", "geometry"):
         if getattr(mech, name) is not None and not callable(getattr(mech, name)):
             _fail(mech, name, "callable or None")
     if mech.cuboid is not None and not isinstance(mech.cuboid, CuboidExtras):

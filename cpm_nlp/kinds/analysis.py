@@ -42,6 +42,7 @@ def closed_form_result(
 
 class ActuatorWorkspace(ProblemKind):
     name = "actuator_workspace"
+    plots = ("workspace",)
     description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
     plots = ("workspace",)  # its points (inputs.points: true): the images of the stroke grid
 
@@ -136,6 +137,7 @@ def _dynamics(model: Model) -> DynamicsModel:
 
 class Dynamics(ProblemKind):
     name = "dynamics"
+    plots = ("dynamics", "matrices")
     description = "Lagrange dynamics at home: M, K, G (AD of the energies) and the natural frequencies"
 
     def supports(self, model: Model) -> str | None:

@@ -125,7 +125,7 @@ def _model_info(model: Model) -> dict[str, Any]:
 class ForwardKinematics(ProblemKind):
     name = "forward_kinematics"
     description = "platform pose from the actuator displacements (FK), checked against IK"
-    plots = ("io", "workspace")
+    plots = ("io", "mechanism", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
         return actuator_options(model, "grid") + list(MODE_OPTIONS)
@@ -262,7 +262,7 @@ def _modes_result(kind: str, model: Model, found: AssemblyModes, solver: SolverC
 class InverseKinematics(ProblemKind):
     name = "inverse_kinematics"
     description = "actuator displacements and passive joints for a platform pose (IK)"
-    plots = ("io", "workspace")
+    plots = ("io", "mechanism", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
         return task_options(model, "grid") + [
@@ -298,6 +298,7 @@ class InverseKinematics(ProblemKind):
 class Jacobian(ProblemKind):
     name = "jacobian"
     description = "forward/inverse Jacobians (AD) and singularity measures at one pose"
+    plots = ("jacobian", "matrices")
 
     def input_options(self, model: Model) -> list[Option]:
         return (

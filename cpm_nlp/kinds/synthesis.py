@@ -237,6 +237,7 @@ def formulation(model: Model) -> SynthesisFormulation | None:
 
 class Synthesis(ProblemKind):
     name = "synthesis"
+    plots = ("comparison", "design")
     description = (
         "dimensional synthesis by the mechanism's own formulation, else the generic one: the largest inscribed "
         "cuboid per unit of footprint (IPOPT, multi-start)"

@@ -38,7 +38,7 @@ import math
 import casadi as ca
 import numpy as np
 
-from ..core.mechanism import JointStiffness, Mechanism
+from ..core.mechanism import Drawing, JointStiffness, Mechanism
 from ..core.model import Coordinate, LoopClosure, Model
 from ..core.options import Option
 
@@ -311,6 +311,29 @@ def build(closure_: LoopClosure, parameters: dict, limits: dict) -> Model:
     )
 
 
+def geometry(model: Model, x, q) -> Drawing:
+    """The 3-PRS at pose x, actuators q: actuator zero positions A_i (eq 2), sliders
+    C_i (eq A.2) on their rails, legs C_iB_i and the platform B_1B_2B_3 (eq 5-6)."""
+    b, L, alpha0 = (float(model.parameters[k]) for k in ("b", "L", "alpha0"))
+    a = actuator_radius(b, L, alpha0)
+    x = np.asarray(x, dtype=float).ravel()
+    R = rotation(x[3], x[4], x[5])
+    P = ca.DM(x[0:3])
+    pts = {"P": x[0:3]}
+    for i in range(3):
+        pts[f"A{i + 1}"] = np.asarray(OA(i, a)).ravel()
+        pts[f"C{i + 1}"] = np.asarray(OC(i, float(q[i]), a)).ravel()
+        pts[f"B{i + 1}"] = np.asarray(OB(i, P, R, b)).ravel()
+    return Drawing(
+        points=pts,
+        segments=tuple((f"A{i}", f"C{i}", "actuator") for i in (1, 2, 3))
+        + tuple((f"C{i}", f"B{i}", "leg") for i in (1, 2, 3)),
+        faces=(("base", ("A1", "A2", "A3")), ("platform", ("B1", "B2", "B3"))),
+        joints={**{f"C{i}": "R" for i in (1, 2, 3)}, **{f"B{i}": "S" for i in (1, 2, 3)}},
+        note="sliders C_i move on rails from A_i towards the axis (P joints); R at C_i, S at B_i",
+    )
+
+
 #: The flexure joints of section 5: the stiffnesses the paper measured on its FEM
 #: models of the joints, the hinge geometry, and the material of section 4.
 #: Readings (documented, not tuned): the revolute hinge is a circular notch of
@@ -360,6 +383,7 @@ MECHANISM = Mechanism(
     limits=LIMITS,
     closure=closure,
     build=build,
+    geometry=geometry,
     stiffness=STIFFNESS,
     problem_files=(
         "prs3_forward_kinematics.yaml",

@@ -37,8 +37,8 @@ from ..core.errors import InputError
 from ..core.units import DIMENSIONS, to_display
 from ..io.atomic import check_output_path, replace_atomically
 
-#: file types :func:`save` writes
-FIGURE_FORMATS = (".png", ".svg", ".pdf")
+#: file types :func:`save` writes (.html: an interactive Plotly figure, :mod:`cpm_nlp.plot.interactive`)
+FIGURE_FORMATS = (".png", ".svg", ".pdf", ".html")
 _LENGTHS = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
 _GREEK = (
     "alpha",
@@ -128,8 +128,27 @@ def _number(v: float) -> str:
     return f"{v:.0f}" if 1e3 <= abs(v) < 1e5 else f"{v:.3g}"
 
 
+def unit_text(unit: str) -> str:
+    """A unit for a label, powers in mathtext: ``mm^3`` -> mm³ (``$\\mathrm{mm}^{3}$``)."""
+    if "^" not in unit:
+        return unit
+    text = re.sub(r"[A-Za-zµ]+", lambda m: r"\mathrm{" + m.group() + "}", unit)
+    text = re.sub(r"\^(-?\d+)", r"^{\1}", text).replace("*", r"\cdot ")
+    return f"${text}$"
+
+
 def axis_label(name: str, unit: str) -> str:
-    return f"{pretty(name)} ({unit})" if unit else pretty(name)
+    return f"{pretty(name)} ({unit_text(unit)})" if unit else pretty(name)
+
+
+def value_text(v: float, digits: int = 5) -> str:
+    """A value to read: ``digits`` significant digits, more where rounding would
+    make it look like a round number it is not (0.99999999991 is not "1")."""
+    text = f"{v:.{digits}g}"
+    shown = float(text)
+    if shown != v and shown == round(shown):
+        text = f"{v:.12g}"
+    return text
 
 
 # -- saving -----------------------------------------------------------------------------------
@@ -145,9 +164,30 @@ def check_figure_path(path: str | os.PathLike, option: str = "-o", inputs: Seque
     check_output_path(str(path), inputs, option=option)
 
 
+def require_backend(path: str | os.PathLike) -> None:
+    """The plotting library a figure file needs is installed (an :class:`InputError` saying
+    which extra installs it if not): Plotly for .html, Matplotlib for the others."""
+    from ..core.extras import require
+
+    if Path(path).suffix.lower() == ".html":
+        require("plotly", "plot", "interactive (.html) plots")
+    else:
+        require("matplotlib", "plot", "plotting")
+
+
 def save(fig: Any, path: str | os.PathLike, option: str = "-o", inputs: Sequence[str | os.PathLike] = ()) -> None:
-    """Write a figure (format from the suffix) all at once."""
+    """Write a figure (format from the suffix) all at once; .html: a Plotly figure,
+    self-contained (plotly.js embedded: it opens without a network)."""
     fmt = Path(path).suffix.lower().lstrip(".")
+    if fmt == "html":
+        replace_atomically(
+            path,
+            lambda tmp: fig.write_html(tmp, include_plotlyjs=True, full_html=True),
+            suffix=".html",
+            inputs=inputs,
+            option=option,
+        )
+        return
     replace_atomically(
         path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=150), suffix=f".{fmt}", inputs=inputs, option=option
     )
@@ -156,7 +196,65 @@ def save(fig: Any, path: str | os.PathLike, option: str = "-o", inputs: Sequence
 # -- (a) workspace -------------------------------------------------------------------------------
 
 
-def workspace_figure(
+@dataclass
+class BoundarySlice:
+    """A plane slice of the workspace for :func:`workspace_figure`: membership of
+    a grid in the plane of task axes ``axes`` (i, j) with the third at ``at`` (SI).
+
+    x, y: the grid lines (SI) along axes i and j; inside: (len(y), len(x)):
+    bools, or the signed margin of the membership test (> 0 inside), whose
+    zero level places the boundary between the grid lines.
+    """
+
+    axes: tuple[int, int]
+    x: Any
+    y: Any
+    inside: Any
+    at: float
+
+
+def _slice_lines(sl: BoundarySlice) -> list[np.ndarray]:
+    """The boundary of the reachable part of a slice: polylines (K x 2, SI) of the 0.5 level."""
+    from contourpy import contour_generator
+
+    raw = np.asarray(sl.inside)
+    level = 0.5 if raw.dtype == bool else 0.0
+    z = raw.astype(float)
+    finite = z[np.isfinite(z)]
+    if not finite.size or finite.min() >= level or finite.max() <= level:
+        return []
+    z = np.where(np.isfinite(z), z, finite.min())
+    gen = contour_generator(np.asarray(sl.x, dtype=float), np.asarray(sl.y, dtype=float), z)
+    return [np.asarray(line) for line in gen.lines(level)]
+
+
+def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
+_BOX_FACES = ([0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5])
+_BOX_EDGES = ((0, 1), (1, 3), (3, 2), (2, 0), (4, 5), (5, 7), (7, 6), (6, 4), (0, 4), (1, 5), (2, 6), (3, 7))
+#: colours of further boxes (a paper's formulation beside ours)
+_OTHER_BOXES = ("tab:purple", "tab:orange", "tab:green")
+
+
+def _box_sizes(lo: np.ndarray, hi: np.ndarray, scales: Sequence[tuple[float, str]]) -> str:
+    units = {s[1] for s in scales}
+    if len(units) == 1:
+        return " × ".join(_number(d) for d in hi - lo) + f" {units.pop()}".rstrip()
+    return " × ".join(f"{_number(d)} {u}".rstrip() for d, (_, u) in zip(hi - lo, scales))
+
+
+def _few_ticks(ax: Any, three_d: bool) -> None:
+    """At most four ticks per 3-D axis (long labels of a short range overlap otherwise)."""
+    from matplotlib.ticker import MaxNLocator
+
+    axes = (ax.xaxis, ax.yaxis, ax.zaxis) if three_d else (ax.xaxis, ax.yaxis)
+    for axis in axes:
+        axis.set_major_locator(MaxNLocator(4 if three_d else 6))
+
+
+def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxes, boundary slices)
     points: Any,
     *,
     cuboid: tuple[Sequence[float], Sequence[float]] | None = None,
@@ -165,19 +263,37 @@ def workspace_figure(
     title: str = "",
     points_label: str = "reachable points",
     cuboid_label: str = "maximal inscribed cuboid",
+    boxes: Sequence[tuple[Sequence[float], Sequence[float], str]] = (),
+    slices: Sequence[BoundarySlice] = (),
+    hull: Any = None,
 ) -> Any:
     """A point cloud (N x 3, SI) in 3-D and its three projections, with an
-    optional cuboid ``(lower corner, upper corner)`` drawn in."""
+    optional cuboid ``(lower corner, upper corner)`` drawn in, further
+    ``boxes`` (lower, upper, label: e.g. a paper's formulation, dashed),
+    boundary ``slices`` (the workspace's boundary in a plane through the box,
+    drawn in the projection of that plane and in 3-D) and the convex ``hull``
+    of given points (K x 3, SI; e.g. the vertices of an actuator workspace)."""
     Figure = _figure_class()
     from matplotlib.patches import Rectangle
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
-    if not len(pts) and cuboid is None:
+    if not len(pts) and cuboid is None and hull is None:
         raise InputError("no finite points to plot")
     box = None if cuboid is None else np.array([np.asarray(c, dtype=float).ravel()[:3] for c in cuboid])
-    both = pts if box is None else np.vstack([pts, box])
+    others = [(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float), label) for lo, hi, label in boxes]
+    hull_pts = None if hull is None else np.asarray(hull, dtype=float).reshape(-1, 3)
+    parts = [pts] + ([] if box is None else [box]) + [np.vstack([lo, hi]) for lo, hi, _ in others]
+    parts += [] if hull_pts is None else [hull_pts]
+    for sl in slices:
+        i, j = sl.axes
+        grid = np.zeros((4, 3))
+        grid[:, i] = [min(sl.x), max(sl.x)] * 2
+        grid[:, j] = [min(sl.y), max(sl.y), max(sl.y), min(sl.y)]
+        grid[:, 3 - i - j] = sl.at
+        parts.append(grid)
+    both = np.vstack(parts)
     # one unit per dimension, so that three lengths are read on one scale
     scales = [
         display_unit(dimensions[i], both[:, [j for j in range(3) if dimensions[j] == dimensions[i]]]) for i in range(3)
@@ -188,37 +304,93 @@ def workspace_figure(
     fig = Figure(figsize=(11, 9), layout="constrained")
     ax = fig.add_subplot(2, 2, 1, projection="3d")
     size = float(np.clip(3000 / max(len(P), 1), 2, 25))
-    ax.scatter(
-        P[:, 0], P[:, 1], P[:, 2], s=size, c=P[:, 2], cmap="viridis", alpha=0.6, label=f"{points_label} ({len(P)})"
-    )
+    if len(P):
+        ax.scatter(
+            P[:, 0], P[:, 1], P[:, 2], s=size, c=P[:, 2], cmap="viridis", alpha=0.5, label=f"{points_label} ({len(P)})"
+        )
     ax.set_xlabel(labels[0])
     ax.set_ylabel(labels[1])
     ax.set_zlabel(labels[2])
+    _few_ticks(ax, True)
+    if hull_pts is not None:
+        from scipy.spatial import ConvexHull
+
+        H = hull_pts * f
+        faces = ConvexHull(H).simplices
+        ax.add_collection3d(
+            Poly3DCollection([H[fc] for fc in faces], facecolor="tab:blue", edgecolor="none", alpha=0.15)
+        )
+        ax.scatter(H[:, 0], H[:, 1], H[:, 2], color="tab:blue", s=12)
+        ax.plot([], [], color="tab:blue", lw=6, alpha=0.3, label=f"workspace: hull of {len(H)} vertices")
+    lines_by_slice = [(sl, _slice_lines(sl)) for sl in slices]
+    drawn_boundary = False
+    for sl, lines in lines_by_slice:
+        i, j = sl.axes
+        k = 3 - i - j
+        for line in lines:
+            xyz = np.zeros((len(line), 3))
+            xyz[:, i], xyz[:, j], xyz[:, k] = line[:, 0], line[:, 1], sl.at
+            xyz = xyz * f
+            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label=None if drawn_boundary else "_b")
+            drawn_boundary = True
+    if drawn_boundary:
+        ax.plot([], [], color="k", lw=1.2, label="workspace boundary (slices through the box centre)")
     B = None
     if box is not None:
         B = box * f
         lo, hi = B.min(axis=0), B.max(axis=0)
-        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-        faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
+        corners = _box_corners(lo, hi)
         ax.add_collection3d(
-            Poly3DCollection([corners[fc] for fc in faces], facecolor="tab:red", edgecolor="darkred", alpha=0.25)
+            Poly3DCollection([corners[fc] for fc in _BOX_FACES], facecolor="tab:red", edgecolor="darkred", alpha=0.25)
         )
-        units = {s[1] for s in scales}
-        if len(units) == 1:
-            sizes = " × ".join(_number(d) for d in hi - lo) + f" {units.pop()}".rstrip()
-        else:
-            sizes = " × ".join(f"{_number(d)} {u}".rstrip() for d, (_, u) in zip(hi - lo, scales))
-        ax.plot([], [], color="tab:red", lw=6, alpha=0.4, label=f"{cuboid_label} ({sizes})")
-    ax.legend(loc="upper left", fontsize="small")
-    for k, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
-        a2 = fig.add_subplot(2, 2, k + 2)
-        a2.scatter(P[:, i], P[:, j], s=size, color="tab:blue", alpha=0.4)
+        ax.plot([], [], color="tab:red", lw=6, alpha=0.4, label=f"{cuboid_label} ({_box_sizes(lo, hi, scales)})")
+    for (olo, ohi, olabel), colour in zip(others, _OTHER_BOXES):
+        lo, hi = np.minimum(olo, ohi) * f, np.maximum(olo, ohi) * f
+        corners = _box_corners(lo, hi)
+        for a, b in _BOX_EDGES:
+            ax.plot(*corners[[a, b]].T, color=colour, lw=1.8, ls="--")
+        ax.plot([], [], color=colour, lw=1.8, ls="--", label=f"{olabel} ({_box_sizes(lo, hi, scales)})")
+    handles = [h for h, lab in zip(*ax.get_legend_handles_labels()) if not lab.startswith("_")]
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize="small")
+    for n, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
+        a2 = fig.add_subplot(2, 2, n + 2)
+        if len(P):
+            a2.scatter(P[:, i], P[:, j], s=size, color="tab:blue", alpha=0.3, lw=0)
+        if hull_pts is not None:
+            from scipy.spatial import ConvexHull
+
+            H2 = (hull_pts * f)[:, [i, j]]
+            try:
+                loop = H2[ConvexHull(H2).vertices]
+                a2.fill(loop[:, 0], loop[:, 1], color="tab:blue", alpha=0.15)
+                a2.plot(*np.vstack([loop, loop[:1]]).T, color="tab:blue", lw=1)
+            except (ValueError, RuntimeError):  # a flat projection: the points alone
+                a2.plot(H2[:, 0], H2[:, 1], "o", color="tab:blue")
+        for sl, lines in lines_by_slice:
+            if set(sl.axes) == {i, j}:
+                swap = sl.axes != (i, j)
+                for line in lines:
+                    u, v = (line[:, 1], line[:, 0]) if swap else (line[:, 0], line[:, 1])
+                    a2.plot(u * f[i], v * f[j], color="k", lw=1.2)
+                k = 3 - i - j
+                at = sl.at * f[k]
+                at = 0.0 if abs(at) < 1e-9 * max(np.ptp(both[:, k] * f[k]), 1e-300) else at
+                a2.set_title(
+                    f"boundary at {pretty(names[k])} = {_number(at)} {scales[k][1]}".rstrip(), fontsize="small"
+                )
         if B is not None:
             lo, hi = B.min(axis=0), B.max(axis=0)
             a2.add_patch(Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor="tab:red", lw=2))
+        for (olo, ohi, _), colour in zip(others, _OTHER_BOXES):
+            lo, hi = np.minimum(olo, ohi) * f, np.maximum(olo, ohi) * f
+            a2.add_patch(
+                Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor=colour, lw=1.8, ls="--")
+            )
         a2.set_xlabel(labels[i])
         a2.set_ylabel(labels[j])
         a2.grid(True, alpha=0.3)
+        a2.autoscale_view()
     if title:
         fig.suptitle(title)
     return fig
@@ -356,7 +528,13 @@ def design_map_figure(  # noqa: C901 - one branch per optional layer of the map
             mappable = ax.scatter(X[good], Y[good], c=Z[good], cmap="viridis", s=30, norm=norm)
         elif good.sum() <= 2000:
             ax.plot(X[good], Y[good], ".", color="k", ms=1.5, alpha=0.5)
-    fig.colorbar(mappable, ax=ax, label=axis_label(names[2], uz_) + (", log scale" if norm is not None else ""))
+    fig.colorbar(
+        mappable,
+        ax=ax,
+        pad=0.01,
+        fraction=0.05,
+        label=axis_label(names[2], uz_) + (", log scale" if norm is not None else ""),
+    )
     if inside_region is not None and inside_region.any():
         ax.plot([], [], color="tab:red", lw=2, label=region_label)
     if away.any():  # few: dotted; many (a grid around the domain): the blank says it
@@ -381,7 +559,15 @@ def design_map_figure(  # noqa: C901 - one branch per optional layer of the map
     if best in ("max", "min"):
         idx = np.flatnonzero(good)
         k = idx[np.argmax(Z[idx])] if best == "max" else idx[np.argmin(Z[idx])]
-        ax.plot(X[k], Y[k], "*", color="tab:red", ms=16, mec="k", label=f"{best} {Z[k]:.5g} {uz_}".strip())
+        ax.plot(
+            X[k],
+            Y[k],
+            "*",
+            color="tab:red",
+            ms=16,
+            mec="k",
+            label=f"{best} {value_text(Z[k])} {unit_text(uz_)}".strip(),
+        )
         ax.annotate(
             f"({X[k]:.4g}, {Y[k]:.4g})", (X[k], Y[k]), textcoords="offset points", xytext=(8, 8), fontsize="small"
         )
@@ -411,6 +597,8 @@ class Panel:
     series: Mapping[str, Any] = field(default_factory=dict)
     annotate_range: bool = False
     title: str = ""
+    #: published points drawn over the curves: (x SI, value SI, label)
+    points: Sequence[tuple[float, float, str]] = ()
 
 
 #: SI values smaller than this are rounding noise of an exact zero (residuals are
@@ -424,7 +612,7 @@ def as_floats(values: Any) -> np.ndarray:
     return np.where(np.abs(arr) < NUMERICAL_ZERO, 0.0, arr)
 
 
-def panels_figure(
+def panels_figure(  # noqa: C901 - one branch per optional layer of a panel
     x: Any,
     panels: Sequence[Panel],
     *,
@@ -445,7 +633,8 @@ def panels_figure(
     n = len(panels)
     ncols = ncols or min(n, 3 if n in (3, 5, 6, 9) else 4)
     nrows = math.ceil(n / ncols)
-    fig = Figure(figsize=(4.2 * ncols, 3.3 * nrows + 0.5), layout="constrained")
+    width = max(4.2 * ncols, 6.5)
+    fig = Figure(figsize=(width, 3.3 * nrows + 0.5 + 0.25 * title.count("\n")), layout="constrained")
     drawn = 0
     for k, panel in enumerate(panels):
         ax = fig.add_subplot(nrows, ncols, k + 1)
@@ -457,21 +646,389 @@ def panels_figure(
                 raise InputError(f"{label}: expected {len(xs)} values (one per point), got {len(ys)}")
             ax.plot(xs * fx, ys * fy, marker="o" if markers else None, ms=3, lw=1.2, label=pretty(label))
             drawn += int(np.isfinite(ys).any())
+        if panel.points:
+            label = panel.points[0][2]
+            px_, py_ = np.array([(p[0], p[1]) for p in panel.points]).T
+            ax.plot(px_ * fx, py_ * fy, "D", ms=7, mfc="none", mec="tab:red", mew=1.5, label=label)
+            drawn += 1
         ax.set_ylabel(axis_label(panel.name, uy))
         ax.set_xlabel(axis_label(xname, ux) if xdimension else xname)
         ax.grid(True, alpha=0.3)
-        if len(panel.series) > 1:
-            ax.legend(fontsize="x-small", ncol=min(3, len(panel.series)))
+        if len(panel.series) + bool(panel.points) > 1:
+            ax.legend(fontsize="x-small", ncol=min(3, len(panel.series) + bool(panel.points)))
         finite = both[np.isfinite(both)] * fy
         text = panel.title
         if panel.annotate_range and finite.size:
             text = (text + "\n" if text else "") + f"{finite.min():.3g} … {finite.max():.3g} {uy}".strip()
         if text:
-            ax.set_title(text, fontsize="small")
+            ax.set_title(_wrap(text, int(4.2 * 9)), fontsize="small")
     if not drawn:
         raise InputError("no point has a value to plot (no point solved)")
     if title:
+        fig.suptitle("\n".join(_wrap(line, int(width * 9)) for line in title.split("\n")))
+    return fig
+
+
+# -- (e) the mechanism at a pose --------------------------------------------------------------------
+
+#: colour and width of each part of a drawing
+_PART_STYLE = {
+    "base": ("0.45", 1.5),
+    "actuator": ("tab:orange", 4.0),
+    "link": ("tab:blue", 2.5),
+    "leg": ("tab:blue", 2.5),
+    "platform": ("tab:green", 2.0),
+}
+_FACE_COLOUR = {
+    "base": "0.75",
+    "platform": "tab:green",
+    "actuator": "tab:orange",
+    "link": "tab:blue",
+    "leg": "tab:blue",
+}
+#: marker of each joint letter (prismatic, revolute, universal, spherical, cylindrical)
+_JOINT_MARKER = {"P": "s", "R": "o", "U": "D", "S": "o", "C": "^"}
+_JOINT_NAME = {"P": "prismatic", "R": "revolute", "U": "universal", "S": "spherical", "C": "cylindrical"}
+
+
+@dataclass
+class Arrow:
+    """An arrow on a mechanism drawing: from ``origin`` (SI point) along ``vector``
+    (drawn to the figure's scale), with a legend ``label``."""
+
+    origin: Any
+    vector: Any
+    label: str = ""
+    colour: str = "tab:red"
+
+
+def draw_mechanism(
+    ax: Any,
+    drawing: Any,
+    *,
+    factor: float,
+    faint: bool = False,
+    label_points: bool = True,
+    arrows: Sequence[Arrow] = (),
+) -> None:
+    """Draw a :class:`~cpm_nlp.core.mechanism.Drawing` (SI) into a 3-D axes,
+    shown = SI * factor; ``faint``: a reference pose (thin, grey, no labels)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    pts = {k: np.asarray(v, dtype=float).ravel()[:3] * factor for k, v in drawing.points.items()}
+    for part, corners in drawing.faces:
+        poly = np.array([pts[c] for c in corners])
+        colour = "0.85" if faint else _FACE_COLOUR[part]
+        ax.add_collection3d(
+            Poly3DCollection(
+                [poly], facecolor=colour, edgecolor="0.5" if faint else colour, alpha=0.12 if faint else 0.3
+            )
+        )
+    seen: set[str] = set()
+    for a, b, part in drawing.segments:
+        colour, width = _PART_STYLE[part]
+        xyz = np.array([pts[a], pts[b]])
+        label = "_" if faint or part in seen else part
+        seen.add(part)
+        ax.plot(
+            *xyz.T, color="0.7" if faint else colour, lw=1.0 if faint else width, ls="--" if faint else "-", label=label
+        )
+    if faint:
+        ax.plot([], [], color="0.7", lw=1.0, ls="--", label="home pose")
+        return
+    kinds: set[str] = set()
+    for name, letter in drawing.joints.items():
+        p = pts[name]
+        face = "white" if letter == "S" else "k"
+        label = "_" if letter in kinds else f"{_JOINT_NAME[letter]} joint ({letter})"
+        kinds.add(letter)
+        ax.scatter(*p, marker=_JOINT_MARKER[letter], s=40, facecolor=face, edgecolor="k", depthshade=False, label=label)
+    if label_points:
+        for name, p in pts.items():
+            ax.text(*p, f" {name}", fontsize="x-small", color="0.2")
+    for arrow in arrows:
+        o = np.asarray(arrow.origin, dtype=float) * factor
+        v = np.asarray(arrow.vector, dtype=float) * factor
+        ax.quiver(*o, *v, color=arrow.colour, lw=2, arrow_length_ratio=0.15, label=arrow.label or "_")
+
+
+def equal_aspect(ax: Any, points: np.ndarray) -> None:
+    """Equal scales on the three axes of a 3-D axes around ``points`` (shown units)."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    span = float(max(np.max(hi - lo), 1e-300))
+    mid = (lo + hi) / 2
+    pad = 0.55 * span
+    ax.set_xlim(mid[0] - pad, mid[0] + pad)
+    ax.set_ylim(mid[1] - pad, mid[1] + pad)
+    ax.set_zlim(mid[2] - pad, mid[2] + pad)
+    ax.set_box_aspect((1, 1, 1))
+
+
+def mechanism_axes(
+    fig: Any,
+    position: Any,
+    drawing: Any,
+    *,
+    home: Any = None,
+    arrows: Sequence[Arrow] = (),
+    title: str = "",
+) -> Any:
+    """A 3-D axes of ``fig`` (subplot ``position``) with the mechanism drawn at
+    its pose (and faintly at ``home``), axes in one length unit, equal scales."""
+    ax = fig.add_subplot(*position, projection="3d")
+    allpts = np.array([np.asarray(v, dtype=float).ravel()[:3] for v in drawing.points.values()])
+    if home is not None:
+        allpts = np.vstack([allpts, [np.asarray(v, dtype=float).ravel()[:3] for v in home.points.values()]])
+    factor, unit = display_unit("length", allpts)
+    if home is not None:
+        draw_mechanism(ax, home, factor=factor, faint=True)
+    draw_mechanism(ax, drawing, factor=factor, arrows=arrows)
+    shown = allpts * factor
+    for arrow in arrows:
+        o = np.asarray(arrow.origin, dtype=float) * factor
+        shown = np.vstack([shown, o, o + np.asarray(arrow.vector, dtype=float) * factor])
+    equal_aspect(ax, shown)
+    ax.set_xlabel(f"x ({unit})")
+    ax.set_ylabel(f"y ({unit})")
+    ax.set_zlabel(f"z ({unit})")
+    _few_ticks(ax, True)
+    if title:
+        ax.set_title(title, fontsize="small")
+    return ax
+
+
+def mechanism_figure(
+    drawing: Any, *, home: Any = None, arrows: Sequence[Arrow] = (), title: str = "", note: str = ""
+) -> Any:
+    """The mechanism at a pose, alone: a 3-D view with its legend and ``note`` below."""
+    Figure = _figure_class()
+    fig = Figure(figsize=(8, 7.5), layout="constrained")
+    ax = mechanism_axes(fig, (1, 1, 1), drawing, home=home, arrows=arrows)
+    _legend_below(fig, ax, note)
+    if title:
         fig.suptitle(title)
+    return fig
+
+
+def _legend_below(fig: Any, ax: Any, note: str = "") -> None:
+    handles, labels = ax.get_legend_handles_labels()
+    keep = [(h, lab) for h, lab in zip(handles, labels) if not lab.startswith("_")]
+    if keep:
+        fig.legend(
+            [h for h, _ in keep],
+            [lab for _, lab in keep],
+            loc="outside lower center",
+            ncols=min(3, len(keep)),
+            fontsize="small",
+            title=note or None,
+            title_fontsize="x-small",
+        )
+
+
+# -- (f) comparisons and matrices ----------------------------------------------------------------------
+
+
+@dataclass
+class Comparison:
+    """One quantity computed here beside a reference (a paper's printed value, a
+    reference design): shown as the reference's ratio to ours."""
+
+    name: str
+    ours: float
+    reference: float
+    dimension: str | None = None
+
+
+def comparison_axes(
+    ax: Any, rows: Sequence[Comparison], *, reference_label: str, ours_label: str = "this model"
+) -> None:
+    """Rows of reference / ours on a log axis (1: agree), each with both values written out."""
+    y = np.arange(len(rows))[::-1]
+    ratios = []
+    for r in rows:
+        ratio = r.reference / r.ours if r.ours not in (0, 0.0) and r.ours is not None else np.nan
+        ratios.append(ratio if np.isfinite(ratio) and ratio > 0 else np.nan)
+    ratios = np.array(ratios)
+    ax.axvline(1.0, color="k", lw=1)
+    ax.barh(
+        y,
+        np.nan_to_num(ratios - 1.0),
+        left=1.0,
+        color=["tab:green" if abs(r - 1) < 0.01 else "tab:orange" for r in np.nan_to_num(ratios, nan=1)],
+        height=0.6,
+    )
+    ax.set_yticks(y, [pretty(r.name) for r in rows])
+    for yi, r in zip(y, rows):
+        f, unit = display_unit(r.dimension, [r.ours, r.reference])
+        ax.annotate(
+            f"{ours_label} {_number(r.ours * f)} · {reference_label} {_number(r.reference * f)} "
+            f"{unit_text(unit)}".rstrip(),
+            (0, yi),
+            xycoords=("axes fraction", "data"),
+            xytext=(4, 9),
+            textcoords="offset points",
+            fontsize="x-small",
+            va="bottom",
+        )
+    finite = ratios[np.isfinite(ratios)]
+    span = max(float(np.max(np.abs(finite - 1.0))) if finite.size else 0.0, 0.05)
+    ax.set_xlim(1.0 - 1.3 * span, 1.0 + 1.3 * span)
+    ax.set_ylim(-0.7, len(rows) - 0.1)
+    ax.set_xlabel(f"{reference_label} / {ours_label}")
+    ax.grid(True, axis="x", alpha=0.3)
+
+
+def matrix_axes(ax: Any, M: Any, *, title: str = "", rows: Sequence[str] = (), cols: Sequence[str] = ()) -> None:
+    """A matrix as a heat map of log10 |entry|, each entry written in."""
+    M = np.asarray(M, dtype=float)
+    mag = np.log10(np.where(np.abs(M) > 0, np.abs(M), np.nan))
+    im = ax.imshow(mag, cmap="Blues", aspect="auto")
+    big = float(np.abs(M).max()) if M.size else 0.0
+    for (i, j), v in np.ndenumerate(M):
+        v = 0.0 if abs(v) <= 1e-12 * big else v  # rounding noise of an exact zero
+        dark = np.isfinite(mag[i, j]) and im.norm(mag[i, j]) > 0.6
+        ax.text(j, i, f"{v:.3g}", ha="center", va="center", fontsize="x-small", color="white" if dark else "black")
+    ax.set_xticks(range(M.shape[1]), [pretty(c) for c in cols] if len(cols) == M.shape[1] else range(1, M.shape[1] + 1))
+    ax.set_yticks(range(M.shape[0]), [pretty(r) for r in rows] if len(rows) == M.shape[0] else range(1, M.shape[0] + 1))
+    ax.set_title(title, fontsize="small")
+    return im
+
+
+def comparison_figure(
+    groups: Sequence[tuple[str, Sequence[Comparison]]], spread: Mapping[str, Any] | None = None, *, title: str = ""
+) -> Any:
+    """One panel per kind of reference (:func:`comparison_axes`), and the
+    multi-start record (starts, converged, agreed; distinct optima) if given."""
+    Figure = _figure_class()
+    spread = dict(spread or {})
+    heights = [max(len(rows), 1) * 0.55 + 1.0 for _, rows in groups]
+    extra = 1 if spread else 0
+    fig = Figure(figsize=(8, sum(heights) + 2.2 * extra + 0.8), layout="constrained")
+    axes = fig.subplots(len(groups) + extra, 1, height_ratios=heights + [2.2] * extra, squeeze=False)[:, 0]
+    for ax, (label, rows) in zip(axes, groups):
+        comparison_axes(ax, rows, reference_label=label)
+        ax.set_title(f"against the {label}", fontsize="small")
+    if spread:
+        ax = axes[-1]
+        optima = spread.pop("optima", None)
+        counts = {k: v for k, v in spread.items() if isinstance(v, (int, float))}
+        if counts:
+            names = list(counts)
+            ax.bar(range(len(names)), [counts[n] for n in names], color="tab:blue", width=0.6)
+            ax.set_xticks(range(len(names)), [n.replace("_", " ") for n in names], fontsize="small")
+            ax.set_ylabel("starts")
+        text = "multi-start: " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counts.items())
+        if optima:
+            text += f"; {len(optima)} distinct optim{'um' if len(optima) == 1 else 'a'}"
+        ax.set_title(text, fontsize="small")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def matrices_figure(mats: Sequence[tuple[str, Any]], units: Mapping[str, str] | None = None, *, title: str = "") -> Any:
+    """Matrices as annotated heat maps (:func:`matrix_axes`), the unit text of each below it."""
+    Figure = _figure_class()
+    units = units or {}
+    n = len(mats)
+    ncols = min(n, 3)
+    nrows = math.ceil(n / ncols)
+    fig = Figure(figsize=(4.6 * ncols, 4.0 * nrows + 0.6), layout="constrained")
+    for k, (name, M) in enumerate(mats):
+        ax = fig.add_subplot(nrows, ncols, k + 1)
+        matrix_axes(ax, M, title=pretty(name))
+        note = units.get(name, "")
+        if note:
+            ax.set_xlabel(_wrap(note, 60), fontsize="x-small")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def _wrap(text: str, width: int) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)) or text
+
+
+def dynamics_figure(
+    freqs: Any,
+    modes: Any,
+    coords: Sequence[str],
+    groups: Sequence[tuple[str, Sequence[Comparison]]],
+    *,
+    title: str = "",
+) -> Any:
+    """Natural frequencies (bars), mode shapes (each normalised to its largest
+    entry, one group of bars per mode) and the comparison with printed values."""
+    Figure = _figure_class()
+    freqs = np.asarray(freqs, dtype=float)
+    modes = np.asarray(modes, dtype=float)
+    fig = Figure(figsize=(11, 4.2 + (2.0 if groups else 0)), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=[4.2, 2.0 * len(groups)]) if groups else (fig, None)
+    a1, a2 = top.subplots(1, 2)
+    labels = [f"mode {k + 1}" for k in range(len(freqs))]
+    a1.bar(labels, freqs, color="tab:blue", width=0.6)
+    for k, f in enumerate(freqs):
+        a1.annotate(f"{f:.4g} Hz", (k, f), ha="center", va="bottom", fontsize="small")
+    a1.set_ylabel("natural frequency (Hz)")
+    a1.set_ylim(0, 1.15 * max(freqs.max(), 1e-12))
+    width = 0.8 / max(len(freqs), 1)
+    for k in range(modes.shape[1]):
+        v = modes[:, k] / np.abs(modes[:, k]).max()
+        a2.bar(np.arange(len(coords)) + (k - (modes.shape[1] - 1) / 2) * width, v, width, label=f"mode {k + 1}")
+    a2.set_xticks(range(len(coords)), [pretty(c) for c in coords])
+    a2.axhline(0, color="k", lw=0.8)
+    a2.set_ylabel("mode shape (normalised)")
+    a2.legend(fontsize="x-small")
+    a2.set_title("eigenvectors of K v = ω² M v", fontsize="small")
+    if bottom is not None:
+        axes = bottom.subplots(len(groups), 1, squeeze=False)[:, 0]
+        for ax, (label, rows) in zip(axes, groups):
+            comparison_axes(ax, rows, reference_label=label)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, int]], values: Mapping) -> Any:
+    """The mechanism at the pose beside cond and manipulability over a slice of
+    the workspace (``got`` from the figure module), or beside J_task when there
+    is no slice."""
+    Figure = _figure_class()
+    fig = Figure(figsize=(15, 5.2), layout="constrained")
+    ax = mechanism_axes(fig, (1, 3, 1), pose, home=home)
+    _legend_below(fig, ax, pose.note)
+    if got is None:
+        a2 = fig.add_subplot(1, 3, 2)
+        matrix_axes(a2, values["J_task"], title="J_task (no workspace slice: the pose is outside)")
+        return fig
+    gx, gy, cond, manip, names, kinds, t0 = got
+    fx, ux = display_unit(kinds[0], gx)
+    fy, uy = display_unit(kinds[1], gy)
+    for (name, pos), Z in zip(panels, (cond, manip)):
+        a = fig.add_subplot(1, 3, pos)
+        finite = Z[np.isfinite(Z) & (Z > 0)]
+        norm = None
+        if finite.size and finite.max() / finite.min() > 20:  # near a singularity: a log scale keeps the rest readable
+            from matplotlib.colors import LogNorm
+
+            norm = LogNorm(finite.min(), finite.max())
+        mesh = a.pcolormesh(
+            _edges(gx * fx), _edges(gy * fy), np.ma.masked_invalid(Z), cmap="viridis", shading="flat", norm=norm
+        )
+        fig.colorbar(mesh, ax=a, pad=0.01, fraction=0.05, label=name + (", log scale" if norm is not None else ""))
+        a.plot(t0[0] * fx, t0[1] * fy, "*", color="tab:red", ms=14, mec="k", label="the pose")
+        a.set_xlabel(axis_label(names[0], ux))
+        a.set_ylabel(axis_label(names[1], uy))
+        f2, u2 = display_unit(kinds[2], [t0[2]])
+        a.set_title(
+            f"{name} at {pretty(names[2])} = {_number(t0[2] * f2)} {u2} (blank: outside)".replace("  ", " "),
+            fontsize="small",
+        )
+        value = values.get(name)
+        if isinstance(value, (int, float)):
+            a.legend(fontsize="x-small", title=f"{name} = {value:.4g}", title_fontsize="x-small", loc="upper right")
     return fig
 
 

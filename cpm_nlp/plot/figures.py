@@ -30,32 +30,44 @@ use the names read here (SI values, units in the result):
 from __future__ import annotations
 
 import json
+import math
 import os
+import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..analysis.workspace import probe_region, sample_workspace
+from ..analysis.workspace import membership, probe_region, sample_workspace
 from ..core.errors import InputError, suggest
-from ..core.kinematics import passive_joints
+from ..core.kinematics import jacobians, passive_joints
 from ..core.units import DIMENSIONS
 from ..io.inputs import MAX_RESULTS_BYTES, read_input_text
 from ..io.results import FORMATS, read_results
 from ..mechanisms.registry import build_model, closure_of, mechanism_type
 from ..problems.registry import kind_names, problem_kind
 from .draw import (
+    Arrow,
+    BoundarySlice,
+    Comparison,
     Panel,
     as_floats,
+    comparison_figure,
     design_map_figure,
+    display_unit,
+    dynamics_figure,
     ellipsoid_figure,
+    jacobian_figure,
+    matrices_figure,
+    mechanism_figure,
     modes_figure,
     panels_figure,
     pretty,
-    workspace_figure,
 )
+from .draw import workspace_figure as workspace_figure_png
+from .interactive import mechanism_html, workspace_html
 
 SWEEP = "sweep"  # the "kind" of a sweep results file in DEFAULTS
 
@@ -85,6 +97,8 @@ class PlotOptions:
     x: str | None = None
     y: str | None = None
     best: str | None = None
+    #: an interactive Plotly figure (``.html``) of the 3-D view, not a Matplotlib one
+    interactive: bool = False
 
 
 @dataclass
@@ -107,6 +121,11 @@ class ResultData:
     live: Any = None  # the Model solved, when at hand (solve --plot): lets a plot sample its workspace
     parameters: list[dict[str, Any]] = field(default_factory=list)
     recorded: list[str] = field(default_factory=list)  # value columns of a sweep
+    units: dict[str, str] = field(
+        default_factory=dict
+    )  # as the result writes them (matrices: what rows and columns are)
+    #: published figures to draw beside the values: (value expression "dz[2]", published SI, label)
+    published: list[tuple[str, float, str]] = field(default_factory=list)
 
     @property
     def kind(self) -> str:
@@ -137,6 +156,7 @@ def from_result(result: Any, source: str = "") -> ResultData:
         d.get("statuses"),
         dict(d.get("model") or {}),
         status=str(d.get("status")),
+        units={k: str(u) for k, u in (d.get("units") or {}).items()},
     )
 
 
@@ -180,10 +200,15 @@ def load(path: str | os.PathLike) -> ResultData:
     return from_result(data, str(path))
 
 
-def figure(data: ResultData, plot_type: str | None = None, options: PlotOptions | None = None) -> tuple[Any, str]:
-    """The figure of a result: ``(figure, plot type)``.  Raises
+def figure(
+    data: ResultData, plot_type: str | None = None, options: PlotOptions | None = None, interactive: bool = False
+) -> tuple[Any, str]:
+    """The figure of a result: ``(figure, plot type)``; ``interactive``: a Plotly
+    figure (for ``.html``) of a 3-D plot type (:data:`INTERACTIVE`).  Raises
     :class:`NothingSolved` for a result without a solved point."""
-    options = options or PlotOptions()
+    options = replace(
+        options or PlotOptions(), interactive=interactive or (options is not None and options.interactive)
+    )
     ok = data.ok
     if (ok is not None and not ok.any()) or (ok is None and data.status != "solved"):
         raise NothingSolved(f"no point of {data.source or 'the result'} is solved; there is nothing to plot")
@@ -210,6 +235,14 @@ def figure(data: ResultData, plot_type: str | None = None, options: PlotOptions 
 
 def _plot_function(name: str) -> Any:
     return PLOTS[name]
+
+
+def _flat_only(options: PlotOptions, name: str) -> None:
+    if options.interactive:
+        raise NotApplicable(
+            f"an interactive (.html) figure is drawn for the 3-D plots ({', '.join(INTERACTIVE)}); "
+            f"'{name}' is drawn to .png, .svg or .pdf"
+        )
 
 
 def _kind_plots(name: str) -> tuple[str, ...]:
@@ -261,8 +294,9 @@ def _dims(data: ResultData, name: str) -> str | None:
 # -- workspace ------------------------------------------------------------------------------------
 
 
-def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG001 - signature of every plot function
+def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901 - one branch per source of points
     """A point cloud with its cuboid (see the module's naming conventions)."""
+    workspace_figure = workspace_html if options.interactive else workspace_figure_png
     v = data.values
     title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
     if v.get("points") is not None:
@@ -279,22 +313,39 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG0
     if len(task) != 3:
         raise NotApplicable(f"a workspace cloud needs 3 task coordinates; {closure.name} has {len(task)}")
     kinds = [closure.x[i].kind for i in closure.task_index]
-    box_label = "maximal inscribed cuboid" if data.problem == "inscribed_cuboid" else "box <t>_min ... <t>_max"
     cuboid = None
     if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
         cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
+    if data.problem == "inscribed_cuboid":
+        box_label = "maximal inscribed cuboid"
+    else:
+        box_label = "bounding box (" + ", ".join(f"{t}_min … {t}_max" for t in task) + ")"
+    hull = None
+    if isinstance(v.get("vertices"), list) and v["vertices"] and len(v["vertices"][0]) == 3:  # actuator_workspace
+        hull = np.asarray(v["vertices"], dtype=float)
+        box_label = "bounding box"
     if all(_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
         pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
         label = "reachable points (seeded sample)"
-    elif cuboid is not None:  # inscribed_cuboid: the cloud from the model, if at hand
-        pts, label = np.zeros((0, 3)), ""
-        if data.live is not None:
-            pts = _cloud_around(data.live, cuboid)
-            label = "reachable points (sample of 20000, seed 0)"
-        else:
+    elif cuboid is not None:  # inscribed_cuboid: the workspace around it from the model, if at hand
+        pts, label, slices = np.zeros((0, 3)), "", ()
+        boxes = _paper_boxes(data)
+        if data.live is not None and data.problem == "inscribed_cuboid":
+            pts, slices = _workspace_around(data.live, cuboid)
+            label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+        elif data.problem == "inscribed_cuboid":
             title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
         return workspace_figure(
-            pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label, cuboid_label=box_label
+            pts,
+            cuboid=cuboid,
+            names=task,
+            dimensions=kinds,
+            title=title,
+            points_label=label,
+            cuboid_label=box_label,
+            boxes=boxes,
+            slices=slices,
+            hull=hull,
         )
     else:  # a batch of poses, one sweep point per pose
         names = [_pose_name(data, closure, t) for t in task]
@@ -309,16 +360,50 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG0
     )
 
 
-def _cloud_around(model: Any, cuboid: tuple) -> np.ndarray:
-    """Reachable points in a box holding the region probed from home and the
-    cuboid, a quarter wider each way: the workspace's boundary near the cuboid
-    shows even where the probe from home stops short of it."""
+def _paper_boxes(data: ResultData) -> list[tuple]:
+    """The box of the paper's own formulation, where the mechanism reads one from the result."""
+    name = data.model.get("type")
+    if not name:
+        return []
+    extras = mechanism_type(name, path=("model", "type")).cuboid
+    if extras is None or extras.paper_box is None:
+        return []
+    box = extras.paper_box(data.values)
+    return [] if box is None else [box]
+
+
+#: points of the cloud drawn around a cuboid, and grid lines per axis of each boundary slice
+CLOUD_SAMPLE = 6000
+SLICE_GRID = 61
+
+
+def _workspace_around(model: Any, cuboid: tuple) -> tuple[np.ndarray, list[BoundarySlice]]:
+    """The workspace around a cuboid: a region holding the cuboid and the region
+    probed from its centre (twice the distance to the boundary along each axis),
+    a quarter wider each way, so that the boundary shows on every side; in it a
+    seeded cloud and the boundary in the three planes through the box centre."""
     lo, hi = (np.asarray(c, dtype=float) for c in cuboid)
-    probed = probe_region(model)
+    centre = (lo + hi) / 2
+    probed = probe_region(model, centre=centre)
+    if probed is None:
+        probed = probe_region(model)
     if probed is not None:
         lo, hi = np.minimum(lo, probed[0]), np.maximum(hi, probed[1])
     margin = 0.25 * (hi - lo)
-    return sample_workspace(model, 20000, 0, (lo - margin, hi + margin))[0]
+    lo, hi = lo - margin, hi + margin
+    cloud = sample_workspace(model, CLOUD_SAMPLE, 0, (lo, hi))[0]
+    slices = []
+    for i, j in ((0, 1), (0, 2), (1, 2)):
+        k = 3 - i - j
+        gx, gy = np.linspace(lo[i], hi[i], SLICE_GRID), np.linspace(lo[j], hi[j], SLICE_GRID)
+        X, Y = np.meshgrid(gx, gy)
+        T = np.empty((X.size, 3))
+        T[:, i], T[:, j], T[:, k] = X.ravel(), Y.ravel(), centre[k]
+        member = membership(model, T)
+        margin = np.where(np.isfinite(member.margin), member.margin, -np.inf)  # does not assemble: outside
+        margin = np.where(member.inside, np.maximum(margin, 0.0), np.minimum(margin, -1e-300))
+        slices.append(BoundarySlice((i, j), gx, gy, margin.reshape(X.shape), float(centre[k])))
+    return cloud, slices
 
 
 # -- map ---------------------------------------------------------------------------------------------
@@ -362,6 +447,7 @@ def _value_column(data: ResultData, options: PlotOptions) -> str:
 def map_plot(data: ResultData, options: PlotOptions) -> Any:
     """A design map: a value over two swept parameters, or over the two grids
     of a kind's ``map_axes`` (see the module's naming conventions)."""
+    _flat_only(options, "map")
     if data.sweep:
         return _sweep_map(data, options)
     v = data.values
@@ -441,6 +527,7 @@ def _sweep_map(data: ResultData, options: PlotOptions) -> Any:
 
 def lines_plot(data: ResultData, options: PlotOptions) -> Any:
     """Values of a one-parameter sweep against the parameter, one panel each."""
+    _flat_only(options, "lines")
     if not data.sweep:
         raise NotApplicable("'lines' plots a sweep results file")
     params = _numeric_columns(data, [p["key"] for p in data.parameters])
@@ -464,10 +551,11 @@ def _families(coords: Any) -> dict[str, list[Any]]:
     return out
 
 
-def requirements_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG001 - signature of every plot function
+def requirements_plot(data: ResultData, options: PlotOptions) -> Any:
     """The joint requirements over the studied poses: platform motions and
     actuator displacements (first row, 3-PRS paper Fig. 6), passive joint
     rotations, relative to home where home is not zero (Fig. 7)."""
+    _flat_only(options, "requirements")
     if data.sweep:
         raise NotApplicable("'requirements' plots one joint_requirements result, not a sweep")
     c = _closure(data)
@@ -508,6 +596,7 @@ def io_plot(data: ResultData, options: PlotOptions) -> Any:
     """Outputs against the input that varies, one panel per output (pantograph
     paper, Fig. 20-22): pose coordinates against an actuator for FK, actuators
     and dependent coordinates against a task coordinate for IK."""
+    _flat_only(options, "io")
     if data.sweep:
         raise NotApplicable("'io' plots one batch result; for a sweep use 'lines'")
     c = _closure(data)
@@ -532,20 +621,399 @@ def io_plot(data: ResultData, options: PlotOptions) -> Any:
     same = [n for n in inputs if np.allclose(cols[n], cols[x], equal_nan=True)]
     xname = " = ".join(same)
     order = np.argsort(cols[x])
-    panels = [Panel(o, _dims(data, o), {o: [data.values[o][i] for i in order]}) for o in outputs if o not in same]
-    return panels_figure(
-        cols[x][order],
-        panels,
-        xname=xname,
-        xdimension=_dims(data, x),
-        title=f"Outputs against {xname} ({data.model.get('type')}, {data.problem})",
+    outputs = [o for o in outputs if o not in same]
+    flat = [o for o in outputs if _constant(data.values[o])] if len(outputs) > 1 else []
+    refs = _published_points(data, cols[x])
+    panels = []
+    for o in outputs:
+        if o in flat:
+            continue
+        series = {o + " (this model)" if o in refs else o: [data.values[o][i] for i in order]}
+        panels.append(Panel(o, _dims(data, o), series, points=refs.get(o, ())))
+    if not panels:
+        raise NotApplicable("every output is constant over the batch")
+    title = f"Outputs against {xname} ({data.model.get('type')}, {data.problem})"
+    if flat:
+        title += "\nconstant over the batch: " + ", ".join(_constant_text(data, o) for o in flat)
+    return panels_figure(cols[x][order], panels, xname=xname, xdimension=_dims(data, x), title=title)
+
+
+def _constant(values: list) -> bool:
+    arr = as_floats(values)
+    arr = arr[np.isfinite(arr)]
+    return bool(arr.size) and float(np.ptp(arr)) <= 1e-9 * max(float(np.abs(arr).max()), 1e-300)
+
+
+def _constant_text(data: ResultData, name: str) -> str:
+    arr = as_floats(data.values[name])
+    v = float(arr[np.isfinite(arr)][0])
+    f, unit = display_unit(_dims(data, name), [v])
+    return f"{name} = {v * f:.4g} {unit}".rstrip()
+
+
+def _published_points(data: ResultData, x: np.ndarray) -> dict[str, list[tuple[float, float, str]]]:
+    """Published values of single points of the batch ("dz[1]": dz at the second
+    input), as (input, published value, label) per output name."""
+    out: dict[str, list[tuple[float, float, str]]] = {}
+    for expr, value, label in data.published:
+        m = re.fullmatch(r"(\w+)\[(\d+)\]", expr)
+        if m is None or int(m.group(2)) >= len(x):
+            continue
+        out.setdefault(m.group(1), []).append((float(x[int(m.group(2))]), float(value), label))
+    return out
+
+
+# -- the mechanism ------------------------------------------------------------------------------------
+
+
+def _model_for(data: ResultData) -> Any:
+    """The model of the result: the one solved (solve --plot), else built from the
+    parameters the result records (without its joint limits)."""
+    if data.live is not None:
+        return data.live
+    name = data.model.get("type")
+    if not name:
+        raise NotApplicable("the result does not name its mechanism (model.type)")
+    mech = mechanism_type(name, path=("model", "type"))
+    params = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
+    try:
+        return build_model(name, params)
+    except InputError as exc:
+        raise NotApplicable(f"cannot rebuild the {name} model from the result ({exc.message})") from None
+
+
+def _geometry(model: Any) -> Any:
+    mech = model.mechanism
+    if mech is None or mech.geometry is None:
+        raise NotApplicable(
+            f"no drawing of the mechanism: {model.name} declares no geometry "
+            "(the Mechanism.geometry capability, cpm_nlp.core.mechanism)"
+        )
+    return mech.geometry
+
+
+def _single_pose(data: ResultData, model: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The pose (x, q) of a one-pose result."""
+    c = model.closure
+    names = c.x_names + c.q_names
+    missing = [n for n in names if n not in data.values]
+    if missing:
+        raise NotApplicable(f"a drawing of the mechanism needs the pose ({', '.join(missing)} missing)")
+    if any(isinstance(data.values[n], list) for n in names):
+        raise NotApplicable(
+            "a drawing of the mechanism shows one pose; this result is a batch (use 'io' or 'workspace')"
+        )
+    if any(data.values[n] is None for n in names):
+        raise NotApplicable("the pose did not solve: there is no mechanism to draw")
+    x = np.array([float(data.values[n]) for n in c.x_names])
+    q = np.array([float(data.values[n]) for n in c.q_names])
+    return x, q
+
+
+#: a pose whose joints move less than this fraction of the mechanism's size from home is drawn exaggerated
+SMALL_MOTION = 0.02
+
+
+def _drawings(model: Any, x: np.ndarray, q: np.ndarray) -> tuple[Any, Any, float]:
+    """(the drawing at the pose, at home, the exaggeration k): compliant mechanisms
+    move micrometres, so where the joints move less than 2 % of the mechanism's
+    size, the displacements from home are drawn k times larger (a round k that
+    brings them to about 10 %)."""
+    geometry = _geometry(model)
+    pose, home = geometry(model, x, q), geometry(model, model.x_home, model.q_home)
+    P = {k: np.asarray(v, dtype=float) for k, v in pose.points.items()}
+    H = {k: np.asarray(v, dtype=float) for k, v in home.points.items()}
+    span = float(np.ptp(np.array(list(H.values())), axis=0).max())
+    move = max(float(np.linalg.norm(P[k] - H[k])) for k in P)
+    if move == 0.0 or span == 0.0 or move >= SMALL_MOTION * span:
+        return pose, home, 1.0
+    k = 0.1 * span / move
+    k = float(10 ** math.floor(math.log10(k)))
+    shown = {n: H[n] + k * (P[n] - H[n]) for n in P}
+    return replace(pose, points=shown), home, k
+
+
+def _pose_title(model: Any, x: np.ndarray, k: float) -> str:
+    c = model.closure
+    parts = []
+    for i in c.task_index:
+        f, unit = display_unit(c.x[i].kind, [x[i]])
+        parts.append(f"{c.x[i].name} = {x[i] * f:.4g} {unit}".rstrip())
+    text = f"{model.name} at {', '.join(parts)}"
+    return text + (f"\n(displacements from home drawn ×{k:g})" if k != 1.0 else "")
+
+
+def mechanism_plot(data: ResultData, options: PlotOptions) -> Any:
+    """The mechanism at the result's pose (legs, joints, platform), home faintly."""
+    if data.sweep:
+        raise NotApplicable("'mechanism' draws one pose, not a sweep")
+    model = _model_for(data)
+    x, q = _single_pose(data, model)
+    pose, home, k = _drawings(model, x, q)
+    draw = mechanism_html if options.interactive else mechanism_figure
+    return draw(pose, home=home, title=_pose_title(model, x, k) + f" ({data.problem})", note=pose.note)
+
+
+def design_plot(data: ResultData, options: PlotOptions) -> Any:
+    """A synthesised design drawn at its home pose (its geometry parameters from
+    the result's values), the design of the file faintly where it differs."""
+    if data.sweep:
+        raise NotApplicable("'design' draws one result")
+    name = data.model.get("type")
+    if not name:
+        raise NotApplicable("the result does not name its mechanism (model.type)")
+    mech = mechanism_type(name, path=("model", "type"))
+    given = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
+    found = {o.name: data.values[o.name] for o in mech.parameters if isinstance(data.values.get(o.name), (int, float))}
+    if not found:
+        raise NotApplicable(
+            f"the result gives none of the {name} parameters ({', '.join(o.name for o in mech.parameters)})"
+        )
+    try:
+        model = build_model(name, {**given, **found})
+        start = build_model(name, given) if given and any(given.get(k) != v for k, v in found.items()) else None
+    except InputError as exc:
+        raise NotApplicable(f"cannot build the designed {name} ({exc.message})") from None
+    geometry = _geometry(model)
+    pose = geometry(model, model.x_home, model.q_home)
+    home = None if start is None else geometry(start, start.x_home, start.q_home)
+    kinds = {o.name: o.kind for o in mech.parameters}
+    shown = [(k, v, *display_unit(kinds[k], [v])) for k, v in found.items()]
+    text = ", ".join(f"{k} = {v * f:.4g} {unit}".rstrip() for k, v, f, unit in shown)
+    title = f"Designed {name} at home: {text} ({data.problem})"
+    note = "; ".join(t for t in (pose.note, "dashed: the design in the file" if home is not None else "") if t)
+    draw = mechanism_html if options.interactive else mechanism_figure
+    return draw(pose, home=home, title=title, note=note)
+
+
+# -- jacobian --------------------------------------------------------------------------------------------
+
+#: grid lines per axis of the conditioning slice of the jacobian plot
+JACOBIAN_GRID = 15
+
+
+def _conditioning_slice(model: Any, x: np.ndarray) -> tuple | None:
+    """cond and manipulability over the plane of the first two task coordinates
+    through the pose (the third fixed), in the region probed from the pose; None
+    if there is no region (the pose outside the workspace)."""
+    c = model.closure
+    t0 = model.task_of(x)
+    region = probe_region(model, centre=t0, factor=1.0)
+    if region is None:
+        return None
+    lo, hi = region
+    gx, gy = (np.linspace(lo[i], hi[i], JACOBIAN_GRID) for i in (0, 1))
+    X, Y = np.meshgrid(gx, gy)
+    T = np.repeat(t0[None, :], X.size, axis=0)
+    T[:, 0], T[:, 1] = X.ravel(), Y.ravel()
+    member = membership(model, T)
+    cond = np.full(X.size, np.nan)
+    manip = np.full(X.size, np.nan)
+    for n in np.flatnonzero(member.inside):
+        rep = jacobians(model, member.X[n], member.Q[n])
+        cond[n], manip[n] = rep.cond, rep.manipulability
+    names = [c.x[i].name for i in c.task_index]
+    kinds = [c.x[i].kind for i in c.task_index]
+    return gx, gy, cond.reshape(X.shape), manip.reshape(X.shape), names, kinds, t0
+
+
+def jacobian_plot(data: ResultData, options: PlotOptions) -> Any:
+    """The mechanism at the pose, and cond and manipulability over a slice of the
+    workspace through it (first two task coordinates); from the JSON alone (no
+    joint limits) the slice is of the unlimited model."""
+    if data.sweep:
+        raise NotApplicable("'jacobian' plots one jacobian result")
+    if not isinstance(data.values.get("J_task"), list):
+        raise NotApplicable("a jacobian plot needs J_task")
+    model = _model_for(data)
+    x, q = _single_pose(data, model)
+    pose, home, k = _drawings(model, x, q)
+    if options.interactive:
+        return mechanism_html(pose, home=home, title=_pose_title(model, x, k) + f" ({data.problem})", note=pose.note)
+    got = _conditioning_slice(model, x)
+    panels = [("cond", 2), ("manipulability", 3)] if got is not None else []
+    fig = jacobian_figure(pose, home, got, panels, data.values)
+    fig.suptitle(_pose_title(model, x, k) + f" ({data.problem})")
+    return fig
+
+
+# -- twists ------------------------------------------------------------------------------------------
+
+
+def twists_plot(data: ResultData, options: PlotOptions) -> Any:
+    """The displacement twists of the platform, one per actuator, as arrows on the
+    mechanism at the pose: the rotation (ω) and the translation (v) of the
+    reference point, each scaled to the drawing (RPR paper, eq 45)."""
+    T = data.values.get("T")
+    if not isinstance(T, list) or len(T) != 6:
+        raise NotApplicable("a twists plot needs the 6 x n twist matrix T")
+    model = _model_for(data)
+    c = model.closure
+    x = np.array([float(data.values.get(n, h)) for n, h in zip(c.x_names, model.x_home)])
+    q = model.q_home if not all(n in data.values for n in c.q_names) else [data.values[n] for n in c.q_names]
+    pose = _geometry(model)(model, x, np.asarray(q, dtype=float))
+    ref = np.asarray(data.values.get("reference_point") or pose.points.get("P", np.zeros(3)), dtype=float)
+    T = np.asarray(T, dtype=float)
+    span = float(np.ptp(np.array([np.asarray(v, dtype=float) for v in pose.points.values()]), axis=0).max())
+    colours = ("tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
+    arrows = []
+    for block, what, style in ((slice(0, 3), "ω", "rotation"), (slice(3, 6), "v", "translation")):
+        big = float(np.abs(T[block]).max())
+        if big == 0:
+            continue
+        scale = 0.35 * span / big
+        for j in range(T.shape[1]):
+            vec = T[block, j]
+            if np.linalg.norm(vec) > 0:
+                arrows.append(
+                    Arrow(
+                        ref + (0 if style == "rotation" else 0.02 * span),
+                        vec * scale,
+                        f"{what} of actuator {j + 1} ({style}, ×{scale:.3g})",
+                        colours[j % len(colours)] if style == "rotation" else colours[(j + 3) % len(colours)],
+                    )
+                )
+    draw = mechanism_html if options.interactive else mechanism_figure
+    return draw(
+        pose,
+        arrows=arrows,
+        title=f"Displacement twists ({data.model.get('type')}, {data.problem}), at the reference point",
+        note=data.units.get("T", ""),
     )
 
 
-def forces_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG001 - signature of every plot function
+# -- comparisons, matrices ----------------------------------------------------------------------------
+
+#: how a result names a reference value beside its own (prefix or suffix, legend label)
+REFERENCES = (
+    ("reference_", "", "reference design"),
+    ("paper_", "", "paper"),
+    ("", "_printed", "paper (printed)"),
+    ("", "_compare", "compared design"),
+    ("", "_design", "design in the file"),
+)
+
+
+def _comparisons(data: ResultData) -> list[tuple[str, list[Comparison]]]:
+    """Pairs (ours, reference) of scalar values, grouped by kind of reference."""
+    v = data.values
+    groups = []
+    for prefix, suffix, label in REFERENCES:
+        rows = []
+        for name, ref in v.items():
+            if not (name.startswith(prefix) and name.endswith(suffix)) or name == prefix + suffix:
+                continue
+            base = name[len(prefix) : len(name) - len(suffix) if suffix else None]
+            ours = v.get(base)
+            if base == name or not all(isinstance(u, (int, float)) and not isinstance(u, bool) for u in (ours, ref)):
+                continue
+            rows.append(Comparison(base, float(ours), float(ref), _dims(data, base)))
+        if rows:
+            groups.append((label, rows))
+    return groups
+
+
+def comparison_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Values computed here beside their references (a paper's printed values, a
+    reference design, the design in the file): the reference's ratio to ours,
+    both values written out; a multi-start spread where the result has one."""
+    _flat_only(options, "comparison")
+    if data.sweep:
+        raise NotApplicable("'comparison' plots one result")
+    groups = _comparisons(data)
+    if not groups:
+        raise NotApplicable("the result has no value beside a reference (reference_*, paper_*, *_printed ...)")
+    spread = _multistart(data)
+    return comparison_figure(
+        groups, spread, title=f"{data.problem} ({data.model.get('type')}): ours against references"
+    )
+
+
+def _multistart(data: ResultData) -> dict[str, Any]:
+    v = data.values
+    out = {k: v[k] for k in ("starts", "starts_converged", "starts_agreed", "converged", "at_best") if k in v}
+    if isinstance(v.get("optima"), list) and v["optima"] and isinstance(v["optima"][0], list):
+        out["optima"] = v["optima"]
+    return out
+
+
+def _matrices(data: ResultData) -> list[tuple[str, np.ndarray]]:
+    out = []
+    for name, value in data.values.items():
+        if isinstance(value, list) and value and isinstance(value[0], list):
+            try:
+                M = np.array(value, dtype=float)
+            except (TypeError, ValueError):
+                continue
+            if M.ndim == 2 and M.size <= 100 and np.isfinite(M).all():
+                out.append((name, M))
+    return out
+
+
+def matrices_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Every matrix of the result (up to 10 x 10) as a heat map of its entries'
+    magnitudes, each entry written in (units from the result)."""
+    _flat_only(options, "matrices")
+    if data.sweep:
+        raise NotApplicable("'matrices' plots one result")
+    mats = _matrices(data)
+    if not mats:
+        raise NotApplicable("the result has no matrix")
+    return matrices_figure(mats, data.units, title=f"{data.problem} ({data.model.get('type')})")
+
+
+# -- dynamics ---------------------------------------------------------------------------------------------
+
+
+def dynamics_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Natural frequencies and mode shapes: the generalized eigenproblem K v = ω² M v
+    of the result's M and K (in the actuator coordinates), beside the paper's
+    printed values where the result has them."""
+    _flat_only(options, "dynamics")
+    M, K = data.values.get("M"), data.values.get("K")
+    if not (isinstance(M, list) and isinstance(K, list)):
+        raise NotApplicable("a dynamics plot needs the mass and stiffness matrices M and K")
+    from scipy.linalg import eigh
+
+    w2, modes = eigh(np.asarray(K, dtype=float), np.asarray(M, dtype=float))
+    freqs = np.sqrt(np.clip(w2, 0, None)) / (2 * math.pi)
+    closure = _closure(data)
+    groups = _comparisons(data)
+    return dynamics_figure(freqs, modes, closure.q_names, groups, title=f"Dynamics ({data.model.get('type')})")
+
+
+# -- amplifier ----------------------------------------------------------------------------------------------
+
+
+def amplifier_plot(data: ResultData, options: PlotOptions) -> Any:
+    """Output against input of the lever amplifier, d = A2 q (prc3 paper, eq 1-2)."""
+    _flat_only(options, "amplifier")
+    v = data.values
+    pairs = [(k, "d" + k[1:]) for k in v if re.fullmatch(r"q\d+", k) and isinstance(v[k], list)]
+    pairs = [(a, b) for a, b in pairs if isinstance(v.get(b), list)]
+    if not pairs or not isinstance(v.get("A2"), (int, float)):
+        raise NotApplicable("an amplifier plot needs A2 and lists q<i>, d<i>")
+    panels = []
+    x = None
+    for qn, dn in pairs:
+        x = v[qn]
+        panels.append(
+            Panel(dn, "length", {dn: v[dn]}, title=f"{dn} = A2 {qn}, A2 = {v['A2']:.4g} (A1 = {v['A1']:.4g})")
+        )
+    return panels_figure(
+        x, panels, xname=pairs[0][0], xdimension="length", title="Lever amplifier output (prc3, eq 1-2)"
+    )
+
+
+#: plot types with an interactive (.html) 3-D figure
+INTERACTIVE = ("workspace", "mechanism", "design", "jacobian", "twists")
+
+
+def forces_plot(data: ResultData, options: PlotOptions) -> Any:
     """Actuator forces and hinge stresses along a motion (actuator_forces over a
     list of inputs; prs3-ruiz.md Table 2 extended to a curve), against the input
     that varies most."""
+    _flat_only(options, "forces")
     if data.sweep:
         raise NotApplicable("'forces' plots one actuator_forces result; for a sweep use 'lines'")
     c = _closure(data)
@@ -576,8 +1044,9 @@ def _translational(c: Any) -> list[int]:
     return [i for i, x in enumerate(c.x) if x.kind == "length"][:3]
 
 
-def ellipsoid_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG001 - signature of every plot function
+def ellipsoid_plot(data: ResultData, options: PlotOptions) -> Any:
     """The compliance ellipsoid of the platform: the translational block of C."""
+    _flat_only(options, "ellipsoid")
     if data.sweep or not isinstance(data.values.get("C"), list):
         raise NotApplicable("'ellipsoid' plots the output compliance C of one platform_compliance result")
     c = _closure(data)
@@ -590,9 +1059,10 @@ def ellipsoid_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG0
     )
 
 
-def modes_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: ARG001 - signature of every plot function
+def modes_plot(data: ResultData, options: PlotOptions) -> Any:
     """Mode shapes as arrows at the platform point (the translational pose
     coordinates) and at each actuator, one panel per mode."""
+    _flat_only(options, "modes")
     if data.sweep or not isinstance(data.values.get("modes_x"), list):
         raise NotApplicable("'modes' plots the mode shapes of one natural_frequencies result")
     c = _closure(data)
@@ -626,4 +1096,12 @@ PLOTS = {
     "requirements": requirements_plot,
     "io": io_plot,
     "lines": lines_plot,
+    "mechanism": mechanism_plot,
+    "design": design_plot,
+    "jacobian": jacobian_plot,
+    "twists": twists_plot,
+    "comparison": comparison_plot,
+    "matrices": matrices_plot,
+    "dynamics": dynamics_plot,
+    "amplifier": amplifier_plot,
 }

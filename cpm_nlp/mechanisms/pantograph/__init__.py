@@ -25,7 +25,9 @@ MECHANISM = Mechanism(
         options=kinematics.CUBOID_OPTIONS,
         value_names=kinematics.CUBOID_VALUE_NAMES,
         values=kinematics.cuboid_values,
+        paper_box=kinematics.paper_box,
     ),
+    geometry=kinematics.geometry,
     paper_membership=kinematics.paper_membership,
     problem_files=(
         "pantograph_forward_kinematics.yaml",

@@ -66,6 +66,7 @@ from ...analysis import flexure
 from ...analysis.certify import certify_box
 from ...analysis.workspace import check_box
 from ...core.errors import InputError
+from ...core.mechanism import Drawing
 from ...core.model import Coordinate, LoopClosure, Model
 from ...core.options import Option
 from ...core.solver import SolverConfig
@@ -596,3 +597,58 @@ def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig
         }
     )
     return values, dims
+
+
+def paper_box(values) -> tuple[list, list, str] | None:
+    """The box of the paper's formulation (eq 32-34) in a cuboid result:
+    k <= px <= x_hat, |py| <= y_hat, |pz| <= z_hat; None if it did not solve."""
+    names = ("paper_k", "paper_x_hat", "paper_y_hat", "paper_z_hat")
+    if values.get("paper_status") != "solved" or not all(isinstance(values.get(n), (int, float)) for n in names):
+        return None
+    k, xh, yh, zh = (float(values[n]) for n in names)
+    outside = values.get("paper_check_outside")
+    label = "paper's eq 32-34 box"
+    if isinstance(outside, int) and outside > 0:
+        label += f", {outside} of {values.get('check_points', '?')} check points outside"
+    return [k, -yh, -zh], [xh, yh, zh], label
+
+
+def geometry(model: Model, x, q) -> Drawing:
+    """The pantograph at pose x, actuators q (Fig. 2, eq 1-8): inputs A = (0, dy, dz)
+    and B = (dx, 0, 0), links A-C-D and D-F-E of length a + b at angles theta1 and
+    theta2 (C = A + a u1, D = A + (a + b) u1, F = D + a u2, E = D + (a + b) u2), the
+    links BC (parallel to DE) and BF (parallel to CD).  The guiding parallelograms
+    that hold the plane at phi are not drawn."""
+    a = float(model.parameters["a"])
+    b = float(model.parameters["b"])
+    x = np.asarray(x, dtype=float).ravel()
+    q = np.asarray(q, dtype=float).ravel()
+    u1 = np.asarray(_u(x[3], x[5]), dtype=float).ravel()
+    u2 = np.asarray(_u(x[4], x[5]), dtype=float).ravel()
+    A = np.array([0.0, q[1], q[2]])
+    B = np.array([q[0], 0.0, 0.0])
+    D = A + (a + b) * u1
+    pts = {
+        "O": np.zeros(3),
+        "A": A,
+        "B": B,
+        "C": A + a * u1,
+        "D": D,
+        "F": D + a * u2,
+        "E": D + (a + b) * u2,
+    }
+    return Drawing(
+        points=pts,
+        segments=(
+            ("O", "A", "actuator"),
+            ("O", "B", "actuator"),
+            ("A", "C", "link"),
+            ("C", "D", "link"),
+            ("D", "F", "link"),
+            ("F", "E", "leg"),
+            ("B", "C", "link"),
+            ("B", "F", "link"),
+        ),
+        joints={"A": "R", "B": "R", "C": "R", "D": "R", "F": "R"},
+        note="actuators move A in y, z and B in x (from O); E is the end-effector; guiding mechanism not drawn",
+    )

@@ -27,6 +27,7 @@ MECHANISM = Mechanism(
         values=kinematics.dynamics_values,
         dimensions=kinematics.DYNAMICS_DIMENSIONS,
     ),
+    geometry=kinematics.geometry,
     kinds={"amplifier": Amplifier},
     problem_files=(
         "prc3_forward_kinematics.yaml",

@@ -18,6 +18,7 @@ from ...kinds.analysis import closed_form_result
 
 class Amplifier(ProblemKind):
     name = "amplifier"
+    plots = ("amplifier",)
     description = "lever amplifier ratios A1, A2 (prc3 eq 1) and the output d = A2 q for given inputs (eq 2)"
 
     def supports(self, model: Model) -> str | None:

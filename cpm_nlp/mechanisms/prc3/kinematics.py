@@ -64,6 +64,7 @@ import casadi as ca
 import numpy as np
 
 from ...analysis import flexure
+from ...core.mechanism import Drawing
 from ...core.model import Coordinate, LoopClosure, Model
 from ...core.options import Option
 
@@ -421,3 +422,38 @@ DYNAMICS_DIMENSIONS = {
     "G_e_printed": "force",
     "f_printed": "frequency",
 }
+
+
+#: half size of the platform in the drawing, as a fraction of the leg length l (the paper's
+#: kinematics treats the platform as its centre P: eq 5 has no platform dimension)
+DRAWN_PLATFORM = 0.3
+
+
+def geometry(model: Model, x, q) -> Drawing:
+    """The 3-PRC at pose x (the platform centre P), inputs q: for limb i the slider
+    C_i, displaced by d_i = A2 q_i (eq 2) along -e_i, the leg C_iB_i of length l
+    (l l_io = P + (l + d_i) e_i, eq 5, 8-9) and the platform joint B_i.  The
+    platform is drawn as a triangle of B_i = P + c e_i with c = 0.3 l (eq 5 has no
+    platform size: a shift along e_i moves C_i and B_i alike); the lever
+    amplifiers are not drawn."""
+    l = float(model.parameters["L7"])
+    A2 = float(model.derived["A2"])
+    c = DRAWN_PLATFORM * l
+    x = np.asarray(x, dtype=float).ravel()
+    q = np.asarray(q, dtype=float).ravel()
+    pts = {"P": x.copy()}
+    for i in range(3):
+        e = np.eye(3)[i]
+        d_i = A2 * q[i]
+        pts[f"B{i + 1}"] = x + c * e
+        pts[f"C{i + 1}"] = (c - l - d_i) * e
+        pts[f"A{i + 1}"] = (c - l) * e  # the slider at q = 0: the rail's origin
+    return Drawing(
+        points=pts,
+        segments=tuple((f"A{i}", f"C{i}", "actuator") for i in (1, 2, 3))
+        + tuple((f"C{i}", f"B{i}", "leg") for i in (1, 2, 3))
+        + tuple((f"B{i}", "P", "platform") for i in (1, 2, 3)),
+        faces=(("platform", ("B1", "B2", "B3")),),
+        joints={**{f"C{i}": "R" for i in (1, 2, 3)}, **{f"B{i}": "C" for i in (1, 2, 3)}},
+        note="platform size drawn at 0.3 l (the paper's model has none); lever amplifiers not drawn",
+    )

@@ -35,6 +35,7 @@ MECHANISM = Mechanism(
     closure=kinematics.closure,
     build=kinematics.build,
     synthesis=Synthesis,
+    geometry=kinematics.geometry,
     stiffness=STIFFNESS,
     kinds={k.name: k for k in (ScrewJacobian, Twists, TransmissionMap, JointDesign, Compliance)},
     problem_files=(

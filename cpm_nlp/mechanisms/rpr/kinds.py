@@ -100,6 +100,7 @@ def _material(raw: Any, path: tuple) -> flexure.Material:
 
 class ScrewJacobian(RprKind, Jacobian):
     name = "rpr_screw_jacobian"
+    plots = ("jacobian", "matrices")
     description = "RPR Jacobian J, G and passive rates G_p by screw theory (eq 7-13) beside the AD Jacobians"
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
@@ -147,6 +148,7 @@ class ScrewJacobian(RprKind, Jacobian):
 
 class Twists(RprKind):
     name = "rpr_twists"
+    plots = ("twists", "matrices")
     description = "displacement twists of the RPR platform for a small displacement of each actuator (eq 45)"
 
     def input_options(self, model: Model) -> list[Option]:
@@ -523,6 +525,7 @@ def _joint_dims(joint: str, geometry: Mapping[str, Any]) -> tuple[float, float, 
 
 class JointDesign(RprKind):
     name = "rpr_joint_design"
+    plots = ("comparison",)
     description = "optimal R and U flexure joints of the RPR (eq 27-32, Table 1) by IPOPT multi-start"
 
     def input_options(self, model: Model) -> list[Option]:
@@ -713,6 +716,7 @@ _LEAF = (
 
 class Compliance(RprKind):
     name = "rpr_compliance"
+    plots = ("matrices",)
     description = "pseudo-rigid-body compliance C and input compliance C_in of the RPR (eq 33-44)"
 
     def input_options(self, model: Model) -> list[Option]:

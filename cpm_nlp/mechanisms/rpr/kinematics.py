@@ -51,6 +51,7 @@ import numpy as np
 
 from ...core import screws
 from ...core.errors import InputError
+from ...core.mechanism import Drawing
 from ...core.model import Coordinate, LoopClosure, Model
 from ...core.options import Option
 
@@ -424,3 +425,22 @@ def passive_jacobian() -> ca.Function:
     AD; G_p = dj_dx G (eq 13)."""
     x, _q, p = _symbols()
     return ca.Function("passive_jacobian", [x, p], [ca.jacobian(passive_angles(x, p), x)], ["x", "p"], ["dj_dx"])
+
+
+def geometry(model: Model, x, q) -> Drawing:  # noqa: ARG001 - q follows from x (|A_iB_i| = l_i)
+    """The RPR at pose x = (theta, alpha, P): base joints A_i (eq 5), platform joints
+    B_i (eq 4), the legs A_iB_i, and the frame origins o and o'."""
+    p = np.array([float(model.parameters[k]) for k in ("r1", "r2", "P0")])
+    x = np.asarray(x, dtype=float).ravel()
+    A, B = joint_points(ca.DM(x), ca.DM(p))
+    pts = {"o": np.zeros(3), "o'": np.asarray(origin(x[0], x[2]), dtype=float).ravel()}
+    for i in range(3):
+        pts[f"A{i + 1}"] = np.asarray(A[i], dtype=float).ravel()
+        pts[f"B{i + 1}"] = np.asarray(B[i], dtype=float).ravel()
+    return Drawing(
+        points=pts,
+        segments=tuple((f"A{i}", f"B{i}", "leg") for i in (1, 2, 3)) + (("o", "o'", "link"),),
+        faces=(("base", ("A1", "A2", "A3")), ("platform", ("B1", "B2", "B3"))),
+        joints={"A1": "R", "A2": "U", "A3": "R", "B1": "U", "B2": "R", "B3": "U"},
+        note="legs 1 and 3 RPU, leg 2 UPR (prismatic legs A_iB_i); o-o' is P",
+    )
