@@ -63,7 +63,7 @@ def test_o_is_written_through_the_atomic_writer(cli, tmp_path, monkeypatch):
 
     seen = []
     real = cli_main.write_atomic
-    monkeypatch.setattr(cli_main, "write_atomic", lambda path, text: (seen.append(path), real(path, text)))
+    monkeypatch.setattr(cli_main, "write_atomic", lambda path, text, **kw: (seen.append(path), real(path, text, **kw)))
     run = cli("reproduce", str(PROBLEMS / "prc3_amplifier.yaml"), "-o", str(tmp_path / "x.json"))
     assert run.code == 0 and seen == [str(tmp_path / "x.json")]
 
@@ -278,14 +278,17 @@ def test_the_full_shipped_summary_counts_dependent_agreements_apart():
     """The categories of the shipped rows, counted without solving (the verdicts
     are pinned by the per-paper tests and `cpm-nlp reproduce` in CI's smoke test)."""
     cats = [fig.category for _, _, fig in _shipped_rows()]
-    assert len(cats) == 141
+    assert len(cats) == 166  # the 141 rows of issues 2-7, then the compliance rows and the file-described 3-PRS
     assert cats.count("read_off_matrix") == 21 and cats.count("derived") == 1
     assert summarize([])["figures"] == 0
 
 
 def test_a_directory_is_read_with_its_subdirectories(cli, tmp_path):
+    (tmp_path / "more").mkdir()
+    _file(tmp_path / "more", [A1])
+    # a mechanisms/ subfolder holds mechanism descriptions (problems/mechanisms/), not problems
     (tmp_path / "mechanisms").mkdir()
-    _file(tmp_path / "mechanisms", [A1])
+    (tmp_path / "mechanisms" / "m.yaml").write_text("name: m\nlegs: []\n")
     run = cli("reproduce", str(tmp_path))
     assert run.code == 0, run.err
     assert run.out.rstrip().endswith("1 figures, 0 unexpected")
