@@ -61,7 +61,8 @@ def _mechanism_section(mech: Mechanism) -> tuple[dict[str, Any], str]:
         path = Path(name) if Path(name).is_absolute() else shipped_problems_dir() / name
         if path.is_file():
             section = read_yaml(path).get("mechanism")
-            if isinstance(section, dict) and section.get("type") == mech.name:
+            # the mechanism's own example: by type, or by its file (a mechanism described in a file)
+            if isinstance(section, dict) and (section.get("type") == mech.name or "file" in section):
                 return section, f"problems/{path.name}" if not Path(name).is_absolute() else str(path)
     return {"type": mech.name}, "the declared defaults"
 
