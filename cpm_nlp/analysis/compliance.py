@@ -130,6 +130,64 @@ def _leaf_stiffness(E, G, d) -> dict[str, float]:
     return out
 
 
+#: the six axes of a hinge in its own frame: three rotations (bend about the compliant
+#: axis, bend2 about the second bending axis, torsion about its length) and three
+#: translations (axial along its length, shear across its thinnest section, i.e. the
+#: direction bending about the compliant axis moves, shear2 along the compliant axis)
+SIX_AXES = ("bend", "bend2", "torsion", "axial", "shear", "shear2")
+
+
+def _beam_shear(E, G, length, inertia, area, alpha_s):
+    """Transverse stiffness of a straight beam at its centre, 1/(l³/(12 E I) + α_s l/(G A)):
+    the compliance of a cantilever's free end (l³/3EI, coupling l²/2EI, l/EI) transported
+    to the mid-point, where the force-moment coupling vanishes (the definition of
+    :func:`~cpm_nlp.analysis.flexure_compliance.circular_notch_compliances`), plus Timoshenko shear."""
+    return 1.0 / (length**3 / (12.0 * E * inertia) + alpha_s * length / (G * area))
+
+
+def _notch_six(E, G, d) -> dict[str, float]:
+    c = circular_notch_compliances(E, G, d["w"], d["t"], d["r"])
+    return {
+        "bend": 1 / c["rz"],
+        "bend2": 1 / c["ry"],
+        "torsion": 1 / c["rx"],
+        "axial": 1 / c["x"],
+        "shear": 1 / c["y"],
+        "shear2": 1 / c["z"],
+    }
+
+
+def _rod_six(E, G, d) -> dict[str, float]:
+    out = _rod_stiffness(E, G, d)
+    dia, length = d["d"], d["l"]
+    area, inertia = math.pi * dia**2 / 4.0, math.pi * dia**4 / 64.0
+    out["shear"] = out["shear2"] = _beam_shear(E, G, length, inertia, area, 10.0 / 9.0)
+    return out
+
+
+def _leaf_six(E, G, d) -> dict[str, float]:
+    out = _leaf_stiffness(E, G, d)
+    t, w, length = d["t"], d["w"], d["l"]
+    out["shear"] = _beam_shear(E, G, length, w * t**3 / 12.0, w * t, 1.2)
+    out["shear2"] = _beam_shear(E, G, length, t * w**3 / 12.0, w * t, 1.2)
+    return out
+
+
+#: the six-axis stiffness of each hinge type at its centre, (E, G, dims) -> {axis: k}
+SIX_AXIS_STIFFNESS = {"circular_notch": _notch_six, "circular_rod": _rod_six, "leaf_spring": _leaf_six}
+
+
+def six_axis_stiffness(h: Hinge) -> dict[str, float] | None:
+    """The hinge's stiffness about and along all of :data:`SIX_AXES` (N*m/rad, N/m),
+    its given k where it has one; None without a flexure type and a material with E
+    and nu (the other axes then cannot be computed)."""
+    if h.kind is None or h.material is None or h.material.E is None or h.material.nu is None:
+        return None
+    out = {a: float(v) for a, v in SIX_AXIS_STIFFNESS[h.kind](h.material.E, h.material.G, h.dims).items()}
+    out.update(h.k)
+    return out
+
+
 @dataclass(frozen=True)
 class HingeType:
     """A flexure hinge geometry: its dimensions, its stiffness about each axis

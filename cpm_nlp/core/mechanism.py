@@ -192,6 +192,9 @@ class Mechanism:
     geometry: Callable[[Any, Any, Any], Drawing] | None = None
     #: default joint stiffnesses and flexure hinges, for the compliance kinds
     stiffness: JointStiffness | None = None
+    #: ``(model) -> Chains``: each leg as a serial chain of joints at the reference
+    #: configuration (:mod:`cpm_nlp.core.chains`), for the six-axis hinge model
+    chains: Callable[[Any], Any] | None = None
     #: problem kinds of its own: kind name -> ProblemKind subclass
     kinds: Mapping[str, type] = field(default_factory=dict)
     #: its shipped problem files: examples of its kinds, and (those with a ``reproduce:``
@@ -234,6 +237,7 @@ CAPABILITIES = (
     "dynamics",
     "geometry",
     "stiffness",
+    "chains",
     "kinds",
     "problem_files",
 )
@@ -264,7 +268,7 @@ def validate(mech: Mechanism) -> None:  # noqa: C901 - one flat check per declar
     for name in ("closure", "build"):
         if not callable(getattr(mech, name)):
             _fail(mech, name, "callable")
-    for name in ("check_parameters", "check_limits", "synthesis", "paper_membership", "geometry"):
+    for name in ("check_parameters", "check_limits", "synthesis", "paper_membership", "geometry", "chains"):
         if getattr(mech, name) is not None and not callable(getattr(mech, name)):
             _fail(mech, name, "callable or None")
     if mech.cuboid is not None and not isinstance(mech.cuboid, CuboidExtras):

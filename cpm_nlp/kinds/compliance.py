@@ -22,6 +22,7 @@ import scipy.optimize
 
 from ..analysis import compliance as cm
 from ..analysis.dynamics import parse_mass
+from ..analysis.hinge_chains import SixAxisModel, six_axis_model
 from ..core.errors import InputError, unknown_key_error
 from ..core.kind import (
     ProblemKind,
@@ -389,11 +390,21 @@ class PlatformCompliance(_HingeKind):
             Option(
                 "k_actuator",
                 "str",
-                "actuator stiffness: 'rigid' (positions held: with rigid links the pseudo-rigid-body model then has "
-                "no deflection), 0 N/m (the actuator forces held, the load case of a FEM with forces at the "
-                "actuators), or a stiffness (one, or one per actuator)",
+                "actuator stiffness: 'rigid' (positions held), 0 N/m (the actuator forces held, the load case of a "
+                "FEM with forces at the actuators), or a stiffness (one, or one per actuator)",
                 default="rigid",
-            )
+            ),
+            Option(
+                "hinge_axes",
+                "str",
+                "the hinge model: 'all' (every flexure a six-axis spring at its joint, the axes the kinematics does "
+                "not move with the flexure library's stiffness; needs the mechanism's leg chains) or 'kinematic' "
+                "(pseudo-rigid-body: each hinge only about the axes the kinematics moves; with the actuators held "
+                "a mechanism of rigid links then does not deflect); default: all where the mechanism gives its "
+                "chains, else kinematic",
+                default=None,
+                choices=("all", "kinematic"),
+            ),
         ]
 
     def input_options(self, model: Model) -> list[Option]:
@@ -408,6 +419,19 @@ class PlatformCompliance(_HingeKind):
         ka = raw.pop("k_actuator", None) if isinstance(raw, dict) else None
         inputs = super().parse_inputs(raw, model, path)
         inputs["k_actuator"] = _k_actuator(ka, model, path + ("k_actuator",))
+        axes = inputs.get("hinge_axes")
+        mech = model.mechanism
+        has_chains = mech is not None and mech.chains is not None
+        if axes == "all" and not has_chains:
+            raise InputError(
+                f"hinge_axes: all needs the legs of {model.name} as serial chains (the mechanism's chains "
+                "capability; a mechanism file of spatial P, R, C, U, S legs gives them)",
+                path=path + ("hinge_axes",),
+                hint="use hinge_axes: kinematic",
+            )
+        inputs["six_axis"] = None
+        if axes == "all" or (axes is None and has_chains):
+            inputs["six_axis"] = six_axis_model(model, inputs["hinge_set"])
         return inputs
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
@@ -427,6 +451,8 @@ class PlatformCompliance(_HingeKind):
         info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
         if not sol.ok:
             return Result(self.name, sol.status, values, units, dims, info, sol.message, None, _model_info(model))
+        if inputs["six_axis"] is not None:
+            return self._run_six_axis(model, inputs, sol, (values, units, dims, info))
         sp = cm.static_point(model, hs, sol.x, sol.q)
         try:
             C = cm.output_compliance(sp, ka)
@@ -473,10 +499,77 @@ class PlatformCompliance(_HingeKind):
         info = SolverInfo("ipopt", sol.iterations + loaded.iterations, sol.seconds)
         return Result(self.name, status, values, units, dims, info, message, None, _model_info(model))
 
+    def _run_six_axis(self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, parts: tuple) -> Result:  # noqa: C901 - unloaded, linearized, loaded, then one value family each
+        """The six-axis hinge model: the unloaded equilibrium at the commanded actuators, the
+        output compliance there, and the loaded pose by IPOPT."""
+        values, units, dims, info = parts
+        c = model.closure
+        sm: SixAxisModel = inputs["six_axis"]
+        f, ka = inputs["load"], inputs["k_actuator"]
+        xs = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
+        z0 = sm.start(sol.x, sol.q)
+        ok, z_u, lam_u, it_u = sm.newton(z0, np.zeros(c.nx), sol.q, None, None)
+        if not ok:
+            msg = "six-axis hinge model: no unloaded equilibrium at the commanded actuators (Newton on the KKT)"
+            return Result(self.name, Status.NOT_CONVERGED, values, units, dims, info, msg, None, _model_info(model))
+        Fc = sm.actuator_reactions(z_u, lam_u, np.zeros(c.nx))
+        try:
+            C = sm.compliance(z_u, lam_u, ka, None if ka is None else Fc)
+        except np.linalg.LinAlgError:
+            msg = (
+                "the six-axis hinge model's stiffness is singular: a motion meets no hinge and no actuator "
+                "(give a positive k_actuator, or more hinges)"
+            )
+            return Result(self.name, Status.SINGULAR, values, units, dims, info, msg, None, _model_info(model))
+        values.update(C=C.tolist(), deflection_linear=(C @ f).tolist(), hinge_model="all")
+        dims.update(C="matrix", deflection_linear="vector", hinge_model="text")
+        units.update(C=f"rows and columns {xs}; m/N, rad/(N*m) and mixed", deflection_linear=xs, hinge_model="")
+        for i, x in enumerate(c.x):
+            values[f"C_{x.name}"] = float(C[i, i])
+            dims[f"C_{x.name}"] = "compliance" if x.kind == "length" else "rotational_compliance"
+            units[f"C_{x.name}"] = "m/N" if x.kind == "length" else "rad/(N*m)"
+        unloaded = sm.stresses(z_u)
+        values["stress_max_unloaded"] = max((v for v in unloaded.values() if v is not None), default=None)
+        dims["stress_max_unloaded"], units["stress_max_unloaded"] = "stress", "Pa"
+        six = ", ".join(sm.six_axis_hinges) or "none"
+        note = f"six-axis hinges: {six}; {sm.chains.note}"
+        if not np.any(f):
+            info = SolverInfo("newton-kkt", sol.iterations + it_u, sol.seconds)
+            msg = f"no load: the output compliance only ({note})"
+            return Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+        ok, z_l, lam_l, it_l, st = sm.ipopt(z_u, f, sol.q, ka, None if ka is None else Fc)
+        info = SolverInfo("ipopt", sol.iterations + it_u + it_l, sol.seconds)
+        if not ok:
+            msg = f"six-axis compliant forward kinematics by IPOPT did not converge ({st})"
+            return Result(self.name, Status.NOT_CONVERGED, values, units, dims, info, msg, None, _model_info(model))
+        d = z_l[: c.nx] - z_u[: c.nx]
+        values["deflection"] = d.tolist()
+        dims["deflection"], units["deflection"] = "vector", xs
+        for i, x in enumerate(c.x):
+            values[f"d_{x.name}"] = float(d[i])
+            dims[f"d_{x.name}"] = x.kind
+            units[f"d_{x.name}"] = _si(x.kind)
+        q_l = z_l[c.nx : c.nx + c.nq]
+        values["q_loaded"] = q_l.tolist()
+        dims["q_loaded"] = "vector"
+        units["q_loaded"] = ", ".join(f"{q.name} [{_si(q.kind)}]" for q in c.q)
+        loaded = sm.stresses(z_l)
+        values["stress_max_loaded"] = max((v for v in loaded.values() if v is not None), default=None)
+        dims["stress_max_loaded"], units["stress_max_loaded"] = "stress", "Pa"
+        if ka is None:
+            F = sm.actuator_reactions(z_l, lam_l, f)
+            for j, q in enumerate(c.q):
+                values[f"F{j + 1}_loaded"] = float(F[j])
+                dims[f"F{j + 1}_loaded"] = "force" if q.kind == "length" else "moment"
+                units[f"F{j + 1}_loaded"] = "N" if q.kind == "length" else "N*m"
+        msg = f"compliant forward kinematics by IPOPT ({st}, {it_l} iterations); {note}"
+        return Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+
     def output_names(self, model: Model) -> list[str]:
         c = model.closure
         names = _pose_names(model)[0] + ["C", "deflection_linear", "deflection", "q_loaded", "stress_max_loaded"]
         names += [f"C_{x.name}" for x in c.x] + [f"d_{x.name}" for x in c.x]
+        names += ["hinge_model", "stress_max_unloaded"] + [f"F{j + 1}_loaded" for j in range(c.nq)]
         return names
 
 

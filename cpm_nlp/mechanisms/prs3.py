@@ -341,6 +341,14 @@ def geometry(model: Model, x, q) -> Drawing:
 #: joint is a round neck of diameter t_sph and length l_sph (R_sph, the fillet radius,
 #: enters only the FEM stiffness the paper gives); K_Rsph applies to both bending
 #: axes (beta_m, beta_n), K_Tsph to the torsion beta_l.
+def chains(model: Model):
+    """The legs as serial chains (P at A_i, R at C_i, S at B_i), from the file twin
+    problems/mechanisms/prs3.yaml, whose closure equals this one to 1e-12 (tested)."""
+    from .described import twin_chains  # the twin is read on first use
+
+    return twin_chains("prs3.yaml", model)
+
+
 STIFFNESS = JointStiffness(
     hinges={
         "revolute": {
@@ -385,6 +393,7 @@ MECHANISM = Mechanism(
     build=build,
     geometry=geometry,
     stiffness=STIFFNESS,
+    chains=chains,
     problem_files=(
         "prs3_forward_kinematics.yaml",
         "prs3_inverse_kinematics.yaml",

@@ -23,6 +23,8 @@ from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
 from ...io.yamlfile import load_yaml_text, read_yaml
+from .chains import chains_function
+from .chains import supported as chains_supported
 from .generate import closure_parts, parameter_options
 from .spec import Description, description_from_dict
 
@@ -31,7 +33,12 @@ log = logging.getLogger(__name__)
 __all__ = ["Description", "load_file", "from_dict", "mechanism", "shipped_files", "read_yaml", "load_yaml_text"]
 
 #: the shipped mechanism files
-SHIPPED_DIR = Path(__file__).resolve().parents[3] / "problems" / "mechanisms"
+#: the shipped mechanism files: the package data of an installed wheel (setup.py maps
+#: problems/ to cpm_nlp/data/problems), else the checkout's problems/mechanisms
+_INSTALLED_DIR = Path(__file__).resolve().parents[2] / "data" / "problems" / "mechanisms"
+SHIPPED_DIR = (
+    _INSTALLED_DIR if _INSTALLED_DIR.is_dir() else Path(__file__).resolve().parents[3] / "problems" / "mechanisms"
+)
 
 _LOCK = threading.Lock()
 #: content hash -> Mechanism (code, not problem data: one per distinct description)
@@ -41,6 +48,18 @@ _CACHE: dict[str, Mechanism] = {}
 def shipped_files() -> list[Path]:
     """The mechanism files shipped in ``problems/mechanisms/``."""
     return sorted(SHIPPED_DIR.glob("*.yaml")) if SHIPPED_DIR.is_dir() else []
+
+
+def twin_chains(file_name: str, model: Model) -> Any:
+    """The ``chains`` of a built-in mechanism from its shipped file twin (same parameter
+    and coordinate names, checked), at the model's parameters."""
+    twin = load_file(SHIPPED_DIR / file_name)
+    closure = twin.closure()
+    c = model.closure
+    if (closure.x_names, closure.q_names) != (c.x_names, c.q_names) or set(closure.parameters) != set(c.parameters):
+        raise ValueError(f"{file_name} is not a twin of {c.name}: its coordinates or parameters differ")
+    twin_model = twin.model(closure, {n: model.parameters[n] for n in closure.parameters}, {}, ())
+    return twin.chains(twin_model)
 
 
 def load_file(path: str | Path) -> Mechanism:
@@ -120,6 +139,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         build=build,
         problem_files=examples,
         origin=f"file {d.file}" if d.file else "described in code",
+        chains=chains_function(gen) if chains_supported(gen) else None,
     )
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults
         model = mech.model(closure, {}, {}, ())

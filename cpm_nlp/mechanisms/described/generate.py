@@ -74,6 +74,8 @@ class _Joint:
     home: list = field(default_factory=list)
     #: elementary motions ("P" | "R", axis, displacement) of a joint in the proximal chain
     motions: list = field(default_factory=list)
+    #: the coordinate names of its degrees of freedom (given, or made up for a passive unknown)
+    names: tuple = ()
 
     @property
     def type(self) -> str:
@@ -117,6 +119,8 @@ class Generator:
         #: passive joints of the proximal chains: (coordinate, symbol, home value, limit, key path)
         self.extra: list[tuple] = []
         self.extra_limits: dict[str, tuple] = {}
+        #: each leg's resolved joints, base first (for the chains of the six-axis hinge model)
+        self.leg_joints: list[tuple[Leg, list[_Joint]]] = []
 
     # -- expressions -----------------------------------------------------------------------
     def value(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ex.Value:
@@ -228,6 +232,7 @@ class Generator:
         if leg.rotate is not None:
             turn = _rot(leg.rotate_axis, self.scalar(leg.rotate, leg.path + ("repeat", "rotate"), env, "angle"))
         joints = [self.resolve(j, env, turn) for j in leg.joints]
+        self.leg_joints.append((leg, joints))
         self.close(leg, joints)
 
     def resolve(self, j: Joint, env: Mapping[str, ex.Value], turn: ca.SX) -> _Joint:  # noqa: C901 - one rule per joint part
@@ -395,6 +400,7 @@ class Generator:
             "S": [("R", a) for a in (j.axes or e)],
         }[j.type]
         names = j.spec.coordinates or tuple(f"{leg.name}_j{k + 1}_{n + 1}" for n in range(len(elementary)))
+        j.names = tuple(names)
         for n, ((kind, axis), name) in enumerate(zip(elementary, names)):
             dim = "length" if kind == "P" else "angle"
             sym = ca.SX.sym(name)

@@ -1,0 +1,425 @@
+"""The six-axis hinge model: compliant forward kinematics and platform compliance
+with every flexure a six-degree-of-freedom spring at its joint.
+
+The pseudo-rigid-body model of :mod:`cpm_nlp.analysis.compliance` lets a hinge
+turn only about the axes the kinematics moves, so with the actuators held a
+mechanism of rigid links does not deflect at all.  A real flexure also bends
+about its second axis, twists, stretches and shears.  Here each leg is the
+serial chain of its joints at the reference configuration (the ``chains``
+capability, :mod:`cpm_nlp.core.chains`) and every hinge adds, at its joint and
+in its own frame (length axis t, compliant axis b1, second axis b2 = b1 x t),
+the axes its joint does not move, each with the flexure library's stiffness
+(:data:`cpm_nlp.analysis.compliance.SIX_AXIS_STIFFNESS`):
+
+    leg k:  G_k(z) = Π_j [ Π_d exp(ξ_jd θ_jd) · Π_a exp(η_ja ε_ja) ]      (product of exponentials)
+    closure: G_k(z) = T_P(x) T_P(x_ref)⁻¹  at the leg's platform point (3 rows) and in rotation (3 rows)
+    energy:  U(z) = ½ Σ_hinges Σ_axes k_a δ_a²,  δ the deflection from the reference configuration
+
+with z = (x, q, θ, ε): the pose, the actuators, the chains' joint variables and
+the hinges' extra deflections.  The loaded pose minimizes V = U - fᵀx (f the
+load conjugate to the pose coordinates) subject to the 6 n_legs closures with
+the actuators held (or on springs k_a about their unloaded forces): an NLP
+solved by IPOPT, and by Newton on its KKT conditions (the fast path, checked
+against IPOPT in the tests).
+
+The output compliance is the linearization of that equilibrium: with
+H = ∇²(V + λᵀg) and A = ∂g/∂z at the solution,
+
+    [H  Aᵀ] [dz]   [E df]
+    [A  0 ] [dλ] = [ 0  ],     C = Eᵀ dz/df  (nx x nx),
+
+E selecting the pose coordinates.  With the extra axes made infinitely stiff it
+reduces to the pseudo-rigid-body C = J (K_q + K_a)⁻¹ Jᵀ (tested), and at an
+unstressed pose to the compliance-matrix method Σ_legs (Σ_h Ad C_h Adᵀ)⁻¹
+(tested against an independent numpy derivation).
+
+The links and the platform stay rigid: a slender leg's own bending is not in
+the model (declare it as a hinge of its own to include it).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ..core.chains import Chains
+from ..core.errors import InputError
+from ..core.model import Model
+from .compliance import HINGE_TYPES, SIX_AXES, HingeSet, six_axis_stiffness
+
+log = logging.getLogger(__name__)
+
+_ROT_AXES = ("bend", "bend2", "torsion")
+
+
+def _rot(axis: np.ndarray, angle: Any) -> Any:
+    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues)."""
+    K = ca.DM(_skew(axis))
+    return ca.DM.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
+
+
+def _skew(a: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v)
+
+
+def _perpendicular(v: np.ndarray) -> np.ndarray:
+    trial = np.eye(3)[int(np.argmin(np.abs(v)))]
+    return _unit(trial - np.dot(trial, v) * v)
+
+
+@dataclass
+class HingeFrame:
+    """One hinge in the chains: where it sits, its frame, and the variable of each axis.
+
+    axes: axis name -> (kind "R" or "P", unit vector); variables: axis name ->
+    (index in z, rest value); k: axis name -> stiffness.
+    """
+
+    name: str
+    kind: str | None
+    dims: dict[str, float]
+    centre: np.ndarray | None
+    axes: dict[str, tuple[str, np.ndarray]] = field(default_factory=dict)
+    variables: dict[str, tuple[int, float]] = field(default_factory=dict)
+    k: dict[str, float] = field(default_factory=dict)
+    extra: tuple[str, ...] = ()
+    #: (leg, joint) of the chains it sits at
+    loc: tuple[int, int] | None = None
+
+
+def _frame(known: dict[str, np.ndarray], link: np.ndarray | None) -> dict[str, np.ndarray]:
+    """The hinge frame (t, b1, b2) from the axes its joint gives and its link direction."""
+    t = known.get("torsion")
+    b1, b2 = known.get("bend"), known.get("bend2")
+    if t is None:
+        t = link if link is not None else _perpendicular(b1 if b1 is not None else b2)
+        for b in (b1, b2):
+            if b is not None:
+                t = t - np.dot(t, b) * b
+        t = _unit(t) if np.linalg.norm(t) > 1e-9 else _perpendicular(b1 if b1 is not None else b2)
+    if b1 is None and b2 is None:
+        b1 = _perpendicular(t)
+    if b2 is None:
+        b2 = _unit(np.cross(b1, t))
+    if b1 is None:
+        b1 = _unit(np.cross(t, b2))
+    return {"torsion": t, "bend": b1, "bend2": b2}
+
+
+class SixAxisModel:
+    """The six-axis hinge model of one model and hinge set (built once, then solved
+    at any pose and load).  Sizes: nz = nx + nq + chain variables + extra hinge axes,
+    6 closure rows per leg."""
+
+    def __init__(self, model: Model, hs: HingeSet, chains: Chains) -> None:
+        c = model.closure
+        self.model, self.hs, self.chains = model, hs, chains
+        self.nx, self.nq = c.nx, c.nq
+        _check_reference(model, chains)
+        x_index = {n: i for i, n in enumerate(c.x_names)}
+        q_index = {n: i for i, n in enumerate(c.q_names)}
+        self.names: list[str] = list(c.x_names) + list(c.q_names)
+        rest: list[float] = list(model.x_home) + list(model.q_home)
+        self._dof: dict[str, tuple[int, float, int, int, int]] = {}  # coordinate -> (z, rest, leg, joint, dof)
+        self._z: list[Any] = [ca.SX.sym(n) for n in self.names]
+        legs = [self._leg_motions(li, x_index, q_index, rest) for li in range(len(chains.legs))]
+        self.frames = self._hinge_frames(hs, c, x_index, q_index, chains)
+        # the extra axes of each hinge: new variables, placed after their joint's own motions
+        extra: dict[tuple[int, int], list[tuple[str, np.ndarray, Any]]] = {}
+        for fr in self.frames:
+            for a in fr.extra:
+                fr.variables[a] = (self._new(f"{fr.name}_{a}", rest), 0.0)
+                kind, u = fr.axes[a]
+                extra.setdefault(fr.loc, []).append((kind, u, self._z[-1]))
+        self.rest = np.array(rest)
+        self.nz = len(self._z)
+        z = ca.vertcat(*self._z)
+        g = self._closures(z, legs, extra)
+        self.ng = g.numel()
+        self._functions(z, g)
+
+    def _new(self, label: str, rest: list[float]) -> int:
+        self._z.append(ca.SX.sym(label))
+        self.names.append(label)
+        rest.append(0.0)
+        return len(self._z) - 1
+
+    def _leg_motions(self, li: int, x_index: dict, q_index: dict, rest: list[float]) -> list:
+        """Each joint of leg li with its elementary motions (kind, axis, displacement from the
+        reference): an actuator's from q, a pose coordinate's from x, else a new variable."""
+        leg, ch = self.chains.legs[li], self.chains
+        rows = []
+        for ji, j in enumerate(leg.joints):
+            motions = []
+            for d, kind in enumerate(j.motions):
+                cname = j.coordinates[d]
+                if j.actuated is not None:
+                    qi = q_index[j.actuated]
+                    value = j.gain * (self._z[self.nx + qi] - ch.q_reference[qi])
+                elif cname and cname in x_index:
+                    xi = x_index[cname]
+                    value = self._z[xi] - ch.x_reference[xi]
+                    self._dof[cname] = (xi, ch.x_reference[xi], li, ji, d)
+                else:
+                    zi = self._new(cname or f"{leg.name}_j{ji + 1}_{d + 1}", rest)
+                    value = self._z[zi]
+                    if cname:
+                        self._dof[cname] = (zi, 0.0, li, ji, d)
+                motions.append((kind, j.axes[:, d], value))
+            rows.append((j, motions))
+        return rows
+
+    def _closures(self, z: Any, legs: list, extra: dict) -> Any:
+        """Per leg, its platform point (3 rows) and its rotation (3 rows) against the platform's."""
+        ch = self.chains
+        P, R = ch.platform(z[: self.nx])
+        P0, R0 = (np.asarray(v, dtype=float) for v in ch.platform(ch.x_reference))
+        P0 = P0.ravel()
+        DR = R @ R0.T
+        g = []
+        for li, rows in enumerate(legs):
+            Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
+            for ji, (j, motions) in enumerate(rows):
+                for kind, axis, value in motions + extra.get((li, ji), []):
+                    if kind == "P":
+                        Rk, tk = ca.SX.eye(3), value * ca.DM(axis)
+                    else:
+                        Rk = _rot(axis, value)
+                        tk = ca.DM(j.at) - Rk @ ca.DM(j.at)
+                    Rm, tm = Rm @ Rk, Rm @ tk + tm
+            tip = ca.DM(ch.legs[li].tip)
+            g.append(Rm @ tip + tm - (DR @ (tip - P0) + P))  # the leg's platform point
+            M = DR.T @ Rm
+            g.append(0.5 * ca.vertcat(M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]))  # rotation
+        return ca.vertcat(*g)
+
+    def _functions(self, z: Any, g: Any) -> None:
+        """The energy of every axis of every hinge, and the named CasADi functions."""
+        name = self.model.closure.name
+        U = 0
+        for fr in self.frames:
+            for a, (zi, r0) in fr.variables.items():
+                U += 0.5 * fr.k[a] * (z[zi] - r0) ** 2
+        f = ca.SX.sym("f", self.nx)
+        qc, ka, Fc = ca.SX.sym("qc", self.nq), ca.SX.sym("ka", self.nq), ca.SX.sym("Fc", self.nq)
+        dq = z[self.nx : self.nx + self.nq] - qc
+        V = U - ca.dot(f, z[: self.nx]) + 0.5 * ca.dot(ka, dq * dq) - ca.dot(Fc, dq)
+        lam = ca.SX.sym("lam", self.ng)
+        par = ca.vertcat(f, qc, ka, Fc)
+        L = V + ca.dot(lam, g)
+        H = ca.hessian(L, z)[0]
+        A = ca.jacobian(g, z)
+        self.kkt = ca.Function(
+            f"{name}_six_axis_kkt",
+            [z, lam, par],
+            [ca.gradient(L, z), g, ca.densify(H), ca.densify(A), V],
+            ["z", "lam", "par"],
+            ["grad_L", "g", "H", "A", "V"],
+        )
+        self.closure_fn = ca.Function(f"{name}_six_axis_closure", [z], [g], ["z"], ["g"])
+        self.energy_fn = ca.Function(f"{name}_six_axis_energy", [z], [U], ["z"], ["U"])
+        self._nlp = {"x": z, "p": par, "f": V, "g": g}
+        self._ipopt: Any = None
+
+    # -- the hinges in the chains ---------------------------------------------------------------
+    def _hinge_frames(self, hs: HingeSet, c, x_index, q_index, chains: Chains) -> list[HingeFrame]:
+        frames = []
+        for h in hs.hinges:
+            fr = HingeFrame(h.name, h.kind, dict(h.dims), None)
+            known: dict[str, np.ndarray] = {}
+            loc = None
+            for a, i in h.axes.items():
+                cname = hs.names[i]
+                if cname in self._dof:
+                    zi, r0, li, ji, d = self._dof[cname]
+                    joint = chains.legs[li].joints[ji]
+                    loc = (li, ji)
+                    if joint.motions[d] == "R" and a in _ROT_AXES:
+                        known[a] = joint.axes[:, d]
+                elif cname in x_index:
+                    zi, r0 = x_index[cname], float(self.model.x_home[x_index[cname]])
+                elif cname in q_index:
+                    zi, r0 = self.nx + q_index[cname], float(self.model.q_home[q_index[cname]])
+                else:
+                    raise InputError(
+                        f"hinge {h.name}: joint {cname} is not in the legs' chains of {c.name}, so the six-axis "
+                        "model cannot place it",
+                        path=("inputs", "hinges", h.group),
+                        hint="use hinge_axes: kinematic",
+                    )
+                fr.variables[a] = (zi, r0)
+                fr.k[a] = h.k[a]
+            six = six_axis_stiffness(h)
+            if loc is not None and six is not None:
+                joint = chains.legs[loc[0]].joints[loc[1]]
+                fr.centre = joint.at
+                frame = _frame(known, joint.link)
+                dirs = {**frame, "axial": frame["torsion"], "shear": frame["bend2"], "shear2": frame["bend"]}
+                fr.extra = tuple(a for a in SIX_AXES if a not in fr.variables)
+                for a in fr.extra:
+                    fr.axes[a] = ("R" if a in _ROT_AXES else "P", dirs[a])
+                    fr.k[a] = six[a]
+            fr.loc = loc
+            frames.append(fr)
+        return frames
+
+    @property
+    def six_axis_hinges(self) -> list[str]:
+        return [fr.name for fr in self.frames if fr.extra]
+
+    # -- solves ---------------------------------------------------------------------------------
+    def start(self, x: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """A start z at a rigid pose: the pose and actuators, the chains' variables fitted to it."""
+        z = self.rest.copy()
+        z[: self.nx], z[self.nx : self.nx + self.nq] = x, q
+        free = np.arange(self.nx + self.nq, self.nz)
+        par = np.zeros(self.nx + 3 * self.nq)
+        for _ in range(30):
+            _, g, _, A, _ = self.kkt(z, np.zeros(self.ng), par)
+            g = np.asarray(g, dtype=float).ravel()
+            if np.max(np.abs(g)) < 1e-14:
+                break
+            Af = np.asarray(A, dtype=float)[:, free]
+            z[free] -= np.linalg.lstsq(Af, g, rcond=None)[0]
+        return z
+
+    def newton(
+        self, z0: np.ndarray, f: np.ndarray, qc: np.ndarray, ka: np.ndarray | None, Fc: np.ndarray | None
+    ) -> tuple[bool, np.ndarray, np.ndarray, int]:
+        """The equilibrium by Newton on the KKT conditions from z0 (q held at qc when
+        ka is None): (converged, z, λ, iterations)."""
+        z = z0.copy()
+        lam = np.zeros(self.ng)
+        par = self._par(f, qc, ka, Fc)
+        free = self._free(ka)
+        if ka is None:
+            z[self.nx : self.nx + self.nq] = qc
+        for it in range(1, 31):
+            gl, g, H, A, _ = self.kkt(z, lam, par)
+            r = np.concatenate([np.asarray(gl, dtype=float).ravel()[free], np.asarray(g, dtype=float).ravel()])
+            K = self._kkt_matrix(np.asarray(H, dtype=float), np.asarray(A, dtype=float), free)
+            step = _solve(K, -r)
+            z[free] += step[: len(free)]
+            lam += step[len(free) :]
+            dz = np.max(np.abs(step[: len(free)]))
+            if dz < 1e-15 * max(1.0, self.model.characteristic_length) and np.max(np.abs(r[len(free) :])) < 1e-14:
+                return True, z, lam, it
+        return False, z, lam, 30
+
+    def ipopt(
+        self, z0: np.ndarray, f: np.ndarray, qc: np.ndarray, ka: np.ndarray | None, Fc: np.ndarray | None
+    ) -> tuple[bool, np.ndarray, np.ndarray, int, str]:
+        """The equilibrium by IPOPT (minimum of V on the closures): (ok, z, λ, iterations, status)."""
+        if self._ipopt is None:
+            opts = {
+                "ipopt.print_level": 0,
+                "print_time": False,
+                "ipopt.sb": "yes",
+                "ipopt.tol": 1e-14,
+                "ipopt.constr_viol_tol": 1e-14,
+                "ipopt.hessian_approximation": "exact",
+            }
+            self._ipopt = ca.nlpsol(f"{self.model.closure.name}_six_axis", "ipopt", self._nlp, opts)
+        lbx, ubx = np.full(self.nz, -np.inf), np.full(self.nz, np.inf)
+        if ka is None:
+            lbx[self.nx : self.nx + self.nq] = ubx[self.nx : self.nx + self.nq] = qc
+        sol = self._ipopt(x0=z0, p=self._par(f, qc, ka, Fc), lbx=lbx, ubx=ubx, lbg=0.0, ubg=0.0)
+        st = self._ipopt.stats()
+        z = np.asarray(sol["x"], dtype=float).ravel()
+        res = float(np.max(np.abs(np.asarray(self.closure_fn(z), dtype=float))))
+        ok = bool(st.get("success", False)) and res < 1e-10 * max(1.0, self.model.characteristic_length)
+        return ok, z, np.asarray(sol["lam_g"], dtype=float).ravel(), int(st.get("iter_count", 0)), st["return_status"]
+
+    def compliance(self, z: np.ndarray, lam: np.ndarray, ka: np.ndarray | None, Fc: np.ndarray | None) -> np.ndarray:
+        """C = Eᵀ dz/df (nx x nx) at an equilibrium (z, λ)."""
+        par = self._par(np.zeros(self.nx), z[self.nx : self.nx + self.nq], ka, Fc)
+        _, _, H, A, _ = self.kkt(z, lam, par)
+        free = self._free(ka)
+        K = self._kkt_matrix(np.asarray(H, dtype=float), np.asarray(A, dtype=float), free)
+        rhs = np.zeros((K.shape[0], self.nx))
+        rhs[: self.nx, :] = np.eye(self.nx)  # the pose coordinates come first among the free variables
+        dz = _solve(K, rhs)
+        C = dz[: self.nx, :]
+        return 0.5 * (C + C.T)
+
+    def actuator_reactions(self, z: np.ndarray, lam: np.ndarray, f: np.ndarray) -> np.ndarray:
+        """The forces the held actuators apply (∂(V + λᵀg)/∂q with the sign of a force on the mechanism)."""
+        par = self._par(f, z[self.nx : self.nx + self.nq], None, None)
+        gl = np.asarray(self.kkt(z, lam, par)[0], dtype=float).ravel()
+        return gl[self.nx : self.nx + self.nq]
+
+    def stresses(self, z: np.ndarray) -> dict[str, float | None]:
+        """Largest stress of each hinge from its moments (all three rotations) and axial force."""
+        out: dict[str, float | None] = {}
+        for fr in self.frames:
+            if fr.kind is None:
+                out[fr.name] = None
+                continue
+            loads = {a: fr.k[a] * (z[zi] - r0) for a, (zi, r0) in fr.variables.items() if a in (*_ROT_AXES, "axial")}
+            out[fr.name] = float(HINGE_TYPES[fr.kind].stress(fr.dims, loads))
+        return out
+
+    def _par(self, f, qc, ka, Fc) -> np.ndarray:
+        zeros = np.zeros(self.nq)
+        return np.concatenate(
+            [np.asarray(f, dtype=float), qc, zeros if ka is None else ka, zeros if Fc is None else Fc]
+        )
+
+    def _free(self, ka: np.ndarray | None) -> np.ndarray:
+        if ka is not None:
+            return np.arange(self.nz)
+        return np.concatenate([np.arange(self.nx), np.arange(self.nx + self.nq, self.nz)])
+
+    def _kkt_matrix(self, H: np.ndarray, A: np.ndarray, free: np.ndarray) -> np.ndarray:
+        n = len(free)
+        K = np.zeros((n + self.ng, n + self.ng))
+        K[:n, :n] = H[np.ix_(free, free)]
+        K[:n, n:] = A[:, free].T
+        K[n:, :n] = A[:, free]
+        return K
+
+
+def _check_reference(model: Model, chains: Chains) -> None:
+    scale = max(model.characteristic_length, 1e-9)
+    if not (
+        np.allclose(model.x_home, chains.x_reference, atol=1e-9 * scale, rtol=0)
+        and np.allclose(model.q_home, chains.q_reference, atol=1e-9 * scale, rtol=0)
+    ):
+        raise InputError(
+            f"mechanism {model.name}: the six-axis hinge model takes the hinges at rest at the chains' "
+            "reference configuration, and the home pose differs from it",
+            path=("inputs", "hinge_axes"),
+            hint="use hinge_axes: kinematic",
+        )
+
+
+def _solve(K: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """K⁻¹ r with symmetric diagonal equilibration (hinge stiffnesses span ten decades);
+    raises LinAlgError when K is singular."""
+    d = np.sqrt(np.maximum(np.max(np.abs(K), axis=1), 1e-300))
+    s = 1.0 / d
+    Ks = K * s[:, None] * s[None, :]
+    if np.linalg.cond(Ks) > 1e13:
+        raise np.linalg.LinAlgError("the KKT matrix of the six-axis hinge model is singular")
+    rs = r * (s[:, None] if r.ndim == 2 else s)
+    y = np.linalg.solve(Ks, rs)
+    return y * (s[:, None] if r.ndim == 2 else s)
+
+
+def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
+    """The six-axis hinge model, or None when the mechanism gives no chains."""
+    mech = model.mechanism
+    if mech is None or mech.chains is None:
+        return None
+    return SixAxisModel(model, hs, mech.chains(model))
+
+
+__all__ = ["HingeFrame", "SixAxisModel", "six_axis_model"]

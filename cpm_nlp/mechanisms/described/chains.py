@@ -1,0 +1,118 @@
+"""The legs of a described mechanism as serial chains (:class:`~cpm_nlp.core.chains.Chains`),
+the ``chains`` capability the six-axis hinge model needs.
+
+The description already gives each leg as a chain at the reference
+configuration; here its joints are evaluated at a model's parameters.  Spatial
+legs of P, R, C, U and S joints are supported; a planar mechanism or a
+``distance`` joint has no chains (the capability is then absent).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ...core.chains import JOINT_DOF, ChainJoint, Chains, LegChain
+from .generate import Generator
+
+_E = (ca.DM([1.0, 0.0, 0.0]), ca.DM([0.0, 1.0, 0.0]), ca.DM([0.0, 0.0, 1.0]))
+
+
+def supported(gen: Generator) -> bool:
+    """Whether every leg is a spatial chain of P, R, C, U and S joints."""
+    if gen.d.platform.planar or not gen.leg_joints:
+        return False
+    return all(j.type in JOINT_DOF for _leg, joints in gen.leg_joints for j in joints)
+
+
+def _motions(j: Any) -> tuple[list[str], list[Any]]:
+    if j.type == "P":
+        return ["P"], [j.axis]
+    if j.type == "R":
+        return ["R"], [j.axis]
+    if j.type == "C":
+        return ["R", "P"], [j.axis, j.axis]
+    if j.type == "U":
+        return ["R", "R"], list(j.axes)
+    return ["R", "R", "R"], list(j.axes) or list(_E)  # S
+
+
+def _names(j: Any) -> tuple[str, ...]:
+    dof = JOINT_DOF[j.type]
+    names = tuple(j.spec.coordinates) or tuple(j.names)
+    return names if len(names) == dof else ("",) * dof
+
+
+def chains_function(gen: Generator):
+    """``(model) -> Chains`` for a built generator (the chains' geometry is a CasADi
+    function of the parameters, evaluated once per model)."""
+    q = ca.vertcat(*gen.q_syms)
+    outs: list[Any] = []
+    layout: list[tuple[str, list[tuple[Any, list[str], tuple[str, ...], str | None]]]] = []
+    for leg, joints in gen.leg_joints:
+        rows = []
+        for j in joints:
+            kinds, axes = _motions(j)
+            outs.append(j.at)
+            outs.append(ca.horzcat(*axes))
+            gain = ca.SX(0)
+            if j.spec.actuated is not None and j.value is not None:
+                gain = ca.sum1(ca.jacobian(j.value, q).T)
+            outs.append(gain)
+            rows.append((j, kinds, _names(j), j.spec.actuated))
+        layout.append((leg.name, rows))
+    geom = ca.Function("chain_geometry", [gen.p], outs)
+    x = gen.x
+    frame = ca.Function("platform_frame_p", [x, gen.p], [gen.P, gen.R], ["x", "p"], ["P", "R"])
+    refs = ca.Function("chain_reference", [gen.p], [gen.x_home, ca.vertcat(*gen.q_home)])
+
+    def make(model: Any) -> Chains:
+        p = np.asarray(model.p, dtype=float)
+        vals = [np.asarray(v, dtype=float) for v in geom(p)] if outs else []
+        legs = []
+        k = 0
+        for name, rows in layout:
+            built = []
+            for _j, kinds, names, actuated in rows:
+                at, axes, gain = vals[k].ravel(), vals[k + 1].reshape(3, -1), float(vals[k + 2].ravel()[0])
+                k += 3
+                built.append((at, axes, kinds, names, actuated, gain))
+            locs = [b[0] for b in built]
+            joints = []
+            for n, (at, axes, kinds, names, actuated, gain) in enumerate(built):
+                joints.append(
+                    ChainJoint(
+                        type=rows[n][0].type,
+                        at=at,
+                        axes=axes / np.linalg.norm(axes, axis=0),
+                        motions=tuple(kinds),
+                        coordinates=names,
+                        actuated=actuated,
+                        gain=gain if actuated else 1.0,
+                        link=_link(locs, n),
+                    )
+                )
+            legs.append(LegChain(name, tuple(joints), locs[-1]))
+        xs = ca.SX.sym("x", x.numel())
+        P, R = frame(xs, p)
+        platform = ca.Function("platform_frame", [xs], [P, R], ["x"], ["P", "R"])
+        x_ref, q_ref = (np.asarray(v, dtype=float).ravel() for v in refs(p))
+        note = "links and the platform are rigid bodies; the hinges are six-axis springs at their joints"
+        return Chains(tuple(legs), platform, x_ref, q_ref, note)
+
+    return make
+
+
+def _link(locs: list[np.ndarray], n: int) -> np.ndarray | None:
+    """The unit direction from joint n to the first later joint elsewhere, else from
+    the last earlier joint elsewhere to joint n."""
+    for m in list(range(n + 1, len(locs))) + list(range(n - 1, -1, -1)):
+        d = locs[m] - locs[n] if m > n else locs[n] - locs[m]
+        if np.linalg.norm(d) > 1e-12:
+            return d / np.linalg.norm(d)
+    return None
+
+
+__all__ = ["chains_function", "supported"]
