@@ -152,3 +152,19 @@ def test_load_in_the_wrong_dimension_exits_2(tmp_path):
     _exits_2(f, "inputs.load.pz", "is not a force")
     f.write_text(PROBLEM.replace("stress_limit: true}", "load: {psi: 1 N}}"))
     _exits_2(f, "inputs.load.psi", "is not a moment")
+
+
+def test_inline_description_declares_its_hinges():
+    """``mechanism: {description: ...}`` carries its stiffness section too, checked at load."""
+    import yaml
+
+    desc = yaml.safe_load(MECH_TEXT.replace("name: prs3_hinged", "name: prs3_inline"))
+    data = yaml.safe_load(PROBLEM)
+    data["mechanism"] = {"description": desc, "parameters": data["mechanism"]["parameters"]}
+    data["inputs"]["stress_limit"] = False
+    res = solve(cn.problem_from_dict(data))
+    ref = solve(load_problem(PROBLEMS / "prs3_table2_forces.yaml"))
+    assert res.values["F1"] == pytest.approx(ref.values["F1"], rel=1e-9)
+    desc["stiffness"]["hinges"]["revolute"]["r"] = "0.5 mm"
+    with pytest.raises(cn.InputError, match=r"^mechanism\.description\.stiffness\.hinges\.revolute\.t: impossible"):
+        cn.problem_from_dict(data)
