@@ -289,6 +289,9 @@ class HingeSet:
     hinges: list[Hinge]
     sigma_allow: float | None = None
     sources: list[str] = field(default_factory=list)
+    #: material name -> (key path, message prefix) where it was given, for a message
+    #: about it (the prefix names a mechanism file that declares it)
+    material_at: dict[str, tuple[tuple, str]] = field(default_factory=dict)
 
     def moments(self, theta: np.ndarray) -> np.ndarray:
         return self.k * (np.asarray(theta, dtype=float) - self.theta0)
@@ -436,6 +439,35 @@ def _parse_hinge(  # noqa: C901 - one flat check per key of a hinge entry
     return out
 
 
+def parse_hinges(
+    closure: LoopClosure, specs: Mapping[str, Any], mat: Material | None, paths: Mapping[str, tuple]
+) -> tuple[np.ndarray, list[Hinge]]:
+    """The hinges of ``specs`` (name -> hinge mapping) on a closure: the stiffness over
+    the joint vector (x, q, passive) and the hinges; ``paths`` gives each hinge's key
+    path for the messages.  A joint may carry one hinge only."""
+    names = joint_names(closure)
+    k = np.zeros(len(names))
+    out: list[Hinge] = []
+    for gname, spec in specs.items():
+        hpath = paths[gname]
+        for h in _parse_hinge(closure, gname, spec, mat, hpath):
+            for a, i in h.axes.items():
+                if k[i] != 0.0:
+                    raise InputError(f"joint {names[i]} carries two hinges", path=hpath + ("joints", a))
+                k[i] = h.k[a]
+            out.append(h)
+    return k, out
+
+
+def check_declared(closure: LoopClosure, hinges: Mapping[str, Any], material_spec: Any, path: tuple) -> None:
+    """Check a mechanism's declared hinges and material (its ``stiffness`` capability)
+    against its closure, by the rules of a problem file's ``inputs.hinges``: joints
+    that name coordinates or families, known hinge types and keys, possible geometry,
+    a known material.  Key paths under ``path`` (``stiffness`` of a mechanism file)."""
+    mat = None if material_spec is None else material(material_spec, path + ("material",))
+    parse_hinges(closure, hinges, mat, {g: path + ("hinges", g) for g in hinges})
+
+
 def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hinge
     model: Model,
     hinges: Mapping[str, Any] | None,
@@ -470,20 +502,42 @@ def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hi
         mat = material(material_spec, path + ("material",))
     elif decl is not None and decl.material is not None:
         mat = material(decl.material, ("mechanism", "stiffness", "material"))
-    names = joint_names(c)
+    paths = {g: path + ("hinges", g) if hinges and g in hinges else ("mechanism", "stiffness", g) for g in merged}
+    k, out = parse_hinges(c, merged, mat, paths)
     coords = list(c.x) + list(c.q) + list(c.passive_coords)
-    k = np.zeros(len(names))
-    out: list[Hinge] = []
-    for gname, spec in merged.items():
-        hpath = path + ("hinges", gname) if hinges and gname in hinges else ("mechanism", "stiffness", gname)
-        for h in _parse_hinge(c, gname, spec, mat, hpath):
-            for a, i in h.axes.items():
-                if k[i] != 0.0:
-                    raise InputError(f"joint {names[i]} carries two hinges", path=hpath + ("joints", a))
-                k[i] = h.k[a]
-            out.append(h)
+    names = joint_names(c)
     theta0 = joint_vector(model, model.x_home, model.q_home)
-    return HingeSet(names, [co.kind for co in coords], k, theta0, out, sigma_allow, [decl.source] if decl else [])
+    hs = HingeSet(names, [co.kind for co in coords], k, theta0, out, sigma_allow, [decl.source] if decl else [])
+    hs.material_at = _material_at(mech, out, merged, hinges, material_spec, path)
+    return hs
+
+
+def _material_at(mech: Any, out: list[Hinge], merged: Mapping, hinges: Any, material_spec: Any, path: tuple) -> dict:
+    """Where each hinge material was given: the problem file's key, or a mechanism file's
+    ``stiffness`` section (named in the message, as the problem file holds no such key)."""
+    origin = getattr(mech, "origin", "") or ""
+
+    def declared(*keys: str) -> tuple[tuple, str] | None:
+        if origin.startswith("file "):
+            return ("mechanism", "file"), f"in the mechanism file {origin[5:]}: stiffness.{'.'.join(keys)}: "
+        return None
+
+    default = (path + ("material",), "")
+    if material_spec is None:
+        default = declared("material") or default
+    at: dict[str, tuple[tuple, str]] = {}
+    for h in out:
+        if h.material is None:
+            continue
+        where = default
+        if isinstance(merged.get(h.group), Mapping) and merged[h.group].get("material") is not None:
+            given = hinges.get(h.group) if isinstance(hinges, Mapping) else None
+            if isinstance(given, Mapping) and given.get("material") is not None:
+                where = (path + ("hinges", h.group, "material"), "")
+            else:
+                where = declared("hinges", h.group, "material") or (("mechanism", "stiffness", h.group, "material"), "")
+        at.setdefault(h.material.name, where)
+    return at
 
 
 def allowable(hs: HingeSet, sigma_allow: float | None, safety_factor: float, path: tuple) -> float:
@@ -498,9 +552,13 @@ def allowable(hs: HingeSet, sigma_allow: float | None, safety_factor: float, pat
         raise InputError("a stress limit needs sigma_allow or a hinge material", path=path + ("sigma_allow",))
     values = []
     why = "a stress limit needs it (or give sigma_allow)"
-    for m in mats.values():
+    for name, m in mats.items():
         if safety_factor > 1 or m.allowable is None:
-            values.append(m.require("yield_strength", path + ("material",), why) / safety_factor)
+            where, prefix = hs.material_at.get(name, (path + ("material",), ""))
+            try:
+                values.append(m.require("yield_strength", where, why) / safety_factor)
+            except InputError as exc:
+                raise InputError(prefix + exc.message, path=exc.path) from None
         else:
             values.append(m.allowable)
     return min(values)

@@ -259,7 +259,11 @@ def section_type(section: Mapping[str, Any], base_dir: Any = None, path: tuple =
         try:
             mech = described.load_file(target)
         except InputError as exc:  # the message names the mechanism file, the problem file names the key
-            raise InputError(f"in the mechanism file {exc.render()}", path=path + ("file",)) from None
+            # (its "did you mean" and hint follow the whole message, so that a long message keeps them)
+            inner = InputError(exc.message, path=exc.path, file=exc.file).render()
+            raise InputError(
+                f"in the mechanism file {inner}", path=path + ("file",), suggestions=exc.suggestions, hint=exc.hint
+            ) from None
         return use_described(mech, path).name
     try:
         mech = described.from_dict(section["description"], base_dir=Path(base_dir) if base_dir else None)

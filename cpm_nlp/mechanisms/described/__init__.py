@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from ...analysis.compliance import check_declared
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
@@ -121,6 +122,8 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         branch=fns["branch"],
         offsets=d.platform.offsets,
     )
+    if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
+        check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))
     params = parameter_options(d)
     limits = gen.limit_options()
     examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)
@@ -138,6 +141,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         closure=lambda: closure,
         build=build,
         problem_files=examples,
+        stiffness=d.stiffness,
         origin=f"file {d.file}" if d.file else "described in code",
         chains=chains_function(gen) if chains_supported(gen) else None,
     )

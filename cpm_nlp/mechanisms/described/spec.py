@@ -36,7 +36,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from ...analysis.compliance import HINGE_KEYS
 from ...core.errors import InputError, suggest, unknown_key_error
+from ...core.mechanism import JointStiffness
 from ...core.options import REQUIRED
 from ...core.units import parse_quantity
 
@@ -182,6 +184,8 @@ class Description:
     characteristic_length: Expr = None
     paper: str = ""
     examples: tuple[str, ...] = ()
+    #: the compliant joints (hinges, material, source): the compliance kinds' defaults
+    stiffness: JointStiffness | None = None
     file: str | None = None
 
 
@@ -202,6 +206,7 @@ TOP = {
     "ik": "{let, pose, actuators, reach}: a closed-form inverse kinematics",
     "characteristic_length": "length expression for conditioning measures",
     "examples": "problem files that use the mechanism (relative to this file)",
+    "stiffness": "{hinges, material, source}: the compliant joints, defaults of the compliance kinds",
 }
 
 
@@ -511,6 +516,32 @@ def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a
             prev = body
 
 
+STIFFNESS_KEYS = {
+    "hinges": "name -> {joints, type, k, t, r, w, d, l, Kt, material}, as a problem file's inputs.hinges",
+    "material": "the hinge material: a name or an inline {name, E, nu, density, yield_strength, allowable}",
+    "source": "where the values come from (paper, section, table)",
+}
+
+
+def _stiffness(raw: Any, path: tuple) -> JointStiffness:
+    """The ``stiffness`` section: its shape and keys (the hinges are checked against the
+    generated closure when the mechanism is built, by the rules of ``inputs.hinges``)."""
+    raw = _mapping(raw, path, "a mapping {hinges, material, source}", STIFFNESS_KEYS)
+    if not raw.get("hinges"):
+        raise InputError("missing key 'hinges' (" + STIFFNESS_KEYS["hinges"] + ")", path=path)
+    hinges = {}
+    for name, spec in _mapping(raw["hinges"], path + ("hinges",), "name -> hinge mapping").items():
+        p = path + ("hinges", name)
+        _name(name, p, "a hinge name")
+        hinges[name] = _mapping(spec, p, "a hinge mapping {joints, type, k, ...}")
+        for key in hinges[name]:
+            if key not in HINGE_KEYS:
+                raise unknown_key_error(str(key), HINGE_KEYS, p + (str(key),), "hinge key")
+    return JointStiffness(
+        hinges=hinges, material=raw.get("material"), source=_text(raw.get("source"), path + ("source",))
+    )
+
+
 IK_KEYS = {"let": "definitions in order", "pose": "dependent coordinates", "actuators": "", "reach": ""}
 
 
@@ -569,5 +600,6 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
         characteristic_length=data.get("characteristic_length"),
         paper=_text(data.get("paper"), ("paper",)),
         examples=tuple(str(e) for e in examples),
+        stiffness=None if data.get("stiffness") is None else _stiffness(data["stiffness"], ("stiffness",)),
         file=file,
     )
