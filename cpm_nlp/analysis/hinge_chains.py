@@ -45,6 +45,7 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
+import scipy.linalg
 
 from ..core.chains import Chains
 from ..core.errors import InputError
@@ -403,14 +404,16 @@ def _check_reference(model: Model, chains: Chains) -> None:
 
 def _solve(K: np.ndarray, r: np.ndarray) -> np.ndarray:
     """K⁻¹ r with symmetric diagonal equilibration (hinge stiffnesses span ten decades);
-    raises LinAlgError when K is singular."""
+    raises LinAlgError when K is singular (LAPACK's reciprocal condition estimate)."""
     d = np.sqrt(np.maximum(np.max(np.abs(K), axis=1), 1e-300))
     s = 1.0 / d
     Ks = K * s[:, None] * s[None, :]
-    if np.linalg.cond(Ks) > 1e13:
+    lu, piv = scipy.linalg.lu_factor(Ks, check_finite=False)
+    rcond, info = scipy.linalg.lapack.dgecon(lu, np.linalg.norm(Ks, 1), norm="1")
+    if info != 0 or not rcond > 1e-13:
         raise np.linalg.LinAlgError("the KKT matrix of the six-axis hinge model is singular")
     rs = r * (s[:, None] if r.ndim == 2 else s)
-    y = np.linalg.solve(Ks, rs)
+    y = scipy.linalg.lu_solve((lu, piv), rs, check_finite=False)
     return y * (s[:, None] if r.ndim == 2 else s)
 
 
