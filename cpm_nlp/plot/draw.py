@@ -744,12 +744,27 @@ def draw_mechanism(
         kinds.add(letter)
         ax.scatter(*p, marker=_JOINT_MARKER[letter], s=40, facecolor=face, edgecolor="k", depthshade=False, label=label)
     if label_points:
-        for name, p in pts.items():
-            ax.text(*p, f" {name}", fontsize="x-small", color="0.2")
+        for p, names in _coincident(pts):
+            ax.text(*p, " " + " = ".join(names), fontsize="x-small", color="0.2")
     for arrow in arrows:
         o = np.asarray(arrow.origin, dtype=float) * factor
         v = np.asarray(arrow.vector, dtype=float) * factor
         ax.quiver(*o, *v, color=arrow.colour, lw=2, arrow_length_ratio=0.15, label=arrow.label or "_")
+
+
+def _coincident(pts: Mapping[str, np.ndarray]) -> list[tuple[np.ndarray, list[str]]]:
+    """The points grouped where they coincide (one label each: "A1 = C1")."""
+    allpts = np.array(list(pts.values())) if pts else np.zeros((0, 3))
+    tol = 1e-9 * (float(np.ptp(allpts, axis=0).max()) if len(allpts) > 1 else 1.0)
+    groups: list[tuple[np.ndarray, list[str]]] = []
+    for name, p in pts.items():
+        for q, names in groups:
+            if np.linalg.norm(p - q) <= tol:
+                names.append(name)
+                break
+        else:
+            groups.append((p, [name]))
+    return groups
 
 
 def equal_aspect(ax: Any, points: np.ndarray) -> None:

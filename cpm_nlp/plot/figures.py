@@ -739,7 +739,8 @@ def _pose_title(model: Any, x: np.ndarray, k: float) -> str:
     for i in c.task_index:
         f, unit = display_unit(c.x[i].kind, [x[i]])
         parts.append(f"{c.x[i].name} = {x[i] * f:.4g} {unit}".rstrip())
-    text = f"{model.name} at {', '.join(parts)}"
+    lines = [", ".join(parts[n : n + 3]) for n in range(0, len(parts), 3)]  # three coordinates a line
+    text = f"{model.name} at " + ",\n".join(lines)
     return text + (f"\n(displacements from home drawn ×{k:g})" if k != 1.0 else "")
 
 

@@ -23,6 +23,7 @@ from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
 from ...io.yamlfile import load_yaml_text, read_yaml
+from .drawing import geometry_of
 from .generate import closure_parts, parameter_options
 from .spec import Description, description_from_dict
 
@@ -119,6 +120,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         closure=lambda: closure,
         build=build,
         problem_files=examples,
+        geometry=geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
         origin=f"file {d.file}" if d.file else "described in code",
     )
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults
