@@ -870,7 +870,7 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
         u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
         dirs = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
         pts = dirs @ S.T * scale + centre
-        ax.plot_surface(pts[..., 0], pts[..., 1], pts[..., 2], alpha=0.35, color="tab:purple")
+        ax.plot_surface(pts[..., 0], pts[..., 1], pts[..., 2], alpha=0.35, color="tab:purple", zorder=9)
     else:
         t = np.linspace(0, 2 * np.pi, 200)
         pts = np.stack([np.cos(t), np.sin(t)], axis=-1) @ S.T * scale
@@ -879,8 +879,9 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
     for k in range(n):  # the principal axes: seen even where the ellipsoid is flat
         a = np.zeros(3)
         a[:n] = V[:, k] * w[k] * scale
-        ax.plot(*np.array([centre - a, centre + a]).T, color="tab:purple", lw=2)
-    ax.plot([], [], color="tab:purple", lw=6, alpha=0.35, label="compliance ellipsoid (scaled)")
+        ax.plot(*np.array([centre - a, centre + a]).T, color="tab:purple", lw=3, zorder=10)
+    ax.computed_zorder = False  # the ellipsoid over the platform's face
+    ax.plot([], [], color="tab:purple", lw=3, label="compliance ellipsoid (scaled)")
 
 
 def _legend_below(fig: Any, ax: Any, note: str = "") -> None:
