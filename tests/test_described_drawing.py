@@ -55,7 +55,15 @@ def test_drawing_at_home_and_at_another_pose(name):
     for drawing in (home, pose):
         for a, b, _part in drawing.segments:
             assert np.all(np.isfinite(drawing.points[a])) and np.all(np.isfinite(drawing.points[b]))
-    links = fixed_links(_layout(model))
+    layout = _layout(model)
+    # the platform is one rigid body: its joint points and its centre P keep their distances
+    platform = [f"{leg}_{len(joints)}" for leg, joints in layout] + ["P"]
+    for i, a in enumerate(platform):
+        for b in platform[i + 1 :]:
+            dh = np.linalg.norm(np.asarray(home.points[a]) - np.asarray(home.points[b]))
+            dp = np.linalg.norm(np.asarray(pose.points[a]) - np.asarray(pose.points[b]))
+            assert dp == pytest.approx(dh, abs=1e-9 * span), (a, b)
+    links = fixed_links(layout)
     assert links or name in ("prc3_file",)
     for a, b in links:
         lh = np.linalg.norm(np.asarray(home.points[a]) - np.asarray(home.points[b]))
