@@ -30,6 +30,9 @@ from cpm_nlp.plot.draw import (
     value_text,
     workspace_figure,
 )
+from cpm_nlp.plot.draw import (
+    _number as draw_number,
+)
 from cpm_nlp.problems.registry import kind_names, problem_kind
 
 from .figure_checks import assert_figure_readable
@@ -242,6 +245,28 @@ def synthetic_comparison():
     return comparison_figure([("paper (printed)", rows)], {"starts": 8, "starts_converged": 8}, title="synthetic")
 
 
+def five_bar_file_drawing():
+    """A mechanism described in a file, drawn from its legs (problems/mechanisms/five_bar.yaml)."""
+    import cpm_nlp as cn
+
+    model = build_model("five_bar")
+    q = model.q_home + np.array([0.15, -0.1])
+    x = cn.forward_kinematics(model, q, cn.SolverConfig("newton")).x
+    pose, home, k = figures._drawings(model, x, q)
+    return mechanism_figure(pose, home=home, title=figures._pose_title(model, x, k), note=pose.note)
+
+
+def _solved_figure(name):
+    import cpm_nlp as cn
+
+    from .conftest import PROBLEMS
+
+    problem = cn.load_problem(PROBLEMS / f"{name}.yaml")
+    data = figures.from_result(cn.solve(problem))
+    data.live = problem.model
+    return figures.figure(data)[0]
+
+
 FIGURES = {
     "workspace_boundary_and_boxes": synthetic_workspace,
     "map_best_max": lambda: synthetic_map()[0],
@@ -249,6 +274,9 @@ FIGURES = {
     "lines_one_panel": synthetic_lines,
     "mechanism_prs3": prs3_drawing,
     "comparison": synthetic_comparison,
+    "mechanism_five_bar_file": five_bar_file_drawing,
+    "modes_prs3": lambda: _solved_figure("prs3_natural_frequencies"),
+    "ellipsoid_prs3": lambda: _solved_figure("prs3_cutting_force"),
 }
 
 
@@ -524,3 +552,46 @@ def test_mechanism_plot_of_a_pose_and_its_html(solved, tmp_path):
     assert kind == "mechanism" and {"link", "revolute joint (R)"} <= {t.name for t in html.data}
     save(html, tmp_path / "m.html")
     assert (tmp_path / "m.html").stat().st_size > 1_000_000
+
+
+def test_mode_shapes_as_arrows_on_the_mechanism(solved):
+    """One panel per mode (up to three) titled with its frequency; the arrow at the platform
+    centre P points along the mode's platform translation (modes_x)."""
+    data = solved("prs3_natural_frequencies")
+    fig, kind = figures.figure(data)
+    assert kind == "modes"
+    titles = [ax.get_title() for ax in fig.axes]
+    assert titles == [f"mode {k + 1}: {draw_number(data.values[f'f{k + 1}'])} Hz" for k in range(3)]
+    model, geometry, x, q = figures._drawn_pose(data)
+    c = model.closure
+    idx = [c.x_names.index(n) for n in ("px", "py", "pz")]
+    for mx, mq in zip(data.values["modes_x"], data.values["modes_q"]):
+        arrows = figures._mode_arrows(model, geometry, x, q, mx, mq)
+        at_p = [a for a in arrows if np.allclose(a.origin, geometry(model, x, q).points["P"])]
+        t = np.array(mx)[idx]
+        if np.linalg.norm(t) > 1e-6 * np.abs(mx).max():
+            (a,) = at_p
+            cos = np.dot(a.vector, t) / (np.linalg.norm(a.vector) * np.linalg.norm(t))
+            assert abs(cos) == pytest.approx(1.0, abs=1e-6)
+    assert_figure_readable(fig)
+
+
+def test_compliance_ellipsoid_on_the_mechanism(solved):
+    data = solved("prs3_cutting_force")
+    fig, kind = figures.figure(data)
+    assert kind == "ellipsoid" and len(fig.axes) == 2
+    assert fig.axes[0].get_title().startswith("at the platform centre: the deflections under |f| =")
+    assert "compliance ellipsoid (scaled)" in [t.get_text() for t in fig.legends[0].get_texts()]
+    assert_figure_readable(fig)
+
+
+def test_file_mechanism_forward_kinematics_plot_draws_it(cli, tmp_path):
+    """``solve --plot`` of a mechanism described in a file draws the mechanism."""
+    from .conftest import PROBLEMS
+    from .figure_checks import assert_png_drawn
+
+    out = tmp_path / "five_bar.png"
+    run = cli("solve", str(PROBLEMS / "five_bar_forward_kinematics.yaml"), "--plot", str(out))
+    assert run.code == 0, run.err
+    assert "(mechanism)" in run.out
+    assert_png_drawn(out)

@@ -744,12 +744,27 @@ def draw_mechanism(
         kinds.add(letter)
         ax.scatter(*p, marker=_JOINT_MARKER[letter], s=40, facecolor=face, edgecolor="k", depthshade=False, label=label)
     if label_points:
-        for name, p in pts.items():
-            ax.text(*p, f" {name}", fontsize="x-small", color="0.2")
+        for p, names in _coincident(pts):
+            ax.text(*p, " " + " = ".join(names), fontsize="x-small", color="0.2")
     for arrow in arrows:
         o = np.asarray(arrow.origin, dtype=float) * factor
         v = np.asarray(arrow.vector, dtype=float) * factor
         ax.quiver(*o, *v, color=arrow.colour, lw=2, arrow_length_ratio=0.15, label=arrow.label or "_")
+
+
+def _coincident(pts: Mapping[str, np.ndarray]) -> list[tuple[np.ndarray, list[str]]]:
+    """The points grouped where they coincide (one label each: "A1 = C1")."""
+    allpts = np.array(list(pts.values())) if pts else np.zeros((0, 3))
+    tol = 1e-9 * (float(np.ptp(allpts, axis=0).max()) if len(allpts) > 1 else 1.0)
+    groups: list[tuple[np.ndarray, list[str]]] = []
+    for name, p in pts.items():
+        for q, names in groups:
+            if np.linalg.norm(p - q) <= tol:
+                names.append(name)
+                break
+        else:
+            groups.append((p, [name]))
+    return groups
 
 
 def equal_aspect(ax: Any, points: np.ndarray) -> None:
@@ -772,6 +787,7 @@ def mechanism_axes(
     home: Any = None,
     arrows: Sequence[Arrow] = (),
     title: str = "",
+    label_points: bool = True,
 ) -> Any:
     """A 3-D axes of ``fig`` (subplot ``position``) with the mechanism drawn at
     its pose (and faintly at ``home``), axes in one length unit, equal scales."""
@@ -782,7 +798,7 @@ def mechanism_axes(
     factor, unit = display_unit("length", allpts)
     if home is not None:
         draw_mechanism(ax, home, factor=factor, faint=True)
-    draw_mechanism(ax, drawing, factor=factor, arrows=arrows)
+    draw_mechanism(ax, drawing, factor=factor, arrows=arrows, label_points=label_points)
     shown = allpts * factor
     for arrow in arrows:
         o = np.asarray(arrow.origin, dtype=float) * factor
@@ -808,6 +824,64 @@ def mechanism_figure(
     if title:
         fig.suptitle(title)
     return fig
+
+
+def drawing_factor(drawing: Any) -> tuple[float, str]:
+    """The length unit :func:`mechanism_axes` shows a drawing in (factor from SI, unit)."""
+    allpts = np.array([np.asarray(v, dtype=float).ravel()[:3] for v in drawing.points.values()])
+    return display_unit("length", allpts)
+
+
+def modes_mechanism_figure(
+    drawing: Any,
+    arrows: Sequence[Sequence[Arrow]],
+    frequencies: Sequence[float],
+    *,
+    title: str = "",
+    note: str = "",
+) -> Any:
+    """Mode shapes on the mechanism: one panel per mode (up to three), the mechanism
+    at its pose with an arrow at each of its points along that point's displacement."""
+    Figure = _figure_class()
+    n = min(len(arrows), 3)
+    if n == 0:
+        raise InputError("no mode to draw")
+    fig = Figure(figsize=(4.6 * n, 5.4), layout="constrained")
+    for k in range(n):
+        mechanism_axes(
+            fig,
+            (1, n, k + 1),
+            drawing,
+            arrows=arrows[k],
+            title=f"mode {k + 1}: {_number(frequencies[k])} Hz",
+            label_points=False,
+        )
+    _legend_below(fig, fig.axes[0], note)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> None:
+    """The ellipsoid {S f : |f| = 1} (or the ellipse of a 2x2 S, in the plane z = centre)
+    drawn in shown units at ``centre``, ``scale`` shown units per m/N."""
+    n = S.shape[0]
+    if n == 3:
+        u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
+        dirs = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
+        pts = dirs @ S.T * scale + centre
+        ax.plot_surface(pts[..., 0], pts[..., 1], pts[..., 2], alpha=0.35, color="tab:purple", zorder=9)
+    else:
+        t = np.linspace(0, 2 * np.pi, 200)
+        pts = np.stack([np.cos(t), np.sin(t)], axis=-1) @ S.T * scale
+        ax.plot(pts[:, 0] + centre[0], pts[:, 1] + centre[1], np.full_like(t, centre[2]), color="tab:purple", lw=2)
+    w, V = np.linalg.eigh(S)
+    for k in range(n):  # the principal axes: seen even where the ellipsoid is flat
+        a = np.zeros(3)
+        a[:n] = V[:, k] * w[k] * scale
+        ax.plot(*np.array([centre - a, centre + a]).T, color="tab:purple", lw=3, zorder=10)
+    ax.computed_zorder = False  # the ellipsoid over the platform's face
+    ax.plot([], [], color="tab:purple", lw=3, label="compliance ellipsoid (scaled)")
 
 
 def _legend_below(fig: Any, ax: Any, note: str = "") -> None:
@@ -1035,10 +1109,14 @@ def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, 
 # -- (d) compliance ellipsoid and mode shapes -------------------------------------------------------
 
 
-def ellipsoid_figure(C: Any, names: Sequence[str], *, title: str = "") -> Any:
+def ellipsoid_figure(
+    C: Any, names: Sequence[str], *, title: str = "", drawing: Any = None, centre: Any = None, note: str = ""
+) -> Any:
     """The compliance ellipsoid {C f : |f| = 1} of a 2x2 or 3x3 translational
     compliance block C (m/N): the deflections a unit force in any direction
-    causes, in 3-D (or 2-D) with its principal axes listed."""
+    causes, in 3-D (or 2-D) with its principal axes listed.  With a ``drawing``
+    of the mechanism (and the platform ``centre``, SI), a first panel draws the
+    ellipsoid there on the mechanism, scaled to a quarter of its size."""
     Figure = _figure_class()
     Cm = np.asarray(C, dtype=float)
     n = Cm.shape[0]
@@ -1048,10 +1126,21 @@ def ellipsoid_figure(C: Any, names: Sequence[str], *, title: str = "") -> Any:
     w, V = np.linalg.eigh(S)
     peak = float(np.max(np.abs(w))) if w.size else 0.0
     f, unit = display_unit("length", [peak])
-    fig = Figure(figsize=(7, 6), layout="constrained")
     text = ", ".join(f"{_number(abs(v) * f)} {unit}/N" for v in w[::-1])
+    panels = 1 if drawing is None else 2
+    fig = Figure(figsize=(7 * panels, 6.5 if drawing is not None else 6), layout="constrained")
+    if drawing is not None:
+        on = mechanism_axes(fig, (1, 2, 1), drawing)
+        df, dunit = drawing_factor(drawing)
+        allpts = np.array([np.asarray(v, dtype=float).ravel()[:3] for v in drawing.points.values()])
+        span = float(np.ptp(allpts, axis=0).max()) or 1.0
+        force = 0.25 * span / (peak or 1.0)
+        force = float(10 ** math.floor(math.log10(force)))
+        _ellipsoid_on(on, S, np.asarray(centre, dtype=float).ravel()[:3] * df, force * df)
+        on.set_title(f"at the platform centre: the deflections under |f| = {force:g} N", fontsize="small")
+        _legend_below(fig, on, note)
     if n == 3:
-        ax = fig.add_subplot(1, 1, 1, projection="3d")
+        ax = fig.add_subplot(1, panels, panels, projection="3d")
         u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
         dirs = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
         pts = dirs @ S.T * f
@@ -1061,7 +1150,7 @@ def ellipsoid_figure(C: Any, names: Sequence[str], *, title: str = "") -> Any:
             ax.plot([-a[0], a[0]], [-a[1], a[1]], [-a[2], a[2]], color="tab:red", lw=2)
         ax.set_zlabel(axis_label(names[2], unit + "/N"))
     else:
-        ax = fig.add_subplot(1, 1, 1)
+        ax = fig.add_subplot(1, panels, panels)
         t = np.linspace(0, 2 * np.pi, 200)
         pts = np.stack([np.cos(t), np.sin(t)], axis=-1) @ S.T * f
         ax.plot(pts[:, 0], pts[:, 1], color="tab:blue")

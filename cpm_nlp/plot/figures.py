@@ -63,6 +63,7 @@ from .draw import (
     matrices_figure,
     mechanism_figure,
     modes_figure,
+    modes_mechanism_figure,
     panels_figure,
     pretty,
 )
@@ -739,7 +740,8 @@ def _pose_title(model: Any, x: np.ndarray, k: float) -> str:
     for i in c.task_index:
         f, unit = display_unit(c.x[i].kind, [x[i]])
         parts.append(f"{c.x[i].name} = {x[i] * f:.4g} {unit}".rstrip())
-    text = f"{model.name} at {', '.join(parts)}"
+    lines = [", ".join(parts[n : n + 3]) for n in range(0, len(parts), 3)]  # three coordinates a line
+    text = f"{model.name} at " + ",\n".join(lines)
     return text + (f"\n(displacements from home drawn ×{k:g})" if k != 1.0 else "")
 
 
@@ -1054,18 +1056,94 @@ def ellipsoid_plot(data: ResultData, options: PlotOptions) -> Any:
     if len(idx) < 2:
         raise NotApplicable("the platform has fewer than two translational coordinates")
     C = np.asarray(data.values["C"], dtype=float)[np.ix_(idx, idx)]
+    drawn = _drawn_pose(data)
+    drawing, centre, note = None, None, ""
+    if drawn is not None:
+        model, geometry, x, q = drawn
+        drawing = geometry(model, x, q)
+        centre, note = _platform_centre(drawing, c, x), drawing.note
     return ellipsoid_figure(
-        C, [c.x_names[i] for i in idx], title=f"Compliance ellipsoid of the platform ({data.model.get('type')})"
+        C,
+        [c.x_names[i] for i in idx],
+        title=f"Compliance ellipsoid of the platform ({data.model.get('type')})",
+        drawing=drawing,
+        centre=centre,
+        note=note,
     )
 
 
+def _drawn_pose(data: ResultData) -> tuple | None:
+    """(model, geometry, x, q) of a one-pose result whose mechanism has a drawing, else None."""
+    try:
+        model = _model_for(data)
+        geometry = _geometry(model)
+        x, q = _single_pose(data, model)
+    except NotApplicable:
+        return None
+    return model, geometry, x, q
+
+
+def _platform_centre(drawing: Any, c: Any, x: np.ndarray) -> np.ndarray:
+    """The platform centre: the drawing's point P, else the translational pose coordinates."""
+    if "P" in drawing.points:
+        return np.asarray(drawing.points["P"], dtype=float).ravel()[:3]
+    out = np.zeros(3)
+    idx = _translational(c)
+    out[: len(idx)] = x[idx]
+    return out
+
+
+#: the mode shapes drawn on the mechanism: the largest point displacement of a mode, as a fraction of its size
+MODE_ARROW = 0.25
+
+
+def _mode_arrows(model: Any, geometry: Any, x: np.ndarray, q: np.ndarray, mx: Any, mq: Any) -> list[Arrow]:
+    """Arrows at the drawing's points along their displacements in one mode (central
+    difference of the drawing between the pose -/+ eps times the mode), scaled to be seen."""
+    mx, mq = np.asarray(mx, dtype=float), np.asarray(mq, dtype=float)
+    at = geometry(model, x, q)
+    names = list(at.points)
+    P = np.array([np.asarray(at.points[n], dtype=float).ravel()[:3] for n in names])
+    span = float(np.ptp(P, axis=0).max()) or 1.0
+    size = max(float(np.abs(mx).max(initial=0.0)), float(np.abs(mq).max(initial=0.0))) or 1.0
+    eps = 1e-6 / size
+    plus, minus = geometry(model, x + eps * mx, q + eps * mq), geometry(model, x - eps * mx, q - eps * mq)
+    D = np.array(
+        [np.asarray(plus.points[n], dtype=float)[:3] - np.asarray(minus.points[n], dtype=float)[:3] for n in names]
+    ) / (2 * eps)
+    peak = float(np.linalg.norm(D, axis=1).max())
+    if peak == 0.0:
+        return []
+    D *= MODE_ARROW * span / peak
+    arrows: list[Arrow] = []
+    seen: list[np.ndarray] = []
+    for p, d in zip(P, D):
+        if np.linalg.norm(d) < 1e-3 * MODE_ARROW * span or any(np.linalg.norm(p - o) < 1e-9 * span for o in seen):
+            continue
+        seen.append(p)
+        arrows.append(Arrow(p, d, "" if arrows else "displacement in the mode (scaled)", "tab:red"))
+    return arrows
+
+
 def modes_plot(data: ResultData, options: PlotOptions) -> Any:
-    """Mode shapes as arrows at the platform point (the translational pose
-    coordinates) and at each actuator, one panel per mode."""
+    """Mode shapes as arrows, one panel per mode (up to three): on the mechanism's
+    drawing where it has one (an arrow at each point along its displacement in the
+    mode), else at the platform point (the translational pose coordinates) and at
+    each actuator."""
     _flat_only(options, "modes")
     if data.sweep or not isinstance(data.values.get("modes_x"), list):
         raise NotApplicable("'modes' plots the mode shapes of one natural_frequencies result")
     c = _closure(data)
+    drawn = _drawn_pose(data)
+    if drawn is not None:
+        model, geometry, x, q = drawn
+        modes = list(zip(data.values["modes_x"], data.values["modes_q"]))[:3]
+        arrows = [_mode_arrows(model, geometry, x, q, mx, mq) for mx, mq in modes]
+        freqs = [data.values[f"f{k + 1}"] for k in range(len(modes))]
+        pose = geometry(model, x, q)
+        return modes_mechanism_figure(
+            pose, arrows, freqs, title=f"Mode shapes ({data.model.get('type')})", note=pose.note
+        )
     idx = _translational(c)
     platform = np.zeros(3)
     platform[: len(idx)] = [data.values[c.x_names[i]] for i in idx]

@@ -26,6 +26,7 @@ from ...core.model import LoopClosure, Model
 from ...io.yamlfile import load_yaml_text, read_yaml
 from .chains import chains_function
 from .chains import supported as chains_supported
+from .drawing import geometry_of
 from .generate import closure_parts, parameter_options
 from .spec import Description, description_from_dict
 
@@ -142,6 +143,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         build=build,
         problem_files=examples,
         stiffness=d.stiffness,
+        geometry=geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
         origin=f"file {d.file}" if d.file else "described in code",
         chains=chains_function(gen) if chains_supported(gen) else None,
     )

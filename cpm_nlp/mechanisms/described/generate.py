@@ -44,6 +44,8 @@ from .spec import Description, Joint, Leg
 
 POINT_JOINTS = {"S", "planar_R"}
 SPHERE_JOINTS = {"U", "S", "planar_R"}
+#: the letter a drawing marks each joint type with (a distance joint: a rod between two spherical joints)
+_LETTER = {"P": "P", "planar_P": "P", "R": "R", "planar_R": "R", "C": "C", "U": "U", "S": "S", "distance": "S"}
 JOINT_DIMS = {"P": "length", "planar_P": "length", "R": "angle", "planar_R": "angle", "U": "angle", "S": "angle"}
 
 
@@ -121,6 +123,8 @@ class Generator:
         self.extra_limits: dict[str, tuple] = {}
         #: each leg's resolved joints, base first (for the chains of the six-axis hinge model)
         self.leg_joints: list[tuple[Leg, list[_Joint]]] = []
+        #: per leg, for the drawing: (leg name, [(joint letter, location at the pose, actuated, slides)])
+        self.drawn: list[tuple[str, list[tuple[str, ca.SX, bool, bool]]]] = []
 
     # -- expressions -----------------------------------------------------------------------
     def value(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ex.Value:
@@ -309,6 +313,7 @@ class Generator:
                 self.unknowns(j, leg, k)
         Rm, tm = self.chain(before)
         B = self.platform_point(tip)
+        self.draw_leg(leg, last, before, elim, slide, Rm, tm, B)
         R_rel = self.R @ self.R_home.T
         rows = 2 if self.d.platform.planar else 3
         if elim is None:
@@ -370,6 +375,43 @@ class Generator:
             self.branch.append(ca.dot(u, v) / ca.dot(u0, u0))
             Rb = self.report_sphere(elim, Rm, u0, v, leg)
         self.report_tip(last, Rb, R_rel, leg.name)
+
+    def draw_leg(
+        self,
+        leg: Leg,
+        last: _Joint,
+        before: list[_Joint],
+        elim: _Joint | None,
+        slide: _Joint | None,
+        Rm: ca.SX,
+        tm: ca.SX,
+        B: ca.SX,
+    ) -> None:
+        """The leg's joints located at the pose x (with q, p), for the drawing: the proximal
+        chain's joints moved by the joints before them, the eliminated joint by the whole
+        proximal chain, a P along the leg at its reference distance from there, the last
+        joint where the platform puts it."""
+        planar = self.d.platform.planar
+        out: list[tuple[str, ca.SX, bool, bool]] = []
+        Rk, tk = ca.SX.eye(3), ca.SX.zeros(3)
+        for j in before:
+            out.append((_LETTER[j.type], Rk @ j.at + tk, j.value is not None and j.spec.actuated is not None, False))
+            Rj, tj = self.chain([j])
+            Rk, tk = Rk @ Rj, Rk @ tj + tk
+        if elim is not None:
+            c = Rm @ elim.at + tm
+            letter = "R" if planar and last.type == "distance" else _LETTER[elim.type]
+            out.append((letter, c, False, elim.type == "C"))
+            if slide is not None:
+                reach = ca.norm_2(slide.at - elim.at)
+                out.append(
+                    (_LETTER[slide.type], c + reach * (B - c) / ca.norm_2(B - c), slide.spec.actuated is not None, True)
+                )
+        tip = "R" if planar and last.type == "distance" else _LETTER[last.type]
+        out.append((tip, B, False, False))
+        # a segment after a P (or C) joint changes length: mark the joints that slide
+        out = [(t, v, act, slides or t in ("P", "C")) for t, v, act, slides in out]
+        self.drawn.append((leg.name, out))
 
     def chain(self, joints: list[_Joint]) -> tuple[ca.SX, ca.SX]:
         """The motion y -> Rm y + tm of the proximal chain's last body (product of exponentials)."""
@@ -581,7 +623,11 @@ class Generator:
             ["p"],
             ["lower", "upper", "length", "derived", "requirements"],
         )
+        points = [v for _leg, joints in self.drawn for _t, v, _a, _s in joints] + [self.P]
+        drawing = ca.Function("drawing_points", [x, q, p], [ca.horzcat(*points)], io, ["points"])
         return {
+            "drawing": drawing,
+            "drawing_legs": [(name, [(t, a, sl) for t, _v, a, sl in joints]) for name, joints in self.drawn],
             "phi": phi,
             "branch": branch,
             "passive": passive,

@@ -1,0 +1,114 @@
+"""The drawing of a mechanism described by its legs (the ``geometry`` capability).
+
+The generator locates every joint of every leg at a pose symbolically (the
+``drawing_points`` function of x, q, p): the joints of the proximal chain moved
+by the joints before them, the eliminated joint by the whole proximal chain, a
+passive P along the leg at its reference distance from there, and the last
+joint where the platform puts it.  This module turns those points into a
+:class:`~cpm_nlp.core.mechanism.Drawing`: the base through the legs' first
+joints, each leg's joints and links, the platform through the legs' last joints.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from ...core.mechanism import Drawing
+
+#: (leg name, [(joint letter, actuated, the link after it changes length)])
+Layout = Sequence[tuple[str, Sequence[tuple[str, bool, bool]]]]
+
+
+def _polygon(pts: dict[str, np.ndarray], names: list[str], tol: float) -> list[str]:
+    """The distinct points among ``names`` in order around their centroid (in their best-fit plane)."""
+    kept: list[str] = []
+    for n in names:
+        if all(np.linalg.norm(pts[n] - pts[k]) > tol for k in kept):
+            kept.append(n)
+    if len(kept) < 3:
+        return kept
+    P = np.array([pts[n] for n in kept])
+    mid = P.mean(axis=0)
+    _u, s, vt = np.linalg.svd(P - mid)
+    if s[1] <= tol:  # collinear
+        return kept
+    a = (P - mid) @ vt[0]
+    b = (P - mid) @ vt[1]
+    return [kept[k] for k in np.argsort(np.arctan2(b, a))]
+
+
+def _ring(part: str, names: list[str]) -> tuple[tuple, tuple]:
+    """A face through three or more points, else a segment through two (else nothing)."""
+    if len(names) >= 3:
+        return (), ((part, tuple(names)),)
+    if len(names) == 2:
+        return ((names[0], names[1], part),), ()
+    return (), ()
+
+
+def build_drawing(values: Any, layout: Layout, planar: bool) -> Drawing:
+    """A drawing from the joints' locations (3 x n: the legs' joints in order, then the platform centre)."""
+    V = np.asarray(values, dtype=float).reshape(3, -1)
+    pts: dict[str, np.ndarray] = {}
+    joints: dict[str, str] = {}
+    segments: list[tuple[str, str, str]] = []
+    first, last = [], []
+    col = 0
+    for leg, legjoints in layout:
+        names = []
+        for n, (letter, _actuated, _slides) in enumerate(legjoints):
+            name = f"{leg}_{n + 1}"
+            pts[name] = V[:, col].copy()
+            joints[name] = letter
+            names.append(name)
+            col += 1
+        for n in range(len(names) - 1):
+            actuated = legjoints[n][1]
+            part = "actuator" if actuated else ("leg" if n == len(names) - 2 else "link")
+            segments.append((names[n], names[n + 1], part))
+        first.append(names[0])
+        last.append(names[-1])
+    centre = "P" if "P" not in pts else "P0"
+    pts[centre] = V[:, col].copy()
+    span = float(np.ptp(np.array(list(pts.values())), axis=0).max()) or 1.0
+    tol = 1e-9 * span
+    segments = [s for s in segments if np.linalg.norm(pts[s[0]] - pts[s[1]]) > tol]  # not a zero-length link
+    base_segments, base_faces = _ring("base", _polygon(pts, first, tol))
+    plat_segments, plat_faces = _ring("platform", _polygon(pts, last, tol))
+    note = "joints at their locations from the legs' chains; links straight between consecutive joints"
+    if planar:
+        note += "; a planar mechanism, drawn in its plane z = 0"
+    return Drawing(
+        points=pts,
+        segments=tuple(base_segments) + tuple(segments) + tuple(plat_segments),
+        faces=tuple(base_faces) + tuple(plat_faces),
+        joints=joints,
+        note=note,
+    )
+
+
+def geometry_of(fn: Any, layout: Layout, planar: bool) -> Callable[[Any, Any, Any], Drawing] | None:
+    """The ``geometry`` capability of a described mechanism (None when it has no legs to draw)."""
+    if not layout:
+        return None
+
+    def geometry(model: Any, x: Any, q: Any) -> Drawing:
+        x = np.asarray(x, dtype=float).ravel()
+        q = np.asarray(q, dtype=float).ravel()
+        values = np.asarray(fn(x, q, np.asarray(model.p, dtype=float).ravel()), dtype=float)
+        return build_drawing(values, layout, planar)
+
+    return geometry
+
+
+def fixed_links(layout: Layout) -> list[tuple[str, str]]:
+    """The segments of the legs whose length the kinematics keeps (the link after a joint that does not slide)."""
+    out = []
+    for leg, legjoints in layout:
+        for n in range(len(legjoints) - 1):
+            if not legjoints[n][2]:
+                out.append((f"{leg}_{n + 1}", f"{leg}_{n + 2}"))
+    return out
