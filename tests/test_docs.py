@@ -13,7 +13,9 @@ of the page may read them):
   ``PATH``.
 * ``python``: executed, the blocks of a page sharing one namespace.
 * ``yaml``: a problem file, written (to the path of a preceding ``<!-- file: PATH -->``
-  comment, else a temporary name) and validated with ``cpm-nlp check``.
+  comment, else a temporary name) and validated with ``cpm-nlp check``; a mechanism file
+  (with ``legs``) is written and loaded, and one marked ``<!-- file: PATH invalid -->``
+  (a deliberate mistake the page shows) must fail to load as bad input.
 * ``text`` and ``toml``: illustrative only (usage synopses, a cluster's own commands, an
   error message, an entry-point table tested by tests/test_plugin.py); kept few.
 """
@@ -44,7 +46,7 @@ EXECUTED = ("bash", "python", "yaml")
 ILLUSTRATIVE = ("text", "toml")
 MAX_ILLUSTRATIVE = 12
 FENCE = re.compile(r"^(?P<indent>[ \t]*)```(?P<lang>[^\s`]*)[^\n]*\n(?P<body>.*?)^(?P=indent)```[ \t]*$", re.M | re.S)
-FILE_MARK = re.compile(r"<!--\s*file:\s*(\S+)\s*-->\s*$")
+FILE_MARK = re.compile(r"<!--\s*file:\s*(\S+)(?P<invalid>\s+invalid)?\s*-->\s*$")
 EXPECT = re.compile(r"^(?P<cmd>.*?)\s*\|\|\s*test \$\? -eq (?P<code>\d+)$")
 
 
@@ -55,6 +57,7 @@ class Block:
     lang: str
     body: str
     file: str | None
+    invalid: bool = False  # a mechanism file written to show its error: loading it must fail (exit 2)
 
 
 def blocks(page: Path) -> list[Block]:
@@ -67,7 +70,8 @@ def blocks(page: Path) -> list[Block]:
         before = text[: m.start()].rstrip("\n").rsplit("\n", 1)[-1]
         mark = FILE_MARK.search(before)
         line = text.count("\n", 0, m.start()) + 1
-        out.append(Block(page, line, m.group("lang"), body, mark.group(1) if mark else None))
+        file, invalid = (mark.group(1), bool(mark.group("invalid"))) if mark else (None, False)
+        out.append(Block(page, line, m.group("lang"), body, file, invalid))
     return out
 
 
@@ -163,6 +167,10 @@ def _run_yaml(block: Block, k: int) -> None:
     path = Path(block.file) if block.file else Path("problems") / f"_doc_block_{k}.yaml"
     if isinstance(data, dict) and "legs" in data and block.file:  # a mechanism file, used by the blocks after it
         path.write_text(block.body, encoding="utf-8")
+        if block.invalid:  # the page shows its error next; loading must fail as bad input
+            with pytest.raises(cn.InputError):
+                cn.load_mechanism_file(path, register=False)
+            return
         cn.load_mechanism_file(path, register=False)
         return
     assert isinstance(data, dict) and "problem" in data, f"{where}: a yaml block must be a whole problem file"
