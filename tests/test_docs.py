@@ -103,8 +103,40 @@ def test_no_links_outside_the_repository():
         assert "shared/papers" not in page.read_text(encoding="utf-8"), _name(page)
 
 
+@pytest.fixture(scope="session")
+def reproduce_memo():
+    """``cpm-nlp reproduce`` runs in several pages over the same shipped problem files
+    (the README and the published-figures page over all of them): a problem solved once
+    in this session is not solved again.  The key is everything the result depends on
+    (the kind, the mechanism's closure object, its parameters and limits, the file's parsed
+    content after ``--set``), so a page that changes a problem still solves it; every block still runs
+    the command, its comparison and its table."""
+    from cpm_nlp.problems import reproduce
+
+    solved: dict[str, tuple] = {}  # key -> (the closure, kept alive so that its id stays its own; result)
+    real = reproduce.solve
+
+    def solve(problem):
+        key = repr(
+            (
+                problem.kind.name,
+                id(problem.model.closure),  # a mechanism file's closure is its content's (and path's)
+                sorted(problem.model.parameters.items()),
+                sorted(problem.model.limits.items()),
+                yaml.safe_dump(problem.data, sort_keys=True),
+            )
+        )
+        if key not in solved:
+            solved[key] = (problem.model.closure, real(problem))
+        return solved[key][1]
+
+    return reproduce, solve
+
+
 @pytest.fixture
-def workdir(tmp_path, monkeypatch):
+def workdir(tmp_path, monkeypatch, reproduce_memo):
+    module, memo = reproduce_memo
+    monkeypatch.setattr(module, "solve", memo)
     for d in ("problems", "configs", "examples"):
         shutil.copytree(ROOT / d, tmp_path / d)
     monkeypatch.chdir(tmp_path)
