@@ -174,3 +174,14 @@ def test_start_up_loads_only_what_the_command_needs():
     import cpm_nlp
 
     assert all(getattr(cpm_nlp, name) is not None for name in cpm_nlp.__all__)
+
+
+def test_describe_a_mechanism_file_loads_and_checks_it(cli, tmp_path):
+    run = cli("describe", str(PROBLEMS / "mechanisms" / "five_bar.yaml"))
+    assert run.code == 0, run.err
+    assert run.out.startswith("five_bar: planar five-bar") and "file " in run.out
+    text = (PROBLEMS / "mechanisms" / "five_bar.yaml").read_text()
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text.replace("type: planar_R, at: [-cx, cy]", "type: planar_RR, at: [-cx, cy]"))
+    run = cli("describe", str(bad))
+    assert run.code == 2 and "legs[0].joints[1].type" in run.err and "did you mean 'planar_R'" in run.err

@@ -13,7 +13,9 @@ of the page may read them):
   ``PATH``.
 * ``python``: executed, the blocks of a page sharing one namespace.
 * ``yaml``: a problem file, written (to the path of a preceding ``<!-- file: PATH -->``
-  comment, else a temporary name) and validated with ``cpm-nlp check``.
+  comment, else a temporary name) and validated with ``cpm-nlp check``; a mechanism file
+  (with ``legs``) is written and loaded, and one marked ``<!-- file: PATH invalid -->``
+  (a deliberate mistake the page shows) must fail to load as bad input.
 * ``text`` and ``toml``: illustrative only (usage synopses, a cluster's own commands, an
   error message, an entry-point table tested by tests/test_plugin.py); kept few.
 """
@@ -44,7 +46,7 @@ EXECUTED = ("bash", "python", "yaml")
 ILLUSTRATIVE = ("text", "toml")
 MAX_ILLUSTRATIVE = 12
 FENCE = re.compile(r"^(?P<indent>[ \t]*)```(?P<lang>[^\s`]*)[^\n]*\n(?P<body>.*?)^(?P=indent)```[ \t]*$", re.M | re.S)
-FILE_MARK = re.compile(r"<!--\s*file:\s*(\S+)\s*-->\s*$")
+FILE_MARK = re.compile(r"<!--\s*file:\s*(\S+)(?P<invalid>\s+invalid)?\s*-->\s*$")
 EXPECT = re.compile(r"^(?P<cmd>.*?)\s*\|\|\s*test \$\? -eq (?P<code>\d+)$")
 
 
@@ -55,6 +57,7 @@ class Block:
     lang: str
     body: str
     file: str | None
+    invalid: bool = False  # a mechanism file written to show its error: loading it must fail (exit 2)
 
 
 def blocks(page: Path) -> list[Block]:
@@ -67,7 +70,8 @@ def blocks(page: Path) -> list[Block]:
         before = text[: m.start()].rstrip("\n").rsplit("\n", 1)[-1]
         mark = FILE_MARK.search(before)
         line = text.count("\n", 0, m.start()) + 1
-        out.append(Block(page, line, m.group("lang"), body, mark.group(1) if mark else None))
+        file, invalid = (mark.group(1), bool(mark.group("invalid"))) if mark else (None, False)
+        out.append(Block(page, line, m.group("lang"), body, file, invalid))
     return out
 
 
@@ -99,8 +103,40 @@ def test_no_links_outside_the_repository():
         assert "shared/papers" not in page.read_text(encoding="utf-8"), _name(page)
 
 
+@pytest.fixture(scope="session")
+def reproduce_memo():
+    """``cpm-nlp reproduce`` runs in several pages over the same shipped problem files
+    (the README and the published-figures page over all of them): a problem solved once
+    in this session is not solved again.  The key is everything the result depends on
+    (the kind, the mechanism's closure object, its parameters and limits, the file's parsed
+    content after ``--set``), so a page that changes a problem still solves it; every block still runs
+    the command, its comparison and its table."""
+    from cpm_nlp.problems import reproduce
+
+    solved: dict[str, tuple] = {}  # key -> (the closure, kept alive so that its id stays its own; result)
+    real = reproduce.solve
+
+    def solve(problem):
+        key = repr(
+            (
+                problem.kind.name,
+                id(problem.model.closure),  # a mechanism file's closure is its content's (and path's)
+                sorted(problem.model.parameters.items()),
+                sorted(problem.model.limits.items()),
+                yaml.safe_dump(problem.data, sort_keys=True),
+            )
+        )
+        if key not in solved:
+            solved[key] = (problem.model.closure, real(problem))
+        return solved[key][1]
+
+    return reproduce, solve
+
+
 @pytest.fixture
-def workdir(tmp_path, monkeypatch):
+def workdir(tmp_path, monkeypatch, reproduce_memo):
+    module, memo = reproduce_memo
+    monkeypatch.setattr(module, "solve", memo)
     for d in ("problems", "configs", "examples"):
         shutil.copytree(ROOT / d, tmp_path / d)
     monkeypatch.chdir(tmp_path)
@@ -163,6 +199,10 @@ def _run_yaml(block: Block, k: int) -> None:
     path = Path(block.file) if block.file else Path("problems") / f"_doc_block_{k}.yaml"
     if isinstance(data, dict) and "legs" in data and block.file:  # a mechanism file, used by the blocks after it
         path.write_text(block.body, encoding="utf-8")
+        if block.invalid:  # the page shows its error next; loading must fail as bad input
+            with pytest.raises(cn.InputError):
+                cn.load_mechanism_file(path, register=False)
+            return
         cn.load_mechanism_file(path, register=False)
         return
     assert isinstance(data, dict) and "problem" in data, f"{where}: a yaml block must be a whole problem file"

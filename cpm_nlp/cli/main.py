@@ -501,7 +501,12 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
         return _describe_kind(args, out)
     if args.mechanism:
         problem_kind(args.name, path=("describe",))  # the unknown kind, with a "did you mean"
-    mt = mechanism_type(args.name, path=("describe",))
+    if args.name.endswith((".yaml", ".yml")) and not args.mechanism:  # a mechanism file: loaded and checked
+        from ..mechanisms.described import load_file
+
+        mt = load_file(args.name)
+    else:
+        mt = mechanism_type(args.name, path=("describe",))
     out.write(f"{mt.name}: {mt.title}\n{mt.paper}\n[{mt.origin}]\n\nparameters:\n")
     for o in mt.parameters:
         default = "" if o.required or o.default is None else f" (default {o.format_value(o.default)})"
@@ -634,8 +639,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="overwrite files of the same name")
     p.set_defaults(func=cmd_examples)
 
-    p = sub.add_parser("describe", help="list mechanisms and problem kinds, or describe one")
-    p.add_argument("name", nargs="?", help="a mechanism or a problem kind")
+    p = sub.add_parser(
+        "describe", help="list mechanisms and problem kinds, or describe one (a mechanism file: load, check, describe)"
+    )
+    p.add_argument("name", nargs="?", help="a mechanism, a problem kind or a mechanism file (.yaml)")
     p.add_argument("--mechanism", metavar="NAME", help="with a problem kind: its inputs and values for this mechanism")
     p.set_defaults(func=cmd_describe)
     return parser
