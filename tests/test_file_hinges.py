@@ -88,7 +88,7 @@ BAD = [
         "stiffness.hinges.revolute.tpye",
         "did you mean 'type'",
     ),
-    ("      type: circular_rod", "      type: circular_road", "stiffness.hinges.spherical.type", "did you mean"),
+    ("      type: filleted_rod", "      type: filleted_road", "stiffness.hinges.spherical.type", "did you mean"),
     (
         "  material: {name: Al 7075 (prs3-ruiz), E",
         "  material: {name: Al 7075 (prs3-ruiz), Young: 1, E",

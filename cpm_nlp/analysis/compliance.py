@@ -173,8 +173,54 @@ def _leaf_six(E, G, d) -> dict[str, float]:
     return out
 
 
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(32)
+
+
+def _filleted_rod_integrals(d: Mapping[str, float]) -> dict[str, float]:
+    """The section integrals of a round neck of diameter d and straight length l with
+    circular fillets of radius r at both ends (a revolved corner-filleted flexure,
+    Lobontiu 2002 ch. 2, with a circular section): over x from the centre,
+    ∫ dx/I, ∫ dx/J, ∫ dx/A, ∫ x² dx/I, the fillet diameter D(s) = d + 2r (1 - cos φ)
+    at s = r sin φ past the neck's end (32-point Gauss-Legendre in φ)."""
+    dia, length, r = d["d"], d["l"], d["r"]
+    half = length / 2.0
+    inertia, area = math.pi * dia**4 / 64.0, math.pi * dia**2 / 4.0
+    out = {"I": length / inertia, "A": length / area, "x2I": 2.0 * half**3 / 3.0 / inertia}
+    for node, weight in zip(_GL_NODES, _GL_WEIGHTS):
+        phi = (float(node) + 1.0) * math.pi / 4.0  # [0, pi/2]
+        ds = r * math.cos(phi) * float(weight) * math.pi / 4.0
+        D = dia + 2.0 * r * (1.0 - math.cos(phi))
+        x = half + r * math.sin(phi)
+        i_x, a_x = math.pi * D**4 / 64.0, math.pi * D**2 / 4.0
+        out["I"] += 2.0 * ds / i_x  # both fillets
+        out["A"] += 2.0 * ds / a_x
+        out["x2I"] += 2.0 * ds * x**2 / i_x
+    out["J"] = out["I"] / 2.0  # J = 2 I of a circle
+    return out
+
+
+def _filleted_rod_stiffness(E, G, d) -> dict[str, float]:
+    n = _filleted_rod_integrals(d)
+    out = {"bend": E / n["I"], "bend2": E / n["I"], "axial": E / n["A"]}
+    if G is not None:
+        out["torsion"] = G / n["J"]
+    return out
+
+
+def _filleted_rod_six(E, G, d) -> dict[str, float]:
+    n = _filleted_rod_integrals(d)
+    out = _filleted_rod_stiffness(E, G, d)
+    out["shear"] = out["shear2"] = 1.0 / (n["x2I"] / E + (10.0 / 9.0) * n["A"] / G)
+    return out
+
+
 #: the six-axis stiffness of each hinge type at its centre, (E, G, dims) -> {axis: k}
-SIX_AXIS_STIFFNESS = {"circular_notch": _notch_six, "circular_rod": _rod_six, "leaf_spring": _leaf_six}
+SIX_AXIS_STIFFNESS = {
+    "circular_notch": _notch_six,
+    "circular_rod": _rod_six,
+    "filleted_rod": _filleted_rod_six,
+    "leaf_spring": _leaf_six,
+}
 
 
 def six_axis_stiffness(h: Hinge) -> dict[str, float] | None:
@@ -216,6 +262,14 @@ HINGE_TYPES: dict[str, HingeType] = {
         "stiffness: E I/l, G J/l, E A/l of a round neck of diameter d and length l (fillets ignored: stiffer); "
         "stress: 32M/(pi d^3), 16T/(pi d^3), von Mises, times Kt (default 1)",
     ),
+    "filleted_rod": HingeType(
+        ("d", "l", "r"),
+        _filleted_rod_stiffness,
+        _rod_stress,
+        "stiffness: Euler-Bernoulli integrals over a round neck of diameter d and straight length l with "
+        "circular fillets of radius r at both ends (a revolved corner-filleted hinge, Lobontiu 2002 ch. 2); "
+        "stress: 32M/(pi d^3), 16T/(pi d^3) at the neck, von Mises, times Kt (default 1)",
+    ),
     "leaf_spring": HingeType(
         ("t", "l", "w"),
         _leaf_stiffness,
@@ -227,7 +281,7 @@ HINGE_TYPES: dict[str, HingeType] = {
 
 DIM_OPTIONS = {
     "t": Option("t", "length", "thickness at the thinnest section", lower=0.0, strict=True),
-    "r": Option("r", "length", "notch radius", lower=0.0, strict=True),
+    "r": Option("r", "length", "notch (or fillet) radius", lower=0.0, strict=True),
     "w": Option("w", "length", "hinge width (along its compliant axis)", lower=0.0, strict=True),
     "d": Option("d", "length", "neck diameter", lower=0.0, strict=True),
     "l": Option("l", "length", "hinge length", lower=0.0, strict=True),
