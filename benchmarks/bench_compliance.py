@@ -10,7 +10,8 @@ hinges of prs3-ruiz.md section 5.
 * **compliant_fk** -- the loaded pose under a 1 N load by IPOPT (warm, the
   solver built); target <= 20 ms.
 * **six_axis_compliance** -- the six-axis hinge model
-  (:mod:`cpm_nlp.analysis.hinge_chains`): the unloaded equilibrium at the
+  (:mod:`cpm_nlp.analysis.hinge_chains`): from the rigid pose, the chains'
+  variables fitted to it, the unloaded equilibrium at the
   commanded actuators (Newton on the KKT) and the 6x6 compliance there, with
   the actuators held; target <= 2 ms;
 * **six_axis_fk** -- the six-axis loaded pose under 1 N in x, y, z by IPOPT from
@@ -79,7 +80,7 @@ def main(argv=None) -> int:
     z0 = sm.start(sol.x, sol.q)
 
     def six_compliance():
-        ok, z, lam, _ = sm.newton(z0, np.zeros(6), q, None, None)
+        ok, z, lam, _ = sm.newton(sm.start(sol.x, sol.q), np.zeros(6), q, None, None)
         return sm.compliance(z, lam, None, None)
 
     _, z_u, _, _ = sm.newton(z0, np.zeros(6), q, None, None)

@@ -251,3 +251,60 @@ def test_filleted_neck_against_adaptive_quadrature():
     thin = cm.SIX_AXIS_STIFFNESS["filleted_rod"](E, G, {"d": d, "l": length, "r": 1e-12})
     for axis in cm.SIX_AXES:
         assert thin[axis] == pytest.approx(rod[axis], rel=1e-6)
+
+
+def _solve_file(tmp_path, text, *sets):
+    f = tmp_path / "p.yaml"
+    f.write_text(text)
+    cmd = [sys.executable, "-m", "cpm_nlp", "solve", str(f), "--json"]
+    for s in sets:
+        cmd += ["--set", s]
+    return subprocess.run(cmd, capture_output=True, text=True)
+
+
+RPS3 = f"""problem: platform_compliance
+mechanism: {{file: {ROOT / "problems/mechanisms/rps3.yaml"}}}
+inputs:
+  material: Al 7075-T6
+  hinges:
+    base: {{joints: a, type: circular_notch, t: 1 mm, r: 5 mm, w: 10 mm}}
+  load: {{px: 0.1 N, pz: 0.1 N, psi: 0.01 N*m}}
+"""
+
+
+def test_a_file_mechanism_of_the_gallery(tmp_path):
+    """The 3-RPS of the gallery with notch hinges given in the problem file: its chains come
+    from its legs; C is symmetric positive definite and the loaded pose follows C f."""
+    out = _solve_file(tmp_path, RPS3)
+    assert out.returncode == 0, out.stderr
+    v = json.loads(out.stdout)["values"]
+    assert v["hinge_model"] == "all"
+    C = np.array(v["C"])
+    np.testing.assert_allclose(C, C.T, atol=1e-12 * np.max(np.abs(C)))
+    assert np.all(np.linalg.eigvalsh(C) > 0)
+    np.testing.assert_allclose(v["deflection"], v["deflection_linear"], rtol=1e-3, atol=1e-3 * np.max(np.abs(C)))
+
+
+RPR = f"""problem: platform_compliance
+mechanism: {{file: {ROOT / "problems/mechanisms/rpr.yaml"}, parameters: {{r1: 40 mm, r2: 80 mm, P0: 40 mm}}}}
+inputs:
+  material: Al 7075-T6
+  k_actuator: 1e5 N/m
+  hinges:
+    a: {{joints: theta_R, type: circular_notch, t: 0.4 mm, r: 4 mm, w: 12 mm}}
+  load: {{P: 1 N}}
+"""
+
+
+def test_hinges_the_chains_cannot_place_fall_back_to_the_kinematic_model(tmp_path):
+    """The RPR file twin writes its R and U joints as expressions (its legs are S-P-S), so
+    its hinges are not in the chains: the default says so and uses the kinematic model;
+    asking for hinge_axes: all is bad input (exit 2, the key path, what to do)."""
+    out = _solve_file(tmp_path, RPR)
+    assert out.returncode == 0, out.stderr
+    res = json.loads(out.stdout)
+    assert res["values"]["hinge_model"] == "kinematic"
+    assert "cannot place" in res["message"]
+    bad = _solve_file(tmp_path, RPR, "inputs.hinge_axes=all")
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr
+    assert "inputs.hinges.a" in bad.stderr and "hinge_axes: kinematic" in bad.stderr

@@ -49,6 +49,7 @@ import scipy.linalg
 
 from ..core.chains import Chains
 from ..core.errors import InputError
+from ..core.kernels import FastFunction
 from ..core.model import Model
 from .compliance import HINGE_TYPES, SIX_AXES, HingeSet, six_axis_stiffness
 
@@ -225,10 +226,12 @@ class SixAxisModel:
             ["z", "lam", "par"],
             ["grad_L", "g", "H", "A", "V"],
         )
+        self._kkt_fast = FastFunction(self.kkt)
         self.closure_fn = ca.Function(f"{name}_six_axis_closure", [z], [g], ["z"], ["g"])
         self.energy_fn = ca.Function(f"{name}_six_axis_energy", [z], [U], ["z"], ["U"])
         self._nlp = {"x": z, "p": par, "f": V, "g": g}
         self._ipopt: Any = None
+        self._last_kkt: tuple | None = None
 
     # -- the hinges in the chains ---------------------------------------------------------------
     def _hinge_frames(self, hs: HingeSet, c, x_index, q_index, chains: Chains) -> list[HingeFrame]:
@@ -278,19 +281,35 @@ class SixAxisModel:
 
     # -- solves ---------------------------------------------------------------------------------
     def start(self, x: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """A start z at a rigid pose: the pose and actuators, the chains' variables fitted to it."""
+        """A start z at a rigid pose: the pose and actuators, the chains' variables from the
+        closure's passive joint values where it reports them, then fitted to the pose
+        (minimum-norm Gauss-Newton on the closures, the extra hinge axes starting at 0)."""
         z = self.rest.copy()
         z[: self.nx], z[self.nx : self.nx + self.nq] = x, q
+        c = self.model.closure
+        if c.passive is not None and self._dof:
+            now = np.asarray(c.passive(x, q, self.model.p), dtype=float).ravel()
+            ref = np.asarray(c.passive(self.chains.x_reference, self.chains.q_reference, self.model.p), dtype=float)
+            for k, name in enumerate(c.passive_names):
+                if name in self._dof and self._dof[name][0] >= self.nx + self.nq:
+                    z[self._dof[name][0]] = now[k] - ref.ravel()[k]
         free = np.arange(self.nx + self.nq, self.nz)
         par = np.zeros(self.nx + 3 * self.nq)
         for _ in range(30):
-            _, g, _, A, _ = self.kkt(z, np.zeros(self.ng), par)
-            g = np.asarray(g, dtype=float).ravel()
+            _, g, _, A = self._eval(z, np.zeros(self.ng), par)
             if np.max(np.abs(g)) < 1e-14:
                 break
-            Af = np.asarray(A, dtype=float)[:, free]
-            z[free] -= np.linalg.lstsq(Af, g, rcond=None)[0]
+            Af = A[:, free]
+            try:
+                z[free] -= Af.T @ np.linalg.solve(Af @ Af.T, g)
+            except np.linalg.LinAlgError:
+                z[free] -= np.linalg.lstsq(Af, g, rcond=None)[0]
         return z
+
+    def _eval(self, z: np.ndarray, lam: np.ndarray, par: np.ndarray) -> tuple[np.ndarray, ...]:
+        """grad_L (nz), g (ng), H (nz x nz), A (ng x nz) as numpy arrays."""
+        gl, g, H, A, _ = self._kkt_fast(z, lam, par)
+        return gl, g, H.reshape(self.nz, self.nz, order="F"), A.reshape(self.ng, self.nz, order="F")
 
     def newton(
         self, z0: np.ndarray, f: np.ndarray, qc: np.ndarray, ka: np.ndarray | None, Fc: np.ndarray | None
@@ -303,15 +322,18 @@ class SixAxisModel:
         free = self._free(ka)
         if ka is None:
             z[self.nx : self.nx + self.nq] = qc
+        length = max(1.0, self.model.characteristic_length)
         for it in range(1, 31):
-            gl, g, H, A, _ = self.kkt(z, lam, par)
-            r = np.concatenate([np.asarray(gl, dtype=float).ravel()[free], np.asarray(g, dtype=float).ravel()])
-            K = self._kkt_matrix(np.asarray(H, dtype=float), np.asarray(A, dtype=float), free)
+            gl, g, H, A = self._eval(z, lam, par)
+            r = np.concatenate([gl[free], g])
+            K = self._kkt_matrix(H, A, free)
             step = _solve(K, -r)
             z[free] += step[: len(free)]
             lam += step[len(free) :]
-            dz = np.max(np.abs(step[: len(free)]))
-            if dz < 1e-15 * max(1.0, self.model.characteristic_length) and np.max(np.abs(r[len(free) :])) < 1e-14:
+            if np.max(np.abs(step[: len(free)])) < 1e-10 * length and np.max(np.abs(g)) < 1e-12 * length:
+                # Newton converges quadratically: the next step would be below 1e-20, and the
+                # KKT matrix of this one serves the linearization (it moves by O(step))
+                self._last_kkt = (z.copy(), lam.copy(), ka is None, K)
                 return True, z, lam, it
         return False, z, lam, 30
 
@@ -342,9 +364,13 @@ class SixAxisModel:
     def compliance(self, z: np.ndarray, lam: np.ndarray, ka: np.ndarray | None, Fc: np.ndarray | None) -> np.ndarray:
         """C = Eᵀ dz/df (nx x nx) at an equilibrium (z, λ)."""
         par = self._par(np.zeros(self.nx), z[self.nx : self.nx + self.nq], ka, Fc)
-        _, _, H, A, _ = self.kkt(z, lam, par)
         free = self._free(ka)
-        K = self._kkt_matrix(np.asarray(H, dtype=float), np.asarray(A, dtype=float), free)
+        last = self._last_kkt
+        if last is not None and last[2] and ka is None and np.array_equal(last[0], z) and np.array_equal(last[1], lam):
+            K = last[3]  # the load enters the KKT matrix only through λ: the same matrix
+        else:
+            _, _, H, A = self._eval(z, lam, par)
+            K = self._kkt_matrix(H, A, free)
         rhs = np.zeros((K.shape[0], self.nx))
         rhs[: self.nx, :] = np.eye(self.nx)  # the pose coordinates come first among the free variables
         dz = _solve(K, rhs)

@@ -13,6 +13,7 @@ given under ``inputs.hinges``); the method is :mod:`cpm_nlp.analysis.compliance`
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping
 from typing import Any
 
@@ -40,6 +41,8 @@ from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.solver import SolverConfig
 from ..core.units import parse_quantity
 from .kinematic import _model_info, _pose_names, _pose_values, _si
+
+log = logging.getLogger(__name__)
 
 #: inputs parsed by hand (mappings), declared for ``describe``
 _SPECIAL = ("hinges", "material", "load", "masses")
@@ -127,6 +130,14 @@ def _check_pose_inputs(model: Model, inputs: Mapping[str, Any], path: tuple, req
         broadcast([inputs[n] for n in c.q_names], c.q_names, path)
     elif pose_keys or required:
         broadcast(task_values(inputs, model, path), list(c.task), path)
+
+
+def _commanded_pose(model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> PoseSolution:
+    """The one pose a scalar kind works at: the given actuators or pose, else home."""
+    c = model.closure
+    if given(inputs, c.q_names) or given(inputs, [o.name for o in task_options(model, "scalar")]):
+        return _solve_poses(model, inputs, solver)[0][0]
+    return inverse_kinematics(model, model.task_of(model.x_home), solver)
 
 
 def _summary(sols: list[PoseSolution], batch: bool) -> tuple[Status, str, list[Status] | None]:
@@ -430,8 +441,16 @@ class PlatformCompliance(_HingeKind):
                 hint="use hinge_axes: kinematic",
             )
         inputs["six_axis"] = None
-        if axes == "all" or (axes is None and has_chains):
+        if axes == "all":
             inputs["six_axis"] = six_axis_model(model, inputs["hinge_set"])
+        elif axes is None and has_chains:
+            try:  # the default: the six-axis model where it can place every hinge
+                inputs["six_axis"] = six_axis_model(model, inputs["hinge_set"])
+            except InputError as exc:
+                log.info("platform_compliance: the kinematic hinge model (%s)", exc.message)
+                inputs["fallback"] = (
+                    f"; hinge_axes: kinematic, as the six-axis model cannot place the hinges ({exc.message})"
+                )
         return inputs
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
@@ -441,18 +460,23 @@ class PlatformCompliance(_HingeKind):
         c = model.closure
         hs: cm.HingeSet = inputs["hinge_set"]
         f, ka = inputs["load"], inputs["k_actuator"]
-        if given(inputs, c.q_names) or given(inputs, [o.name for o in task_options(model, "scalar")]):
-            sol = _solve_poses(model, inputs, solver)[0][0]
-        else:
-            sol = inverse_kinematics(model, model.task_of(model.x_home), solver)
+        sol = _commanded_pose(model, inputs, solver)
         names, dims = _pose_names(model)
         units = {n: _si(dims[n]) for n in names}
         values = _pose_values(model, [sol], False)
         info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
         if not sol.ok:
             return Result(self.name, sol.status, values, units, dims, info, sol.message, None, _model_info(model))
+        note = inputs.get("fallback", "")
         if inputs["six_axis"] is not None:
-            return self._run_six_axis(model, inputs, sol, (values, units, dims, info))
+            res = self._run_six_axis(model, inputs, sol, (values, units, dims, info))
+            if res is not None:
+                return res
+            note = (
+                "; the six-axis hinge model is singular here (a motion of the legs' chains meets no hinge, "
+                "e.g. a leg's spin between two spherical joints), so the default fell back to hinge_axes: kinematic"
+            )
+        values["hinge_model"], dims["hinge_model"], units["hinge_model"] = "kinematic", "text", ""
         sp = cm.static_point(model, hs, sol.x, sol.q)
         try:
             C = cm.output_compliance(sp, ka)
@@ -496,10 +520,11 @@ class PlatformCompliance(_HingeKind):
             status = Status.NOT_CONVERGED
         if ka is None:
             message += "; actuators rigidly held: a pseudo-rigid-body model with rigid links does not deflect"
+        message += note
         info = SolverInfo("ipopt", sol.iterations + loaded.iterations, sol.seconds)
         return Result(self.name, status, values, units, dims, info, message, None, _model_info(model))
 
-    def _run_six_axis(self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, parts: tuple) -> Result:  # noqa: C901 - unloaded, linearized, loaded, then one value family each
+    def _run_six_axis(self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, parts: tuple) -> Result | None:  # noqa: C901 - unloaded, linearized, loaded, then one value family each
         """The six-axis hinge model: the unloaded equilibrium at the commanded actuators, the
         output compliance there, and the loaded pose by IPOPT."""
         values, units, dims, info = parts
@@ -507,18 +532,21 @@ class PlatformCompliance(_HingeKind):
         sm: SixAxisModel = inputs["six_axis"]
         f, ka = inputs["load"], inputs["k_actuator"]
         xs = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
-        z0 = sm.start(sol.x, sol.q)
-        ok, z_u, lam_u, it_u = sm.newton(z0, np.zeros(c.nx), sol.q, None, None)
-        if not ok:
-            msg = "six-axis hinge model: no unloaded equilibrium at the commanded actuators (Newton on the KKT)"
-            return Result(self.name, Status.NOT_CONVERGED, values, units, dims, info, msg, None, _model_info(model))
-        Fc = sm.actuator_reactions(z_u, lam_u, np.zeros(c.nx))
         try:
+            z0 = sm.start(sol.x, sol.q)
+            ok, z_u, lam_u, it_u = sm.newton(z0, np.zeros(c.nx), sol.q, None, None)
+            if not ok:
+                msg = "six-axis hinge model: no unloaded equilibrium at the commanded actuators (Newton on the KKT)"
+                return Result(self.name, Status.NOT_CONVERGED, values, units, dims, info, msg, None, _model_info(model))
+            Fc = sm.actuator_reactions(z_u, lam_u, np.zeros(c.nx))
             C = sm.compliance(z_u, lam_u, ka, None if ka is None else Fc)
         except np.linalg.LinAlgError:
+            if inputs.get("hinge_axes") is None:
+                return None  # the default: the caller falls back to the kinematic model
             msg = (
-                "the six-axis hinge model's stiffness is singular: a motion meets no hinge and no actuator "
-                "(give a positive k_actuator, or more hinges)"
+                "the six-axis hinge model's stiffness is singular: a motion of the legs' chains meets no hinge and "
+                "no actuator (e.g. a leg's spin between two spherical joints; give a positive k_actuator, more "
+                "hinges, or hinge_axes: kinematic)"
             )
             return Result(self.name, Status.SINGULAR, values, units, dims, info, msg, None, _model_info(model))
         values.update(C=C.tolist(), deflection_linear=(C @ f).tolist(), hinge_model="all")
@@ -632,10 +660,7 @@ class NaturalFrequencies(_HingeKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         c = model.closure
         hs: cm.HingeSet = inputs["hinge_set"]
-        if given(inputs, c.q_names) or given(inputs, [o.name for o in task_options(model, "scalar")]):
-            sol = _solve_poses(model, inputs, solver)[0][0]
-        else:
-            sol = inverse_kinematics(model, model.task_of(model.x_home), solver)
+        sol = _commanded_pose(model, inputs, solver)
         names, dims = _pose_names(model)
         units = {n: _si(dims[n]) for n in names}
         values = _pose_values(model, [sol], False)
