@@ -75,6 +75,21 @@ assert {r["category"] for r in doc["figures"]} >= {"published", "derived", "read
 print(f"smoke: reproduce: {s['figures']} figures, {s['agree_independent']} independent agreements, 0 unexpected")
 PY
 
+step "compliance from the wheel: Table 2 forces, the six-axis cutting force, a file mechanism's hinges"
+cpm-nlp examples compl > /dev/null
+cpm-nlp solve compl/problems/prs3_table2_forces.yaml --json > forces.json
+cpm-nlp solve compl/problems/prs3_cutting_force.yaml --json > cutting.json
+cpm-nlp solve compl/problems/prs3_file_table2_forces.yaml --json > file_forces.json
+python - <<'PY'
+import json
+f, c, ff = (json.load(open(n)) for n in ("forces.json", "cutting.json", "file_forces.json"))
+assert f["status"] == c["status"] == ff["status"] == "solved", (f["status"], c["status"], ff["status"])
+assert abs(f["values"]["F1"] - 20) < 1 and abs(ff["values"]["F1"] - f["values"]["F1"]) < 1e-9
+assert c["values"]["hinge_model"] == "all" and abs(c["values"]["d_px"]) > 1e-7
+print(f"smoke: F1 = {f['values']['F1']:.3f} N, cutting-force deflection px = {c['values']['d_px'] * 1e6:.3f} um")
+PY
+rm -rf compl
+
 step "export"
 cpm-nlp export my_fk.yaml --out exported > /dev/null
 test -s exported/manifest.json

@@ -121,13 +121,16 @@ def test_interrupted_sweep_resumes_without_solving_twice(cluster, tmp_path):
 
 
 def _kill_a_busy_worker(client, killed):
-    """A progress callback: at the first result, SIGKILL a worker that is processing a task."""
+    """A progress callback: at the first result at which a worker is processing a task,
+    SIGKILL that worker."""
 
     def callback(done, total):
         if done == 0 or killed:
             return
         busy = [w for w, keys in client.processing().items() if keys]
-        pids = client.run(os.getpid, workers=busy[:1])
+        pids = client.run(os.getpid, workers=busy[:1]) if busy else {}
+        if not pids:  # no worker busy at this instant (both just finished): try at the next result
+            return
         victim = next(iter(pids.values()))
         os.kill(victim, signal.SIGKILL)
         killed.append(victim)
