@@ -1149,6 +1149,10 @@ def ellipsoid_figure(
             a = V[:, k] * w[k] * f
             ax.plot([-a[0], a[0]], [-a[1], a[1]], [-a[2], a[2]], color="tab:red", lw=2)
         ax.set_zlabel(axis_label(names[2], unit + "/N"))
+        # equal scales on the three axes, so a flat ellipsoid looks flat (not a sphere)
+        lim = 1.05 * peak * f or 1.0
+        ax.set_xlim(-lim, lim), ax.set_ylim(-lim, lim), ax.set_zlim(-lim, lim)
+        ax.set_box_aspect((1, 1, 1))
     else:
         ax = fig.add_subplot(1, panels, panels)
         t = np.linspace(0, 2 * np.pi, 200)
