@@ -308,3 +308,37 @@ def test_hinges_the_chains_cannot_place_fall_back_to_the_kinematic_model(tmp_pat
     bad = _solve_file(tmp_path, RPR, "inputs.hinge_axes=all")
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
     assert "inputs.hinges.a" in bad.stderr and "hinge_axes: kinematic" in bad.stderr
+
+
+@pytest.mark.parametrize(
+    ("setting", "needle"),
+    [
+        ("inputs.hinge_axes=kinematc", "did you mean 'kinematic'"),
+        ("inputs.hinge_axes=six", "expected one of 'all', 'kinematic'"),
+        ("inputs.hinges.spherical.r=-4 mm", "inputs.hinges.spherical.r"),
+        ("inputs.load={px: 1 N*m}", "is not a force"),
+    ],
+)
+def test_bad_input_of_the_six_axis_kind(setting, needle):
+    """One clear message and exit 2, the input file untouched."""
+    path = ROOT / "problems/prs3_cutting_force.yaml"
+    before = path.read_bytes()
+    out = subprocess.run(
+        [sys.executable, "-m", "cpm_nlp", "solve", str(path), "--set", setting], capture_output=True, text=True
+    )
+    assert out.returncode == 2 and needle in out.stderr and "Traceback" not in out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1
+    assert path.read_bytes() == before
+
+
+def test_a_load_beyond_reach_is_reported_not_converged():
+    """10^9 N: IPOPT does not find the loaded pose; the result says so (exit 1), no number."""
+    out = subprocess.run(
+        [sys.executable, "-m", "cpm_nlp", "solve", str(ROOT / "problems/prs3_cutting_force.yaml"), "--json"]
+        + ["--set", "inputs.load={px: 1e9 N}"],
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode == 1
+    res = json.loads(out.stdout)
+    assert res["status"] == "not_converged" and "deflection" not in res["values"]

@@ -407,7 +407,7 @@ class PlatformCompliance(_HingeKind):
             ),
             Option(
                 "hinge_axes",
-                "str",
+                "choice",
                 "the hinge model: 'all' (every flexure a six-axis spring at its joint, the axes the kinematics does "
                 "not move with the flexure library's stiffness; needs the mechanism's leg chains) or 'kinematic' "
                 "(pseudo-rigid-body: each hinge only about the axes the kinematics moves; with the actuators held "
