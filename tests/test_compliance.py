@@ -566,3 +566,19 @@ def test_prs3_vertical_mode_against_a_hand_value():
     assert res.values["f1"] == pytest.approx(math.sqrt(kz / m) / (2 * math.pi), rel=1e-6)
     shape = np.array(res.values["modes_x"][0])
     assert abs(shape[2]) > 1e3 * max(abs(shape[3]), abs(shape[4]))  # a pure z translation
+
+
+def test_an_inertia_from_a_block_of_the_material(tmp_path):
+    """masses.psi as a block turning about x: m (w^2 + h^2)/12 by hand, m = rho a b c."""
+    from cpm_nlp.analysis.dynamics import parse_inertia
+
+    rho = 2810.0
+    got = parse_inertia({"length": "120 mm", "width": "120 mm", "height": "10 mm", "about": "x"}, rho, "Al", ("m",))
+    m = rho * 0.12 * 0.12 * 0.01
+    assert got == pytest.approx(m * (0.12**2 + 0.01**2) / 12, rel=1e-12)
+    z = parse_inertia({"length": "120 mm", "width": "60 mm", "height": "10 mm", "about": "z"}, rho, "Al", ("m",))
+    assert z == pytest.approx(rho * 0.12 * 0.06 * 0.01 * (0.12**2 + 0.06**2) / 12, rel=1e-12)
+    with pytest.raises(InputError, match="did you mean 'x'|expected one of"):
+        parse_inertia({"length": "1 mm", "width": "1 mm", "height": "1 mm", "about": "X"}, rho, "Al", ("m",))
+    with pytest.raises(InputError, match="density"):
+        parse_inertia({"length": "1 mm", "width": "1 mm", "height": "1 mm", "about": "x"}, None, "Al", ("m",))

@@ -62,6 +62,33 @@ def parse_mass(raw: Any, density: float | None, material: str, path: tuple) -> f
     return mass
 
 
+#: a block's inertia about an axis through its centre: the block's own axes are x
+#: along its length, y along its width, z along its height
+INERTIA_BLOCK = (
+    *BLOCK,
+    Option("about", "choice", "the axis the coordinate turns the block about", choices=("x", "y", "z")),
+)
+
+
+def parse_inertia(raw: Any, density: float | None, material: str, path: tuple) -> float:
+    """An inertia: a quantity ("2e-4 kg*m^2") or a rectangular block ``{length, width,
+    height, about}`` of the material turning about its x (length), y (width) or z
+    (height) axis through its centre: m (b² + c²)/12 of the other two sides."""
+    if isinstance(raw, Mapping):
+        dims = validate_mapping(raw, INERTIA_BLOCK, path, what="block key")
+        mass = parse_mass({k: raw[k] for k in ("length", "width", "height")}, density, material, path)
+        sides = {"x": ("width", "height"), "y": ("length", "height"), "z": ("length", "width")}[dims["about"]]
+        return mass * (dims[sides[0]] ** 2 + dims[sides[1]] ** 2) / 12.0
+    inertia = parse_quantity(raw, "inertia", path)
+    if not inertia > 0:
+        raise InputError(
+            f"expected a positive inertia such as '2e-4 kg*m^2' or a block {{length, width, height, about}}, "
+            f"got {raw!r}",
+            path=path,
+        )
+    return inertia
+
+
 @functools.lru_cache(maxsize=8)
 def linearized(lagrangian: ca.Function) -> ca.Function:
     """``("lagrange_matrices", [q0, p, w], [M, K, G])`` from a Lagrangian

@@ -22,7 +22,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..analysis import compliance as cm
-from ..analysis.dynamics import parse_mass
+from ..analysis.dynamics import parse_inertia, parse_mass
 from ..analysis.hinge_chains import SixAxisModel, six_axis_model
 from ..core.errors import InputError, unknown_key_error
 from ..core.kind import (
@@ -616,7 +616,8 @@ class NaturalFrequencies(_HingeKind):
                 "masses",
                 "str",
                 "mass (on a length coordinate: '12 g', or a block {length, width, height} of the material) or "
-                "inertia (on an angle coordinate, kg*m^2) per pose or actuator coordinate: "
+                "inertia (on an angle coordinate: kg*m^2, or a block {length, width, height, about: x|y|z} of the "
+                "material turning about its own axis through its centre) per pose or actuator coordinate: "
                 + ", ".join(model.closure.x_names + model.closure.q_names),
             )
         )
@@ -644,9 +645,7 @@ class NaturalFrequencies(_HingeKind):
             if coord.kind == "length":
                 m = parse_mass(value, mat.density if mat else None, mat.name if mat else "?", path + ("masses", key))
             else:
-                m = parse_quantity(value, "inertia", path + ("masses", key))
-                if not m > 0:
-                    raise InputError(f"expected a positive inertia, got {value!r}", path=path + ("masses", key))
+                m = parse_inertia(value, mat.density if mat else None, mat.name if mat else "?", path + ("masses", key))
             if key in c.x_names:
                 mx[c.x_names.index(key)] = m
             else:
