@@ -40,6 +40,8 @@ the model (declare it as a hinge of its own to include it).
 from __future__ import annotations
 
 import logging
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -443,12 +445,47 @@ def _solve(K: np.ndarray, r: np.ndarray) -> np.ndarray:
     return y * (s[:, None] if r.ndim == 2 else s)
 
 
+#: built six-axis models by content (mechanism, parameters, hinges): symbolic construction
+#: and the IPOPT set-up once per design, not once per solve (a sweep over loads or poses)
+_BUILT: OrderedDict[tuple, SixAxisModel] = OrderedDict()
+_BUILT_MAX = 8
+_LOCK = threading.Lock()
+
+
+def _key(model: Model, hs: HingeSet) -> tuple:
+    mech = model.mechanism
+    hinges = tuple(
+        (
+            h.name,
+            h.kind,
+            tuple(sorted(h.dims.items())),
+            tuple(sorted(h.k.items())),
+            tuple(sorted(h.axes.items())),
+            None if h.material is None else (h.material.E, h.material.nu),
+        )
+        for h in hs.hinges
+    )
+    return (mech.name, mech.origin, tuple(np.asarray(model.p, dtype=float)), tuple(model.x_home), hinges)
+
+
 def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
-    """The six-axis hinge model, or None when the mechanism gives no chains."""
+    """The six-axis hinge model, or None when the mechanism gives no chains (built once per
+    mechanism, parameters and hinges, then reused)."""
     mech = model.mechanism
     if mech is None or mech.chains is None:
         return None
-    return SixAxisModel(model, hs, mech.chains(model))
+    key = _key(model, hs)
+    with _LOCK:
+        built = _BUILT.get(key)
+        if built is not None:
+            _BUILT.move_to_end(key)
+            return built
+    built = SixAxisModel(model, hs, mech.chains(model))
+    with _LOCK:
+        _BUILT[key] = built
+        while len(_BUILT) > _BUILT_MAX:
+            _BUILT.popitem(last=False)
+    return built
 
 
 __all__ = ["HingeFrame", "SixAxisModel", "six_axis_model"]
