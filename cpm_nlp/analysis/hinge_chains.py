@@ -53,6 +53,7 @@ from ..core.chains import Chains
 from ..core.errors import InputError
 from ..core.kernels import FastFunction
 from ..core.model import Model
+from ..core.screws import skew
 from .compliance import HINGE_TYPES, SIX_AXES, HingeSet, six_axis_stiffness
 
 log = logging.getLogger(__name__)
@@ -62,12 +63,8 @@ _ROT_AXES = ("bend", "bend2", "torsion")
 
 def _rot(axis: np.ndarray, angle: Any) -> Any:
     """Rotation by ``angle`` about the unit ``axis`` (Rodrigues)."""
-    K = ca.DM(_skew(axis))
+    K = ca.DM(skew(axis))
     return ca.DM.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
-
-
-def _skew(a: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

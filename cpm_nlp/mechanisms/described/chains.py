@@ -15,9 +15,7 @@ import casadi as ca
 import numpy as np
 
 from ...core.chains import JOINT_DOF, ChainJoint, Chains, LegChain
-from .generate import Generator
-
-_E = (ca.DM([1.0, 0.0, 0.0]), ca.DM([0.0, 1.0, 0.0]), ca.DM([0.0, 0.0, 1.0]))
+from .generate import Generator, elementary_motions
 
 
 def supported(gen: Generator) -> bool:
@@ -25,18 +23,6 @@ def supported(gen: Generator) -> bool:
     if gen.d.platform.planar or not gen.leg_joints:
         return False
     return all(j.type in JOINT_DOF for _leg, joints in gen.leg_joints for j in joints)
-
-
-def _motions(j: Any) -> tuple[list[str], list[Any]]:
-    if j.type == "P":
-        return ["P"], [j.axis]
-    if j.type == "R":
-        return ["R"], [j.axis]
-    if j.type == "C":
-        return ["R", "P"], [j.axis, j.axis]
-    if j.type == "U":
-        return ["R", "R"], list(j.axes)
-    return ["R", "R", "R"], list(j.axes) or list(_E)  # S
 
 
 def _names(j: Any) -> tuple[str, ...]:
@@ -54,7 +40,8 @@ def chains_function(gen: Generator):
     for leg, joints in gen.leg_joints:
         rows = []
         for j in joints:
-            kinds, axes = _motions(j)
+            motions = elementary_motions(j)
+            kinds, axes = [m[0] for m in motions], [m[1] for m in motions]
             outs.append(j.at)
             outs.append(ca.horzcat(*axes))
             gain = ca.SX(0)

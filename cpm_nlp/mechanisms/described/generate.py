@@ -84,6 +84,21 @@ class _Joint:
         return self.spec.type
 
 
+def elementary_motions(j: _Joint) -> list[tuple[str, Any]]:
+    """A joint's degrees of freedom as elementary motions ("P" | "R", axis), in the order
+    of its coordinates (product of exponentials about its reference axes)."""
+    e = [ca.DM([1.0, 0, 0]), ca.DM([0, 1.0, 0]), ca.DM([0, 0, 1.0])]
+    return {
+        "P": [("P", j.axis)],
+        "planar_P": [("P", j.axis)],
+        "R": [("R", j.axis)],
+        "planar_R": [("R", j.axis)],
+        "C": [("R", j.axis), ("P", j.axis)],
+        "U": [("R", a) for a in j.axes],
+        "S": [("R", a) for a in (j.axes or e)],
+    }[j.type]
+
+
 @dataclass
 class _Reported:
     coord: Coordinate
@@ -431,16 +446,7 @@ class Generator:
         """A passive joint of the proximal chain: its values become pose unknowns (dependent coordinates)."""
         if j.type == "distance":
             raise InputError(f"leg {leg.name}: a distance joint must be the last of its leg", path=j.spec.path)
-        e = [ca.DM([1.0, 0, 0]), ca.DM([0, 1.0, 0]), ca.DM([0, 0, 1.0])]
-        elementary = {
-            "P": [("P", j.axis)],
-            "planar_P": [("P", j.axis)],
-            "R": [("R", j.axis)],
-            "planar_R": [("R", j.axis)],
-            "C": [("R", j.axis), ("P", j.axis)],
-            "U": [("R", a) for a in j.axes],
-            "S": [("R", a) for a in (j.axes or e)],
-        }[j.type]
+        elementary = elementary_motions(j)
         names = j.spec.coordinates or tuple(f"{leg.name}_j{k + 1}_{n + 1}" for n in range(len(elementary)))
         j.names = tuple(names)
         for n, ((kind, axis), name) in enumerate(zip(elementary, names)):
