@@ -227,7 +227,6 @@ class SixAxisModel:
         )
         self._kkt_fast = FastFunction(self.kkt)
         self.closure_fn = ca.Function(f"{name}_six_axis_closure", [z], [g], ["z"], ["g"])
-        self.energy_fn = ca.Function(f"{name}_six_axis_energy", [z], [U], ["z"], ["U"])
         self._nlp = {"x": z, "p": par, "f": V, "g": g}
         self._ipopt: Any = None
         self._last_kkt: tuple | None = None
