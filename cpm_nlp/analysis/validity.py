@@ -255,23 +255,21 @@ def check_hinges(
 def linear_range_warnings(
     nonlinear: np.ndarray, linear: np.ndarray, names: Sequence[str], kinds: Sequence[str]
 ) -> list[ResultWarning]:
-    """Compliant FK: the loaded pose's deflection against C f, coordinate by coordinate.
-    A coordinate counts when its deflection is not negligible (above 1e-6 of the largest
-    of its kind, lengths and angles apart); the warning names the worst one."""
+    """Compliant FK: the loaded pose's deflection against C f.  Lengths and angles
+    apart, the relative difference of the two deflection vectors,
+    |d - C f| / max(|d|, |C f|) (2-norms), against :data:`LINEAR_RANGE`; the warning
+    names the coordinate that differs most in the worse group."""
     d, lin = np.asarray(nonlinear, dtype=float), np.asarray(linear, dtype=float)
     worst: tuple[float, int] | None = None
-    for kind in set(kinds):
+    for kind in sorted(set(kinds)):
         idx = [i for i, k in enumerate(kinds) if k == kind]
-        scale = max(max(abs(d[i]), abs(lin[i])) for i in idx)
-        if not scale > 0:
+        size = max(float(np.linalg.norm(d[idx])), float(np.linalg.norm(lin[idx])))
+        if not size > 0:
             continue
-        for i in idx:
-            size = max(abs(d[i]), abs(lin[i]))
-            if size < 1e-6 * scale:
-                continue
-            rel = abs(d[i] - lin[i]) / size
-            if worst is None or rel > worst[0]:
-                worst = (rel, i)
+        rel = float(np.linalg.norm(d[idx] - lin[idx])) / size
+        i = idx[int(np.argmax(np.abs(d[idx] - lin[idx])))]
+        if worst is None or rel > worst[0]:
+            worst = (rel, i)
     if worst is None or not worst[0] > LINEAR_RANGE:
         return []
     rel, i = worst
@@ -280,7 +278,8 @@ def linear_range_warnings(
         ResultWarning(
             "beyond_linear_range",
             f"the load is beyond the linear range: the deflection of {names[i]} is {d[i] * k:.4g} {unit}, the "
-            f"linearised C f gives {lin[i] * k:.4g} {unit} ({rel:.0%} apart, more than {LINEAR_RANGE:.0%})",
+            f"linearised C f gives {lin[i] * k:.4g} {unit} (the deflections differ by {rel:.0%}, more than "
+            f"{LINEAR_RANGE:.0%})",
             f"d_{names[i]}",
             float(rel),
             LINEAR_RANGE,
