@@ -29,7 +29,7 @@ from .core.kinematics import (
 )
 from .core.mechanism import CuboidExtras, DynamicsModel, JointStiffness, Mechanism, declare
 from .core.model import Coordinate, LoopClosure, Model
-from .core.result import Result, SolverInfo, Status
+from .core.result import Result, ResultWarning, SolverInfo, Status
 from .core.solver import SolverConfig
 from .core.version import __version__
 from .io.embed import ModelFunctions, model_functions
@@ -114,6 +114,7 @@ __all__ = [
     "ProblemKind",
     "RequirementsReport",
     "Result",
+    "ResultWarning",
     "SolverConfig",
     "SolverInfo",
     "Status",

@@ -94,7 +94,9 @@ def render_result(result: Result, title: str = "") -> str:
 
     lines = []
     lines.append(f"problem : {result.problem}" + (f"  ({title})" if title else ""))
-    lines.append(f"status  : {result.status.value}  -- {result.message or STATUS_TEXT[result.status]}")
+    n = len(result.warnings)
+    flagged = f", with {n} warning{'s' if n != 1 else ''} (below)" if n else ""
+    lines.append(f"status  : {result.status.value}{flagged}  -- {result.message or STATUS_TEXT[result.status]}")
     s = result.solver
     lines.append(f"solver  : {s.name}, {s.iterations} iterations, {s.seconds * 1e3:.2f} ms")
     if result.model:
@@ -106,7 +108,7 @@ def render_result(result: Result, title: str = "") -> str:
         lines.append("model   : " + result.model.get("type", "") + ": " + ", ".join(parts) + "  (SI)")
     if not result.values:
         lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
-        return "\n".join(lines)
+        return "\n".join(lines + _warning_lines(result))
     width = max(len(k) for k in result.values)
     lines.append("")
     for name, value in result.values.items():
@@ -120,7 +122,14 @@ def render_result(result: Result, title: str = "") -> str:
         else:
             si, friendly = _fmt_scalar(value, dim)
             lines.append(f"{name:<{width}}  {si:<22}" + (f"  {friendly}" if friendly else ""))
-    return "\n".join(lines)
+    return "\n".join(lines + _warning_lines(result))
+
+
+def _warning_lines(result: Result) -> list[str]:
+    """The result's warnings, one "warning: ..." line each, after a blank line."""
+    if not result.warnings:
+        return []
+    return ["", *(f"warning: {w.message}" for w in result.warnings)]
 
 
 # -- subcommands --------------------------------------------------------------------------------

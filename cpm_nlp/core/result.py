@@ -86,6 +86,65 @@ def _jsonable(value: Any) -> Any:
 
 
 @dataclass
+class ResultWarning:
+    """A result outside its model's validity: the numbers are given, and why
+    they should not be trusted as they stand (a stress above the material's
+    yield, a deflection beyond the hinge formula's range, a pose near a
+    singularity ...).
+
+    code: a stable identifier (see :data:`WARNING_CODES`); message: one line for
+    a person; where: what it is about (a hinge, a value, a key path); value and
+    limit: the number found and the bound it broke (SI), where there are such.
+    """
+
+    code: str
+    message: str
+    where: str = ""
+    value: float | None = None
+    limit: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "code": self.code,
+            "message": self.message,
+            "where": self.where,
+            "value": _jsonable(self.value),
+            "limit": _jsonable(self.limit),
+        }
+
+    @classmethod
+    def from_dict(cls, d: Any) -> ResultWarning:
+        """A warning read back from a result's JSON (tolerant: a damaged entry keeps its text)."""
+        if not isinstance(d, dict):
+            return cls("unknown", str(d))
+
+        def num(v: Any) -> float | None:
+            return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+
+        return cls(
+            str(d.get("code", "unknown")),
+            str(d.get("message", "")),
+            str(d.get("where", "") or ""),
+            num(d.get("value")),
+            num(d.get("limit")),
+        )
+
+    def __str__(self) -> str:
+        return self.message
+
+
+#: Codes of :class:`ResultWarning` (docs/site/howto/read-status.md lists them).
+WARNING_CODES = {
+    "stress_above_yield": "a hinge stress above its material's yield strength",
+    "stress_above_allowable": "a hinge stress above the allowable (design) stress",
+    "deflection_beyond_formula": "a hinge deflection beyond the range of its stiffness formula",
+    "hinge_geometry": "a hinge geometry outside its formula's validity",
+    "beyond_linear_range": "compliant FK: linear and nonlinear deflection differ by more than 10 %",
+    "near_singular": "a pose near a singularity (ill-conditioned Jacobian)",
+}
+
+
+@dataclass
 class Result:
     """The answer to one problem.
 
@@ -106,10 +165,21 @@ class Result:
     message: str = ""
     statuses: list[Status] | None = None  # per point, for batches
     model: dict[str, Any] = field(default_factory=dict)  # parameters used, SI
+    #: where the numbers are outside their model's validity (empty when clean)
+    warnings: list[ResultWarning] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
         return self.status.ok
+
+    def warn(self, *warnings: ResultWarning) -> Result:
+        """Add warnings (one per code and place: a repeated one is kept once)."""
+        seen = {(w.code, w.where) for w in self.warnings}
+        for w in warnings:
+            if (w.code, w.where) not in seen:
+                seen.add((w.code, w.where))
+                self.warnings.append(w)
+        return self
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {
@@ -124,6 +194,7 @@ class Result:
             out["statuses"] = [s.value for s in self.statuses]
         if self.model:
             out["model"] = _jsonable(self.model)
+        out["warnings"] = [w.to_dict() for w in self.warnings]
         return out
 
     def to_json(self, indent: int | None = 2) -> str:

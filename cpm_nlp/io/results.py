@@ -1,7 +1,9 @@
 """Results files of sweeps: one row per point, written as points finish.
 
 Columns: ``point`` (its number in the sweep), one column per swept key (SI
-values), ``status``, ``message``, ``seconds`` (wall time of the point), then
+values), ``status``, ``message``, ``seconds`` (wall time of the point),
+``warnings`` (the point's result warnings, a JSON list of
+``{code, message, where, value, limit}``, ``[]`` when clean), then
 the recorded result values (SI; ``null``/empty where the point did not
 solve; a list is stored as JSON text).  The file also carries metadata: the
 sweep's fingerprint, its parameters and their dimensions, and the units of
@@ -63,6 +65,17 @@ class SweepTable:
 
     def column(self, name: str) -> list[Any]:
         return [r.get(name) for r in self.rows]
+
+    def warnings(self) -> list[list[Any]]:
+        """Each row's result warnings (:class:`~cpm_nlp.core.result.ResultWarning`; [] for a
+        file written before sweeps recorded them)."""
+        from ..core.result import ResultWarning
+
+        out = []
+        for r in self.rows:
+            raw = r.get("warnings")
+            out.append([ResultWarning.from_dict(w) for w in raw] if isinstance(raw, list) else [])
+        return out
 
 
 def results_format(path: str | os.PathLike) -> str:

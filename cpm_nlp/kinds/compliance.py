@@ -22,6 +22,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..analysis import compliance as cm
+from ..analysis import validity
 from ..analysis.dynamics import parse_inertia, parse_mass
 from ..analysis.hinge_chains import SixAxisModel, six_axis_model
 from ..core.errors import InputError, unknown_key_error
@@ -200,6 +201,15 @@ def _stress_values(hs: cm.HingeSet, points: list[cm.StaticPoint | None], batch: 
     return values, dims
 
 
+def _point_warnings(hs: cm.HingeSet, points: list[cm.StaticPoint | None], sigma: float | None = None) -> list:
+    """The hinges' geometry, stresses and deflections at the solved points (:mod:`~cpm_nlp.analysis.validity`)."""
+    pts = [
+        None if sp is None else (sp.stresses, validity.hinge_deflections(hs.hinges, sp.theta, hs.theta0))
+        for sp in points
+    ]
+    return validity.hinge_warnings(hs.hinges, pts, sigma)
+
+
 class ActuatorForces(_HingeKind):
     name = "actuator_forces"
     description = (
@@ -291,7 +301,8 @@ class ActuatorForces(_HingeKind):
             sum(s.iterations for s in sols),
             sum(s.seconds for s in sols),
         )
-        return Result(self.name, status, values, units, dims, info, message, statuses, _model_info(model))
+        res = Result(self.name, status, values, units, dims, info, message, statuses, _model_info(model))
+        return res.warn(*_point_warnings(hs, points, inputs.get("sigma", inputs.get("sigma_allow"))))
 
     def _limit(self, model: Model, hs: cm.HingeSet, inputs: Mapping[str, Any], end: PoseSolution, solver):  # noqa: C901 - bracket, root, then one value family per coordinate kind
         """The scale λ of the ray home -> end at which the largest stress reaches σ_allow."""
@@ -456,7 +467,7 @@ class PlatformCompliance(_HingeKind):
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _check_pose_inputs(model, inputs, path, required=False)
 
-    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:  # noqa: C901 - one branch per hinge model and outcome
         c = model.closure
         hs: cm.HingeSet = inputs["hinge_set"]
         f, ka = inputs["load"], inputs["k_actuator"]
@@ -522,7 +533,11 @@ class PlatformCompliance(_HingeKind):
             message += "; actuators rigidly held: a pseudo-rigid-body model with rigid links does not deflect"
         message += note
         info = SolverInfo("ipopt", sol.iterations + loaded.iterations, sol.seconds)
-        return Result(self.name, status, values, units, dims, info, message, None, _model_info(model))
+        res = Result(self.name, status, values, units, dims, info, message, None, _model_info(model))
+        if not loaded.ok:
+            return res.warn(*validity.hinge_geometry_warnings(hs.hinges))
+        res.warn(*_point_warnings(hs, [spl]))
+        return res.warn(*validity.linear_range_warnings(d, lin, c.x_names, [x.kind for x in c.x]))
 
     def _run_six_axis(self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, parts: tuple) -> Result | None:  # noqa: C901 - unloaded, linearized, loaded, then one value family each
         """The six-axis hinge model: the unloaded equilibrium at the commanded actuators, the
@@ -564,7 +579,8 @@ class PlatformCompliance(_HingeKind):
         if not np.any(f):
             info = SolverInfo("newton-kkt", sol.iterations + it_u, sol.seconds)
             msg = f"no load: the output compliance only ({note})"
-            return Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+            res = Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+            return res.warn(*_six_axis_warnings(sm, [z_u]))
         ok, z_l, lam_l, it_l, st = sm.ipopt(z_u, f, sol.q, ka, None if ka is None else Fc)
         info = SolverInfo("ipopt", sol.iterations + it_u + it_l, sol.seconds)
         if not ok:
@@ -591,7 +607,9 @@ class PlatformCompliance(_HingeKind):
                 dims[f"F{j + 1}_loaded"] = "force" if q.kind == "length" else "moment"
                 units[f"F{j + 1}_loaded"] = "N" if q.kind == "length" else "N*m"
         msg = f"compliant forward kinematics by IPOPT ({st}, {it_l} iterations); {note}"
-        return Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+        res = Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+        res.warn(*_six_axis_warnings(sm, [z_l]))
+        return res.warn(*validity.linear_range_warnings(d, C @ f, c.x_names, [x.kind for x in c.x]))
 
     def output_names(self, model: Model) -> list[str]:
         c = model.closure
@@ -599,6 +617,12 @@ class PlatformCompliance(_HingeKind):
         names += [f"C_{x.name}" for x in c.x] + [f"d_{x.name}" for x in c.x]
         names += ["hinge_model", "stress_max_unloaded"] + [f"F{j + 1}_loaded" for j in range(c.nq)]
         return names
+
+
+def _six_axis_warnings(sm: SixAxisModel, zs: list[np.ndarray]) -> list:
+    """Geometry, stresses and deflections of the six-axis model's hinges at the equilibria ``zs``."""
+    pts = [(sm.stresses(z), validity.six_axis_deflections(sm.frames, z)) for z in zs]
+    return validity.hinge_warnings(sm.hs.hinges, pts)
 
 
 class NaturalFrequencies(_HingeKind):
@@ -698,7 +722,8 @@ class NaturalFrequencies(_HingeKind):
             modes_x=f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)",
         )
         msg = "frequencies from |K_q - (2 pi f)^2 M| = 0 at the pose"
-        return Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+        res = Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+        return res.warn(*_point_warnings(hs, [sp]))
 
     def output_names(self, model: Model) -> list[str]:
         c = model.closure

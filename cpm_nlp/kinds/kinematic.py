@@ -14,6 +14,7 @@ import numpy as np
 
 from ..analysis.assembly import AssemblyModes, assembly_modes
 from ..analysis.requirements import joint_requirements
+from ..analysis.validity import NEAR_SINGULAR_CONDITION, near_singular_warning
 from ..core.batch import batch_forward_kinematics, batch_inverse_kinematics
 from ..core.errors import InputError
 from ..core.kernels import batch_newton_supported
@@ -101,6 +102,7 @@ def _result(
     values = _pose_values(model, sols, batch)
     if extra:
         values.update(extra)
+    warning = _singularity_warning(model, sols)
     return Result(
         kind,
         status,
@@ -111,7 +113,34 @@ def _result(
         message,
         statuses,
         _model_info(model),
+        [warning] if warning else [],
     )
+
+
+def _condition(model: Model, s: PoseSolution) -> float:
+    """cond(Φ_x) of a solved pose: the 2-norm value where the solve computed it, else its
+    1-norm estimate, refined by the SVD when that is above the warning threshold."""
+    cond = s.details.get("cond_phi_x")
+    if cond is not None:
+        return float(cond)
+    cond1 = s.details.get("cond1_phi_x")
+    if cond1 is None or not cond1 > NEAR_SINGULAR_CONDITION:
+        return 0.0 if cond1 is None else float(cond1)
+    c = model.closure
+    sv = np.linalg.svd(np.asarray(c.phi_x(s.x, s.q, model.p), dtype=float), compute_uv=False)
+    return float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+
+
+def _singularity_warning(model: Model, sols: Sequence[PoseSolution]) -> Any:
+    """A ``near_singular`` warning for the worst solved pose whose cond(Φ_x) is above
+    :data:`~cpm_nlp.analysis.validity.NEAR_SINGULAR_CONDITION` (None when none is)."""
+    conds = [(_condition(model, s), k) for k, s in enumerate(sols) if s.ok]
+    near = [ck for ck in conds if ck[0] > NEAR_SINGULAR_CONDITION]
+    if not near:
+        return None
+    cond, k = max(near)
+    points = f" (at {len(near)} of {len(sols)} points; the worst, point {k})" if len(sols) > 1 else ""
+    return near_singular_warning(cond, "Phi_x", "Phi_x", points)
 
 
 def _si(dimension: str) -> str:
@@ -375,6 +404,8 @@ class Jacobian(ProblemKind):
                 "characteristic_length": "m",
             }
         res = _result(self.name, model, [sol], False, solver, extra)
+        if extra:  # an inverse (type I) singularity: the homogenized J_task loses rank
+            res.warn(*filter(None, [near_singular_warning(extra["cond"], "J_task, homogenized", "cond")]))
         res.units.update(units)
         res.dimensions.update(
             {

@@ -43,6 +43,7 @@ import numpy as np
 from ..analysis.workspace import membership, probe_region, sample_workspace
 from ..core.errors import InputError, suggest
 from ..core.kinematics import jacobians, passive_joints
+from ..core.result import ResultWarning
 from ..core.units import DIMENSIONS
 from ..io.inputs import MAX_RESULTS_BYTES, read_input_text
 from ..io.results import FORMATS, read_results
@@ -127,6 +128,8 @@ class ResultData:
     )  # as the result writes them (matrices: what rows and columns are)
     #: published figures to draw beside the values: (value expression "dz[2]", published SI, label)
     published: list[tuple[str, float, str]] = field(default_factory=list)
+    #: the result's warnings (:class:`~cpm_nlp.core.result.ResultWarning`), read back from its JSON
+    warnings: list[Any] = field(default_factory=list)
 
     @property
     def kind(self) -> str:
@@ -158,13 +161,15 @@ def from_result(result: Any, source: str = "") -> ResultData:
         dict(d.get("model") or {}),
         status=str(d.get("status")),
         units={k: str(u) for k, u in (d.get("units") or {}).items()},
+        warnings=[ResultWarning.from_dict(w) for w in d.get("warnings") or [] if isinstance(d.get("warnings"), list)],
     )
 
 
 def from_table(table: Any) -> ResultData:
     """A sweep results file read by :func:`cpm_nlp.io.results.read_results`."""
     meta = table.meta
-    names = ["point", *(p["key"] for p in table.parameters), "status", "message", "seconds", *table.values]
+    names = ["point", *(p["key"] for p in table.parameters), "status", "message", "seconds", "warnings"]
+    names += table.values
     values = {n: table.column(n) for n in names}
     dims = {p["key"]: p["dimension"] for p in table.parameters if p.get("dimension")}
     dims.update(meta.get("dimensions") or {})

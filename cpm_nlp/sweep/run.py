@@ -93,12 +93,14 @@ def solve_point(job: Job, k: int) -> tuple[dict[str, Any], dict[str, str], dict[
     units: dict[str, str] = {}
     dims: dict[str, str] = {}
     values: dict[str, Any] = {}
+    warnings: list[dict[str, Any]] = []
     try:
         data = apply_overrides(job.data, [override(key, v) for key, v in params.items()])
         problem = problem_from_dict(data, file=job.file, base_dir=Path(job.base_dir) if job.base_dir else None)
         result = solve(problem)
         status, message = result.status.value, result.message
         values = result.to_dict()["values"]
+        warnings = [w.to_dict() for w in result.warnings]
         units, dims = dict(result.units), dict(result.dimensions)
     except InputError as exc:
         status, message = INVALID_INPUT, exc.render()
@@ -107,6 +109,7 @@ def solve_point(job: Job, k: int) -> tuple[dict[str, Any], dict[str, str], dict[
         status, message = ERROR, f"internal error: {exc.__class__.__name__}: {exc}"
     record: dict[str, Any] = {"point": k, **params}
     record.update(status=status, message=" ".join(str(message).split()), seconds=round(time.perf_counter() - t0, 6))
+    record["warnings"] = warnings
     for name in job.values:
         record[name] = values.get(name)
     return record, {n: units[n] for n in job.values if n in units}, {n: dims[n] for n in job.values if n in dims}
@@ -174,7 +177,7 @@ def metadata(problem: Any, job: Job) -> dict[str, Any]:
 
 def columns(job: Job) -> list[str]:
     """Columns of a results file, in order."""
-    return ["point", *(a.key for a in job.spec.axes), "status", "message", "seconds", *job.values]
+    return ["point", *(a.key for a in job.spec.axes), "status", "message", "seconds", "warnings", *job.values]
 
 
 # -- running on Dask --------------------------------------------------------------------------

@@ -131,7 +131,15 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     derived_names = [(n, dim) for n, _sx, dim in gen.derived]
 
     def build(closure_: LoopClosure, parameters: dict, lims: dict) -> Model:
-        return _build(closure_, parameters, lims, fns, derived_names, d)
+        try:
+            return _build(closure_, parameters, lims, fns, derived_names, d)
+        except InputError as exc:  # a key of the mechanism file, with the problem's parameters
+            if not d.file or exc.file:
+                raise
+            inner = InputError(exc.message, path=exc.path, file=d.file).render()
+            raise InputError(
+                f"in the mechanism file {inner}", path=("mechanism", "file"), suggestions=exc.suggestions, hint=exc.hint
+            ) from None
 
     mech = Mechanism(
         name=d.name,
@@ -158,6 +166,13 @@ def _build(
 ) -> Model:
     p = np.array([float(parameters[n]) for n in closure.parameters])
     values = fns["extras"](p)
+    lower, upper = (np.asarray(v, dtype=float).ravel() for v in values[:2])
+    for name, lo, hi in zip(closure.x_names, lower, upper):
+        if name in d.platform.bounds and not lo < hi:
+            raise InputError(
+                f"expected [low, high] with low < high, got [{lo:.6g}, {hi:.6g}] (SI) with these parameters",
+                path=("platform", "bounds", name),
+            )
     length = float(values[2])
     derived_vals = np.asarray(values[3], dtype=float).ravel()
     dims = {par.name: par.dimension for par in d.parameters}
@@ -172,6 +187,8 @@ def _build(
     )
     for (what, path), value in zip(fns["requirements"], np.asarray(values[4], dtype=float).ravel()):
         if not abs(value) < 1e-9:
+            if what.startswith("expected"):  # a rule of the file, not a deviation (the S joint's axes)
+                raise InputError(what, path=path)
             raise InputError(
                 f"the reference configuration does not assemble: {what} (deviation {value:.3e})", path=path
             )

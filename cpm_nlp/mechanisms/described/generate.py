@@ -289,6 +289,8 @@ class Generator:
             raise InputError(f"a {j.type} joint takes {need or 'no'} axes, got {len(j.axes)}", path=j.path + ("axes",))
         if j.type == "U" and not j.axes:
             raise InputError("a U joint needs its two 'axes'", path=j.path)
+        if j.type == "S" and j.axes:
+            self._independent_axes(out.axes, j.path + ("axes",))
         dof = {"P": 1, "R": 1, "planar_R": 1, "planar_P": 1, "C": 2, "U": 2, "S": 3, "distance": 0}[j.type]
         if j.coordinates and len(j.coordinates) != dof:
             raise InputError(
@@ -300,6 +302,27 @@ class Generator:
             dim = JOINT_DIMS.get(j.type)
             out.home = [self.scalar(h, j.path + ("home", k), env, dim) for k, h in enumerate(j.home)]
         return out
+
+    #: |det| of an S joint's three unit axes below which they count as linearly dependent
+    DEPENDENT_AXES = 1e-6
+
+    def _independent_axes(self, axes: list, path: tuple) -> None:
+        """An S joint's three axes span space: its angles about them (and its motion as three
+        revolutes) need three independent directions.  Axes that depend on the parameters are
+        checked with the parameters' values (a requirement of the reference configuration)."""
+        det = ca.det(ca.horzcat(*axes))
+        text = "the S joint's three axes are linearly dependent (parallel or in one plane)"
+        if det.is_constant():
+            value = float(ca.DM(det))
+            if not abs(value) > self.DEPENDENT_AXES:
+                raise InputError(
+                    f"expected three independent axes, got axes whose triple product is {value:.3g}: {text}; "
+                    "give three directions that span space (default: x, y, z)",
+                    path=path,
+                )
+            return
+        text = f"expected three independent axes; with these parameters {text}"
+        self.requirements.append((ca.if_else(ca.fabs(det) > self.DEPENDENT_AXES, 0, 1), text, path))
 
     def close(self, leg: Leg, joints: list[_Joint]) -> None:  # noqa: C901 - one branch per leg ending
         last = joints[-1]
@@ -579,6 +602,7 @@ class Generator:
                 _Reported(Coordinate(qty.name, dim, qty.description, fam), v.sx, None, ("passive", qty.name))
             )
         self.add_unknowns()
+        self._unique_names()
         nx, nrows = len(self.x_names), len(self.rows)
         if nrows != nx:
             what = "over" if nrows > nx else "under"
@@ -607,6 +631,23 @@ class Generator:
             self.x_names.append(coord.name)
             self.x_coords.append(coord)
             self.extra_limits[coord.group] = (coord.kind, limit, coord.description)
+
+    def _unique_names(self) -> None:
+        """Every reported joint value has a name of its own (two joints declaring one
+        coordinate name would lose one value from the result)."""
+        seen = {n: ("platform", "coordinates", n) for n in self.x_names}
+        seen.update({c.name: ("actuators", c.name) for c in self.q_coords})
+        for r in self.reported:
+            name = r.coord.name
+            if name in seen:
+                path = r.path + ("coordinates",) if r.path and r.path[0] != "passive" else r.path
+                also = "by every copy of this repeated leg" if seen[name] == r.path else f"also at {_where(seen[name])}"
+                raise InputError(
+                    f"the coordinate name {name!r} is declared twice ({also}); give each joint value its own "
+                    "name (in a repeated leg, with its index: e.g. 'alpha{i}')",
+                    path=path,
+                )
+            seen[name] = r.path
 
     def functions(self, q: ca.SX) -> dict[str, Any]:
         x, p = self.x, self.p

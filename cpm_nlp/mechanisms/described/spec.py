@@ -264,6 +264,8 @@ def _parameter(name: str, raw: Any, path: tuple) -> Parameter:
         if not isinstance(b, list) or len(b) != 2:
             raise InputError(f"expected [low, high] (null for none), got {b!r}", path=path + ("bounds",))
         lower, upper = (None if v is None else parse_quantity(v, dim, path + ("bounds", k)) for k, v in enumerate(b))
+        if lower is not None and upper is not None and not lower < upper:
+            raise InputError(f"expected [low, high] with low < high, got {b!r}", path=path + ("bounds",))
     default = REQUIRED if raw.get("default") is None else parse_quantity(raw["default"], dim, path + ("default",))
     return Parameter(name, dim, default, lower, upper, _text(raw.get("description"), path + ("description",)))
 
