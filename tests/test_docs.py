@@ -16,6 +16,9 @@ of the page may read them):
   comment, else a temporary name) and validated with ``cpm-nlp check``; a mechanism file
   (with ``legs``) is written and loaded, and one marked ``<!-- file: PATH invalid -->``
   (a deliberate mistake the page shows) must fail to load as bad input.
+* a ``bash`` block may be followed by ``<!-- output: TEXT -->`` lines: each claim the
+  prose makes about that block's output, which must then contain TEXT (runs of
+  whitespace compared as one space).
 * ``text`` and ``toml``: illustrative only (usage synopses, a cluster's own commands, an
   error message, an entry-point table tested by tests/test_plugin.py); kept few.
 """
@@ -48,6 +51,7 @@ MAX_ILLUSTRATIVE = 12
 FENCE = re.compile(r"^(?P<indent>[ \t]*)```(?P<lang>[^\s`]*)[^\n]*\n(?P<body>.*?)^(?P=indent)```[ \t]*$", re.M | re.S)
 FILE_MARK = re.compile(r"<!--\s*file:\s*(\S+)(?P<invalid>\s+invalid)?\s*-->\s*$")
 EXPECT = re.compile(r"^(?P<cmd>.*?)\s*\|\|\s*test \$\? -eq (?P<code>\d+)$")
+OUTPUT_MARK = re.compile(r"\A\s*<!--\s*output:\s*(?P<text>.*?)\s*-->[ \t]*\n?")
 
 
 @dataclass
@@ -58,6 +62,7 @@ class Block:
     body: str
     file: str | None
     invalid: bool = False  # a mechanism file written to show its error: loading it must fail (exit 2)
+    outputs: tuple[str, ...] = ()  # <!-- output: TEXT --> after the block: what its output must contain
 
 
 def blocks(page: Path) -> list[Block]:
@@ -71,12 +76,16 @@ def blocks(page: Path) -> list[Block]:
         mark = FILE_MARK.search(before)
         line = text.count("\n", 0, m.start()) + 1
         file, invalid = (mark.group(1), bool(mark.group("invalid"))) if mark else (None, False)
-        out.append(Block(page, line, m.group("lang"), body, file, invalid))
+        outputs, rest = [], text[m.end() :].lstrip("\n")
+        while (claim := OUTPUT_MARK.match(rest)) is not None:
+            outputs.append(claim.group("text"))
+            rest = rest[claim.end() :]
+        out.append(Block(page, line, m.group("lang"), body, file, invalid, tuple(outputs)))
     return out
 
 
 def _name(page: Path) -> str:
-    return str(page.relative_to(ROOT))
+    return str(page.relative_to(ROOT)) if page.is_relative_to(ROOT) else str(page)
 
 
 def test_every_block_is_executed_or_marked_illustrative():
@@ -157,7 +166,7 @@ def _check_pip(segment: str, where: str) -> None:
         assert not extra or extra in _extras(), f"{where}: no extra {extra!r} in pyproject.toml"
 
 
-def _run_cpm(command: str, where: str) -> None:
+def _run_cpm(command: str, where: str) -> str:
     expected = 0
     m = EXPECT.match(command)
     if m:
@@ -167,16 +176,25 @@ def _run_cpm(command: str, where: str) -> None:
     run = run_cli(*argv[1:])
     detail = f"{run.err}{run.out[-2000:]}"
     assert run.code == expected, f"{where}: `{command}` exited {run.code}, expected {expected}\n{detail}"
+    return run.out + run.err
 
 
 def _simple(line: str) -> bool:
     return all(s.startswith(("cpm-nlp ", "pip install ", "python -m pytest")) for s in line.split(" && "))
 
 
+def _check_claims(block: Block, output: str) -> None:
+    """Each ``<!-- output: TEXT -->`` after the block is in what it printed."""
+    flat = " ".join(output.split())
+    for claim in block.outputs:
+        assert " ".join(claim.split()) in flat, f"{_name(block.page)}:{block.line}: the output lacks {claim!r}"
+
+
 def _run_bash(block: Block) -> None:
     where = f"{_name(block.page)}:{block.line}"
     lines = [line for line in block.body.splitlines() if line.strip() and not line.lstrip().startswith("#")]
     if all(_simple(line) for line in lines):
+        printed = []
         for line in lines:
             for segment in line.split(" && "):
                 if segment.startswith("pip install "):
@@ -184,13 +202,15 @@ def _run_bash(block: Block) -> None:
                 elif segment.startswith("python -m pytest"):
                     assert segment == "python -m pytest", where  # this suite, run by .ci/run
                 else:
-                    _run_cpm(segment, where)
+                    printed.append(_run_cpm(segment, where))
+        _check_claims(block, "\n".join(printed))
         return
     env = dict(os.environ, PATH=str(Path(sys.executable).parent) + os.pathsep + os.environ.get("PATH", ""))
     proc = subprocess.run(
         ["bash", "-euo", "pipefail", "-c", block.body], capture_output=True, text=True, env=env, timeout=600
     )
     assert proc.returncode == 0, f"{where}: exit {proc.returncode}\n{proc.stderr[-3000:]}{proc.stdout[-2000:]}"
+    _check_claims(block, proc.stdout + proc.stderr)
 
 
 def _run_yaml(block: Block, k: int) -> None:
@@ -227,3 +247,15 @@ def test_page_runs(page, workdir):
             exec(code, namespace)  # noqa: S102 - the documentation's own example code
         elif block.lang == "yaml":
             _run_yaml(block, k)
+
+
+def test_output_claims_are_read_and_checked(tmp_path):
+    """``<!-- output: TEXT -->`` after a bash block: read with the block, and a claim the
+    output does not bear out fails the page."""
+    page = tmp_path / "page.md"
+    page.write_text("```bash\ncpm-nlp --version\n```\n<!-- output: cpm-nlp -->\n<!-- output: not printed -->\n")
+    (block,) = blocks(page)
+    assert block.outputs == ("cpm-nlp", "not printed")
+    _check_claims(Block(page, 1, "bash", "", None, outputs=("cpm-nlp  0",)), "cpm-nlp\t0\n")
+    with pytest.raises(AssertionError, match="lacks 'not printed'"):
+        _check_claims(block, "cpm-nlp 0.1\n")

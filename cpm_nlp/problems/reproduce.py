@@ -47,6 +47,20 @@ def plugin_problem_files() -> list[Path]:
     return out
 
 
+def _unique(files: Iterable[Path]) -> list[Path]:
+    """``files`` without repeats: a file reached twice (the shipped problems/ and a
+    plugin's or file mechanism's own list, a path and a symbolic link to it) is
+    compared once, so every published figure is one row of the table."""
+    seen: set[Path] = set()
+    out: list[Path] = []
+    for f in files:
+        key = f.resolve()
+        if key not in seen:
+            seen.add(key)
+            out.append(f)
+    return out
+
+
 def reproduce(paths: Iterable[str | Path] | None = None) -> list[Comparison]:
     """Solve every problem file with a ``reproduce`` section; all rows.  Without
     paths: the shipped problem files, and those of mechanism plugins.  Comparing
@@ -60,6 +74,7 @@ def reproduce(paths: Iterable[str | Path] | None = None) -> list[Comparison]:
         dirs = default_problem_dirs()
         files = problem_files(dirs) + plugin_problem_files()
         what = ", ".join(str(d) for d in dirs) if dirs else "the shipped problems/ (not found)"
+    files = _unique(files)
     if not files:
         raise InputError(f"no problem files (*.yaml) to compare in {what}")
     rows: list[Comparison] = []
