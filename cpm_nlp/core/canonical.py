@@ -26,7 +26,6 @@ canonical form, computed here.
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 #: eigenvalues within this relative distance (of the larger of two neighbours,
 #: or of the largest eigenvalue near zero) form one cluster: a repeated eigenvalue.
@@ -121,6 +120,8 @@ def canonical_eigh(K: np.ndarray, M: np.ndarray | None = None, rtol: float = CLU
     columns, clusters).  The eigenvalues of a cluster are replaced by their mean
     (a repeated eigenvalue is reported once, exactly repeated); the eigenvectors of
     each cluster are its :func:`canonical_basis` (M-orthonormal, sign fixed)."""
+    import scipy.linalg  # here: a solve that needs no eigenvalues loads no scipy (start-up time)
+
     K = np.asarray(K, dtype=float)
     lam, V = scipy.linalg.eigh(K, M) if M is not None else scipy.linalg.eigh(K)
     clusters = eigen_clusters(lam, rtol)
