@@ -12,7 +12,7 @@ py="${PYTHON:-python}"
 # a download slower than MINDEPS_INSTALL_TIMEOUT seconds is skipped with a note, not failed
 status=0
 timeout "${MINDEPS_INSTALL_TIMEOUT:-900}" "$work/venv/bin/python" -m pip install -q \
-    -c "$repo/.ci/constraints-min.txt" casadi numpy scipy pyyaml pint pytest hypothesis || status=$?
+    -c "$repo/.ci/constraints-min.txt" casadi numpy scipy pyyaml pint threadpoolctl pytest hypothesis || status=$?
 if [ "$status" -eq 124 ]; then
     echo "note: could not install the lowest supported dependencies in time; their tests were skipped" >&2
     exit 0
@@ -20,9 +20,9 @@ fi
 [ "$status" -eq 0 ] || exit "$status"
 "$work/venv/bin/python" -m pip install -q --no-deps -e "$repo"
 "$work/venv/bin/python" - <<'PY'
-import casadi, numpy, scipy, yaml, pint
+import casadi, numpy, scipy, yaml, pint, threadpoolctl
 print("mindeps: casadi", casadi.__version__, "numpy", numpy.__version__, "scipy", scipy.__version__,
-      "pyyaml", yaml.__version__, "pint", pint.__version__)
+      "pyyaml", yaml.__version__, "pint", pint.__version__, "threadpoolctl", threadpoolctl.__version__)
 PY
 cd "$repo"
 "$work/venv/bin/python" -m pytest -q -p no:cacheprovider -o addopts="" tests/test_units.py tests/test_prs3_kinematics.py \

@@ -154,23 +154,55 @@ def test_a_worker_that_dies_is_retried_and_the_sweep_completes(tmp_path):
     assert sorted(r["point"] for r in read_results(out).rows) == list(range(20))
 
 
+def _die_once_at_point(point, marker):
+    """A function for ``client.run``: in each worker process, solving ``point`` kills
+    that process (SIGKILL, while its task runs), the first time in the cluster only
+    (``marker``, created atomically, says it happened)."""
+
+    def install():
+        import cpm_nlp.sweep.run as run
+
+        solve = run.solve_point
+
+        def solve_point(job, k):
+            if k == point:
+                try:
+                    os.close(os.open(marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+                except FileExistsError:
+                    return solve(job, k)
+                os.kill(os.getpid(), signal.SIGKILL)
+            return solve(job, k)
+
+        run.solve_point = solve_point
+
+    return install
+
+
 def test_a_task_that_fails_beyond_the_retries_is_split_into_points(tmp_path, caplog):
     """With no retry allowed, the task of the killed worker fails (KilledWorker): its
-    points are solved one by one, none is lost."""
+    points are solved one by one, none is lost.
+
+    The worker dies inside the task, while it solves point 5 (of the task of points
+    4-7).  Killing a worker from the progress callback instead was a race: the worker
+    could finish its last task between "it is busy" and the kill; its result then lived
+    on the dead worker, Dask computed it again (a lost result is no failure), and no
+    task failed (1 run in 3)."""
     import dask
 
     problem = problem_of(tmp_path, MAP)
     out = tmp_path / "map.csv"
+    marker = str(tmp_path / "killed")
     with (
         dask.config.set({"distributed.scheduler.allowed-failures": 0}),
         distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cl,
         distributed.Client(cl) as client,
     ):
-        killed = []
+        client.run(_die_once_at_point(5, marker))
         with caplog.at_level("WARNING", logger="cpm_nlp.sweep.run"):
-            summary = run_sweep(problem, out, client=client, chunk_size=4, progress=_kill_a_busy_worker(client, killed))
-    assert killed
-    assert any("a task of 4 points failed" in r.getMessage() and "one by one" in r.getMessage() for r in caplog.records)
+            summary = run_sweep(problem, out, client=client, chunk_size=4)
+    assert os.path.exists(marker)  # a worker died in the task
+    failed = [r.getMessage() for r in caplog.records if "a task of 4 points failed" in r.getMessage()]
+    assert failed and all("died while running it" in m and "one by one" in m for m in failed)
     assert summary.ok and summary.statuses == {"solved": 20}
     assert sorted(r["point"] for r in read_results(out).rows) == list(range(20))
 

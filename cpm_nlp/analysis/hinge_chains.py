@@ -49,6 +49,7 @@ import casadi as ca
 import numpy as np
 import scipy.linalg
 
+from ..core.blas import one_blas_thread
 from ..core.chains import Chains
 from ..core.errors import InputError
 from ..core.kernels import FastFunction
@@ -278,6 +279,7 @@ class SixAxisModel:
         return [fr.name for fr in self.frames if fr.extra]
 
     # -- solves ---------------------------------------------------------------------------------
+    @one_blas_thread  # small dense solves: BLAS threads cost more than they give
     def start(self, x: np.ndarray, q: np.ndarray) -> np.ndarray:
         """A start z at a rigid pose: the pose and actuators, the chains' variables from the
         closure's passive joint values where it reports them, then fitted to the pose
@@ -309,6 +311,7 @@ class SixAxisModel:
         gl, g, H, A, _ = self._kkt_fast(z, lam, par)
         return gl, g, H.reshape(self.nz, self.nz, order="F"), A.reshape(self.ng, self.nz, order="F")
 
+    @one_blas_thread
     def newton(
         self, z0: np.ndarray, f: np.ndarray, qc: np.ndarray, ka: np.ndarray | None, Fc: np.ndarray | None
     ) -> tuple[bool, np.ndarray, np.ndarray, int]:
@@ -359,6 +362,7 @@ class SixAxisModel:
         ok = bool(st.get("success", False)) and res < 1e-10 * max(1.0, self.model.characteristic_length)
         return ok, z, np.asarray(sol["lam_g"], dtype=float).ravel(), int(st.get("iter_count", 0)), st["return_status"]
 
+    @one_blas_thread
     def compliance(self, z: np.ndarray, lam: np.ndarray, ka: np.ndarray | None, Fc: np.ndarray | None) -> np.ndarray:
         """C = Eᵀ dz/df (nx x nx) at an equilibrium (z, λ)."""
         par = self._par(np.zeros(self.nx), z[self.nx : self.nx + self.nq], ka, Fc)

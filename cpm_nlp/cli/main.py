@@ -23,7 +23,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
-from ..core import progress
+from ..core import blas, progress
 from ..core.errors import CpmError, InputError
 from ..core.version import __version__
 from ..io.atomic import check_output_path, write_atomic
@@ -175,6 +175,7 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     _check_plot_args(args, [args.file, args.output])
     with solver_output_to_stderr(args.json), progress.reporting(_batch_progress(args)):
         problem = load_problem(args.file, args.set or [])
+        blas.cap_process()  # small dense algebra only: BLAS threads cost more than they give (core/blas.py)
         result = solve(problem)
     # the result first: a plot that cannot be drawn never takes it away
     if args.json:
@@ -450,6 +451,7 @@ def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
     from ..problems.reproduce import reproduce
 
     check_output_path(args.output, args.paths)
+    blas.cap_process()
     with solver_output_to_stderr(args.json):
         rows = reproduce(args.paths or None)
     summary = summarize(rows)

@@ -31,6 +31,8 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from .canonical import canonical_basis
+
 #: Δ of the reciprocal product, $1ᵀ Δ $2 (rpr-2rpu-upr-zhang-2022.md, eq 9).
 DELTA = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
 
@@ -198,11 +200,14 @@ def null_screw(rows: Any) -> Any:
 
 def reciprocal_basis(screws: Any, tol: float = 1e-9) -> np.ndarray:
     """Columns spanning every screw reciprocal to all columns of ``screws``
-    (numerical, by SVD; relative tolerance ``tol``)."""
+    (numerical, by SVD; relative tolerance ``tol``), orthonormal, in the canonical
+    basis of :func:`cpm_nlp.core.canonical.canonical_basis` (the SVD's null space
+    is any basis of it, which depends on the BLAS kernel)."""
     A = (DELTA @ np.asarray(screws, dtype=float)).T
     _, sv, vt = np.linalg.svd(A)
     rank = int(np.sum(sv > tol * (sv[0] if sv.size else 1.0)))
-    return vt[rank:].T
+    null = vt[rank:].T
+    return canonical_basis(null) if null.shape[1] else null
 
 
 # -- compliance matrices -------------------------------------------------------------------------

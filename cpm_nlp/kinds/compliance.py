@@ -18,13 +18,13 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-import scipy.linalg
 import scipy.optimize
 
 from ..analysis import compliance as cm
 from ..analysis import validity
 from ..analysis.dynamics import parse_inertia, parse_mass
 from ..analysis.hinge_chains import SixAxisModel, six_axis_model
+from ..core.canonical import canonical_eigh, degenerate_note, multiplicities
 from ..core.errors import InputError, unknown_key_error
 from ..core.kind import (
     ProblemKind,
@@ -693,8 +693,8 @@ class NaturalFrequencies(_HingeKind):
         sp = cm.static_point(model, hs, sol.x, sol.q)
         M = sp.J.T @ np.diag(inputs["M_x"]) @ sp.J + np.diag(inputs["M_q"])
         K = 0.5 * (sp.K_q + sp.K_q.T)
-        try:
-            lam, modes = scipy.linalg.eigh(K, M)
+        try:  # canonical modes: the same on every BLAS kernel (docs/site/guide/compliance.md)
+            lam, modes, clusters = canonical_eigh(K, M)
         except np.linalg.LinAlgError:
             return Result(
                 self.name,
@@ -714,20 +714,26 @@ class NaturalFrequencies(_HingeKind):
             units[f"f{k + 1}"] = "Hz"
         shapes = (sp.J @ modes).T
         values.update(M=M.tolist(), K=K.tolist(), modes_q=modes.T.tolist(), modes_x=shapes.tolist())
-        dims.update(M="matrix", K="matrix", modes_q="matrix", modes_x="matrix")
+        values["multiplicity"] = multiplicities(clusters)
+        dims.update(M="matrix", K="matrix", modes_q="matrix", modes_x="matrix", multiplicity="vector")
         units.update(
             M=f"kg or kg*m^2 (generalized coordinates {', '.join(c.q_names)})",
             K="N/m or N*m/rad",
-            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized)",
+            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized, canonical basis)",
             modes_x=f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)",
+            multiplicity="per mode: how many frequencies equal its own (1: a simple frequency)",
         )
         msg = "frequencies from |K_q - (2 pi f)^2 M| = 0 at the pose"
+        repeated = [idx for idx in clusters if len(idx) > 1]
+        if repeated:
+            msg += "; " + "; ".join(degenerate_note(idx) for idx in repeated)
         res = Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
         return res.warn(*_point_warnings(hs, [sp]))
 
     def output_names(self, model: Model) -> list[str]:
         c = model.closure
-        return _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)] + ["M", "K", "modes_q", "modes_x"]
+        names = _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)]
+        return names + ["M", "K", "modes_q", "modes_x", "multiplicity"]
 
 
 # -- stress limits for the workspace kinds ---------------------------------------------------------

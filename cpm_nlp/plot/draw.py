@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.canonical import canonical_eigh
 from ..core.errors import InputError
 from ..core.units import DIMENSIONS, to_display
 from ..io.atomic import check_output_path, replace_atomically
@@ -862,6 +863,15 @@ def modes_mechanism_figure(
     return fig
 
 
+def principal_axes(S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Principal compliances (ascending) and axes (columns) of a symmetric block S, in
+    the canonical form of :func:`cpm_nlp.core.canonical.canonical_eigh`: each axis'
+    first significant component positive, and equal compliances (a circle, a sphere)
+    with axes along the coordinates in their order, on every BLAS kernel."""
+    w, V, _ = canonical_eigh(np.asarray(S, dtype=float))
+    return w, V
+
+
 def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> None:
     """The ellipsoid {S f : |f| = 1} (or the ellipse of a 2x2 S, in the plane z = centre)
     drawn in shown units at ``centre``, ``scale`` shown units per m/N."""
@@ -875,7 +885,7 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
         t = np.linspace(0, 2 * np.pi, 200)
         pts = np.stack([np.cos(t), np.sin(t)], axis=-1) @ S.T * scale
         ax.plot(pts[:, 0] + centre[0], pts[:, 1] + centre[1], np.full_like(t, centre[2]), color="tab:purple", lw=2)
-    w, V = np.linalg.eigh(S)
+    w, V = principal_axes(S)
     for k in range(n):  # the principal axes: seen even where the ellipsoid is flat
         a = np.zeros(3)
         a[:n] = V[:, k] * w[k] * scale
@@ -1123,7 +1133,7 @@ def ellipsoid_figure(
     if n not in (2, 3) or Cm.shape != (n, n):
         raise InputError(f"a compliance ellipsoid needs a 2x2 or 3x3 block, got {Cm.shape}")
     S = 0.5 * (Cm + Cm.T)
-    w, V = np.linalg.eigh(S)
+    w, V = principal_axes(S)
     peak = float(np.max(np.abs(w))) if w.size else 0.0
     f, unit = display_unit("length", [peak])
     text = ", ".join(f"{_number(abs(v) * f)} {unit}/N" for v in w[::-1])

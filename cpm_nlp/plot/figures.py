@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.workspace import membership, probe_region, sample_workspace
+from ..core.canonical import canonical_eigh, degenerate_note, eigen_clusters
 from ..core.errors import InputError, suggest
 from ..core.kinematics import jacobians, passive_joints
 from ..core.result import ResultWarning
@@ -980,13 +981,30 @@ def dynamics_plot(data: ResultData, options: PlotOptions) -> Any:
     M, K = data.values.get("M"), data.values.get("K")
     if not (isinstance(M, list) and isinstance(K, list)):
         raise NotApplicable("a dynamics plot needs the mass and stiffness matrices M and K")
-    from scipy.linalg import eigh
-
-    w2, modes = eigh(np.asarray(K, dtype=float), np.asarray(M, dtype=float))
+    # the canonical modes (core.canonical): the same bars on every BLAS kernel
+    w2, modes, clusters = canonical_eigh(np.asarray(K, dtype=float), np.asarray(M, dtype=float))
     freqs = np.sqrt(np.clip(w2, 0, None)) / (2 * math.pi)
     closure = _closure(data)
     groups = _comparisons(data)
-    return dynamics_figure(freqs, modes, closure.q_names, groups, title=f"Dynamics ({data.model.get('type')})")
+    title = _with_degenerate_note(f"Dynamics ({data.model.get('type')})", clusters, len(freqs))
+    return dynamics_figure(freqs, modes, closure.q_names, groups, title=title)
+
+
+def _with_degenerate_note(title: str, clusters: list[list[int]], shown: int) -> str:
+    """``title`` with a line per repeated frequency among the first ``shown`` modes,
+    e.g. "f2 = f3: any combination of modes 2 and 3 is a mode"."""
+    notes = [degenerate_note(idx) for idx in clusters if len(idx) > 1 and idx[0] < shown]
+    return "\n".join([title, *notes])
+
+
+def _mode_clusters(data: ResultData) -> list[list[int]]:
+    """The repeated frequencies of a natural_frequencies result (also of one written
+    before results carried ``multiplicity``): clusters of equal f^2 (core.canonical)."""
+    freqs, k = [], 1
+    while isinstance(data.values.get(f"f{k}"), (int, float)):
+        freqs.append(float(data.values[f"f{k}"]))
+        k += 1
+    return eigen_clusters(np.square(freqs)) if freqs else []
 
 
 # -- amplifier ----------------------------------------------------------------------------------------------
@@ -1146,9 +1164,8 @@ def modes_plot(data: ResultData, options: PlotOptions) -> Any:
         arrows = [_mode_arrows(model, geometry, x, q, mx, mq) for mx, mq in modes]
         freqs = [data.values[f"f{k + 1}"] for k in range(len(modes))]
         pose = geometry(model, x, q)
-        return modes_mechanism_figure(
-            pose, arrows, freqs, title=f"Mode shapes ({data.model.get('type')})", note=pose.note
-        )
+        title = _with_degenerate_note(f"Mode shapes ({data.model.get('type')})", _mode_clusters(data), len(modes))
+        return modes_mechanism_figure(pose, arrows, freqs, title=title, note=pose.note)
     idx = _translational(c)
     platform = np.zeros(3)
     platform[: len(idx)] = [data.values[c.x_names[i]] for i in idx]
@@ -1166,7 +1183,8 @@ def modes_plot(data: ResultData, options: PlotOptions) -> Any:
         shapes.append(d)
     freqs = [data.values[f"f{k + 1}"] for k in range(len(shapes))]
     names = [c.x_names[i] for i in idx] + ["z"] * (3 - len(idx))
-    return modes_figure(np.array(pts), shapes, freqs, names, title=f"Mode shapes ({data.model.get('type')})")
+    title = _with_degenerate_note(f"Mode shapes ({data.model.get('type')})", _mode_clusters(data), len(shapes))
+    return modes_figure(np.array(pts), shapes, freqs, names, title=title)
 
 
 #: plot type -> function(data, options) -> Figure

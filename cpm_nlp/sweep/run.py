@@ -49,6 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..core import blas
 from ..core.errors import InputError
 from ..core.extras import require
 from ..problems.file import problem_from_dict, solve
@@ -117,6 +118,7 @@ def solve_point(job: Job, k: int) -> tuple[dict[str, Any], dict[str, str], dict[
 
 def solve_points(job: Job, ids: Sequence[int]) -> dict[str, Any]:
     """A worker task: solve some points; records plus the units learned."""
+    blas.cap_process()  # one BLAS thread in the worker process (core/blas.py): Dask's processes run in parallel
     records, units, dims = [], {}, {}
     for k in ids:
         rec, u, d = solve_point(job, k)

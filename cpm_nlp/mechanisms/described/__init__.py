@@ -219,8 +219,11 @@ def check_reference(model: Model, row_names: list[str]) -> None:
     rank = int(np.sum(s > tol))
     if rank < c.nx:
         _u, _s, vt = np.linalg.svd(J)
-        free = vt[-1]
-        names = [c.x_names[k] for k in np.argsort(-np.abs(free)) if abs(free[k]) > 1e-6 * np.max(np.abs(free))]
+        # the coordinates the free motions move: the rows of the whole null space (not one
+        # SVD vector of it, which is any vector of a null space of dimension 2 or more and
+        # changes with the BLAS kernel), by their share of it, in the coordinates' order
+        share = np.linalg.norm(vt[rank:], axis=0)
+        names = [c.x_names[k] for k in range(c.nx) if share[k] > 1e-6 * np.max(share)]
         raise InputError(
             f"wrong mobility: with the actuators locked the closures leave {c.nx - rank} free motion(s) of the "
             f"platform at the reference configuration (rank Φ_x = {rank} < {c.nx}); free: {', '.join(names)} "

@@ -37,7 +37,15 @@ def _polygon(pts: dict[str, np.ndarray], names: list[str], tol: float) -> list[s
         return kept
     a = (P - mid) @ vt[0]
     b = (P - mid) @ vt[1]
-    return [kept[k] for k in np.argsort(np.arctan2(b, a))]
+    ring = [int(k) for k in np.argsort(np.arctan2(b, a))]
+    # canonical: the SVD's in-plane axes have no sign of their own (and any direction in
+    # the plane when s[0] = s[1], as for a regular polygon), which turns or mirrors the
+    # ring; start it at the first point given, towards the lower-numbered of its neighbours
+    start = ring.index(0)
+    ring = ring[start:] + ring[:start]
+    if ring[-1] < ring[1]:
+        ring = [ring[0]] + ring[:0:-1]
+    return [kept[k] for k in ring]
 
 
 def _ring(part: str, names: list[str]) -> tuple[tuple, tuple]:
