@@ -127,12 +127,17 @@ def test_prs3_frequencies_report_the_double_frequency_and_its_canonical_modes():
     assert v["f2"] == v["f3"] and v["f1"] < v["f2"]
     assert "f2 = f3: any combination of modes 2 and 3 is a mode" in result.message
     Q, M, K = (np.array(v[k]) for k in ("modes_q", "M", "K"))
-    # mode 1 moves the three sliders together (+), modes 2 and 3 the echelon basis of the rest
+    # mode 1 moves the three sliders together (+); modes 2 and 3 are the echelon basis of the rest read
+    # in the pose coordinates (px, py, pz, psi, theta, phi): a tilt in psi alone, then one in theta alone
     np.testing.assert_allclose(Q[0] / Q[0, 0], [1.0, 1.0, 1.0], atol=1e-12)
     assert Q[0, 0] > 0
-    np.testing.assert_allclose(Q[1] / Q[1, 0], [1.0, 0.0, -1.0], atol=1e-12)
-    np.testing.assert_allclose(Q[2] / -Q[2, 0], [-1.0, 2.0, -1.0], atol=1e-12)
-    assert Q[1, 0] > 0 and Q[2, 1] > 0 and Q[1, 1] == 0.0
+    np.testing.assert_allclose(Q[1] / Q[1, 1], [0.0, 1.0, -1.0], atol=1e-12)
+    np.testing.assert_allclose(Q[2] / -Q[2, 0], [-1.0, 0.5, 0.5], atol=1e-12)
+    assert Q[1, 0] == 0.0 and Q[1, 1] > 0 and Q[2, 1] > 0
+    X = np.array(v["modes_x"])
+    scale = np.abs(X[1:, 3:5]).max()
+    assert X[1, 3] > 0 and abs(X[1, 4]) < 1e-12 * scale  # psi alone, positive
+    assert X[2, 4] > 0 and abs(X[2, 3]) < 1e-12 * scale  # theta alone, positive
     np.testing.assert_allclose(Q @ M @ Q.T, np.eye(3), atol=1e-12)
     lam = (2 * np.pi * np.array([v["f1"], v["f2"], v["f3"]])) ** 2
     np.testing.assert_allclose(K @ Q.T, M @ Q.T * lam, rtol=0, atol=1e-9 * np.abs(K).max())

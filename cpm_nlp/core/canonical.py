@@ -84,24 +84,29 @@ def _pivots(Q: np.ndarray) -> list[int]:
     return sorted(pivots)
 
 
-def canonical_basis(V: np.ndarray, M: np.ndarray | None = None) -> np.ndarray:
+def canonical_basis(V: np.ndarray, M: np.ndarray | None = None, T: np.ndarray | None = None) -> np.ndarray:
     """The canonical basis of the span of the columns of ``V`` (n x m, full column rank).
 
-    Coordinates are weighted by sqrt(diag M) (so their units do not matter);
-    the pivots are chosen in coordinate order (:func:`_pivots`); the basis W with
-    W[pivots] = I (the reduced row echelon form) is orthonormalised in order in
-    the metric M (identity if None) by Gram-Schmidt, which keeps each vector's
-    pivot component positive.  The result is M-orthonormal, and the same for any
-    basis V of the same subspace."""
+    The echelon form is taken in the coordinates the user reads: those of ``T V``
+    when ``T`` (p x n, e.g. the task Jacobian that maps actuator motions to pose
+    coordinates) is given and ``T V`` has rank m, else those of ``V``, weighted by
+    sqrt(diag M) (so their units do not matter).  The pivots are chosen in
+    coordinate order (:func:`_pivots`); the basis W with W[pivots] = I (the
+    reduced row echelon form) is orthonormalised in order in the metric M
+    (identity if None) by Gram-Schmidt, which keeps each vector's pivot
+    component positive.  The result is M-orthonormal, and the same for any basis
+    V of the same subspace: with T, the 3-PRS's two equal tilt modes come out as
+    a tilt about x and a tilt about y."""
     V = np.asarray(V, dtype=float)
     n, m = V.shape
     M = np.eye(n) if M is None else np.asarray(M, dtype=float)
     d = np.sqrt(np.clip(np.diag(M), 0.0, None))
     d = np.where(d > 0, d, 1.0)
-    Q = np.linalg.qr(d[:, None] * V)[0]  # orthonormal basis of the weighted subspace
+    view = _coordinates(V, d, T)  # the reading coordinates: maps a vector of R^n to them
+    X = view(V)
+    Q, R = np.linalg.qr(X)  # orthonormal basis of the subspace in the reading coordinates
     piv = _pivots(Q)
-    W = Q @ np.linalg.inv(Q[piv])  # echelon form: W[piv] = I, unique for the subspace
-    W = W / d[:, None]
+    W = V @ np.linalg.solve(R, np.linalg.inv(Q[piv]))  # echelon form: view(W)[piv] = I
     out = np.zeros((n, m))
     for k in range(m):
         w = W[:, k].copy()
@@ -111,15 +116,30 @@ def canonical_basis(V: np.ndarray, M: np.ndarray | None = None) -> np.ndarray:
             w -= (out[:, i] @ M @ w) * out[:, i]
         w /= np.sqrt(w @ M @ w)
         w[np.abs(w) <= ZERO_RTOL * np.abs(w).max()] = 0.0  # a zero by symmetry is 0, not +-1e-17
-        out[:, k] = w if w[piv[k]] >= 0 else -w
+        out[:, k] = w if view(w[:, None])[piv[k], 0] >= 0 else -w
     return out
 
 
-def canonical_eigh(K: np.ndarray, M: np.ndarray | None = None, rtol: float = CLUSTER_RTOL):
+def _coordinates(V: np.ndarray, d: np.ndarray, T: np.ndarray | None):
+    """The map from R^n to the coordinates a canonical basis is read in: ``T x``
+    when T keeps the span of V at full rank, else ``d * x`` (the weighted own coordinates)."""
+    if T is not None:
+        T = np.asarray(T, dtype=float)
+        X = T @ V
+        s = np.linalg.svd(X, compute_uv=False)
+        if s.size == V.shape[1] and s[-1] > 1e-9 * max(s[0], 1e-300):
+            return lambda x: T @ x
+    return lambda x: d[:, None] * x
+
+
+def canonical_eigh(
+    K: np.ndarray, M: np.ndarray | None = None, rtol: float = CLUSTER_RTOL, T: np.ndarray | None = None
+):
     """``scipy.linalg.eigh(K, M)`` in canonical form: (eigenvalues, eigenvectors as
     columns, clusters).  The eigenvalues of a cluster are replaced by their mean
     (a repeated eigenvalue is reported once, exactly repeated); the eigenvectors of
-    each cluster are its :func:`canonical_basis` (M-orthonormal, sign fixed)."""
+    each cluster are its :func:`canonical_basis` (M-orthonormal, sign fixed), read
+    in the coordinates of ``T`` (e.g. the task Jacobian) when it is given."""
     import scipy.linalg  # here: a solve that needs no eigenvalues loads no scipy (start-up time)
 
     K = np.asarray(K, dtype=float)
@@ -128,7 +148,7 @@ def canonical_eigh(K: np.ndarray, M: np.ndarray | None = None, rtol: float = CLU
     lam = lam.copy()
     for idx in clusters:
         lam[idx] = float(np.mean(lam[idx]))
-        V[:, idx] = canonical_basis(V[:, idx], M)
+        V[:, idx] = canonical_basis(V[:, idx], M, T)
     return lam, V, clusters
 
 

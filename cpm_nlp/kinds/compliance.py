@@ -694,7 +694,7 @@ class NaturalFrequencies(_HingeKind):
         M = sp.J.T @ np.diag(inputs["M_x"]) @ sp.J + np.diag(inputs["M_q"])
         K = 0.5 * (sp.K_q + sp.K_q.T)
         try:  # canonical modes: the same on every BLAS kernel (docs/site/guide/compliance.md)
-            lam, modes, clusters = canonical_eigh(K, M)
+            lam, modes, clusters = canonical_eigh(K, M, T=sp.J)  # read in the pose coordinates
         except np.linalg.LinAlgError:
             return Result(
                 self.name,
@@ -719,7 +719,7 @@ class NaturalFrequencies(_HingeKind):
         units.update(
             M=f"kg or kg*m^2 (generalized coordinates {', '.join(c.q_names)})",
             K="N/m or N*m/rad",
-            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized, canonical basis)",
+            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized, canonical basis in the pose coordinates)",
             modes_x=f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)",
             multiplicity="per mode: how many frequencies equal its own (1: a simple frequency)",
         )

@@ -981,8 +981,12 @@ def dynamics_plot(data: ResultData, options: PlotOptions) -> Any:
     M, K = data.values.get("M"), data.values.get("K")
     if not (isinstance(M, list) and isinstance(K, list)):
         raise NotApplicable("a dynamics plot needs the mass and stiffness matrices M and K")
-    # the canonical modes (core.canonical): the same bars on every BLAS kernel
+    # the canonical modes (core.canonical): the same bars on every BLAS kernel; the result's own
+    # modes_q where it has them (read in the pose coordinates, which M and K alone do not give)
     w2, modes, clusters = canonical_eigh(np.asarray(K, dtype=float), np.asarray(M, dtype=float))
+    given = data.values.get("modes_q")
+    if isinstance(given, list) and np.shape(given) == modes.T.shape:
+        modes = np.asarray(given, dtype=float).T
     freqs = np.sqrt(np.clip(w2, 0, None)) / (2 * math.pi)
     closure = _closure(data)
     groups = _comparisons(data)
