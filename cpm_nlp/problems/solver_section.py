@@ -83,12 +83,13 @@ def load_preset(name: str, base_dir: Path | None, path: tuple) -> dict[str, Any]
         raw = _solver_mapping(data, ())
         if raw.get("preset"):
             raise InputError("a preset cannot name another preset", path=("preset",))
-        try:  # the preset's own options pass the allow-list; a refusal names the preset file and its key
+        try:  # the preset's own options pass the allow-list
             check_options(raw.get("method") or SolverConfig.method, raw["options"])
         except InputError as exc:
             raise InputError(exc.message, path=exc.path[1:], suggestions=exc.suggestions, hint=exc.hint) from None
-    except InputError as exc:
-        raise exc.at(file=str(presets[name])) from None
+    except InputError as exc:  # the message names the preset file and its key, the problem file names the key
+        inner = InputError(exc.message, path=exc.path, file=str(presets[name])).render()
+        raise InputError(f"in the preset {inner}", path=path, suggestions=exc.suggestions, hint=exc.hint) from None
     return raw
 
 
