@@ -416,3 +416,39 @@ def refused_table() -> list[tuple[str, str]]:
     rows += [(f"ipopt.{n}", why[0]) for n, why in sorted(ipopt_rules()[1].items())]
     rows += [(f"ipopt.{n}: {v}", why) for (n, v), why in sorted(ipopt_rules()[2].items())]
     return rows
+
+
+def reference_markdown() -> str:
+    """The docs page ``reference/solver-options.md``: every allowed option per method and every
+    refused one, from this module's tables (generated at every docs build by docs/hooks.py)."""
+
+    def cell(text: str) -> str:
+        return " ".join(str(text).replace("|", "\\|").split())
+
+    data = table()
+    out = [
+        "# Solver options",
+        "",
+        "Generated from `cpm_nlp/core/solver_options.py` and the option documentation of the",
+        f"IPOPT {data['ipopt_version']} and CasADi {data['casadi_version']} it ships with",
+        "(`python tools/gen_solver_options.py` regenerates it). A problem file, a preset and",
+        "`--set` may give these options and no others (see [Choose a solver](../howto/choose-solver.md)",
+        "and the [threat model](../guide/threat-model.md)); an unknown name is refused with a",
+        '"did you mean", a refused one with the reason.',
+        "",
+    ]
+    for method, title in (("newton", "Method `newton` (CasADi's rootfinder)"), ("ipopt", "Method `ipopt`")):
+        out += [f"## {title}", "", "| option | accepts | what it does |", "|---|---|---|"]
+        out += [f"| `{n}` | {cell(e)} | {cell(d)} |" for n, e, d in option_table(method)]
+        out.append("")
+    out += [
+        "## Refused",
+        "",
+        "Any method; IPOPT's options with their `ipopt.` prefix. Every other name (for instance",
+        "`jit_options.compiler`, `common_options.jit`) is refused as well.",
+        "",
+        "| option | refused because it |",
+        "|---|---|",
+    ]
+    out += [f"| `{cell(n)}` | {cell(why)} |" for n, why in refused_table()]
+    return "\n".join(out) + "\n"
