@@ -306,3 +306,36 @@ def test_every_shipped_problem_file_passes_the_allow_list():
             if key.startswith("solver.options."):
                 for v in values if isinstance(values, list) else [values]:
                     parse_solver({"method": "ipopt", "options": {key[len("solver.options.") :]: v}}, f.parent)
+
+
+# -- mechanism files: names that become C and file names, files a problem file may read ------------------
+
+RPR_FILE = load_yaml_text((PROBLEMS / "rpr_file_forward_kinematics.yaml").read_text())
+
+
+@pytest.mark.parametrize(
+    "name", ["m" + "a" * 299, "_a", "a_", "a__b", "éa"], ids=["300_chars", "lead", "trail", "double", "non_ascii"]
+)
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_a_mechanism_name_that_cannot_name_c_or_files_is_refused(tmp_path, monkeypatch, name, command):
+    # the issue: exporting a mechanism with a 300-character name failed inside CasADi
+    monkeypatch.chdir(tmp_path)
+    mech = load_yaml_text((PROBLEMS / "mechanisms" / "rpr.yaml").read_text())
+    (tmp_path / "m.yaml").write_text(dump({**mech, "name": name}))
+    problem = tmp_path / "p.yaml"
+    problem.write_text(dump({**RPR_FILE, "mechanism": {**RPR_FILE["mechanism"], "file": "m.yaml"}}))
+    line = _refused_in_time(tmp_path, [*COMMANDS[command], str(problem)], problem, "mechanism.file:")
+    assert "name: expected a mechanism type name of at most 64" in line
+
+
+@pytest.mark.parametrize("target", ["/etc/passwd", "../../../../../../etc/passwd", "/etc/hostname"])
+def test_a_problem_file_reads_only_yaml_mechanism_files_and_never_echoes_another_file(tmp_path, monkeypatch, target):
+    monkeypatch.chdir(tmp_path)
+    problem = tmp_path / "p.yaml"
+    problem.write_text(dump({**RPR_FILE, "mechanism": {**RPR_FILE["mechanism"], "file": target}}))
+    line = _refused_in_time(tmp_path, ["check", str(problem)], problem, "mechanism.file:")
+    assert "ending in .yaml or .yml" in line
+    (tmp_path / "secret.yaml").write_text("the first line of a file that is not a mechanism\n")
+    problem.write_text(dump({**RPR_FILE, "mechanism": {**RPR_FILE["mechanism"], "file": "secret.yaml"}}))
+    line = _refused_in_time(tmp_path, ["check", str(problem)], problem, "mechanism.file:")
+    assert "first line" not in line and "got str of" in line

@@ -567,6 +567,12 @@ IK_KEYS = {"let": "definitions in order", "pose": "dependent coordinates", "actu
 
 def description_from_dict(data: Any, file: str | None = None) -> Description:  # noqa: C901 - one step per section
     """Read a mechanism description from a parsed mechanism file (errors carry key paths)."""
+    if not isinstance(data, Mapping):  # not echoed: the file may be any file a problem file names
+        size = f" of {len(data)} characters" if isinstance(data, str) else ""
+        raise InputError(
+            f"expected a mechanism description (a mapping with name, parameters, platform, legs), "
+            f"got {'an empty file' if data is None else type(data).__name__ + size}"
+        )
     data = _mapping(data, (), "a mechanism description (a mapping with name, parameters, platform, legs)", TOP)
     for key in ("name", "platform"):
         if key not in data:
