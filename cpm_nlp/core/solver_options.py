@@ -134,7 +134,7 @@ NLPSOL_ALLOWED: dict[str, str] = {
 #: CasADi options of the Newton rootfinder (method newton) a file may set
 NEWTON_ALLOWED: dict[str, str] = {
     "abstol": "real",
-    "abstolStep": "real",
+    "abstolStep": "real0",  # 0: no test on the step, iterate to abstol
     "max_iter": "int",
     "line_search": "bool",
     "print_iteration": "bool",
@@ -297,7 +297,7 @@ def _casadi_rule(name: str, kind: str, descriptions: Mapping[str, str]) -> Solve
         return SolverOption(name, "bool", text, None)
     if kind == "int":
         return SolverOption(name, "int", text, None, lower=1, upper=MAX_INT)
-    return SolverOption(name, "dimensionless", text, None, lower=0.0, lower_strict=True)
+    return SolverOption(name, "dimensionless", text, None, lower=0.0, lower_strict=kind == "real")
 
 
 @functools.cache
