@@ -1,4 +1,5 @@
-"""Packaging beyond pyproject.toml: the shipped problem files and solver presets.
+"""Packaging beyond pyproject.toml: the shipped problem files and solver presets,
+and the solver option table (cpm_nlp/core/solver_options.json).
 
 ``problems/`` and ``configs/`` stay at the top of the repository; installed, they
 are the package data ``cpm_nlp/data/problems`` and ``cpm_nlp/data/configs``
@@ -12,5 +13,5 @@ DATA = {"cpm_nlp.data.problems": "problems", "cpm_nlp.data.configs": "configs"}
 setup(
     packages=find_packages(include=["cpm_nlp", "cpm_nlp.*"]) + list(DATA),
     package_dir=DATA,
-    package_data={name: ["*.yaml", "**/*.yaml"] for name in DATA},
+    package_data={**{name: ["*.yaml", "**/*.yaml"] for name in DATA}, "cpm_nlp.core": ["solver_options.json"]},
 )

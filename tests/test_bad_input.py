@@ -303,10 +303,11 @@ def test_missing_task_coordinate(cli, tmp_path, kind):
 
 
 def test_solver_option_given_a_mapping(cli, tmp_path):
-    """An unhashable option value is checked by CasADi like any other (it was a crash, exit 70)."""
+    """An unhashable option value is refused by its declared type (it was a crash, exit 70)."""
     expect_input_error(
         cli,
         tmp_path,
         GOOD + "solver: {options: {ipopt.mu_min: {a: 1}}}\n",
-        "solver.options.ipopt.mu_min: CasADi rejected the value {'a': 1} of option 'ipopt.mu_min' (type mismatch)",
+        "solver.options.ipopt.mu_min: expected a dimensionless number such as '0.5' or a bare SI number, "
+        "got dict {'a': 1}",
     )

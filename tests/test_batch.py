@@ -172,8 +172,8 @@ def test_batch_solutions_are_pose_solutions(limited):
         (lambda m: cn.batch_forward_kinematics(m, [[0.0, 0.0, 0.0]], cn.SolverConfig()), "solves by Newton"),
         (lambda m: cn.batch_forward_kinematics(m, [[0.0] * 3], backend="compild"), "did you mean 'compiled'"),
         (
-            lambda m: cn.batch_forward_kinematics(m, [[0.0] * 3], cn.SolverConfig("newton", {"linear_solver": "qr"})),
-            "takes only abstol, abstolStep, max_iter; got 'linear_solver'",
+            lambda m: cn.batch_forward_kinematics(m, [[0.0] * 3], cn.SolverConfig("newton", {"line_search": False})),
+            "takes only abstol, abstolStep, max_iter; got 'line_search'",
         ),
         (lambda m: cn.batch_forward_kinematics(m, np.zeros((4, 3)), guess=np.zeros((3, 6))), "expected 1 or 4 rows"),
     ],

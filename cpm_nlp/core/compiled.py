@@ -19,6 +19,7 @@ import ctypes
 import hashlib
 import logging
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -185,8 +186,20 @@ class BoundNative(BoundCall):
         return state[3]
 
 
+#: a kernel name (a CasADi Function name, which CasADi checks): it names C functions and the files built
+_KERNEL_NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9]){0,127}")
+
+
 def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Path:
-    """Compile ``source`` into a shared library in the cache (once per content)."""
+    """Compile ``source`` into a shared library in the cache (once per content).
+
+    ``source`` is C that CasADi generated from the model's expressions (numbers and
+    symbols, never text from a file), plus :func:`batch_loop_source`; ``name`` a
+    kernel name (ASCII letters, digits and single underscores; a mechanism file's
+    name is checked when it is read).  The command is the user's ``$CC`` or a
+    compiler on PATH, never anything from a problem file."""
+    if not _KERNEL_NAME.fullmatch(name):  # programming error: names come from the code
+        raise ValueError(f"not a kernel name: {name!r:.80}")
     cmd = find_compiler()
     if cmd is None:
         raise CompilerError(

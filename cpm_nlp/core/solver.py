@@ -1,10 +1,11 @@
 """Solver configuration and construction.
 
 The method (IPOPT or Newton) is chosen here; problem and mechanism know
-nothing about it.  CasADi options pass through unchanged as a dict, merged
-over quiet defaults (``{"ipopt.tol": 1e-10}`` overrides just that key).
-CasADi itself validates them; its rejection becomes an :class:`InputError`
-naming the option, with a "did you mean" where one can be found.
+nothing about it.  CasADi options are checked against a declared allow-list
+(:mod:`cpm_nlp.core.solver_options`: type, range, refused options) before
+CasADi sees them, then merged over quiet defaults (``{"ipopt.tol": 1e-10}``
+overrides just that key).  CasADi validates them once more; its rejection
+becomes an :class:`InputError` naming the option.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import casadi as ca
 import numpy as np
 
 from .errors import InputError, suggest
-from .options import Option
+from .solver_options import check_options, ipopt_rules
 
 log = logging.getLogger(__name__)
 
@@ -45,110 +46,6 @@ DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
     },
 }
 
-#: Largest integer an option of IPOPT or CasADi takes (a C int).
-MAX_INT = 2**31 - 1
-
-
-def _real(name: str, description: str, lower: float = 0.0, strict: bool = True, upper: float | None = None) -> Option:
-    return Option(name, "dimensionless", description, default=None, lower=lower, upper=upper, strict=strict)
-
-
-def _count(name: str, description: str, lower: int = 0, upper: int = MAX_INT) -> Option:
-    return Option(name, "int", description, default=None, lower=lower, upper=upper)
-
-
-def _yes_no(name: str, description: str) -> Option:
-    return Option(name, "choice", description, default=None, choices=("yes", "no"))
-
-
-#: The IPOPT options checked by type and range before IPOPT sees them (names
-#: without the ``ipopt.`` prefix; https://coin-or.github.io/Ipopt/OPTIONS.html).
-#: An option not listed here is passed to IPOPT, which checks its name.
-IPOPT_OPTIONS: dict[str, Option] = {
-    o.name: o
-    for o in (
-        _real("tol", "desired convergence tolerance (relative)"),
-        _count("max_iter", "maximum number of iterations"),
-        _count("print_level", "output verbosity level", upper=12),
-        _real("acceptable_tol", "'acceptable' convergence tolerance (relative)"),
-        _count("acceptable_iter", "number of 'acceptable' iterates before stopping"),
-        _real("constr_viol_tol", "desired threshold for the constraint violation (absolute)"),
-        _real("acceptable_constr_viol_tol", "'acceptance' threshold for the constraint violation"),
-        _real("dual_inf_tol", "desired threshold for the dual infeasibility"),
-        _real("compl_inf_tol", "desired threshold for the complementarity conditions"),
-        Option("mu_strategy", "choice", "barrier parameter update", None, choices=("monotone", "adaptive")),
-        _real("mu_init", "initial value for the barrier parameter"),
-        Option(
-            "linear_solver",
-            "choice",
-            "linear solver used for step computations",
-            None,
-            choices=("mumps", "ma27", "ma57", "ma77", "ma86", "ma97", "pardiso", "pardisomkl", "spral", "wsmp"),
-        ),
-        Option(
-            "hessian_approximation",
-            "choice",
-            "what Hessian information is to be used",
-            None,
-            choices=("exact", "limited-memory"),
-        ),
-        Option(
-            "nlp_scaling_method",
-            "choice",
-            "technique used for scaling the problem",
-            None,
-            choices=("none", "user-scaling", "gradient-based", "equilibration-based"),
-        ),
-        _real("bound_push", "desired minimum absolute distance from the initial point to bound"),
-        _real("bound_frac", "desired minimum relative distance from the initial point to bound", upper=0.5),
-        _real("bound_relax_factor", "factor for initial relaxation of the bounds", strict=False),
-        _yes_no("warm_start_init_point", "warm-start for the initial point"),
-        _real("max_cpu_time", "maximum number of CPU seconds"),
-        _real("max_wall_time", "maximum number of wall-clock seconds"),
-        _yes_no("sb", "suppress the IPOPT banner"),
-        _yes_no("print_timing_statistics", "print timing statistics at the end"),
-        Option(
-            "derivative_test",
-            "choice",
-            "derivative checker",
-            None,
-            choices=("none", "first-order", "second-order", "only-second-order"),
-        ),
-        Option(
-            "fixed_variable_treatment",
-            "choice",
-            "how fixed variables are handled",
-            None,
-            choices=("make_parameter", "make_parameter_nodual", "make_constraint", "relax_bounds"),
-        ),
-        _yes_no("honor_original_bounds", "project the final point into the original bounds"),
-        _yes_no("check_derivatives_for_naninf", "check the derivative matrices for NaN and Inf"),
-    )
-}
-
-#: The options of CasADi's Newton rootfinder (casadi.rootfinder_options("newton"))
-#: and of every rootfinder, checked by type and range; any other name is refused.
-NEWTON_OPTIONS: dict[str, Option] = {
-    o.name: o
-    for o in (
-        _real("abstol", "stopping criterion tolerance on the residual max-norm"),
-        _real("abstolStep", "stopping criterion tolerance on the step size"),
-        _count("max_iter", "maximum number of Newton iterations", lower=1),
-        Option("line_search", "bool", "enable the line search", None),
-        Option("print_iteration", "bool", "print information about each iteration", None),
-        Option("error_on_fail", "bool", "raise an error when the iteration fails", None),
-    )
-}
-
-#: Options of every CasADi function, for either method.
-COMMON_OPTIONS: dict[str, Option] = {
-    o.name: o
-    for o in (
-        Option("print_time", "bool", "print the time spent in the solver", None),
-        Option("verbose", "bool", "verbose evaluation (debugging)", None),
-    )
-}
-
 
 def run_nlp(solver: ca.Function, what: str, **args: Any) -> tuple[np.ndarray, bool, str, int]:
     """One call of an IPOPT ``nlpsol``: ``(x, converged, return status, iterations)``.
@@ -165,31 +62,6 @@ def run_nlp(solver: ca.Function, what: str, **args: Any) -> tuple[np.ndarray, bo
     return z, ok, str(stats.get("return_status", "")), int(stats.get("iter_count", 0))
 
 
-def check_options(method: str, options: Mapping[str, Any]) -> dict[str, Any]:
-    """The options checked by type and range where they are known; the
-    checked values (an integer written ``50.0`` becomes ``50``).  An unknown
-    Newton option, or an IPOPT option given to Newton, is refused with a
-    "did you mean" among Newton's options."""
-    out: dict[str, Any] = {}
-    for key, value in options.items():
-        path = ("solver", "options", key)
-        rule = COMMON_OPTIONS.get(key)
-        if method == "ipopt" and key.startswith("ipopt."):
-            rule = IPOPT_OPTIONS.get(key[len("ipopt.") :])
-        elif method == "newton" and rule is None:
-            rule = NEWTON_OPTIONS.get(key)
-            if rule is None:
-                known = sorted({*NEWTON_OPTIONS, *COMMON_OPTIONS})
-                what = "an IPOPT option" if key.startswith("ipopt.") else "not an option of this solver"
-                raise InputError(
-                    f"'{key}' is {what}; the newton method takes: {', '.join(known)}",
-                    path=path,
-                    suggestions=suggest(key.rpartition(".")[2], known),
-                )
-        out[key] = value if rule is None else rule.parse(value, path)
-    return out
-
-
 @dataclass(frozen=True)
 class SolverConfig:
     """How to solve.
@@ -198,7 +70,8 @@ class SolverConfig:
         "ipopt" (default; an NLP with bounds that select the assembly branch)
         or "newton" (CasADi's Newton rootfinder, the fast path).
     options:
-        CasADi/IPOPT options, passed unchanged, over :data:`DEFAULT_OPTIONS`.
+        CasADi/IPOPT options, checked against the allow-list
+        (:func:`~cpm_nlp.core.solver_options.check_options`), over :data:`DEFAULT_OPTIONS`.
     tolerance:
         largest accepted loop-closure residual (max norm, in the model's
         residual unit, m for every shipped mechanism).
@@ -220,6 +93,8 @@ class SolverConfig:
             )
         if not (self.tolerance > 0 and np.isfinite(self.tolerance)):
             raise InputError(f"expected a positive tolerance, got {self.tolerance!r}", path=("solver", "tolerance"))
+        # every configuration, from a file or from Python, passes the allow-list: nothing refused reaches CasADi
+        object.__setattr__(self, "options", check_options(self.method, self.options))
 
     def casadi_options(self) -> dict[str, Any]:
         merged = dict(DEFAULT_OPTIONS[self.method])
@@ -292,7 +167,7 @@ def translate_casadi_error(exc: Exception, options: Mapping[str, Any]) -> InputE
         return InputError(
             f"IPOPT has no option '{name}'",
             path=("solver", "options", f"ipopt.{name}"),
-            suggestions=[f"ipopt.{s}" for s in suggest(name, IPOPT_OPTIONS)],
+            suggestions=[f"ipopt.{s}" for s in suggest(name, ipopt_rules()[0])],
             hint="see https://coin-or.github.io/Ipopt/OPTIONS.html",
         )
     m = re.search(r"Unknown option: (\S+)", text)

@@ -34,6 +34,7 @@ import datetime
 import hashlib
 import json
 import os
+import re
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
@@ -64,6 +65,11 @@ from ..core.version import __version__
 from .atomic import check_output_path
 
 WHAT = ("fk", "ik", "jacobian")
+
+#: a mechanism name usable in C identifiers and file names (described mechanisms are checked when read:
+#: cpm_nlp.mechanisms.described.spec.MAX_TYPE_NAME); anything else is refused before a file is written
+SAFE_NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9])*")
+MAX_NAME = 64
 FORMATS = ("casadi", "c")
 MANIFEST = "manifest.json"
 
@@ -206,6 +212,7 @@ def exported_functions(
     program written against it) stays as it was.
     """
     config = solver or SolverConfig("newton")
+    check_name(model.name)
     out = []
     for w in parse_what(what):
         k = kernel(model.closure, w, config)
@@ -213,6 +220,17 @@ def exported_functions(
             k = dataclasses.replace(k, outputs=FK_OUTPUTS)
         out.append((k, bake(k, model, config.tolerance)))
     return out
+
+
+def check_name(name: str) -> str:
+    """``name`` if it may become C identifiers and file names (``<name>_kinematics.c``)."""
+    if not (isinstance(name, str) and len(name) <= MAX_NAME and SAFE_NAME.fullmatch(name)):
+        raise InputError(
+            f"cannot export a mechanism named {name!r:.80}: its name becomes C identifiers and file names; "
+            f"expected at most {MAX_NAME} ASCII letters, digits and single underscores, starting with a letter",
+            path=("mechanism", "name"),
+        )
+    return name
 
 
 # -- C wrappers -------------------------------------------------------------------------------

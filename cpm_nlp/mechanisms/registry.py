@@ -49,6 +49,10 @@ BUILTIN = {
 }
 
 
+#: what a mechanism file named by a problem file is called (the problem file reads only YAML files)
+MECHANISM_FILE_SUFFIXES = (".yaml", ".yml")
+
+
 class PluginError(InputError):
     """A mechanism plugin that cannot be loaded or breaks the interface (the message names the plugin)."""
 
@@ -254,6 +258,10 @@ def section_type(section: Mapping[str, Any], base_dir: Any = None, path: tuple =
         if not isinstance(raw, str) or not raw.strip():
             raise InputError(f"expected the path of a mechanism file, got {raw!r}", path=path + ("file",))
         target = Path(raw) if Path(raw).is_absolute() or base_dir is None else Path(base_dir) / raw
+        if target.suffix.lower() not in MECHANISM_FILE_SUFFIXES:  # a problem file reads YAML, not /etc/passwd
+            raise InputError(
+                f"expected a mechanism file ending in .yaml or .yml, got {raw!r:.200}", path=path + ("file",)
+            )
         if not target.is_file():
             raise InputError(f"mechanism file not found: {target}", path=path + ("file",))
         try:

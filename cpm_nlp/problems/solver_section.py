@@ -1,5 +1,15 @@
 """The ``solver`` section of a problem file: a preset name, or
-``{preset, method, options, tolerance}``; presets are YAML files under ``configs/``."""
+``{preset, options, tolerance}``, or ``{method, options, tolerance}``
+(a preset and a method together are refused: the preset names its method).
+
+Presets are YAML files under ``configs/``, looked up in ``$CPM_NLP_CONFIGS``
+(set by the user), beside the problem file (``configs/``, ``../configs/``: the
+problem file's own folder, from which it also reads its mechanism files), then
+among the presets shipped with cpm_nlp.  The working directory is not searched:
+a ``configs/ipopt.yaml`` that happens to be there must not change what
+``solver: ipopt`` means.  A preset is data like the problem file: its options
+pass the same allow-list (:mod:`cpm_nlp.core.solver_options`), and a refusal
+names the preset file."""
 
 from __future__ import annotations
 
@@ -10,14 +20,15 @@ from typing import Any
 
 from ..core.errors import InputError, suggest
 from ..core.options import Option, validate_mapping
-from ..core.solver import METHODS, SolverConfig, check_options
+from ..core.solver import METHODS, SolverConfig
+from ..core.solver_options import check_options
 from .reader import read_yaml
 from .shipped import shipped_configs_dir
 
 SOLVER_OPTIONS = (
     Option("preset", "str", "name of a preset under configs/", default=None),
     Option("method", "choice", "ipopt (NLP with bounds) or newton (rootfinder)", default=None, choices=METHODS),
-    Option("options", "str", "CasADi/IPOPT options, passed unchanged", default=None),  # checked below
+    Option("options", "str", "CasADi/IPOPT options from the allow-list", default=None),  # checked below
     Option(
         "tolerance",
         "dimensionless",
@@ -38,7 +49,7 @@ def config_dirs(base_dir: Path | None) -> list[Path]:
         dirs.append(Path(env))
     if base_dir is not None:
         dirs += [base_dir / "configs", base_dir.parent / "configs"]
-    dirs += [Path.cwd() / "configs", shipped_configs_dir()]
+    dirs.append(shipped_configs_dir())  # not the working directory: see the module docstring
     seen, out = set(), []
     for d in dirs:
         r = d.resolve()
@@ -70,10 +81,15 @@ def load_preset(name: str, base_dir: Path | None, path: tuple) -> dict[str, Any]
     data = read_yaml(presets[name])
     try:
         raw = _solver_mapping(data, ())
-    except InputError as exc:
-        raise exc.at(file=str(presets[name])) from None
-    if raw.get("preset"):
-        raise InputError("a preset cannot name another preset", path=("preset",), file=str(presets[name]))
+        if raw.get("preset"):
+            raise InputError("a preset cannot name another preset", path=("preset",))
+        try:  # the preset's own options pass the allow-list
+            check_options(raw.get("method") or SolverConfig.method, raw["options"])
+        except InputError as exc:
+            raise InputError(exc.message, path=exc.path[1:], suggestions=exc.suggestions, hint=exc.hint) from None
+    except InputError as exc:  # the message names the preset file and its key, the problem file names the key
+        inner = InputError(exc.message, path=exc.path, file=str(presets[name])).render()
+        raise InputError(f"in the preset {inner}", path=path, suggestions=exc.suggestions, hint=exc.hint) from None
     return raw
 
 
@@ -101,15 +117,20 @@ def parse_solver(raw: Any, base_dir: Path | None, path: tuple = ("solver",)) -> 
     if isinstance(raw, str):
         raw = {"preset": raw}
     section = _solver_mapping(raw, path)
+    if section.get("preset") and section.get("method"):
+        method = section["method"]
+        raise InputError(
+            f"'preset' and 'method' given together (preset {section['preset']!r}, method {method!r}); "
+            "use one: a preset names its method",
+            path=path,
+            hint=f"write solver: {method} (the preset), or solver: {{method: {method}, options: ...}}; "
+            f"on the command line, --set solver={method}",
+        )
     merged: dict[str, Any] = {"method": None, "options": {}, "tolerance": None}
     if section.get("preset"):
         preset = load_preset(section["preset"], base_dir, path + ("preset",))
         merged.update({k: v for k, v in preset.items() if k in ("method", "tolerance") and v is not None})
-        # a preset's options belong to its method: they do not survive a method override
-        # ({preset: newton, method: ipopt} must not pass Newton's abstol to IPOPT)
-        preset_method = merged["method"] or SolverConfig.method
-        overridden = section.get("method") is not None and section["method"] != preset_method
-        merged["options"] = {} if overridden else dict(preset["options"])
+        merged["options"] = dict(preset["options"])
     for k in ("method", "tolerance"):
         if section.get(k) is not None:
             merged[k] = section[k]
@@ -120,8 +141,7 @@ def parse_solver(raw: Any, base_dir: Path | None, path: tuple = ("solver",)) -> 
     if merged["tolerance"] is not None:
         kwargs["tolerance"] = float(merged["tolerance"])
     try:
-        kwargs["options"] = check_options(merged["method"] or "ipopt", merged["options"])  # typed: 50.0 -> 50
-        config = SolverConfig(**kwargs)
+        config = SolverConfig(**kwargs)  # checks the options against the allow-list (typed: 50.0 -> 50)
         config.validate()
     except InputError as exc:
         raise InputError(exc.message, path=path + exc.path[1:], suggestions=exc.suggestions, hint=exc.hint) from None

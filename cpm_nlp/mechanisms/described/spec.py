@@ -232,6 +232,26 @@ def _name(value: Any, path: tuple, what: str) -> str:
     return value
 
 
+#: longest mechanism type name: it names CasADi Functions, C functions and files (``<name>_kinematics.c``)
+MAX_TYPE_NAME = 64
+#: a name CasADi takes for a Function (a letter, then letters, digits and single underscores) and C takes
+#: for an identifier: ASCII only
+_TYPE_NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9])*")
+
+
+def _type_name(value: Any, path: tuple) -> str:
+    """The mechanism type name: it becomes part of CasADi Function names, C identifiers and file names."""
+    _name(value, path, "a mechanism type name")
+    if len(value) > MAX_TYPE_NAME or not _TYPE_NAME.fullmatch(value):
+        raise InputError(
+            f"expected a mechanism type name of at most {MAX_TYPE_NAME} ASCII letters, digits and single "
+            f"underscores, starting with a letter and not ending with an underscore, got {value!r:.80}"
+            + (f" ({len(value)} characters)" if len(value) > MAX_TYPE_NAME else ""),
+            path=path,
+        )
+    return value
+
+
 def _text(value: Any, path: tuple) -> str:
     if value is None:
         return ""
@@ -549,11 +569,17 @@ IK_KEYS = {"let": "definitions in order", "pose": "dependent coordinates", "actu
 
 def description_from_dict(data: Any, file: str | None = None) -> Description:  # noqa: C901 - one step per section
     """Read a mechanism description from a parsed mechanism file (errors carry key paths)."""
+    if not isinstance(data, Mapping):  # not echoed: the file may be any file a problem file names
+        size = f" of {len(data)} characters" if isinstance(data, str) else ""
+        raise InputError(
+            f"expected a mechanism description (a mapping with name, parameters, platform, legs), "
+            f"got {'an empty file' if data is None else type(data).__name__ + size}"
+        )
     data = _mapping(data, (), "a mechanism description (a mapping with name, parameters, platform, legs)", TOP)
     for key in ("name", "platform"):
         if key not in data:
             raise InputError(f"missing required key {key!r} ({TOP[key]})")
-    name = _name(data["name"], ("name",), "a mechanism type name")
+    name = _type_name(data["name"], ("name",))
     params = [
         _parameter(_name(n, ("parameters", n), "a parameter name"), v, ("parameters", n))
         for n, v in _mapping(data.get("parameters") or {}, ("parameters",), "name -> {dimension, default}").items()
