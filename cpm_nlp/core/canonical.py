@@ -132,9 +132,7 @@ def _coordinates(V: np.ndarray, d: np.ndarray, T: np.ndarray | None):
     return lambda x: d[:, None] * x
 
 
-def canonical_eigh(
-    K: np.ndarray, M: np.ndarray | None = None, rtol: float = CLUSTER_RTOL, T: np.ndarray | None = None
-):
+def canonical_eigh(K: np.ndarray, M: np.ndarray | None = None, rtol: float = CLUSTER_RTOL, T: np.ndarray | None = None):
     """``scipy.linalg.eigh(K, M)`` in canonical form: (eigenvalues, eigenvectors as
     columns, clusters).  The eigenvalues of a cluster are replaced by their mean
     (a repeated eigenvalue is reported once, exactly repeated); the eigenvectors of

@@ -719,7 +719,7 @@ class NaturalFrequencies(_HingeKind):
         units.update(
             M=f"kg or kg*m^2 (generalized coordinates {', '.join(c.q_names)})",
             K="N/m or N*m/rad",
-            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized, canonical basis in the pose coordinates)",
+            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized, canonical in the pose coordinates)",
             modes_x=f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)",
             multiplicity="per mode: how many frequencies equal its own (1: a simple frequency)",
         )
