@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import functools
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -14,11 +14,15 @@ from ...core.batch import evaluate_points
 from ...core.kernels import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
 from ...core.model import LoopClosure, Model
 from ...core.solver import SolverConfig
+from .exclusion import prove_outside
+from .point_ik import IPOPT_STARTS, ipopt_solve, newton, reduce_angles, start_set
 
 log = logging.getLogger(__name__)
 
 #: a limited quantity may exceed its bound by this much (SI) and still count as inside
 CHECK_TOLERANCE = 1e-9
+#: the statuses of a task point
+INSIDE, OUTSIDE, UNDECIDED = "inside", "outside", "undecided"
 
 # -- limited quantities --------------------------------------------------------------------------
 
@@ -65,8 +69,10 @@ class Membership:
     """Membership of N task points.
 
     inside: bool (N,); margin: (N,) the worst signed margin (SI, of the
-    quantity named in ``binding``; >= -CHECK_TOLERANCE inside); X (N, nx),
-    Q (N, nq): the poses (NaN where the mechanism does not assemble).
+    quantity named in ``binding``; >= -CHECK_TOLERANCE inside; -inf where the
+    mechanism does not assemble, is singular or the point is undecided); X (N, nx),
+    Q (N, nq): the poses (NaN where none was found); status: per point "inside",
+    "outside" or "undecided" (no pose on the designated branch found; not inside).
     """
 
     inside: np.ndarray
@@ -74,10 +80,20 @@ class Membership:
     binding: list[str]
     X: np.ndarray
     Q: np.ndarray
+    status: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            self.status = [INSIDE if v else OUTSIDE for v in np.asarray(self.inside, dtype=bool)]
 
     @property
     def count_outside(self) -> int:
+        """Points not inside (outside or undecided)."""
         return int(np.count_nonzero(~self.inside))
+
+    @property
+    def count_undecided(self) -> int:
+        return sum(1 for s in self.status if s == UNDECIDED)
 
     def worst(self) -> tuple[float, str]:
         k = int(np.argmin(self.margin))
@@ -131,74 +147,201 @@ def task_point_function(closure: LoopClosure) -> ca.Function:
 
 
 @dataclass
-class _PoseValues:
-    """Poses of N task points and the membership values there (NaN where not assembled)."""
+class _Judged:
+    """Membership values of M poses: converged (Φ within the solver tolerance), on the
+    designated branch, the worst margin and its quantity, singular."""
 
+    converged: np.ndarray
+    on_branch: np.ndarray
+    margin: np.ndarray
+    binding: np.ndarray
     X: np.ndarray
     Q: np.ndarray
-    ok: np.ndarray
-    V: np.ndarray | None = None  # (N, n limited)
-    PX: np.ndarray | None = None  # (N, nx, nx), transposed Φ_x (same singular values)
+
+    @property
+    def witness(self) -> np.ndarray:
+        return self.converged & self.on_branch & (self.margin >= -self.tolerance)
+
+    @property
+    def evidence(self) -> np.ndarray:
+        """A pose on the designated branch that violates a limit or is singular."""
+        return self.converged & self.on_branch & ~(self.margin >= -self.tolerance)
+
+    tolerance: float = CHECK_TOLERANCE
 
 
-def _pose_values_at(model: Model, T: np.ndarray, solver: SolverConfig | None) -> _PoseValues:
+def judge(
+    model: Model, X: np.ndarray, Q: np.ndarray, config: SolverConfig, tolerance: float = CHECK_TOLERANCE, values=None
+) -> _Judged:
+    """Judge M poses (X, Q): residual, branch, limits (to ``tolerance``) and Φ_x.
+    ``values``: (V, R, PX) already evaluated at them (else one mapped call)."""
+    c = model.closure
+    M = X.shape[0]
+    _fn, names = limited_function(c)
+    lo, hi = limit_bounds(model)
+    finite = np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
+    V = np.full((M, len(names)), np.nan)
+    R = np.full((M, c.nx), np.nan)
+    PX = np.full((M, c.nx * c.nx), np.nan)
+    if values is not None:
+        V, R, PX = (np.array(v, dtype=float) for v in values)
+    elif np.any(finite):
+        V[finite], R[finite], PX[finite] = evaluate_points(
+            c, POSE_VALUES_KEY, pose_check_function(c), [X[finite], Q[finite]], model.p
+        )
+    with np.errstate(invalid="ignore"):
+        resid = np.where(finite, np.max(np.abs(R), axis=1), np.inf)
+        converged = finite & (resid <= config.tolerance)
+        m = np.minimum(V - lo, hi - V)
+    m = np.where(np.isnan(m), np.inf, m)
+    is_branch = np.array([n.startswith("branch[") for n in names], dtype=bool)
+    with np.errstate(invalid="ignore"):
+        on_branch = np.all(m[:, is_branch] >= -tolerance, axis=1) if is_branch.any() else np.ones(M, dtype=bool)
+        xd = X[:, c.dep_index]
+        on_branch &= np.all(xd >= model.x_lower[c.dep_index] - tolerance, axis=1)
+        on_branch &= np.all(xd <= model.x_upper[c.dep_index] + tolerance, axis=1)
+    worst = np.argmin(m, axis=1) if M else np.zeros(0, dtype=int)
+    w = m[np.arange(M), worst]
+    binding = np.where(np.isfinite(w), np.asarray(names, dtype=object)[worst], "")
+    margin = np.where(np.isfinite(w), w, np.inf)
+    margin = np.where(converged, margin, -np.inf)
+    binding = np.where(converged, binding, "no assembly")
+    idx = np.flatnonzero(converged)
+    if idx.size:  # forward singularities: Φ_x rank deficient
+        sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, c.nx)) < SINGULAR_CONDITION)
+        margin[idx[sing]], binding[idx[sing]] = -np.inf, "singular"
+    return _Judged(converged, on_branch, margin, binding.astype(object), X, Q, tolerance)
+
+
+@dataclass
+class _Points:
+    """Verdicts of N task points."""
+
+    status: np.ndarray  # INSIDE, OUTSIDE, UNDECIDED
+    margin: np.ndarray
+    binding: np.ndarray
+    X: np.ndarray
+    Q: np.ndarray
+
+
+def _closed_form_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float) -> _Points:
+    """Every point at once through the closed-form IK: decided inside or outside (a
+    negative reach margin proves that the mechanism does not assemble there)."""
+    c = model.closure
+    X, Q, reach, V, R, PX = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
+    ok = reach.ravel() >= 0
+    V, R = np.where(ok[:, None], V, np.nan), np.where(ok[:, None], R, np.nan)
+    X, Q = np.where(ok[:, None], X, np.nan), np.where(ok[:, None], Q, np.nan)
+    j = judge(model, X, Q, config, tolerance, (V, R, PX))
+    # on the closed form's branch by construction; the branch rows still count as limits
+    status = np.where(j.converged & (j.margin >= -tolerance), INSIDE, OUTSIDE).astype(object)
+    return _Points(status, j.margin, j.binding, X, Q)
+
+
+def _assemble(model: Model, T: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    c = model.closure
+    nd = len(c.dep_index)
+    X = np.empty((T.shape[0], c.nx))
+    X[:, c.task_index] = T
+    X[:, c.dep_index] = Y[:, :nd]
+    return X, Y[:, nd:]
+
+
+def _take(points: _Points, model, T, k: np.ndarray, Y: np.ndarray, j: _Judged, index: np.ndarray) -> None:
+    """Record the verdict of points ``k`` from judged poses ``index`` of ``j``."""
+    X, Q = _assemble(model, T[k], Y[index])
+    points.X[k], points.Q[k] = X, Q
+    points.margin[k], points.binding[k] = j.margin[index], j.binding[index]
+
+
+def _decide(points: _Points, model, T, todo: np.ndarray, Y: np.ndarray, j: _Judged, per: int) -> None:
+    """Verdicts from ``per`` judged starts of each point of ``todo`` (rows point-major):
+    the first witness in start order makes a point inside; else the first pose on the
+    designated branch outside a limit makes it outside (the branch designates one pose)."""
+    wit = j.witness.reshape(todo.size, per)
+    evi = j.evidence.reshape(todo.size, per)
+    base = np.arange(todo.size) * per
+    has_w = wit.any(axis=1)
+    if has_w.any():
+        rows = base[has_w] + np.argmax(wit[has_w], axis=1)
+        points.status[todo[has_w]] = INSIDE
+        _take(points, model, T, todo[has_w], Y, j, rows)
+    has_e = ~has_w & evi.any(axis=1)
+    if has_e.any():
+        rows = base[has_e] + np.argmax(evi[has_e], axis=1)
+        points.status[todo[has_e]] = OUTSIDE
+        _take(points, model, T, todo[has_e], Y, j, rows)
+
+
+def _solved_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float) -> _Points:
+    """Every point from its own start set (:mod:`.point_ik`), never from another point."""
+    c = model.closure
+    N = T.shape[0]
+    starts = start_set(model, T)
+    points = _Points(
+        np.full(N, UNDECIDED, dtype=object),
+        np.full(N, -np.inf),
+        np.full(N, "undecided", dtype=object),
+        np.full((N, c.nx), np.nan),
+        np.full((N, c.nq), np.nan),
+    )
+    for first, last in ((0, 2), (2, starts.shape[1])):  # Newton rounds
+        todo = np.flatnonzero(points.status == UNDECIDED)
+        if todo.size and first > 0:  # before more starts: a proof that no pose passes
+            fn, _names = limited_function(c)
+            lo, hi = limit_bounds(model)
+            proven = todo[prove_outside(model, T[todo], tolerance, fn, lo, hi)]
+            points.status[proven] = OUTSIDE
+            points.binding[proven] = "no pose within the limits (interval proof)"
+            todo = np.flatnonzero(points.status == UNDECIDED)
+        if not todo.size:
+            break
+        per = last - first
+        Y0 = starts[todo, first:last].reshape(-1, starts.shape[2])
+        Tr = np.repeat(T[todo], per, axis=0)
+        Y, _norm = newton(model, Y0, Tr, config.tolerance)
+        Y = reduce_angles(model, Y)
+        X, Q = _assemble(model, Tr, Y)
+        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance), per)
+    for s in range(min(IPOPT_STARTS, starts.shape[1])):  # IPOPT with the strokes as bounds
+        todo = np.flatnonzero(points.status == UNDECIDED)
+        if not todo.size:
+            break
+        Y = np.full((todo.size, starts.shape[2]), np.nan)
+        for i, k in enumerate(todo):
+            y, conv = ipopt_solve(model, T[k], starts[k, s], config)
+            if conv:
+                Y[i] = y
+        Y = reduce_angles(model, Y)
+        X, Q = _assemble(model, T[todo], Y)
+        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance), 1)
+    und = points.status == UNDECIDED
+    points.binding[und] = f"undecided: no pose on the designated branch from {starts.shape[1]} starts"
+    return points
+
+
+def _points(model: Model, T, solver: SolverConfig | None, tolerance: float) -> _Points:
     c = model.closure
     config = solver or SolverConfig()
     T = np.atleast_2d(np.asarray(T, dtype=float))
-    N = T.shape[0]
-    nv = len(limited_function(c)[1])
-    if N == 0:
-        return _PoseValues(np.zeros((0, c.nx)), np.zeros((0, c.nq)), np.zeros(0, dtype=bool))
+    if T.shape[0] == 0:
+        e = np.zeros(0, dtype=object)
+        return _Points(e, np.zeros(0), e.copy(), np.zeros((0, c.nx)), np.zeros((0, c.nq)))
     if c.ik is not None:
-        X, Q, reach, V, R, PX = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
-        ok = reach.ravel() >= 0
-    else:
-        X, Q, ok = _solve_poses(model, T, config)
-        V, R, PX = (np.full((N, k), np.nan) for k in (nv, c.nx, c.nx * c.nx))
-        good = ok & np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
-        if np.any(good):
-            V[good], R[good], PX[good] = evaluate_points(
-                c, POSE_VALUES_KEY, pose_check_function(c), [X[good], Q[good]], model.p
-            )
-    good = ok & np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
-    with np.errstate(invalid="ignore"):
-        resid = np.where(good, np.max(np.abs(R), axis=1), np.inf)
-    ok = good & (resid <= config.tolerance)
-    return _PoseValues(X, Q, ok, V, PX.reshape(N, c.nx, c.nx))
-
-
-def _solve_poses(model: Model, T: np.ndarray, config: SolverConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The IK solved point by point (no closed form), each from the previous
-    point's solution (or home), with the configured solver and its bounds."""
-    c = model.closure
-    N = T.shape[0]
-    built = c.ik_solver(config)
-    nd = len(c.dep_index)
-    lower = np.r_[model.x_lower[c.dep_index], np.full(c.nq, -np.inf)]
-    upper = np.r_[model.x_upper[c.dep_index], np.full(c.nq, np.inf)]
-    home = np.r_[model.x_home[c.dep_index], model.q_home]
-    X, Q = np.full((N, c.nx), np.nan), np.full((N, c.nq), np.nan)
-    ok = np.zeros(N, dtype=bool)
-    y0 = home
-    for k in range(N):
-        y, conv, *_ = built.solve(y0, np.r_[T[k], model.p], lower, upper)
-        if not conv:
-            y, conv, *_ = built.solve(home, np.r_[T[k], model.p], lower, upper)
-        if conv:
-            X[k], Q[k], ok[k] = c.assemble_x(T[k], y[:nd]), y[nd:], True
-            y0 = y
-    return X, Q, ok
+        return _closed_form_points(model, T, config, tolerance)
+    return _solved_points(model, T, config, tolerance)
 
 
 def poses(model: Model, T: np.ndarray, solver: SolverConfig | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Poses (X, Q) for task points T (N, nq) and whether each assembles.
+    """Poses (X, Q) for task points T (N, nq) and whether each assembles on the
+    designated branch (inside or outside the limits).
 
-    With a closed-form IK all points are evaluated at once (one mapped CasADi
-    call); otherwise the IK is solved point by point, each from the previous
-    point's solution (or home), with the configured solver and its bounds.
+    With a closed-form IK all points are evaluated at once (one mapped CasADi call);
+    otherwise each point's IK is solved from its own start set (:mod:`.point_ik`).
     """
-    got = _pose_values_at(model, T, solver)
-    return got.X, got.Q, got.ok
+    got = _points(model, T, solver, CHECK_TOLERANCE)
+    ok = np.all(np.isfinite(got.X), axis=1) & np.all(np.isfinite(got.Q), axis=1)
+    return got.X, got.Q, ok
 
 
 def condition_numbers(PX: np.ndarray) -> np.ndarray:
@@ -221,27 +364,12 @@ def condition_numbers(PX: np.ndarray) -> np.ndarray:
 def membership(model: Model, T, solver: SolverConfig | None = None, tolerance: float = CHECK_TOLERANCE) -> Membership:
     """Which task points T (N, nq) lie in the reachable workspace: the pose
     assembles on the designated branch, is not singular, and every limited
-    quantity is within its limits (to ``tolerance``)."""
-    c = model.closure
-    T = np.atleast_2d(np.asarray(T, dtype=float))
-    N = T.shape[0]
-    got = _pose_values_at(model, T, solver)
-    margin = np.full(N, -np.inf)
-    binding = np.full(N, "no assembly", dtype=object)
-    _fn, names = limited_function(c)
-    lo, hi = limit_bounds(model)
-    idx = np.flatnonzero(got.ok)
-    if idx.size:
-        V = got.V[idx].T
-        with np.errstate(invalid="ignore"):
-            m = np.minimum(V - lo[:, None], hi[:, None] - V)
-        m = np.where(np.isnan(m), np.inf, m)
-        worst = np.argmin(m, axis=0)
-        w = m[worst, np.arange(idx.size)]
-        binding[idx] = np.where(np.isfinite(w), np.asarray(names, dtype=object)[worst], "")
-        margin[idx] = np.where(np.isfinite(w), w, np.inf)
-        # forward singularities: Φ_x rank deficient
-        sing = ~(condition_numbers(got.PX[idx]) < SINGULAR_CONDITION)
-        margin[idx[sing]], binding[idx[sing]] = -np.inf, "singular"
-    inside = margin >= -tolerance
-    return Membership(inside, margin, binding.tolist(), got.X, got.Q)
+    quantity is within its limits (to ``tolerance``).
+
+    Each point is decided on its own (never from another point's solution): inside
+    (a pose that passes), outside (the closed form's reach margin is negative, or
+    the pose on the designated branch violates a limit or is singular) or undecided
+    (no pose on the designated branch from any start; ``inside`` is False there)."""
+    got = _points(model, T, solver, tolerance)
+    inside = got.status == INSIDE
+    return Membership(inside, got.margin, got.binding.tolist(), got.X, got.Q, got.status.tolist())
