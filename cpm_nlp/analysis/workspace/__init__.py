@@ -66,6 +66,9 @@ from .cuboid import (
 )
 from .membership import (
     CHECK_TOLERANCE,
+    INSIDE,
+    OUTSIDE,
+    UNDECIDED,
     Membership,
     condition_numbers,
     limit_bounds,
@@ -75,7 +78,7 @@ from .membership import (
     poses,
     task_point_function,
 )
-from .sampling import PROBE_BISECTIONS, PROBE_LEVELS, probe_region, sample_workspace
+from .sampling import PROBE_BISECTIONS, PROBE_LEVELS, Cloud, probe_region, sample_workspace, workspace_cloud
 
 __all__ = [
     "ADDED_PER_ROUND",
@@ -83,11 +86,15 @@ __all__ = [
     "CHECK_TOLERANCE",
     "CLOSED_FORM_IPOPT",
     "CUBOID_IPOPT",
+    "Cloud",
     "CuboidCheck",
     "CuboidNLP",
     "CuboidResult",
     "EXTRA_SLOTS",
     "FORMULATIONS",
+    "INSIDE",
+    "OUTSIDE",
+    "UNDECIDED",
     "Membership",
     "NLP_MARGIN",
     "PROBE_BISECTIONS",
@@ -116,4 +123,5 @@ __all__ = [
     "sample_workspace",
     "surface_grid",
     "task_point_function",
+    "workspace_cloud",
 ]

@@ -4,12 +4,13 @@ cloud of the workspace."""
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 
 from ...core.model import Model
 from ...core.solver import SolverConfig
-from .membership import membership
+from .membership import UNDECIDED, membership
 
 log = logging.getLogger(__name__)
 
@@ -18,8 +19,8 @@ log = logging.getLogger(__name__)
 
 #: bisection steps of :func:`probe_region` along each direction
 PROBE_BISECTIONS = 40
-#: bisection levels decided per membership call when membership is one vectorised call
-#: (closed-form IK): the 2^k - 1 midpoints of the next k levels are tested at once
+#: bisection levels decided per membership call (membership is one vectorised call, each
+#: point decided on its own): the 2^k - 1 midpoints of the next k levels are tested at once
 PROBE_LEVELS = 4
 
 
@@ -31,15 +32,15 @@ def probe_region(  # noqa: C901 - one loop of probe rounds with its stop rules
     by doubling and bisection), times ``factor``.  None if the centre itself
     is outside.
 
-    With a closed-form IK the steps of the doubling are tested in one call and
-    the bisection decides :data:`PROBE_LEVELS` levels per call (all midpoints
-    those levels could visit); the result is the same as one level per call.
+    The steps of the doubling are tested in one call and the bisection decides
+    :data:`PROBE_LEVELS` levels per call (all midpoints those levels could visit);
+    the result is the same as one level per call.
     """
     t0 = model.task_of(model.x_home) if centre is None else np.asarray(centre, dtype=float)
     d = t0.size
     if not membership(model, t0[None, :], solver).inside[0]:
         return None
-    levels = PROBE_LEVELS if model.closure.ik is not None else 1
+    levels = PROBE_LEVELS
     dirs = np.vstack([np.eye(d), -np.eye(d)])
     cols = np.arange(2 * d)
     inside_step = np.zeros(2 * d)
@@ -89,6 +90,60 @@ def probe_region(  # noqa: C901 - one loop of probe rounds with its stop rules
     return t0 - factor * np.maximum(minus, 0.25 * span), t0 + factor * np.maximum(plus, 0.25 * span)
 
 
+@dataclass
+class Cloud:
+    """A seeded point cloud of the workspace.
+
+    points: the points inside (M, nq); region: the box they were drawn from (None if
+    the home pose is outside and no region was given); drawn, inside, undecided:
+    counts; volume: the Monte-Carlo estimate (region volume × inside / drawn);
+    volume_upper: the same with the undecided points counted inside (equal to
+    ``volume`` when none is undecided); undecided_points: those points (U, nq).
+    """
+
+    points: np.ndarray
+    region: tuple[np.ndarray, np.ndarray] | None
+    drawn: int = 0
+    inside: int = 0
+    undecided: int = 0
+    volume: float = 0.0
+    volume_upper: float = 0.0
+    undecided_points: np.ndarray | None = None
+
+
+def workspace_cloud(
+    model: Model,
+    count: int,
+    seed: int = 0,
+    region: tuple[np.ndarray, np.ndarray] | None = None,
+    solver: SolverConfig | None = None,
+) -> Cloud:
+    """``count`` points drawn uniformly in ``region`` (default: :func:`probe_region`)
+    with a seeded generator, each decided by :func:`membership` (see :class:`Cloud`)."""
+    nq = model.closure.nq
+    if region is None:
+        region = probe_region(model, solver)
+        if region is None:
+            return Cloud(np.zeros((0, nq)), None, undecided_points=np.zeros((0, nq)))
+    lo, hi = (np.asarray(v, dtype=float) for v in region)
+    rng = np.random.default_rng(seed)
+    T = lo + (hi - lo) * rng.random((count, lo.size))
+    mem = membership(model, T, solver)
+    undecided = np.array([s == UNDECIDED for s in mem.status], dtype=bool)
+    n_in, n_und = int(np.count_nonzero(mem.inside)), int(np.count_nonzero(undecided))
+    box = float(np.prod(hi - lo))
+    return Cloud(
+        T[mem.inside],
+        (lo, hi),
+        count,
+        n_in,
+        n_und,
+        box * n_in / max(count, 1),
+        box * (n_in + n_und) / max(count, 1),
+        T[undecided],
+    )
+
+
 def sample_workspace(
     model: Model,
     count: int,
@@ -98,14 +153,7 @@ def sample_workspace(
 ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray] | None, float]:
     """A seeded point cloud of the workspace: ``count`` points drawn uniformly
     in ``region`` (default: :func:`probe_region`), those inside kept.  Returns
-    (points inside (M, nq), the region, the Monte-Carlo volume estimate)."""
-    if region is None:
-        region = probe_region(model, solver)
-        if region is None:
-            return np.zeros((0, model.closure.nq)), None, 0.0
-    lo, hi = (np.asarray(v, dtype=float) for v in region)
-    rng = np.random.default_rng(seed)
-    T = lo + (hi - lo) * rng.random((count, lo.size))
-    inside = membership(model, T, solver).inside
-    volume = float(np.prod(hi - lo)) * np.count_nonzero(inside) / max(count, 1)
-    return T[inside], (lo, hi), volume
+    (points inside (M, nq), the region, the Monte-Carlo volume estimate); see
+    :func:`workspace_cloud` for the counts of undecided points."""
+    cloud = workspace_cloud(model, count, seed, region, solver)
+    return cloud.points, cloud.region, cloud.volume
