@@ -25,7 +25,7 @@ from ..analysis.workspace import (
     EXTRA_SLOTS,
     inscribed_cuboid,
     membership,
-    sample_workspace,
+    workspace_cloud,
 )
 from ..core.errors import InputError
 from ..core.kind import ProblemKind, broadcast, require_ipopt
@@ -79,11 +79,18 @@ def _region(inputs: Mapping[str, Any], model: Model, path: tuple) -> tuple[np.nd
     return np.array([inputs[n][0] for n in names]), np.array([inputs[n][1] for n in names])
 
 
+#: the size of a box or a region by its number of translational task coordinates
+SIZE_DIMENSIONS = {1: "length", 2: "area", 3: "volume"}
+
+
 def _volume_dimension(model: Model) -> tuple[str, str]:
-    """Dimension and SI unit of a box volume in the task coordinates."""
+    """Dimension and SI unit of the size of a box in the task coordinates: a length,
+    an area or a volume when every task coordinate is a length (by their number),
+    else the product of their units (a "task volume")."""
     kinds = [model.closure.x[i].kind for i in model.closure.task_index]
-    if all(k == "length" for k in kinds):
-        return "volume", "m^3"
+    if all(k == "length" for k in kinds) and len(kinds) in SIZE_DIMENSIONS:
+        dim = SIZE_DIMENSIONS[len(kinds)]
+        return dim, DIMENSIONS[dim].si
     unit = "*".join(DIMENSIONS[k].si for k in kinds)
     return "task volume", unit
 
@@ -283,9 +290,9 @@ class Workspace(ProblemKind):
     def output_names(self, model: Model) -> list[str]:
         task = list(model.closure.task)
         return (
-            ["inside", "margin", "binding", "inside_paper", "count_inside"]
+            ["inside", "status", "margin", "binding", "inside_paper", "count_inside", "count_undecided"]
             + [f"cloud_{t}" for t in task]
-            + ["cloud_count", "volume_estimate"]
+            + ["cloud_count", "cloud_undecided", "volume_estimate", "volume_estimate_upper"]
             + [f"{t}_range" for t in task]
         )
 
@@ -299,33 +306,54 @@ class Workspace(ProblemKind):
             T, _batch = broadcast([inputs[t] for t in task], task, ("inputs",))
             mem = membership(model, T, solver)
             values["inside"] = mem.inside.tolist()
+            values["status"] = list(mem.status)
             values["margin"] = [float(m) if np.isfinite(m) else None for m in mem.margin]
             values["binding"] = mem.binding
             values["count_inside"] = int(np.count_nonzero(mem.inside))
-            dims.update(inside="text", margin="si", binding="text", count_inside="dimensionless")
+            values["count_undecided"] = mem.count_undecided
+            dims.update(
+                inside="text",
+                status="text",
+                margin="si",
+                binding="text",
+                count_inside="dimensionless",
+                count_undecided="dimensionless",
+            )
             paper = _paper_membership(model)
             if paper is not None:
                 values["inside_paper"] = paper(model, T)[0].tolist()
                 dims["inside_paper"] = "text"
         status, message = Status.SOLVED, ""
         if inputs["samples"]:
-            pts, region, vol = sample_workspace(
-                model, inputs["samples"], inputs["seed"], _region(inputs, model, ()), solver
-            )
-            if region is None:
+            cloud = workspace_cloud(model, inputs["samples"], inputs["seed"], _region(inputs, model, ()), solver)
+            if cloud.region is None:
                 status = Status.INFEASIBLE
                 message = "the home configuration is outside the workspace; give a search region (<task>_range)"
             else:
+                vdim = _volume_dimension(model)[0]
                 for k, t in enumerate(task):
-                    values[f"cloud_{t}"] = pts[:, k].tolist()
-                    values[f"{t}_range"] = [float(region[0][k]), float(region[1][k])]
+                    values[f"cloud_{t}"] = cloud.points[:, k].tolist()
+                    values[f"{t}_range"] = [float(cloud.region[0][k]), float(cloud.region[1][k])]
                     dims[f"cloud_{t}"] = dims[f"{t}_range"] = c.x[c.task_index[k]].kind
-                values["cloud_count"] = len(pts)
-                values["volume_estimate"] = vol
-                dims["cloud_count"] = "dimensionless"
-                dims["volume_estimate"] = _volume_dimension(model)[0]
-                message = f"{len(pts)} of {inputs['samples']} points of the search region inside"
-        units = {k: _unit(d) for k, d in dims.items()}
+                values["cloud_count"] = len(cloud.points)
+                values["cloud_undecided"] = cloud.undecided
+                values["volume_estimate"] = cloud.volume
+                values["volume_estimate_upper"] = cloud.volume_upper
+                dims.update(cloud_count="dimensionless", cloud_undecided="dimensionless")
+                dims["volume_estimate"] = dims["volume_estimate_upper"] = vdim
+                message = (
+                    f"{cloud.inside} of {cloud.drawn} points of the search region inside, "
+                    f"{cloud.drawn - cloud.inside - cloud.undecided} outside, {cloud.undecided} undecided"
+                )
+                if cloud.undecided:
+                    message += " (volume_estimate counts them outside, volume_estimate_upper inside)"
+        if values.get("status") is not None and mem.count_undecided:
+            message = (message + "; " if message else "") + (
+                f"{mem.count_undecided} of {len(mem.status)} given points undecided (no pose on the designated "
+                "branch found from any start)"
+            )
+        vunit = _volume_dimension(model)[1]
+        units = {k: (vunit if d == "task volume" else _unit(d)) for k, d in dims.items()}
         return Result(
             self.name, status, values, units, dims, SolverInfo(solver.name), message, None, _model_info(model)
         )

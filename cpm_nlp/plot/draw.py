@@ -1105,11 +1105,11 @@ def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, 
         a.plot(t0[0] * fx, t0[1] * fy, "*", color="tab:red", ms=14, mec="k", label="the pose")
         a.set_xlabel(axis_label(names[0], ux))
         a.set_ylabel(axis_label(names[1], uy))
-        f2, u2 = display_unit(kinds[2], [t0[2]])
-        a.set_title(
-            f"{name} at {pretty(names[2])} = {_number(t0[2] * f2)} {u2} (blank: outside)".replace("  ", " "),
-            fontsize="small",
-        )
+        at = ""
+        for k in range(2, len(names)):  # the task coordinates held at the pose (none for a 2-D task)
+            fk, uk = display_unit(kinds[k], [t0[k]])
+            at += f" at {pretty(names[k])} = {_number(t0[k] * fk)} {uk}"
+        a.set_title(f"{name}{at} (blank: outside)".replace("  ", " "), fontsize="small")
         value = values.get(name)
         if isinstance(value, (int, float)):
             a.legend(fontsize="x-small", title=f"{name} = {value:.4g}", title_fontsize="x-small", loc="upper right")

@@ -1,0 +1,375 @@
+"""Membership of task points in the reachable workspace: the limited quantities, the
+pose of each point and the test."""
+
+from __future__ import annotations
+
+import functools
+import logging
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from ...core.batch import evaluate_points
+from ...core.kernels import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
+from ...core.model import LoopClosure, Model
+from ...core.solver import SolverConfig
+from .exclusion import prove_outside
+from .point_ik import IPOPT_STARTS, ipopt_solve, newton, reduce_angles, start_set
+
+log = logging.getLogger(__name__)
+
+#: a limited quantity may exceed its bound by this much (SI) and still count as inside
+CHECK_TOLERANCE = 1e-9
+#: the statuses of a task point
+INSIDE, OUTSIDE, UNDECIDED = "inside", "outside", "undecided"
+
+# -- limited quantities --------------------------------------------------------------------------
+
+
+@functools.cache
+def limited_function(closure: LoopClosure) -> tuple[ca.Function, tuple[str, ...]]:
+    """``limited(x, q, p) -> v``: actuators, pose coordinates, passive joints and
+    branch indicators, the quantities that joint limits and the branch bound
+    (built once per mechanism type), with their names."""
+    x = ca.SX.sym("x", closure.nx)
+    q = ca.SX.sym("q", closure.nq)
+    p = ca.SX.sym("p", closure.np)
+    rows = [q, x]
+    names = list(closure.q_names) + list(closure.x_names)
+    if closure.passive is not None:
+        rows.append(closure.passive(x, q, p))
+        names += closure.passive_names
+    if closure.branch is not None:
+        g = closure.branch(x, q, p)
+        rows.append(g)
+        names += [f"branch[{i}]" for i in range(g.size1())]
+    fn = ca.Function("limited", [x, q, p], [ca.vertcat(*rows)], ["x", "q", "p"], ["v"])
+    return fn, tuple(names)
+
+
+def limit_bounds(model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of the limited quantities (±inf where unlimited;
+    branch indicators must be >= 0)."""
+    c = model.closure
+    lo, hi = [], []
+    for coord in list(c.q) + list(c.x) + list(c.passive_coords):
+        lim = model.limit_of(coord)
+        lo.append(-np.inf if lim is None else lim[0])
+        hi.append(np.inf if lim is None else lim[1])
+    n_branch = len(limited_function(c)[1]) - len(lo)
+    return np.r_[lo, np.zeros(n_branch)], np.r_[hi, np.full(n_branch, np.inf)]
+
+
+# -- membership ----------------------------------------------------------------------------------
+
+
+@dataclass
+class Membership:
+    """Membership of N task points.
+
+    inside: bool (N,); margin: (N,) the worst signed margin (SI, of the
+    quantity named in ``binding``; >= -CHECK_TOLERANCE inside; -inf where the
+    mechanism does not assemble, is singular or the point is undecided); X (N, nx),
+    Q (N, nq): the poses (NaN where none was found); status: per point "inside",
+    "outside" or "undecided" (no pose on the designated branch found; not inside).
+    """
+
+    inside: np.ndarray
+    margin: np.ndarray
+    binding: list[str]
+    X: np.ndarray
+    Q: np.ndarray
+    status: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            self.status = [INSIDE if v else OUTSIDE for v in np.asarray(self.inside, dtype=bool)]
+
+    @property
+    def count_outside(self) -> int:
+        """Points not inside (outside or undecided)."""
+        return int(np.count_nonzero(~self.inside))
+
+    @property
+    def count_undecided(self) -> int:
+        return sum(1 for s in self.status if s == UNDECIDED)
+
+    def worst(self) -> tuple[float, str]:
+        k = int(np.argmin(self.margin))
+        return float(self.margin[k]), self.binding[k]
+
+
+#: cache keys of the membership functions
+POSE_VALUES_KEY = ("workspace", "pose_values")
+TASK_POINT_KEY = ("workspace", "task_point")
+
+
+def _pose_values(c: LoopClosure, x, q, p) -> list:
+    """Symbolic values the membership test needs at a pose: the limited
+    quantities, the loop-closure residuals and Φ_x (dense, column-major),
+    common subexpressions shared."""
+    fn, _names = limited_function(c)
+    return ca.cse([fn(x, q, p), c.phi(x, q, p), ca.vec(ca.densify(c.phi_x(x, q, p)))])
+
+
+def pose_check_function(closure: LoopClosure) -> ca.Function:
+    """``<name>_pose_values: (x, q, p) -> (v, phi, phi_x)`` (built once per mechanism type)."""
+
+    def build() -> ca.Function:
+        c = closure
+        x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
+        return ca.Function(
+            f"{c.name}_pose_values", [x, q, p], _pose_values(c, x, q, p), ["x", "q", "p"], ["v", "phi", "phi_x"]
+        )
+
+    return closure.solvers.memo(POSE_VALUES_KEY, build)
+
+
+def task_point_function(closure: LoopClosure) -> ca.Function:
+    """``<name>_task_point: (t, p) -> (x, q, reach, v, phi, phi_x)``: the closed-form
+    IK at a task point and the values of :func:`pose_check_function` there (one
+    flat SX graph, built once per mechanism type)."""
+
+    def build() -> ca.Function:
+        c = closure
+        t, p = ca.SX.sym("t", c.nq), ca.SX.sym("p", c.np)
+        x, q, reach = c.ik(t, p)
+        return ca.Function(
+            f"{c.name}_task_point",
+            [t, p],
+            ca.cse([x, q, reach, *_pose_values(c, x, q, p)]),
+            ["t", "p"],
+            ["x", "q", "reach", "v", "phi", "phi_x"],
+        )
+
+    return closure.solvers.memo(TASK_POINT_KEY, build)
+
+
+@dataclass
+class _Judged:
+    """Membership values of M poses: converged (Φ within the solver tolerance), on the
+    designated branch, the worst margin and its quantity, singular."""
+
+    converged: np.ndarray
+    on_branch: np.ndarray
+    margin: np.ndarray
+    binding: np.ndarray
+    X: np.ndarray
+    Q: np.ndarray
+
+    @property
+    def witness(self) -> np.ndarray:
+        return self.converged & self.on_branch & (self.margin >= -self.tolerance)
+
+    @property
+    def evidence(self) -> np.ndarray:
+        """A pose on the designated branch that violates a limit or is singular."""
+        return self.converged & self.on_branch & ~(self.margin >= -self.tolerance)
+
+    tolerance: float = CHECK_TOLERANCE
+
+
+def judge(
+    model: Model, X: np.ndarray, Q: np.ndarray, config: SolverConfig, tolerance: float = CHECK_TOLERANCE, values=None
+) -> _Judged:
+    """Judge M poses (X, Q): residual, branch, limits (to ``tolerance``) and Φ_x.
+    ``values``: (V, R, PX) already evaluated at them (else one mapped call)."""
+    c = model.closure
+    M = X.shape[0]
+    _fn, names = limited_function(c)
+    lo, hi = limit_bounds(model)
+    finite = np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
+    V = np.full((M, len(names)), np.nan)
+    R = np.full((M, c.nx), np.nan)
+    PX = np.full((M, c.nx * c.nx), np.nan)
+    if values is not None:
+        V, R, PX = (np.array(v, dtype=float) for v in values)
+    elif np.any(finite):
+        V[finite], R[finite], PX[finite] = evaluate_points(
+            c, POSE_VALUES_KEY, pose_check_function(c), [X[finite], Q[finite]], model.p
+        )
+    with np.errstate(invalid="ignore"):
+        resid = np.where(finite, np.max(np.abs(R), axis=1), np.inf)
+        converged = finite & (resid <= config.tolerance)
+        m = np.minimum(V - lo, hi - V)
+    m = np.where(np.isnan(m), np.inf, m)
+    is_branch = np.array([n.startswith("branch[") for n in names], dtype=bool)
+    with np.errstate(invalid="ignore"):
+        on_branch = np.all(m[:, is_branch] >= -tolerance, axis=1) if is_branch.any() else np.ones(M, dtype=bool)
+        xd = X[:, c.dep_index]
+        on_branch &= np.all(xd >= model.x_lower[c.dep_index] - tolerance, axis=1)
+        on_branch &= np.all(xd <= model.x_upper[c.dep_index] + tolerance, axis=1)
+    worst = np.argmin(m, axis=1) if M else np.zeros(0, dtype=int)
+    w = m[np.arange(M), worst]
+    binding = np.where(np.isfinite(w), np.asarray(names, dtype=object)[worst], "")
+    margin = np.where(np.isfinite(w), w, np.inf)
+    margin = np.where(converged, margin, -np.inf)
+    binding = np.where(converged, binding, "no assembly")
+    idx = np.flatnonzero(converged)
+    if idx.size:  # forward singularities: Φ_x rank deficient
+        sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, c.nx)) < SINGULAR_CONDITION)
+        margin[idx[sing]], binding[idx[sing]] = -np.inf, "singular"
+    return _Judged(converged, on_branch, margin, binding.astype(object), X, Q, tolerance)
+
+
+@dataclass
+class _Points:
+    """Verdicts of N task points."""
+
+    status: np.ndarray  # INSIDE, OUTSIDE, UNDECIDED
+    margin: np.ndarray
+    binding: np.ndarray
+    X: np.ndarray
+    Q: np.ndarray
+
+
+def _closed_form_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float) -> _Points:
+    """Every point at once through the closed-form IK: decided inside or outside (a
+    negative reach margin proves that the mechanism does not assemble there)."""
+    c = model.closure
+    X, Q, reach, V, R, PX = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
+    ok = reach.ravel() >= 0
+    V, R = np.where(ok[:, None], V, np.nan), np.where(ok[:, None], R, np.nan)
+    X, Q = np.where(ok[:, None], X, np.nan), np.where(ok[:, None], Q, np.nan)
+    j = judge(model, X, Q, config, tolerance, (V, R, PX))
+    # on the closed form's branch by construction; the branch rows still count as limits
+    status = np.where(j.converged & (j.margin >= -tolerance), INSIDE, OUTSIDE).astype(object)
+    return _Points(status, j.margin, j.binding, X, Q)
+
+
+def _assemble(model: Model, T: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    c = model.closure
+    nd = len(c.dep_index)
+    X = np.empty((T.shape[0], c.nx))
+    X[:, c.task_index] = T
+    X[:, c.dep_index] = Y[:, :nd]
+    return X, Y[:, nd:]
+
+
+def _take(points: _Points, model, T, k: np.ndarray, Y: np.ndarray, j: _Judged, index: np.ndarray) -> None:
+    """Record the verdict of points ``k`` from judged poses ``index`` of ``j``."""
+    X, Q = _assemble(model, T[k], Y[index])
+    points.X[k], points.Q[k] = X, Q
+    points.margin[k], points.binding[k] = j.margin[index], j.binding[index]
+
+
+def _decide(points: _Points, model, T, todo: np.ndarray, Y: np.ndarray, j: _Judged, per: int) -> None:
+    """Verdicts from ``per`` judged starts of each point of ``todo`` (rows point-major):
+    the first witness in start order makes a point inside; else the first pose on the
+    designated branch outside a limit makes it outside (the branch designates one pose)."""
+    wit = j.witness.reshape(todo.size, per)
+    evi = j.evidence.reshape(todo.size, per)
+    base = np.arange(todo.size) * per
+    has_w = wit.any(axis=1)
+    if has_w.any():
+        rows = base[has_w] + np.argmax(wit[has_w], axis=1)
+        points.status[todo[has_w]] = INSIDE
+        _take(points, model, T, todo[has_w], Y, j, rows)
+    has_e = ~has_w & evi.any(axis=1)
+    if has_e.any():
+        rows = base[has_e] + np.argmax(evi[has_e], axis=1)
+        points.status[todo[has_e]] = OUTSIDE
+        _take(points, model, T, todo[has_e], Y, j, rows)
+
+
+def _solved_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float) -> _Points:
+    """Every point from its own start set (:mod:`.point_ik`), never from another point."""
+    c = model.closure
+    N = T.shape[0]
+    starts = start_set(model, T)
+    points = _Points(
+        np.full(N, UNDECIDED, dtype=object),
+        np.full(N, -np.inf),
+        np.full(N, "undecided", dtype=object),
+        np.full((N, c.nx), np.nan),
+        np.full((N, c.nq), np.nan),
+    )
+    for first, last in ((0, 2), (2, starts.shape[1])):  # Newton rounds
+        todo = np.flatnonzero(points.status == UNDECIDED)
+        if todo.size and first > 0:  # before more starts: a proof that no pose passes
+            fn, _names = limited_function(c)
+            lo, hi = limit_bounds(model)
+            proven = todo[prove_outside(model, T[todo], tolerance, fn, lo, hi)]
+            points.status[proven] = OUTSIDE
+            points.binding[proven] = "no pose within the limits (interval proof)"
+            todo = np.flatnonzero(points.status == UNDECIDED)
+        if not todo.size:
+            break
+        per = last - first
+        Y0 = starts[todo, first:last].reshape(-1, starts.shape[2])
+        Tr = np.repeat(T[todo], per, axis=0)
+        Y, _norm = newton(model, Y0, Tr, config.tolerance)
+        Y = reduce_angles(model, Y)
+        X, Q = _assemble(model, Tr, Y)
+        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance), per)
+    for s in range(min(IPOPT_STARTS, starts.shape[1])):  # IPOPT with the strokes as bounds
+        todo = np.flatnonzero(points.status == UNDECIDED)
+        if not todo.size:
+            break
+        Y = np.full((todo.size, starts.shape[2]), np.nan)
+        for i, k in enumerate(todo):
+            y, conv = ipopt_solve(model, T[k], starts[k, s], config)
+            if conv:
+                Y[i] = y
+        Y = reduce_angles(model, Y)
+        X, Q = _assemble(model, T[todo], Y)
+        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance), 1)
+    und = points.status == UNDECIDED
+    points.binding[und] = f"undecided: no pose on the designated branch from {starts.shape[1]} starts"
+    return points
+
+
+def _points(model: Model, T, solver: SolverConfig | None, tolerance: float) -> _Points:
+    c = model.closure
+    config = solver or SolverConfig()
+    T = np.atleast_2d(np.asarray(T, dtype=float))
+    if T.shape[0] == 0:
+        e = np.zeros(0, dtype=object)
+        return _Points(e, np.zeros(0), e.copy(), np.zeros((0, c.nx)), np.zeros((0, c.nq)))
+    if c.ik is not None:
+        return _closed_form_points(model, T, config, tolerance)
+    return _solved_points(model, T, config, tolerance)
+
+
+def poses(model: Model, T: np.ndarray, solver: SolverConfig | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Poses (X, Q) for task points T (N, nq) and whether each assembles on the
+    designated branch (inside or outside the limits).
+
+    With a closed-form IK all points are evaluated at once (one mapped CasADi call);
+    otherwise each point's IK is solved from its own start set (:mod:`.point_ik`).
+    """
+    got = _points(model, T, solver, CHECK_TOLERANCE)
+    ok = np.all(np.isfinite(got.X), axis=1) & np.all(np.isfinite(got.Q), axis=1)
+    return got.X, got.Q, ok
+
+
+def condition_numbers(PX: np.ndarray) -> np.ndarray:
+    """2-norm condition numbers of N square matrices (N, n, n), computed by SVD only
+    where they may reach :data:`SINGULAR_CONDITION`: κ₂ ≤ ‖A‖_F^n / |det A| (since
+    σ_max ≤ ‖A‖_F and σ_min ≥ |det A| / σ_max^(n-1)); elsewhere the returned value
+    is that bound (below the threshold, so the verdict is the same); inf for a
+    matrix with a NaN or infinite entry."""
+    n = PX.shape[-1]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        bound = np.sqrt(np.sum(PX * PX, axis=(1, 2))) ** n / np.abs(np.linalg.det(PX))
+    flagged = ~(bound < 0.5 * SINGULAR_CONDITION)  # NaN and inf included
+    finite = np.all(np.isfinite(PX), axis=(1, 2))
+    bound[flagged & ~finite] = np.inf
+    if np.any(flagged & finite):
+        bound[flagged & finite] = np.linalg.cond(PX[flagged & finite])
+    return bound
+
+
+def membership(model: Model, T, solver: SolverConfig | None = None, tolerance: float = CHECK_TOLERANCE) -> Membership:
+    """Which task points T (N, nq) lie in the reachable workspace: the pose
+    assembles on the designated branch, is not singular, and every limited
+    quantity is within its limits (to ``tolerance``).
+
+    Each point is decided on its own (never from another point's solution): inside
+    (a pose that passes), outside (the closed form's reach margin is negative, or
+    the pose on the designated branch violates a limit or is singular) or undecided
+    (no pose on the designated branch from any start; ``inside`` is False there)."""
+    got = _points(model, T, solver, tolerance)
+    inside = got.status == INSIDE
+    return Membership(inside, got.margin, got.binding.tolist(), got.X, got.Q, got.status.tolist())

@@ -1,0 +1,159 @@
+"""A search region around the home pose (probed along the task axes) and a seeded point
+cloud of the workspace."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...core.model import Model
+from ...core.solver import SolverConfig
+from .membership import UNDECIDED, membership
+
+log = logging.getLogger(__name__)
+
+# -- sampling ------------------------------------------------------------------------------------
+
+
+#: bisection steps of :func:`probe_region` along each direction
+PROBE_BISECTIONS = 40
+#: bisection levels decided per membership call (membership is one vectorised call, each
+#: point decided on its own): the 2^k - 1 midpoints of the next k levels are tested at once
+PROBE_LEVELS = 4
+
+
+def probe_region(  # noqa: C901 - one loop of probe rounds with its stop rules
+    model: Model, solver: SolverConfig | None = None, centre=None, factor: float = 2.0
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """A box around ``centre`` (default: the home pose) in the task coordinates:
+    the distance to the workspace boundary along each task axis (both ways,
+    by doubling and bisection), times ``factor``.  None if the centre itself
+    is outside.
+
+    The steps of the doubling are tested in one call and the bisection decides
+    :data:`PROBE_LEVELS` levels per call (all midpoints those levels could visit);
+    the result is the same as one level per call.
+    """
+    t0 = model.task_of(model.x_home) if centre is None else np.asarray(centre, dtype=float)
+    d = t0.size
+    if not membership(model, t0[None, :], solver).inside[0]:
+        return None
+    levels = PROBE_LEVELS
+    dirs = np.vstack([np.eye(d), -np.eye(d)])
+    cols = np.arange(2 * d)
+    inside_step = np.zeros(2 * d)
+    outside_step = np.full(2 * d, np.nan)
+    steps = [1e-9]
+    while steps[-1] * 2 < 1e4:
+        steps.append(steps[-1] * 2)
+    block = len(steps) if levels > 1 else 1
+    for first in range(0, len(steps), block):  # doubling
+        todo = np.flatnonzero(np.isnan(outside_step))
+        if not todo.size:
+            break
+        s = np.array(steps[first : first + block])
+        pts = t0 + s[None, :, None] * dirs[todo][:, None, :]
+        inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(todo.size, s.size)
+        for row, k in enumerate(todo):
+            out = np.flatnonzero(~inside[row])
+            if out.size:
+                outside_step[k] = s[out[0]]
+                if out[0] > 0:
+                    inside_step[k] = s[out[0] - 1]
+            else:
+                inside_step[k] = s[-1]
+    outside_step = np.where(np.isnan(outside_step), 1e4, outside_step)
+    done = 0
+    while done < PROBE_BISECTIONS:  # bisection, k levels per call
+        k = min(levels, PROBE_BISECTIONS - done)
+        nodes = 2**k - 1  # a binary tree: node i has children 2i + 1 (outside) and 2i + 2 (inside)
+        low, high, mid = (np.empty((nodes, 2 * d)) for _ in range(3))
+        low[0], high[0] = inside_step, outside_step
+        for i in range(nodes):
+            mid[i] = 0.5 * (low[i] + high[i])
+            if 2 * i + 2 < nodes:
+                low[2 * i + 1], high[2 * i + 1] = low[i], mid[i]
+                low[2 * i + 2], high[2 * i + 2] = mid[i], high[i]
+        pts = t0 + mid[:, :, None] * dirs[None, :, :]
+        inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(nodes, 2 * d)
+        node = np.zeros(2 * d, dtype=int)
+        for _ in range(k):
+            ins, m = inside[node, cols], mid[node, cols]
+            inside_step = np.where(ins, m, inside_step)
+            outside_step = np.where(ins, outside_step, m)
+            node = np.where(ins, 2 * node + 2, 2 * node + 1)
+        done += k
+    plus, minus = inside_step[:d], inside_step[d:]
+    span = np.maximum(plus + minus, 1e-12)
+    return t0 - factor * np.maximum(minus, 0.25 * span), t0 + factor * np.maximum(plus, 0.25 * span)
+
+
+@dataclass
+class Cloud:
+    """A seeded point cloud of the workspace.
+
+    points: the points inside (M, nq); region: the box they were drawn from (None if
+    the home pose is outside and no region was given); drawn, inside, undecided:
+    counts; volume: the Monte-Carlo estimate (region volume × inside / drawn);
+    volume_upper: the same with the undecided points counted inside (equal to
+    ``volume`` when none is undecided); undecided_points: those points (U, nq).
+    """
+
+    points: np.ndarray
+    region: tuple[np.ndarray, np.ndarray] | None
+    drawn: int = 0
+    inside: int = 0
+    undecided: int = 0
+    volume: float = 0.0
+    volume_upper: float = 0.0
+    undecided_points: np.ndarray | None = None
+
+
+def workspace_cloud(
+    model: Model,
+    count: int,
+    seed: int = 0,
+    region: tuple[np.ndarray, np.ndarray] | None = None,
+    solver: SolverConfig | None = None,
+) -> Cloud:
+    """``count`` points drawn uniformly in ``region`` (default: :func:`probe_region`)
+    with a seeded generator, each decided by :func:`membership` (see :class:`Cloud`)."""
+    nq = model.closure.nq
+    if region is None:
+        region = probe_region(model, solver)
+        if region is None:
+            return Cloud(np.zeros((0, nq)), None, undecided_points=np.zeros((0, nq)))
+    lo, hi = (np.asarray(v, dtype=float) for v in region)
+    rng = np.random.default_rng(seed)
+    T = lo + (hi - lo) * rng.random((count, lo.size))
+    mem = membership(model, T, solver)
+    undecided = np.array([s == UNDECIDED for s in mem.status], dtype=bool)
+    n_in, n_und = int(np.count_nonzero(mem.inside)), int(np.count_nonzero(undecided))
+    box = float(np.prod(hi - lo))
+    return Cloud(
+        T[mem.inside],
+        (lo, hi),
+        count,
+        n_in,
+        n_und,
+        box * n_in / max(count, 1),
+        box * (n_in + n_und) / max(count, 1),
+        T[undecided],
+    )
+
+
+def sample_workspace(
+    model: Model,
+    count: int,
+    seed: int = 0,
+    region: tuple[np.ndarray, np.ndarray] | None = None,
+    solver: SolverConfig | None = None,
+) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray] | None, float]:
+    """A seeded point cloud of the workspace: ``count`` points drawn uniformly
+    in ``region`` (default: :func:`probe_region`), those inside kept.  Returns
+    (points inside (M, nq), the region, the Monte-Carlo volume estimate); see
+    :func:`workspace_cloud` for the counts of undecided points."""
+    cloud = workspace_cloud(model, count, seed, region, solver)
+    return cloud.points, cloud.region, cloud.volume
