@@ -137,7 +137,7 @@ def failure_message(model: Model, status: Status, details: dict, x, q, passive, 
     if status is Status.WRONG_BRANCH:
         margin = details.get("branch_margin", np.inf)
         if not margin > 0:
-            return f"branch indicator {margin:.3g} <= 0"
+            return branch_failure(model, x, q, margin)
         err = details.get("round_trip_error", np.inf)
         if not np.isfinite(err):
             return "the closed-form IK has no real solution at this pose's task coordinates"
@@ -147,6 +147,22 @@ def failure_message(model: Model, status: Status, details: dict, x, q, passive, 
     if status is Status.OUTSIDE_JOINT_LIMITS:
         return "; ".join(_limit_violations(model, x, q, passive))
     return ""
+
+
+def branch_failure(model: Model, x, q, margin: float) -> str:
+    """Which branch indicator failed, named (its leg and joint) with its value."""
+    c = model.closure
+    if c.branch is None or x is None or q is None:
+        return f"branch indicator {margin:.3g} <= 0"
+    g = np.asarray(c.branch(np.asarray(x, dtype=float), np.asarray(q, dtype=float), model.p), dtype=float).ravel()
+    bad = [k for k in range(g.size) if not g[k] > 0]
+    if not bad:
+        return f"branch indicator {margin:.3g} <= 0"
+    parts = []
+    for k in bad:
+        what = c.branch_descriptions[k]
+        parts.append(f"{c.branch_names[k]} = {g[k]:.3g} <= 0" + (f" ({what})" if what else ""))
+    return "branch indicator " + "; ".join(parts)
 
 
 def _assess(
