@@ -20,10 +20,7 @@ import casadi as ca
 
 #: the name of the aspect indicator
 ASPECT = "aspect"
-ASPECT_DESCRIPTION = (
-    "det Φ_x per platform twist relative to the reference configuration "
-    "(negative: another assembly mode, across a forward singularity)"
-)
+ASPECT_DESCRIPTION = "det Φ_x per platform twist over its value at home; negative: another assembly mode"
 #: an aspect indicator is built for at most this many pose coordinates (a symbolic determinant)
 ASPECT_MAX_NX = 6
 

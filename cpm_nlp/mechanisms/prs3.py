@@ -279,8 +279,8 @@ BRANCH_DESCRIPTIONS = tuple(
     d
     for i in (1, 2, 3)
     for d in (
-        f"leg {i}, R joint at C{i}: l{i}0 . s{i}0 (the leg leans towards the axis, eq 20's minus root)",
-        f"leg {i}, R joint at C{i}: l{i}0 . z (the leg rises from slider to platform)",
+        f"leg {i}, R joint at C{i}: l{i}0 . s{i}0, the leg leans towards the axis (eq 20's minus root)",
+        f"leg {i}, R joint at C{i}: l{i}0 . z, the leg rises from the slider to the platform",
     )
 ) + (ASPECT_DESCRIPTION,)
 

@@ -46,8 +46,8 @@ from .spec import Description, Joint, Leg
 
 POINT_JOINTS = {"S", "planar_R"}
 #: what the generated indicators measure
-_COSINE = "cosine of the link from this joint to the platform joint to its reference direction"
-_COSINE_AXIS = "cosine of the link about this joint's axis to its reference direction"
+_COSINE = "cosine of the link to the platform joint to its reference direction"
+_COSINE_AXIS = "cosine of the link about the joint's axis to its reference direction"
 
 SPHERE_JOINTS = {"U", "S", "planar_R"}
 #: the letter a drawing marks each joint type with (a distance joint: a rod between two spherical joints)
@@ -362,8 +362,10 @@ class Generator:
                     slide.spec.path,
                 )
             )
-            self.rows.append((ca.norm_2(v) - (r + slide.value), f"leg {leg.name}: length"))
-            self.indicator((r + slide.value) / r, leg, slide, "leg length over its reference length")
+            # squared (polynomial in the pose): Newton from far starts converges far more often than on
+            # |v| - length; near a solution it is (length / r)(|v| - length)
+            self.rows.append(((ca.dot(v, v) - (r + slide.value) ** 2) / (2 * r), f"leg {leg.name}: length"))
+            self.indicator((r + slide.value) / r, leg, slide, "the leg's length over its reference length")
             self.indicator(ca.dot(u, v) / (r * ca.norm_2(v)), leg, elim, _COSINE)
             if elim.type == "R":  # R-P-S: the leg also stays in the plane normal to the R axis
                 w = Rm @ elim.axis
@@ -404,7 +406,7 @@ class Generator:
         n = j.spec.path[-1] + 1 if j.spec.path and isinstance(j.spec.path[-1], int) else 0
         letter = "R" if j.type == "planar_R" else "P" if j.type == "planar_P" else j.type
         name = f"{leg.name}.{letter}{n}"
-        self.branch.append((value, name, f"leg {leg.name}, {j.type} joint (joint {n} of the leg): {what}"))
+        self.branch.append((value, name, f"leg {leg.name}, joint {n} ({j.type}): {what}"))
 
     def draw_leg(
         self,
