@@ -620,7 +620,7 @@ class Generator:
         spec = self.d.branch
         items = spec if isinstance(spec, list) else (spec or {}).get("add", []) if isinstance(spec, dict) else []
         base = ("branch",) if isinstance(spec, list) else ("branch", "add")
-        names = {b[1] for b in self.branch}
+        names = {b[1] for b in self.branch} | {ASPECT}  # the aspect indicator is generated after the closures
         out = []
         for k, item in enumerate(items):
             if isinstance(item, str) and item in names and isinstance(spec, list):
@@ -646,6 +646,8 @@ class Generator:
             keep = names
         elif isinstance(spec, list):
             keep = [v for v in spec if isinstance(v, str) and v in names]
+            if ASPECT in spec and ASPECT not in names:
+                check(ASPECT, ("branch", spec.index(ASPECT)))
         else:
             keep = names if spec["keep"] == "all" else [] if spec["keep"] == "none" else spec["keep"]
             for k, name in enumerate(() if isinstance(keep, list) and keep is names else keep):
