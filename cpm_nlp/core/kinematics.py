@@ -340,7 +340,11 @@ def forward_kinematics(
     qv = _vector(q, c.nq, "q")
     x0 = None if guess is None else _vector(guess, c.nx, "guess")
     sol = _forward_once(model, qv, x0, config, backend)
-    if not sol.ok and continuation and sol.status in CONTINUED:
+    # IPOPT stopped by a limit of its own options (max_iter, max_cpu_time: the user's) is the configured
+    # solver's verdict; a pose off the branch, no pose inside IPOPT's bounds, or Newton from far away is
+    # where continuing from home helps
+    limited = config.method != "newton" and "Maximum" in sol.message
+    if not sol.ok and continuation and sol.status in CONTINUED and not limited:
         alt = continued_forward_kinematics(model, qv, config, backend=backend)
         if alt.ok:
             alt.details["first_attempt"] = f"{sol.status.value}: {sol.message}" if sol.message else sol.status.value
