@@ -53,7 +53,8 @@ def main(argv: list[str] | None = None) -> int:
         found = assembly_modes(model, lengths, starts=args.starts)
         times.append(time.perf_counter() - t0)
     best = min(times)
-    lo, hi = search_region(model)
+    region = search_region(model)
+    lo, hi = region.lower, region.upper
     rng = np.random.default_rng(0)
     starts = lo + (hi - lo) * rng.random((args.baseline, lo.size))
     newton = cn.SolverConfig("newton")

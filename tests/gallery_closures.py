@@ -364,8 +364,11 @@ def stewart_closure() -> LoopClosure:
             np.array([r, r, 2 * pv[4] + r, math.pi, math.pi / 2, math.pi]),
         )
 
+    xf, pf = ca.SX.sym("x", 6), ca.SX.sym("p", 5)
+    frame = _fn("frame", [xf, pf], [_rz(xf[5]) @ _ry(xf[4]) @ _rx(xf[3]), xf[:3]], ["x", "p"], ["R", "position"])
     return LoopClosure(
         "stewart",
+        frame=frame,
         x=SIX,
         q=tuple(Coordinate(f"l{i}", "length", f"leg {i} length", "l") for i in range(1, 7)),
         parameters=("ra", "rp", "half_a", "half_p", "h0"),

@@ -90,7 +90,7 @@ def test_wrong_branch_in_batch(prs3):
     far = cn.batch_forward_kinematics(prs3, [[0.3, -0.3, 0.0]])
     assert far.statuses == [Status.NOT_CONVERGED]
     assert far.message(0).startswith("Newton stopped at max |Φ| = ")
-    single = cn.forward_kinematics(prs3, q[0], NEWTON, guess=guess)
+    single = cn.forward_kinematics(prs3, q[0], NEWTON, guess=guess, continuation=False)
     assert res.message(0) == single.message
     assert np.all(np.isnan(res.x))
 

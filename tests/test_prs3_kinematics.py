@@ -161,9 +161,14 @@ def test_wrong_branch_is_reported_not_returned(prs3):
     assembly; the tool says so instead of returning its numbers."""
     guess = prs3.x_home.copy()
     guess[2] = -guess[2]
-    sol = cn.forward_kinematics(prs3, [0.5e-3, 0.2e-3, 0.1e-3], NEWTON, guess=guess)
+    sol = cn.forward_kinematics(prs3, [0.5e-3, 0.2e-3, 0.1e-3], NEWTON, guess=guess, continuation=False)
     assert sol.status is Status.WRONG_BRANCH
     assert sol.x is None and sol.q is None
+    # by default FK then follows the designated branch from home (issue 20): the working pose
+    cont = cn.forward_kinematics(prs3, [0.5e-3, 0.2e-3, 0.1e-3], NEWTON, guess=guess)
+    home = cn.forward_kinematics(prs3, [0.5e-3, 0.2e-3, 0.1e-3], NEWTON)
+    assert cont.ok and "continuation from home" in cont.solver and cont.details["first_attempt"].startswith("wrong")
+    np.testing.assert_allclose(cont.x, home.x, rtol=0, atol=1e-12)
 
 
 def test_unreachable_pose(prs3):

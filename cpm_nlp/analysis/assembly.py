@@ -10,31 +10,41 @@ the others, so that a designer sees how far the working mode is from them.
 
 Method
 ------
-1. ``starts`` initial poses are drawn (seeded, uniform) in the search region,
-   the box ``[model.x_lower, model.x_upper]`` that IPOPT also uses (an
-   unbounded side is replaced by the home pose ± the largest finite span of
-   the coordinates of its kind, or ± 1 SI unit); the home pose is the first.
+1. The search region (:func:`search_region`) needs no bounds from the user:
+   every angle coordinate takes a full turn (-pi, pi] (the closures are
+   periodic in it), every length coordinate the home value ± the reach (the
+   largest of the declared half-span, the characteristic length, the
+   distances of the home pose and the lengths among the actuators).
+   ``starts`` initial poses are drawn there (seeded, uniform); the home pose
+   is the first.
 2. Newton's method runs from every start at once (the FK kernel of
    :mod:`cpm_nlp.core.batch`, CasADi ``fast_newton``, mapped over threads).
-3. Angle coordinates of the converged poses are wrapped into the ±π interval
-   about the middle of the region (a closure periodic in an angle gives the
-   same pose; one that is not keeps its unwrapped value, see step 5); poses
-   outside the region are dropped and counted.
-4. The remaining poses are merged when they agree within ``merge_tolerance``
-   (lengths divided by the region's largest length span, angles in radians).
+3. Angle coordinates of the converged poses are reduced to (-pi, pi] (one
+   the closures are not periodic in keeps its value).  Every converged real
+   solution is a mode, wherever it lies: a solution outside the start box is
+   kept and counted.
+4. Poses are merged on SE(3), not on angles: by the platform's rotation
+   matrix and position (the closure's ``frame``) and the other coordinates
+   (angles by their sine and cosine), within ``merge_tolerance`` (lengths
+   divided by the reach).  Without a ``frame`` the coordinates are compared
+   with angles wrapped (two angle triples of one rotation then stay two
+   modes).
 5. Each distinct pose is checked like any FK solution (:func:`~cpm_nlp.core.kinematics.assess`:
    residual, branch indicators, IK round trip, conditioning, joint limits)
-   and reported with its branch indicators and whether it lies on the
-   designated branch.
+   and reported with its residual, status, branch indicators, whether it lies
+   on the designated branch, and how many starts reached it.
+6. The counts give a completeness estimate (:func:`completeness`): Chao1's
+   estimate of the modes no start reached, from the modes reached once and
+   twice, Good-Turing's probability that one more start finds a new mode, and
+   the starts a 99 % chance of reaching the smallest basin seen would take.
 
 The working mode is the solution of the ordinary FK (the configured solver
-from the home pose, or the given guess).  Its distance to the nearest other
-mode is reported in the lengths (m) and angles (rad) of the pose.
+from the home pose or the given guess, with the continuation from home).  A
+failure of that FK is its own status, not the search's: the search that ran
+is ``solved`` with the modes it found.
 
-The search is **not a proof of completeness**: a mode whose basin of
-attraction holds none of the starts, or that lies outside the search region,
-is missed.  The result says so, with the number of starts that reached each
-mode (a mode reached by few starts suggests others may hide in small basins).
+The search is **not a proof of completeness**: a mode whose basin holds none
+of the starts is missed.  The result says how likely that is from the counts.
 """
 
 from __future__ import annotations
@@ -58,14 +68,22 @@ log = logging.getLogger(__name__)
 
 #: two converged poses within this (scaled) distance are the same mode
 MERGE_TOLERANCE = 1e-6
-#: a converged pose may lie this far (scaled) outside the search region and still count
-REGION_SLACK = 1e-9
 #: statuses of converged real solutions (the others: Newton did not reach a solution)
 REAL = (Status.SOLVED, Status.WRONG_BRANCH, Status.OUTSIDE_JOINT_LIMITS, Status.SINGULAR)
+#: a mode reached by fewer starts than this is "rarely hit" (its basin is small: others may hide)
+FEW = 3
+#: the probability of reaching a basin the search aims at
+CONFIDENCE = 0.99
 
-COMPLETENESS_NOTE = (
-    "a multi-start search, not a proof of completeness: modes whose basins hold none of the starts, "
-    "or that lie outside the search region, are not found"
+COMPLETE_NOTE = (
+    "every mode found was reached by at least {few} starts and Chao1 estimates no unseen mode; "
+    "still a multi-start search, not a proof: a mode whose basin holds less than {p:.2g} of the "
+    "starts is missed with probability above 1 %"
+)
+INCOMPLETE_NOTE = (
+    "probably incomplete: {rare} mode(s) reached by fewer than {few} starts; Chao1 estimates "
+    "{unseen:.3g} unseen mode(s) (about {estimate:.3g} in all); the smallest basin found holds "
+    "{p:.2g} of the starts, and a 99 % chance of reaching a basin that small takes {needed} starts"
 )
 
 
@@ -74,10 +92,11 @@ class AssemblyMode:
     """One assembly mode: the pose, its check and its branch indicators.
 
     status: as an FK solution would report it (``wrong_branch`` off the
-    designated branch); designated: on the branch the model designates
-    (branch indicators > 0 and the closed-form IK round trip agrees);
-    branch: the branch indicator values (empty without indicators);
-    basin: the number of starts that converged to it.
+    designated branch); message: why, when not solved; residual: max |Φ|;
+    designated: on the branch the model designates (branch indicators > 0
+    and the closed-form IK round trip agrees); branch: the branch indicator
+    values (empty without indicators); basin: the number of starts that
+    converged to it.
     """
 
     x: np.ndarray
@@ -92,17 +111,88 @@ class AssemblyMode:
 
 
 @dataclass
+class SearchRegion:
+    """Where the starts are drawn: ``lower``, ``upper`` per pose coordinate (an
+    angle's is a full turn, (-pi, pi]) and how each side was chosen."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    names: list[str]
+    kinds: list[str]
+    source: list[str]
+
+    def describe(self) -> str:
+        parts = []
+        for n, k, lo, hi, src in zip(self.names, self.kinds, self.lower, self.upper, self.source):
+            if k == "angle":
+                parts.append(f"{n} in (-180, 180] deg ({src})")
+            else:
+                parts.append(f"{n} in [{lo:.6g}, {hi:.6g}] {'m' if k == 'length' else ''} ({src})".replace("  ", " "))
+        return "; ".join(parts)
+
+    def as_dict(self) -> dict:
+        return {
+            n: {"lower": float(lo), "upper": float(hi), "kind": k, "source": s}
+            for n, k, lo, hi, s in zip(self.names, self.kinds, self.lower, self.upper, self.source)
+        }
+
+
+@dataclass
+class Completeness:
+    """What the counts of starts per mode say about the modes not found.
+
+    hits: starts that reached a mode (the sum of the basins); singletons,
+    doubletons: modes reached by one and by two starts; unseen: Chao1's
+    estimate of the modes no start reached (bias-corrected form when there is
+    no doubleton); estimate: found + unseen; new_mode_probability:
+    Good-Turing's probability that one more converged start finds a new mode
+    (singletons / hits); smallest_basin: the smallest fraction of the starts
+    that reached one mode; starts_needed: starts for a 99 % chance of
+    reaching a basin that small; rare: indices of the modes reached by fewer
+    than :data:`FEW` starts; complete: no rare mode and no unseen mode
+    estimated.
+    """
+
+    hits: int
+    singletons: int
+    doubletons: int
+    unseen: float
+    estimate: float
+    new_mode_probability: float
+    smallest_basin: float
+    starts_needed: int
+    rare: list[int]
+    complete: bool
+    note: str
+
+    def as_dict(self) -> dict:
+        return {
+            "hits": self.hits,
+            "singletons": self.singletons,
+            "doubletons": self.doubletons,
+            "unseen_chao1": self.unseen,
+            "estimated_modes": self.estimate,
+            "new_mode_probability": self.new_mode_probability,
+            "smallest_basin": self.smallest_basin,
+            "starts_needed": self.starts_needed,
+            "rarely_hit_modes": self.rare,
+            "complete": self.complete,
+        }
+
+
+@dataclass
 class AssemblyModes:
     """The distinct assembly modes found for one actuator vector.
 
     modes: found, the working mode (if any) first, then by basin size;
     working: index of the working mode in ``modes`` (None if the ordinary FK
-    failed); nearest: index of the mode nearest to the working one;
-    distance_length (m), distance_angle (rad): Euclidean distances of the
-    length and angle coordinates of the pose between them;
-    starts, converged, outside_region: how many starts ran, converged to a real
-    solution, and converged outside the search region (dropped);
-    region: the search region (x_lower, x_upper).
+    failed: ``working_solution`` says why); nearest: index of the mode
+    nearest to the working one; distance_length (m), distance_angle (rad):
+    Euclidean distances of the length and angle coordinates of the pose
+    between them (angles wrapped); starts, converged: how many starts ran and
+    converged to a real solution; outside_region: modes found outside the
+    start box (kept); region: the search region; completeness: the estimate
+    from the counts.
     """
 
     q: np.ndarray
@@ -115,65 +205,99 @@ class AssemblyModes:
     starts: int
     converged: int
     outside_region: int
-    region: tuple[np.ndarray, np.ndarray]
+    region: SearchRegion
+    completeness: Completeness
     seconds: float
-    note: str = COMPLETENESS_NOTE
     details: dict = field(default_factory=dict)
 
     @property
     def count(self) -> int:
         return len(self.modes)
 
+    @property
+    def note(self) -> str:
+        return self.completeness.note
 
-def search_region(model: Model) -> tuple[np.ndarray, np.ndarray]:
-    """The box the starts are drawn from: the IPOPT bounds, unbounded sides
-    replaced by home ± the largest finite span of that kind (or ± 1)."""
+
+def reach(model: Model) -> float:
+    """Half-span of the start box of the length coordinates: the largest of the
+    declared (finite) half-spans, the characteristic length, the length
+    coordinates of the home pose and the lengths among the actuators at home."""
     c = model.closure
-    lo, hi = model.x_lower.astype(float).copy(), model.x_upper.astype(float).copy()
-    kinds = np.array([x.kind for x in c.x])
-    for kind in set(kinds.tolist()):
-        idx = np.flatnonzero(kinds == kind)
-        spans = (hi - lo)[idx]
-        finite = spans[np.isfinite(spans)]
-        span = float(finite.max()) if finite.size else 1.0
-        for i in idx:
-            if not np.isfinite(lo[i]):
-                lo[i] = model.x_home[i] - span
-            if not np.isfinite(hi[i]):
-                hi[i] = model.x_home[i] + span
-    return lo, hi
+    vals = [model.characteristic_length]
+    for i, x in enumerate(c.x):
+        if x.kind == "length":
+            vals.append(abs(model.x_home[i]))
+            span = model.x_upper[i] - model.x_lower[i]
+            if np.isfinite(span):
+                vals.append(0.5 * span)
+    vals += [abs(model.q_home[j]) for j, qc in enumerate(c.q) if qc.kind == "length"]
+    return float(max(v for v in vals if np.isfinite(v)))
 
 
-def _scales(model: Model, region: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Per-coordinate divisors for distances (lengths by the largest length span,
-    angles 1) and the mask of angle coordinates."""
+def search_region(model: Model) -> SearchRegion:
+    """The box the starts are drawn from, without bounds from the user: a full
+    turn for every angle, home ± :func:`reach` for every other coordinate."""
     c = model.closure
-    angle = np.array([x.kind == "angle" for x in c.x])
-    span = region[1] - region[0]
-    scale = np.ones(c.nx)
-    for kind in {x.kind for x in c.x} - {"angle"}:
-        idx = [i for i, x in enumerate(c.x) if x.kind == kind]
-        scale[idx] = max(float(np.max(span[idx])), 1e-300)
-    return scale, angle
+    r = reach(model)
+    lo, hi, src = [], [], []
+    for i, x in enumerate(c.x):
+        if x.kind == "angle":
+            lo.append(-math.pi)
+            hi.append(math.pi)
+            src.append("full turn")
+        else:
+            half = r if x.kind == "length" else max(abs(model.x_home[i]), 1.0)
+            lo.append(model.x_home[i] - half)
+            hi.append(model.x_home[i] + half)
+            src.append("home ± reach" if x.kind == "length" else "home ± 1")
+    return SearchRegion(np.array(lo), np.array(hi), list(c.x_names), [x.kind for x in c.x], src)
 
 
-def _wrap(X: np.ndarray, angle: np.ndarray, centre: np.ndarray) -> np.ndarray:
+def _reduce(X: np.ndarray, angle: np.ndarray) -> np.ndarray:
     out = X.copy()
-    a = np.flatnonzero(angle)
-    out[:, a] = centre[a] + (X[:, a] - centre[a] + math.pi) % (2 * math.pi) - math.pi
+    out[:, angle] = math.pi - (math.pi - X[:, angle]) % (2 * math.pi)
     return out
 
 
-def _merge(X: np.ndarray, scale: np.ndarray, angle: np.ndarray, tol: float) -> tuple[list[int], np.ndarray]:
-    """Greedy clustering of the rows of X: (index of each cluster's first row, cluster of each row)."""
+def _frame_columns(model: Model) -> np.ndarray:
+    """Which pose coordinates the closure's frame (R, position) depends on."""
+    fr = model.closure.frame
+    dep = np.zeros(model.closure.nx, dtype=bool)
+    for k in range(fr.n_out()):
+        sp = fr.sparsity_jac(0, k)  # (output entries, nx)
+        dep[np.unique(np.array(sp.get_col(), dtype=int))] = True
+    return dep
+
+
+def features(model: Model, X: np.ndarray, length: float) -> np.ndarray:
+    """One row per pose, equal for equal configurations: the platform's rotation
+    matrix and position (over ``length``) when the closure has a frame, the other
+    coordinates as they are (lengths over ``length``, angles by sine and cosine)."""
+    c = model.closure
+    angle = np.array([x.kind == "angle" for x in c.x])
+    scale = np.array([length if x.kind == "length" else 1.0 for x in c.x])
+    cols = []
+    rest = np.ones(c.nx, dtype=bool)
+    if c.frame is not None and len(X):
+        dep = _frame_columns(model)
+        rest = ~dep
+        fm = c.frame.map(len(X))
+        R, pos = (np.asarray(v, dtype=float) for v in fm(X.T, model.p))
+        n = len(X)
+        cols += [R.reshape(3, n, 3).transpose(1, 0, 2).reshape(n, 9), pos.T / length]
+    ang, lin = rest & angle, rest & ~angle
+    cols += [X[:, lin] / scale[lin], np.cos(X[:, ang]), np.sin(X[:, ang])]
+    return np.hstack(cols) if cols else np.zeros((len(X), 0))
+
+
+def _merge(F: np.ndarray, tol: float) -> tuple[list[int], np.ndarray]:
+    """Greedy clustering of the rows of F (max-norm): (first row of each cluster, cluster of each row)."""
     reps: list[int] = []
-    label = np.empty(len(X), dtype=int)
-    Y = X / scale
-    for k in range(len(X)):
+    label = np.empty(len(F), dtype=int)
+    for k in range(len(F)):
         if reps:
-            diff = Y[reps] - Y[k]
-            diff[:, angle] = (diff[:, angle] + math.pi) % (2 * math.pi) - math.pi
-            dist = np.max(np.abs(diff), axis=1)
+            dist = np.max(np.abs(F[reps] - F[k]), axis=1)
             j = int(np.argmin(dist))
             if dist[j] <= tol:
                 label[k] = j
@@ -209,7 +333,56 @@ def _mode(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float, basin: i
     )
 
 
-def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, wrap, merge, check, working mode
+#: Newton iterations of the search (random starts need more than a solve from a near guess)
+SEARCH_MAX_ITER = 100
+
+
+def search_solver(config: SolverConfig) -> SolverConfig:
+    """The Newton configuration of the search: the given one (or Newton at its
+    tolerance), with at least :data:`SEARCH_MAX_ITER` iterations."""
+    opts = dict(config.options) if config.method == "newton" else {}
+    opts["max_iter"] = max(int(opts.get("max_iter", 0)), SEARCH_MAX_ITER)
+    return SolverConfig("newton", options=opts, tolerance=config.tolerance)
+
+
+def completeness(basins: list[int], starts: int) -> Completeness:
+    """The completeness estimate from the number of starts that reached each mode."""
+    hits = int(sum(basins))
+    f1 = sum(1 for b in basins if b == 1)
+    f2 = sum(1 for b in basins if b == 2)
+    if f2 > 0:
+        unseen = f1 * f1 / (2.0 * f2)
+    else:
+        unseen = f1 * (f1 - 1) / 2.0
+    rare = [k for k, b in enumerate(basins) if 0 < b < FEW]
+    found = [b for b in basins if b > 0]
+    smallest = min(found) / starts if found else 1.0 / max(starts, 1)
+    needed = int(math.ceil(math.log(1 - CONFIDENCE) / math.log1p(-min(smallest, 0.999999))))
+    complete = not rare and unseen == 0 and bool(found)
+    if complete:
+        note = COMPLETE_NOTE.format(few=FEW, p=-math.log(1 - CONFIDENCE) / starts)
+    else:
+        note = INCOMPLETE_NOTE.format(
+            rare=len(rare), few=FEW, unseen=unseen, estimate=len(basins) + unseen, p=smallest, needed=needed
+        )
+        if not found:
+            note = f"no start converged to a real solution of the {starts}; modes may exist in basins none reached"
+    return Completeness(
+        hits=hits,
+        singletons=f1,
+        doubletons=f2,
+        unseen=float(unseen),
+        estimate=float(len(basins) + unseen),
+        new_mode_probability=f1 / hits if hits else 1.0,
+        smallest_basin=float(smallest),
+        starts_needed=needed,
+        rare=rare,
+        complete=complete,
+        note=note,
+    )
+
+
+def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge, check, working mode
     model: Model,
     q,
     solver: SolverConfig | None = None,
@@ -237,11 +410,11 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, wrap, merge, c
         raise InputError(f"expected at least 1 start, got {starts}", path=("starts",))
     t0 = time.perf_counter()
     region = search_region(model)
-    lo, hi = region
+    lo, hi = region.lower, region.upper
     rng = np.random.default_rng(seed)
     X0 = lo + (hi - lo) * rng.random((int(starts), c.nx))
     X0[0] = model.x_home if guess is None else np.asarray(guess, dtype=float)
-    newton = config if config.method == "newton" else SolverConfig("newton", tolerance=config.tolerance)
+    newton = search_solver(config)
     res = batch_forward_kinematics(
         model, np.broadcast_to(qv, (len(X0), c.nq)), newton, X0, backend=backend, threads=threads
     )
@@ -249,45 +422,48 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, wrap, merge, c
     real = np.array([s in REAL for s in statuses])
     X = res.x.copy() if res.raw_joints is None else res.raw_joints[:, : c.nx].copy()
     X = X[real]
-    scale, angle = _scales(model, region)
-    centre = 0.5 * (lo + hi)
-    Xw = _wrap(X, angle, centre) if angle.any() else X
-    slack = REGION_SLACK * scale
-    inside = np.all((Xw >= lo - slack) & (Xw <= hi + slack), axis=1)
-    # a closure that is not periodic in an angle: keep the unwrapped pose where it lies inside
-    inside_raw = np.all((X >= lo - slack) & (X <= hi + slack), axis=1)
-    Xw[~inside & inside_raw] = X[~inside & inside_raw]
-    keep = inside | inside_raw
-    outside = int(np.count_nonzero(~keep))
-    Xk, Xr = Xw[keep], X[keep]
-    reps, label = _merge(Xk, scale, angle, merge_tolerance)
+    angle = np.array([x.kind == "angle" for x in c.x])
+    Xr = _reduce(X, angle) if angle.any() else X
+    length = reach(model)
+    F = features(model, Xr, length)
+    # a closure not periodic in an angle: the reduced pose breaks it; those keep their own value
+    reps, label = _merge(F, merge_tolerance)
+    scale = np.array([length if x.kind == "length" else 1.0 for x in c.x])
     modes = []
-    for j, k in enumerate(reps):
-        basin = int(np.count_nonzero(label == j))
-        mode = _mode(model, Xk[k], qv, config.tolerance, basin)
-        if mode.status is Status.RESIDUAL_TOO_LARGE:  # the wrapped angle broke the closure: not periodic
-            mode = _mode(model, Xr[k], qv, config.tolerance, basin)
+    for j in range(len(reps)):
+        members = np.flatnonzero(label == j)
+        # the representative: of the coordinates of one pose (two angle triples of one rotation),
+        # those nearest to home, so that the working mode reads like the ordinary FK
+        d = Xr[members] - model.x_home
+        d[:, angle] = (d[:, angle] + math.pi) % (2 * math.pi) - math.pi
+        k = int(members[np.argmin(np.max(np.abs(d / scale), axis=1))])
+        mode = _mode(model, Xr[k], qv, config.tolerance, int(members.size))
+        if mode.status is Status.RESIDUAL_TOO_LARGE:  # the reduced angle broke the closure: not periodic
+            mode = _mode(model, X[k], qv, config.tolerance, int(members.size))
         if mode.status in REAL:
             modes.append(mode)
     work = forward_kinematics(model, qv, config, guess)
     working = None
     if work.ok:
-        xw = _wrap(work.x[None, :], angle, centre)[0] if angle.any() else work.x
-        dist = [np.max(np.abs(_wrapped_diff(m.x - xw, angle) / scale)) for m in modes]
-        j = int(np.argmin(dist)) if dist else -1
-        if j >= 0 and dist[j] <= max(merge_tolerance, 1e3 * config.tolerance / float(np.min(scale))):
+        fw = features(model, _reduce(work.x[None, :], angle), length)[0]
+        fm = features(model, np.array([m.x for m in modes]), length) if modes else np.zeros((0, fw.size))
+        dist = np.max(np.abs(fm - fw), axis=1) if len(fm) else np.zeros(0)
+        j = int(np.argmin(dist)) if dist.size else -1
+        if j >= 0 and dist[j] <= max(merge_tolerance, 1e3 * config.tolerance / length):
             working = j
+            modes[j] = _mode(model, work.x, qv, config.tolerance, modes[j].basin)  # the FK's own coordinates
         else:  # the ordinary FK found a mode the search missed
             log.info("the working mode was not among the modes of the search; added")
             modes.append(_mode(model, work.x, qv, config.tolerance, 0))
             working = len(modes) - 1
-    order = sorted(range(len(modes)), key=lambda i: (i != working, -modes[i].basin))
+    order = sorted(range(len(modes)), key=lambda i: (i != working, -modes[i].basin, modes[i].x.tolist()))
     modes = [modes[i] for i in order]
     working = 0 if working is not None else None
+    inside = [bool(np.all((m.x >= lo - 1e-12) & (m.x <= hi + 1e-12))) for m in modes]
     nearest = dl = da = None
     if working is not None and len(modes) > 1:
-        scaled = [np.linalg.norm(_wrapped_diff(m.x - modes[0].x, angle) / scale) for m in modes[1:]]
-        nearest = 1 + int(np.argmin(scaled))
+        fm = features(model, np.array([m.x for m in modes]), length)
+        nearest = 1 + int(np.argmin(np.linalg.norm(fm[1:] - fm[0], axis=1)))
         dl, da = _distances(model, modes[0].x, modes[nearest].x)
     return AssemblyModes(
         q=qv,
@@ -299,14 +475,15 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, wrap, merge, c
         distance_angle=da,
         starts=int(starts),
         converged=int(np.count_nonzero(real)),
-        outside_region=outside,
+        outside_region=int(len(inside) - sum(inside)),
         region=region,
+        completeness=completeness([m.basin for m in modes], int(starts)),
         seconds=time.perf_counter() - t0,
-        details={"merge_tolerance": merge_tolerance, "backend": res.backend, "newton_seconds": res.seconds},
+        details={
+            "merge_tolerance": merge_tolerance,
+            "backend": res.backend,
+            "newton_seconds": res.seconds,
+            "reach": length,
+            "merged_on": "rotation matrix and position" if c.frame is not None else "coordinates (angles wrapped)",
+        },
     )
-
-
-def _wrapped_diff(d: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    out = np.array(d, dtype=float)
-    out[angle] = (out[angle] + math.pi) % (2 * math.pi) - math.pi
-    return out

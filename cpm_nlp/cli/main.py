@@ -20,6 +20,7 @@ import logging
 import os
 import sys
 import time
+from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
@@ -54,6 +55,14 @@ def _fmt_scalar(value: Any, dim: str | None) -> tuple[str, str]:
     return si, friendly
 
 
+def _fmt_words(flat: list) -> str:
+    """A long list of words (statuses, names): how many of each, or the first few."""
+    counts = Counter(str(v) for v in flat)
+    if len(counts) <= 6:
+        return f"{len(flat)} values: " + ", ".join(f"{n} {w}" for w, n in counts.items())
+    return f"{len(flat)} values: " + ", ".join(str(v) for v in flat[:6]) + ", ..."
+
+
 def _fmt_list(value: list, dim: str | None) -> str:
     flat = value
     if flat and all(isinstance(v, list) for v in flat):
@@ -74,6 +83,8 @@ def _fmt_list(value: list, dim: str | None) -> str:
         return "matrix " + "; ".join("[" + ", ".join(cell(x) for x in row) + "]" for row in flat)
     nums = [v for v in flat if isinstance(v, (int, float))]
     nulls = len(flat) - len(nums)
+    if len(flat) > 4 and all(isinstance(v, (str, bool)) for v in flat):
+        return _fmt_words(flat)
     if len(flat) <= 4:
         return "[" + ", ".join(_fmt_scalar(v, dim)[1] or _fmt_scalar(v, dim)[0] for v in flat) + "]"
     text = f"{len(flat)} values"

@@ -137,7 +137,7 @@ def failure_message(model: Model, status: Status, details: dict, x, q, passive, 
     if status is Status.WRONG_BRANCH:
         margin = details.get("branch_margin", np.inf)
         if not margin > 0:
-            return f"branch indicator {margin:.3g} <= 0"
+            return branch_failure(model, x, q, margin)
         err = details.get("round_trip_error", np.inf)
         if not np.isfinite(err):
             return "the closed-form IK has no real solution at this pose's task coordinates"
@@ -147,6 +147,24 @@ def failure_message(model: Model, status: Status, details: dict, x, q, passive, 
     if status is Status.OUTSIDE_JOINT_LIMITS:
         return "; ".join(_limit_violations(model, x, q, passive))
     return ""
+
+
+def branch_failure(model: Model, x, q, margin: float) -> str:
+    """Which branch indicator failed, named (its leg and joint) with its value."""
+    c = model.closure
+    if c.branch is None or x is None or q is None:
+        return f"branch indicator {margin:.3g} <= 0"
+    g = np.asarray(c.branch(np.asarray(x, dtype=float), np.asarray(q, dtype=float), model.p), dtype=float).ravel()
+    bad = [k for k in range(g.size) if not g[k] > 0]
+    if not bad:
+        return f"branch indicator {margin:.3g} <= 0"
+    k = min(bad, key=lambda i: (g[i], i))  # the most negative
+    what = c.branch_descriptions[k]
+    text = f"branch indicator {c.branch_names[k]} = {g[k]:.3g} <= 0" + (f" ({what})" if what else "")
+    others = [c.branch_names[i] for i in bad if i != k]
+    if others:
+        text += f"; also <= 0: {', '.join(others)}"
+    return text
 
 
 def _assess(
@@ -293,8 +311,9 @@ def forward_kinematics(
     guess: Sequence[float] | None = None,
     *,
     backend: str = "auto",
+    continuation: bool = True,
 ) -> PoseSolution:
-    """Solve Φ(x, q; p) = 0 for the pose x.
+    """Solve Φ(x, q; p) = 0 for the pose x on the designated branch.
 
     q: actuated joints, size nq (SI).  guess: initial pose, size nx (default:
     the home pose).  The answer is checked (:func:`assess`) before it is
@@ -309,13 +328,44 @@ def forward_kinematics(
     settle the pose (``PoseSolution.path``).  backend: "auto" (compiled C when
     a compiler is available, built once per machine), "compiled" or "map"
     (CasADi's virtual machine).
+
+    continuation: when the solve from the guess fails (no convergence, or a
+    pose off the designated branch, as from a pose far from home), FK follows
+    the designated branch from home to q (:func:`continued_forward_kinematics`)
+    before reporting the failure.  Angles of a solved pose are reduced
+    (:func:`reduce_angles`).
     """
     config = solver or SolverConfig()
     c = model.closure
     qv = _vector(q, c.nq, "q")
     x0 = None if guess is None else _vector(guess, c.nx, "guess")
+    sol = _forward_once(model, qv, x0, config, backend)
+    # IPOPT stopped by a limit of its own options (max_iter, max_cpu_time: the user's) is the configured
+    # solver's verdict; a pose off the branch, no pose inside IPOPT's bounds, or Newton from far away is
+    # where continuing from home helps
+    limited = config.method != "newton" and "Maximum" in sol.message
+    if not sol.ok and continuation and sol.status in CONTINUED and not limited:
+        alt = continued_forward_kinematics(model, qv, config, backend=backend)
+        if alt.ok:
+            alt.details["first_attempt"] = f"{sol.status.value}: {sol.message}" if sol.message else sol.status.value
+            sol = alt
+    if sol.ok:
+        sol.x = reduce_angles(model, sol.x, sol.q, config.tolerance)
+    return sol
+
+
+#: statuses after which FK tries the continuation from home (a real pose may exist on the branch)
+CONTINUED = (Status.NOT_CONVERGED, Status.WRONG_BRANCH, Status.RESIDUAL_TOO_LARGE, Status.SINGULAR)
+#: numbers of steps the continuation from home tries, in turn
+CONTINUATION_STEPS = (4, 16, 64)
+#: statuses an intermediate step of the continuation may have (a real pose on the branch)
+_ON_PATH = (Status.SOLVED, Status.OUTSIDE_JOINT_LIMITS)
+
+
+def _forward_once(model: Model, qv: np.ndarray, x0: np.ndarray | None, config: SolverConfig, backend: str):
     if config.method == "newton" and batch_newton_supported(config):
         return _kernel_forward(model, qv, x0, config, backend)
+    c = model.closure
     x0 = model.x_home if x0 is None else x0
     built = c.fk_solver(config)
     x, ok, iters, msg, sec = built.solve(x0, np.concatenate([qv, model.p]), model.x_lower, model.x_upper)
@@ -328,6 +378,79 @@ def forward_kinematics(
             message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
         )
     return _checked(model, x, qv, config.tolerance, iters, sec, config.name)
+
+
+def _newton_step(model: Model, q: np.ndarray, x0: np.ndarray, config: SolverConfig, backend: str):
+    """One Newton solve on Φ from x0 (the kernel's, no IK path): (x, status)."""
+    call, index = _bound_fk(model, config, backend)
+    outs = call(q, x0)
+    code = int(outs[index[-1]][0])
+    return outs[index[0]].copy(), STATUSES[code]
+
+
+def continued_forward_kinematics(
+    model: Model, q: Sequence[float], solver: SolverConfig | None = None, *, backend: str = "auto"
+) -> PoseSolution:
+    """FK by continuation in the inputs from home: q_k = q_home + (k/n)(q - q_home),
+    each step's Newton solve warm-started from the previous pose, which stays on
+    the designated branch while the path meets no singularity.  Tries n = 4, 16,
+    64 steps in turn; the last pose is checked like any FK solution."""
+    config = solver or SolverConfig()
+    c = model.closure
+    qv = _vector(q, c.nq, "q")
+    newton = config if config.method == "newton" else SolverConfig("newton", tolerance=config.tolerance)
+    if not batch_newton_supported(newton):
+        newton = SolverConfig("newton", tolerance=config.tolerance)
+    t0 = time.perf_counter()
+    last = PoseSolution(Status.NOT_CONVERGED, message="the continuation from home did not reach q")
+    for n in CONTINUATION_STEPS:
+        x = model.x_home.copy()
+        reached = True
+        for k in range(1, n + 1):
+            qk = model.q_home + (k / n) * (qv - model.q_home)
+            xk, status = _newton_step(model, qk, x, newton, backend)
+            if k < n and status not in _ON_PATH:
+                reached = False
+                break
+            x = xk
+        if not reached:
+            continue
+        sec = time.perf_counter() - t0
+        sol = _checked(model, x, qv, config.tolerance, n, sec, f"{newton.name} (continuation from home, {n} steps)")
+        sol.details["continuation_steps"] = n
+        if sol.ok:
+            return sol
+        last = sol
+    last.seconds = time.perf_counter() - t0
+    return last
+
+
+def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> np.ndarray:
+    """The pose with each angle coordinate reduced to its declared range (its
+    joint limits, else the bounds of the pose coordinates) if a turn of it lies
+    there, else to (-pi, pi]; a coordinate the
+    closures are not periodic in (the residual grows) keeps its value."""
+    c = model.closure
+    out = np.array(x, dtype=float)
+    for k, coord in enumerate(c.x):
+        if coord.kind != "angle":
+            continue
+        v = out[k]
+        r = math.pi - (math.pi - v) % (2 * math.pi)  # in (-pi, pi]
+        for lim in (model.limit_of(coord), (model.x_lower[k], model.x_upper[k])):
+            if lim is None or not (math.isfinite(lim[0]) and math.isfinite(lim[1])):
+                continue
+            turns = math.ceil((lim[0] - r) / (2 * math.pi))
+            if lim[0] <= r + 2 * math.pi * turns <= lim[1]:
+                r += 2 * math.pi * turns
+                break
+        if r == v:
+            continue
+        trial = out.copy()
+        trial[k] = r
+        if np.max(np.abs(residual(model, trial, q)), initial=0.0) <= max(tolerance, 1e-12):
+            out = trial
+    return out
 
 
 def inverse_kinematics(

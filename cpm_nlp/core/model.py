@@ -84,6 +84,13 @@ class LoopClosure:
     offsets:
         input/output names for coordinates measured from the home pose,
         e.g. ``{"dz": "pz"}`` (dz = pz - pz_home).
+    branch_names, branch_descriptions:
+        optional name and meaning of each branch indicator (a ``wrong_branch``
+        message names the one that failed); default ``g[k]``.
+    frame:
+        optional ``("frame", [x, p], [R, position])``: the platform's rotation
+        matrix (3 x 3) and position (3); assembly modes are told apart on it
+        (not on angles, which alias).
     """
 
     def __init__(
@@ -103,6 +110,9 @@ class LoopClosure:
         branch: ca.Function | None = None,
         offsets: Mapping[str, str] | None = None,
         residual_unit: str = "m",
+        branch_names: Sequence[str] = (),
+        branch_descriptions: Sequence[str] = (),
+        frame: ca.Function | None = None,
     ) -> None:
         self.name = name
         self.x = tuple(x)
@@ -118,6 +128,12 @@ class LoopClosure:
         self.bounds = bounds
         self.residual_unit = residual_unit
         self.offsets = dict(offsets or {})
+        nb = branch.size1_out(0) if branch is not None else 0
+        self.branch_names = tuple(branch_names) or tuple(f"g[{k}]" for k in range(nb))
+        self.branch_descriptions = tuple(branch_descriptions) or ("",) * nb
+        if len(self.branch_names) != nb or len(self.branch_descriptions) != nb:
+            raise ValueError(f"{name}: {nb} branch indicators, {len(self.branch_names)} names")
+        self.frame = frame
         self.nx, self.nq, self.np = len(self.x), len(self.q), len(self.parameters)
         x_names = _names(self.x)
         missing = [t for t in self.task if t not in x_names]

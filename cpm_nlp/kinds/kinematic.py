@@ -229,20 +229,30 @@ def mode_value_names(model: Model) -> list[str]:
         "modes",
         *per_mode,
         "modes_status",
+        "modes_message",
+        "modes_residual",
         "modes_designated",
         "modes_branch",
         "modes_basin",
+        "branch_names",
         "nearest_mode",
         "distance_length",
         "distance_angle",
+        "designated_status",
+        "designated_message",
+        "mode_starts_converged",
+        "mode_region",
+        "mode_completeness",
         "mode_search",
     ]
 
 
 def _modes_result(kind: str, model: Model, found: AssemblyModes, solver: SolverConfig) -> Result:
-    """A forward_kinematics result: the working mode as usual, every mode found beside it."""
+    """A forward_kinematics result: the search that ran is ``solved``; the designated pose
+    (the ordinary FK) is reported as usual, with its own status, and every mode found beside it."""
     c = model.closure
     modes = found.modes
+    work = found.working_solution
     extra: dict[str, Any] = {"modes": found.count}
     dims: dict[str, str] = {"modes": "dimensionless"}
     for i, coord in enumerate(c.x):
@@ -252,29 +262,50 @@ def _modes_result(kind: str, model: Model, found: AssemblyModes, solver: SolverC
         extra[f"modes_{coord.name}"] = [m.passive.get(coord.name) for m in modes]
         dims[f"modes_{coord.name}"] = coord.kind
     extra["modes_status"] = [m.status.value for m in modes]
+    extra["modes_message"] = [m.message for m in modes]
+    extra["modes_residual"] = [m.residual for m in modes]
     extra["modes_designated"] = [m.designated for m in modes]
     extra["modes_branch"] = [m.branch.tolist() for m in modes]
     extra["modes_basin"] = [m.basin for m in modes]
+    extra["branch_names"] = list(c.branch_names)
     extra["nearest_mode"] = found.nearest
     extra["distance_length"] = found.distance_length
     extra["distance_angle"] = found.distance_angle
+    extra["designated_status"] = work.status.value
+    extra["designated_message"] = work.message or STATUS_TEXT[work.status]
+    extra["mode_starts_converged"] = found.converged
+    extra["mode_region"] = found.region.as_dict()
+    est = found.completeness
+    extra["mode_completeness"] = est.as_dict()
     extra["mode_search"] = (
-        f"{found.starts} Newton starts in the search region, {found.converged} converged, "
-        f"{found.outside_region} outside the region dropped; {found.note}"
+        f"{found.starts} Newton starts, {found.converged} converged to a real solution, "
+        f"{found.count} distinct mode(s) (merged on {found.details['merged_on']}); "
+        f"search region: {found.region.describe()}"
+        + (f"; {found.outside_region} mode(s) found outside it (kept)" if found.outside_region else "")
+        + f"; {est.note}"
     )
     dims.update(
         modes_status="text",
+        modes_message="text",
+        modes_residual="length" if c.residual_unit == "m" else "dimensionless",
         modes_designated="text",
         modes_branch="matrix",
         modes_basin="dimensionless",
+        branch_names="text",
         nearest_mode="dimensionless",
         distance_length="length",
         distance_angle="angle",
+        designated_status="text",
+        designated_message="text",
+        mode_starts_converged="dimensionless",
+        mode_region="text",
+        mode_completeness="text",
         mode_search="text",
     )
-    res = _result(kind, model, [found.working_solution], False, solver, extra)
+    res = _result(kind, model, [work], False, solver, extra)
     res.dimensions.update(dims)
     res.units.update({k: _si(d) for k, d in dims.items()})
+    res.status = Status.SOLVED
     designated = sum(m.designated for m in modes)
     summary = f"{found.count} assembly mode(s) found, {designated} on the designated branch"
     if designated > 1:
@@ -284,7 +315,12 @@ def _modes_result(kind: str, model: Model, found: AssemblyModes, solver: SolverC
             f"; nearest other mode: {found.distance_length:.6g} m and {found.distance_angle:.6g} rad away"
             " (lengths and angles of the pose)"
         )
-    res.message = f"{res.message}; {summary}; {found.note}"
+    if work.ok:
+        pose = "designated pose: solved"
+    else:
+        pose = f"designated pose (the ordinary FK): {work.status.value}"
+        pose += f" ({work.message})" if work.message else ""
+    res.message = f"mode search ran; {summary}; {pose}; {est.note}"
     return res
 
 

@@ -38,6 +38,7 @@ import math
 import casadi as ca
 import numpy as np
 
+from ..core.aspect import ASPECT, ASPECT_DESCRIPTION, aspect
 from ..core.mechanism import Drawing, JointStiffness, Mechanism
 from ..core.model import Coordinate, LoopClosure, Model
 from ..core.options import Option
@@ -254,7 +255,11 @@ def passive_joints() -> ca.Function:
 
 
 def branch_indicator() -> ca.Function:
-    """g > 0 on the designated branch: l_i0·s_i0 > 0 and l_i0·z > 0 for every leg."""
+    """g > 0 on the designated branch: l_i0·s_i0 > 0 and l_i0·z > 0 for every leg
+    (:data:`BRANCH_NAMES`), and the aspect of the home pose (det Φ_x per platform
+    twist has its sign at home, :mod:`cpm_nlp.core.aspect`): with a leg folded
+    down (alpha_i ~ 10 deg) and the platform tilted ~45 deg, the legs keep
+    their signs and only the aspect tells that assembly mode from the working one."""
     x = ca.SX.sym("x", 6)
     q = ca.SX.sym("q", 3)
     p = ca.SX.sym("p", 3)
@@ -262,7 +267,29 @@ def branch_indicator() -> ca.Function:
     for i in range(3):
         _R, l0, _ = _leg_frames(i, x, q, p)
         g += [ca.dot(l0, s0(i)), l0[2]]
+    R = rotation(x[3], x[4], x[5])
+    x_home = ca.vertcat(0, 0, p[1] * ca.sin(p[2]), 0, 0, 0)
+    g.append(aspect(loop_closure()(x, q, p), x, q, R, x_home, ca.SX.zeros(3)))
     return ca.Function("branch", [x, q, p], [ca.vertcat(*g)], ["x", "q", "p"], ["g"])
+
+
+#: the names of the branch indicators, and what each measures
+BRANCH_NAMES = tuple(n for i in (1, 2, 3) for n in (f"leg{i}.inward", f"leg{i}.rising")) + (ASPECT,)
+BRANCH_DESCRIPTIONS = tuple(
+    d
+    for i in (1, 2, 3)
+    for d in (
+        f"leg {i}, R joint at C{i}: l{i}0 . s{i}0, the leg leans towards the axis (eq 20's minus root)",
+        f"leg {i}, R joint at C{i}: l{i}0 . z, the leg rises from the slider to the platform",
+    )
+) + (ASPECT_DESCRIPTION,)
+
+
+def frame() -> ca.Function:
+    """The platform's rotation matrix (eq 4) and position."""
+    x = ca.SX.sym("x", 6)
+    p = ca.SX.sym("p", 3)
+    return ca.Function("frame", [x, p], [rotation(x[3], x[4], x[5]), x[0:3]], ["x", "p"], ["R", "position"])
 
 
 def home(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -292,6 +319,9 @@ def closure() -> LoopClosure:
         passive=passive_joints(),
         passive_coords=PASSIVE,
         branch=branch_indicator(),
+        branch_names=BRANCH_NAMES,
+        branch_descriptions=BRANCH_DESCRIPTIONS,
+        frame=frame(),
         offsets={"dz": "pz"},
         home=home,
         bounds=bounds,

@@ -122,6 +122,9 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         passive_coords=[r.coord for r in gen.reported],
         branch=fns["branch"],
         offsets=d.platform.offsets,
+        branch_names=fns["branch_names"],
+        branch_descriptions=fns["branch_descriptions"],
+        frame=fns["frame"],
     )
     if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
         check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))
@@ -212,7 +215,8 @@ def check_reference(model: Model, row_names: list[str]) -> None:
     if c.branch is not None:
         g = np.asarray(c.branch(model.x_home, model.q_home, model.p), dtype=float).ravel()
         if not np.all(g > 0):
-            raise InputError(f"branch indicators not positive at the reference configuration: {g}", path=("legs",))
+            bad = ", ".join(f"{n} = {v:.3g}" for n, v in zip(c.branch_names, g) if not v > 0)
+            raise InputError(f"branch indicators not positive at the reference configuration: {bad}", path=("legs",))
     J = np.asarray(c.phi_x(model.x_home, model.q_home, model.p), dtype=float)
     s = np.linalg.svd(J, compute_uv=False)
     tol = max(J.shape) * np.finfo(float).eps * max(s[0], 1.0) * 1e3

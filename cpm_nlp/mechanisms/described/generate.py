@@ -35,7 +35,9 @@ from typing import Any
 import casadi as ca
 
 from ...analysis import flexure
-from ...core.errors import InputError, format_key_path
+from ...core.aspect import ASPECT, ASPECT_DESCRIPTION, ASPECT_MAX_NX
+from ...core.aspect import aspect as aspect_indicator
+from ...core.errors import InputError, format_key_path, suggest
 from ...core.model import Coordinate
 from ...core.options import Option, validate_mapping
 from ...core.units import parse_quantity
@@ -43,6 +45,10 @@ from . import expr as ex
 from .spec import Description, Joint, Leg
 
 POINT_JOINTS = {"S", "planar_R"}
+#: what the generated indicators measure
+_COSINE = "cosine of the link to the platform joint to its reference direction"
+_COSINE_AXIS = "cosine of the link about the joint's axis to its reference direction"
+
 SPHERE_JOINTS = {"U", "S", "planar_R"}
 #: the letter a drawing marks each joint type with (a distance joint: a rod between two spherical joints)
 _LETTER = {"P": "P", "planar_P": "P", "R": "R", "planar_R": "R", "C": "C", "U": "U", "S": "S", "distance": "S"}
@@ -125,7 +131,8 @@ class Generator:
             self.derived.append((q.name, v.sx, q.dimension or _dim_name(v.dim)))
         self.reported: list[_Reported] = []
         self.rows: list[tuple[ca.SX, str]] = []
-        self.branch: list[ca.SX] = []
+        #: the assembly-branch indicators: (expression, name, what it measures)
+        self.branch: list[tuple[ca.SX, str, str]] = []
         self.q_coords: list[Coordinate] = []
         self.q_syms: list[ca.SX] = []
         self.q_home: list[ca.SX] = []
@@ -378,9 +385,11 @@ class Generator:
                     slide.spec.path,
                 )
             )
-            self.rows.append((ca.norm_2(v) - (r + slide.value), f"leg {leg.name}: length"))
-            self.branch.append((r + slide.value) / r)
-            self.branch.append(ca.dot(u, v) / (r * ca.norm_2(v)))
+            # squared (polynomial in the pose): Newton from far starts converges far more often than on
+            # |v| - length; near a solution it is (length / r)(|v| - length)
+            self.rows.append(((ca.dot(v, v) - (r + slide.value) ** 2) / (2 * r), f"leg {leg.name}: length"))
+            self.indicator((r + slide.value) / r, leg, slide, "the leg's length over its reference length")
+            self.indicator(ca.dot(u, v) / (r * ca.norm_2(v)), leg, elim, _COSINE)
             if elim.type == "R":  # R-P-S: the leg also stays in the plane normal to the R axis
                 w = Rm @ elim.axis
                 self.rows.append((ca.dot(v, w) - ca.dot(u0, elim.axis), f"leg {leg.name}: plane of the R joint"))
@@ -395,7 +404,7 @@ class Generator:
             up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
             self.rows.append((ca.dot(v, w) - h, f"leg {leg.name}: plane of the R joint"))
             self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: radius about the R joint"))
-            self.branch.append(ca.dot(up, vp) / ca.dot(up, up))
+            self.indicator(ca.dot(up, vp) / ca.dot(up, up), leg, elim, _COSINE_AXIS)
             theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
             self.report(elim, [theta], leg.name)
             Rb = _rot(w, theta) @ Rm
@@ -404,15 +413,23 @@ class Generator:
             up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
             rp = ca.norm_2(u0 - ca.dot(u0, elim.axis) * elim.axis)
             self.rows.append(((ca.dot(vp, vp) - rp**2) / (2 * rp), f"leg {leg.name}: cylinder of the C joint"))
-            self.branch.append(ca.dot(up, vp) / ca.dot(up, up))
+            self.indicator(ca.dot(up, vp) / ca.dot(up, up), leg, elim, _COSINE_AXIS)
             theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
             self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0, elim.axis)], leg.name)
             Rb = _rot(w, theta) @ Rm
         else:
             self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: distance"))
-            self.branch.append(ca.dot(u, v) / ca.dot(u0, u0))
+            self.indicator(ca.dot(u, v) / ca.dot(u0, u0), leg, elim, _COSINE)
             Rb = self.report_sphere(elim, Rm, u0, v, leg)
         self.report_tip(last, Rb, R_rel, leg.name)
+
+    def indicator(self, value: ca.SX, leg: Leg, j: _Joint, what: str) -> None:
+        """A generated branch indicator, named after its leg and joint (``a1.U1``: leg a1, its
+        first joint, a U)."""
+        n = j.spec.path[-1] + 1 if j.spec.path and isinstance(j.spec.path[-1], int) else 0
+        letter = "R" if j.type == "planar_R" else "P" if j.type == "planar_P" else j.type
+        name = f"{leg.name}.{letter}{n}"
+        self.branch.append((value, name, f"leg {leg.name}, joint {n} ({j.type}): {what}"))
 
     def draw_leg(
         self,
@@ -590,8 +607,7 @@ class Generator:
             self._bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("actuators", c.name))
         for k, text in enumerate(d.closures):
             self.rows.append((self.scalar(text, ("closures", k), full), f"closures[{k}]"))
-        for k, text in enumerate(d.branch):
-            self.branch.append(self.scalar(text, ("branch", k), full))
+        added = self.branch_expressions(full)
         families = list(dict.fromkeys(r.coord.group for r in self.reported))
         self.reported.sort(key=lambda r: families.index(r.coord.group))  # alpha1..3, beta1..3, as the papers list them
         for qty in d.passive:
@@ -612,6 +628,8 @@ class Generator:
                 path=("platform", "coordinates"),
                 hint="declare the coordinates the structure fixes under platform.fixed, or add legs",
             )
+        self.aspect(q)
+        self.select_branch(added)
         if len(d.platform.task) != len(self.q_coords):
             raise InputError(
                 f"{len(d.platform.task)} task coordinate(s) for {len(self.q_coords)} actuator(s) "
@@ -619,6 +637,62 @@ class Generator:
                 path=("platform", "task"),
             )
         return self.functions(q)
+
+    def branch_expressions(self, env: Mapping[str, ex.Value]) -> list[tuple[ca.SX, str, str]]:
+        """The indicators the ``branch`` section writes as expressions (named ``branch[k]`` unless given
+        a name); an item that is a generated indicator's name is a selection, not an expression."""
+        spec = self.d.branch
+        items = spec if isinstance(spec, list) else (spec or {}).get("add", []) if isinstance(spec, dict) else []
+        base = ("branch",) if isinstance(spec, list) else ("branch", "add")
+        names = {b[1] for b in self.branch} | {ASPECT}  # the aspect indicator is generated after the closures
+        out = []
+        for k, item in enumerate(items):
+            if isinstance(item, str) and item in names and isinstance(spec, list):
+                continue
+            name, text = next(iter(item.items())) if isinstance(item, dict) else (f"branch[{k}]", item)
+            out.append((self.scalar(text, base + (k,), env), name, f"declared: {text}"))
+        return out
+
+    def select_branch(self, added: list[tuple[ca.SX, str, str]]) -> None:
+        """Apply the ``branch`` section to the generated indicators (absent: all of them)."""
+        spec, generated = self.d.branch, self.branch
+        names = [b[1] for b in generated]
+
+        def check(name: str, path: tuple) -> None:
+            if name not in names:
+                raise InputError(
+                    f"no generated branch indicator {name!r}; they are: {', '.join(names) or 'none'}",
+                    path=path,
+                    suggestions=suggest(name, names),
+                )
+
+        if spec is None:
+            keep = names
+        elif isinstance(spec, list):
+            keep = [v for v in spec if isinstance(v, str) and v in names]
+            if ASPECT in spec and ASPECT not in names:
+                check(ASPECT, ("branch", spec.index(ASPECT)))
+        else:
+            keep = names if spec["keep"] == "all" else [] if spec["keep"] == "none" else spec["keep"]
+            for k, name in enumerate(() if isinstance(keep, list) and keep is names else keep):
+                check(name, ("branch", "keep", k))
+            for k, name in enumerate(spec["remove"]):
+                check(name, ("branch", "remove", k))
+            keep = [n for n in keep if n not in spec["remove"]]
+        self.branch = [b for b in generated if b[1] in keep] + added
+        taken = [b[1] for b in self.branch]
+        dup = sorted({n for n in taken if taken.count(n) > 1})
+        if dup:
+            raise InputError(f"the branch indicator name {dup[0]!r} is used twice", path=("branch",))
+
+    def aspect(self, q: ca.SX) -> None:
+        """The aspect indicator (:mod:`cpm_nlp.core.aspect`): negative in an assembly mode across a
+        forward singularity from the reference configuration."""
+        if self.x.numel() > ASPECT_MAX_NX:
+            return
+        phi = ca.vertcat(*[r[0] for r in self.rows])
+        value = aspect_indicator(phi, self.x, q, self.R, self.x_home, ca.vertcat(*self.q_home))
+        self.branch.append((value, ASPECT, ASPECT_DESCRIPTION))
 
     def add_unknowns(self) -> None:
         if not self.extra:
@@ -653,7 +727,9 @@ class Generator:
         x, p = self.x, self.p
         io = ["x", "q", "p"]
         phi = ca.Function("phi", [x, q, p], [ca.vertcat(*[r[0] for r in self.rows])], io, ["phi"])
-        branch = ca.Function("branch", [x, q, p], [ca.vertcat(*self.branch)], io, ["g"]) if self.branch else None
+        g = ca.vertcat(*[b[0] for b in self.branch])
+        branch = ca.Function("branch", [x, q, p], [g], io, ["g"]) if self.branch else None
+        frame = ca.Function("frame", [x, p], [self.R, self.P], ["x", "p"], ["R", "position"])
         passive = None
         if self.reported:
             passive = ca.Function("passive", [x, q, p], [ca.vertcat(*[r.value for r in self.reported])], io, ["j"])
@@ -677,6 +753,9 @@ class Generator:
             "drawing_legs": [(name, [(t, a, sl) for t, _v, a, sl in joints]) for name, joints in self.drawn],
             "phi": phi,
             "branch": branch,
+            "branch_names": [b[1] for b in self.branch],
+            "branch_descriptions": [b[2] for b in self.branch],
+            "frame": frame,
             "passive": passive,
             "home": home,
             "extras": extras,

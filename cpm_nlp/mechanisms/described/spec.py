@@ -178,7 +178,10 @@ class Description:
     #: actuators declared without joints: name -> (dimension, value at the reference configuration)
     actuators: dict[str, tuple[str, Expr]] = field(default_factory=dict)
     closures: list[Expr] = field(default_factory=list)
-    branch: list[Expr] = field(default_factory=list)
+    #: the branch indicators: None (absent) the generated ones; a list: exactly these (an item is a
+    #: generated indicator's name, an expression, or {name: expression}; [] none); a mapping
+    #: {keep, remove, add}: the generated ones filtered and extended (see :func:`_branch`)
+    branch: list[Any] | dict[str, Any] | None = None
     passive: list[Quantity] = field(default_factory=list)
     ik: ClosedFormIK | None = None
     characteristic_length: Expr = None
@@ -498,6 +501,42 @@ def _legs(raw: Any, path: tuple) -> list[Leg]:
     return legs
 
 
+BRANCH_KEYS = {
+    "keep": "generated indicators to keep (names, or all / none; default all)",
+    "remove": "generated indicators to remove (names)",
+    "add": "indicators to add (expressions, or {name: expression})",
+}
+
+
+def _branch(raw: Any, path: tuple) -> list[Any] | dict[str, Any]:
+    """The ``branch`` section: a list (exactly these indicators) or {keep, remove, add}.  The
+    names of generated indicators are checked when the mechanism is generated."""
+    if raw is None:
+        return []
+    if isinstance(raw, list):
+        return [_branch_item(v, path + (k,)) for k, v in enumerate(raw)]
+    m = _mapping(raw, path, "a list of indicators, or {keep, remove, add}", BRANCH_KEYS)
+    keep = m.get("keep", "all")
+    if keep not in ("all", "none"):
+        keep = [_text(v, path + ("keep", k)) for k, v in enumerate(_list(keep, path + ("keep",), "a list of names"))]
+    removed = _list(m.get("remove") or [], path + ("remove",), "a list of names")
+    remove = [_text(v, path + ("remove", k)) for k, v in enumerate(removed)]
+    added = _list(m.get("add") or [], path + ("add",), "a list of expressions")
+    add = [_branch_item(v, path + ("add", k)) for k, v in enumerate(added)]
+    return {"keep": keep, "remove": remove, "add": add}
+
+
+def _branch_item(v: Any, path: tuple) -> Any:
+    if isinstance(v, dict):
+        if len(v) != 1:
+            raise InputError(f"expected one {{name: expression}}, got {v!r:.60}", path=path)
+        ((name, text),) = v.items()
+        return {_text(name, path): text}
+    if isinstance(v, bool) or not isinstance(v, (str, int, float)):
+        raise InputError(f"expected an indicator's name or an expression, got {v!r:.60}", path=path)
+    return v
+
+
 def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a chain can break
     """Each leg is a serial chain base -> bodies -> platform: a joint carries the next body (its
     ``body``, default the leg's own next link, the platform for the last joint)."""
@@ -622,7 +661,7 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
         derived=derived,
         actuators=actuators,
         closures=list(_list(data.get("closures") or [], ("closures",), "a list of expressions")),
-        branch=list(_list(data.get("branch") or [], ("branch",), "a list of expressions")),
+        branch=_branch(data.get("branch"), ("branch",)) if "branch" in data else None,
         passive=passive,
         ik=ik,
         characteristic_length=data.get("characteristic_length"),
