@@ -27,7 +27,7 @@ from ..core import progress
 from ..core.errors import CpmError, InputError
 from ..core.version import __version__
 from ..io.atomic import check_output_path, write_atomic
-from ..io.inputs import inputs_scope
+from ..io.inputs import check_input_file, inputs_scope
 
 TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
 if TYPE_CHECKING:
@@ -484,6 +484,8 @@ def cmd_examples(args: argparse.Namespace, out: TextIO) -> int:
 
 
 def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - one branch per thing described
+    if args.name and _names_a_file(args.name) and not args.mechanism and args.name != "-":
+        check_input_file(args.name, allow_pipe=True)  # a sparse file, a device: refused before the imports
     from ..mechanisms.registry import mechanism_names, mechanism_type
     from ..problems.registry import kind_names, problem_kind
 
@@ -501,10 +503,10 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
         return _describe_kind(args, out)
     if args.mechanism:
         problem_kind(args.name, path=("describe",))  # the unknown kind, with a "did you mean"
-    if args.name.endswith((".yaml", ".yml")) and not args.mechanism:  # a mechanism file: loaded and checked
+    if _names_a_file(args.name) and not args.mechanism:  # a mechanism file: loaded and checked
         from ..mechanisms.described import load_file
 
-        mt = load_file(args.name)
+        mt = load_file(args.name, allow_pipe=True)
     else:
         mt = mechanism_type(args.name, path=("describe",))
     out.write(f"{mt.name}: {mt.title}\n{mt.paper}\n[{mt.origin}]\n\nparameters:\n")
@@ -524,6 +526,12 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
     return EXIT_OK
+
+
+def _names_a_file(name: str) -> bool:
+    """Whether ``describe NAME`` names a mechanism file: ``.yaml``/``.yml``, ``-``
+    (standard input), or a path with a folder (``/dev/fd/63`` of ``<(cat m.yaml)``)."""
+    return name.endswith((".yaml", ".yml")) or name == "-" or ("/" in name or os.sep in name)
 
 
 def _describe_kind(args: argparse.Namespace, out: TextIO) -> int:

@@ -31,6 +31,7 @@ from ..core.kind import ProblemKind
 from ..core.model import Model
 from ..core.result import Result
 from ..core.solver import SolverConfig
+from ..io.inputs import display_name, input_dir
 from ..mechanisms.registry import SECTION_KEYS, build_model, section_type
 from .overrides import apply_overrides
 from .published import parse_reproduce
@@ -156,14 +157,16 @@ def _parse_outputs(raw: Any, names: list[str]) -> list[str] | None:
 
 
 def load_problem(path: str | os.PathLike, overrides: Sequence[str] = ()) -> Problem:
-    """Read, override (``--set``) and validate a problem file."""
-    file = str(path)
-    data = read_yaml(path)
+    """Read, override (``--set``) and validate a problem file.  ``path`` may be
+    ``-`` (standard input) or a pipe (``<(cat p.yaml)``); the relative paths in
+    such a file are resolved against the working directory."""
+    file = display_name(path)
+    data = read_yaml(path, allow_pipe=True)
     try:
         data = apply_overrides(data, overrides)
     except InputError as exc:
         raise exc.at(file=file) from None
-    return problem_from_dict(data, file=file, base_dir=Path(path).resolve().parent)
+    return problem_from_dict(data, file=file, base_dir=input_dir(path))
 
 
 def solve(problem: Problem) -> Result:
