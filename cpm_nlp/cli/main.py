@@ -278,6 +278,7 @@ def _progress_bars(args: argparse.Namespace) -> progress.Callback | None:
                 file=args.err,
                 dynamic_ncols=True,
                 disable=False,
+                leave=False,  # a finished bar is erased: the result follows on a clean screen
                 mininterval=0,  # cpm_nlp.core.progress reports every 0.2 s at most already
             )
         bar.update(done - bar.n)
@@ -782,6 +783,7 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
         err.write(f"internal error: {exc.__class__.__name__}: {exc} (please report; rerun with --debug)\n")
         return EXIT_INTERNAL
     finally:
+        _close_bars(args)
         root.removeHandler(handler)
 
 
