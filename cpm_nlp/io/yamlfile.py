@@ -309,6 +309,7 @@ def load_yaml_text(text: str) -> Any:
             if "nesting depth" in str(getattr(exc, "problem", "")):  # LibYAML's own limit (1000), ours is lower
                 problem = f"nested more than {MAX_DEPTH} levels deep"
                 raise ComposerError(None, None, problem, getattr(exc, "problem_mark", None)) from None
+            _python_error(text)  # a syntax error: in PyYAML's words, the same with or without LibYAML
             raise
         if node is None:
             return None
@@ -316,6 +317,13 @@ def load_yaml_text(text: str) -> Any:
         return loader.construct_document(node)
     finally:
         loader.dispose()
+
+
+def _python_error(text: str) -> None:
+    """Raise the error PyYAML's own parser finds in ``text`` (the limits first, so
+    that it stays fast); return if it finds none."""
+    _precheck(text)
+    yaml.load(text, Loader=_Loader)  # noqa: S506 - a SafeLoader subclass
 
 
 def read_yaml(path: str | os.PathLike, *, allow_pipe: bool = False) -> Any:
