@@ -349,25 +349,24 @@ def test_interrupted_cli_sweep_says_how_to_resume(cli, tmp_path, monkeypatch):
 
 
 def test_progress_bar_redraws_in_place_on_a_terminal():
+    """The sweep's progress: a tqdm bar redrawn in place on a terminal, closed
+    (a new line) at the end; nothing when stderr is a log, or with -q."""
+    import argparse
     import io
 
-    from cpm_nlp.cli.main import ProgressBar
+    from cpm_nlp.cli.main import _progress_bars
 
     class Tty(io.StringIO):
         def isatty(self):
             return True
 
     stream = Tty()
-    bar = ProgressBar(stream, width=10)
+    show = _progress_bars(argparse.Namespace(quiet=False, err=stream))
     for done in (0, 5, 10):
-        bar(done, 10)
-        bar.last_draw = 0.0  # no throttling in the test
+        show("sweep", done, 10)
     text = stream.getvalue()
-    assert text.startswith("\r[          ] sweep: 0/10 points (0%)")
-    assert "\r[#####     ] sweep: 5/10 points (50%)" in text and "s left" in text
-    assert text.endswith("\n") and "\r[##########] sweep: 10/10 points (100%)" in text
-    logs = io.StringIO()
-    bar = ProgressBar(logs)
-    for done in range(11):
-        bar(done, 10)
-    assert len(logs.getvalue().splitlines()) == 11  # a line per tenth when not a terminal
+    assert text.startswith("\rsweep:   0%") and "0/10" in text
+    assert "\rsweep:  50%" in text and "5/10" in text and " points" in text
+    assert "\rsweep: 100%" in text and "10/10" in text and text.endswith("\r")  # erased when done
+    assert _progress_bars(argparse.Namespace(quiet=False, err=io.StringIO())) is None  # a log: no bar
+    assert _progress_bars(argparse.Namespace(quiet=True, err=Tty())) is None

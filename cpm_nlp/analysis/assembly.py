@@ -53,9 +53,11 @@ import logging
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from ..core import progress
 from ..core.batch import batch_forward_kinematics
 from ..core.errors import InputError
 from ..core.kernels import ROUND_TRIP_FACTOR, STATUSES
@@ -68,6 +70,10 @@ log = logging.getLogger(__name__)
 
 #: two converged poses within this (scaled) distance are the same mode
 MERGE_TOLERANCE = 1e-6
+#: starts per mapped Newton call of the search (about 0.1 s: a Ctrl-C stops the search that soon)
+SEARCH_CHUNK = 256
+#: rows of a block of the merge, and most distances computed at once
+MERGE_BLOCK, MERGE_CELLS = 8192, 1 << 22
 #: statuses of converged real solutions (the others: Newton did not reach a solution)
 REAL = (Status.SOLVED, Status.WRONG_BRANCH, Status.OUTSIDE_JOINT_LIMITS, Status.SINGULAR)
 #: a mode reached by fewer starts than this is "rarely hit" (its basin is small: others may hide)
@@ -292,19 +298,51 @@ def features(model: Model, X: np.ndarray, length: float) -> np.ndarray:
 
 
 def _merge(F: np.ndarray, tol: float) -> tuple[list[int], np.ndarray]:
-    """Greedy clustering of the rows of F (max-norm): (first row of each cluster, cluster of each row)."""
+    """Greedy clustering of the rows of F (max-norm): (first row of each cluster, cluster of each row).
+
+    Row k joins the nearest cluster (the first of equally near ones) whose
+    first row is within ``tol``, among the clusters started before it, or
+    starts one.  The rows are taken in blocks (vectorized: a million converged
+    starts merge in seconds), with the result of a row-by-row loop."""
     reps: list[int] = []
     label = np.empty(len(F), dtype=int)
-    for k in range(len(F)):
-        if reps:
-            dist = np.max(np.abs(F[reps] - F[k]), axis=1)
-            j = int(np.argmin(dist))
-            if dist[j] <= tol:
-                label[k] = j
-                continue
-        label[k] = len(reps)
-        reps.append(k)
+
+    def dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.max(np.abs(a[:, None, :] - b[None, :, :]), axis=2, initial=0.0)
+
+    with progress.task("merging the converged starts", len(F)) as report:
+        k = 0
+        while k < len(F):
+            k = _merge_block(F, k, reps, label, dist, tol)
+            report.update(k)
     return reps, label
+
+
+def _merge_block(Y: np.ndarray, k: int, reps: list[int], label: np.ndarray, dist: Any, tol: float) -> int:
+    """Merge the block of rows from ``k`` (see :func:`_merge`); the first row after it."""
+    size = max(1, min(MERGE_BLOCK, MERGE_CELLS // max(1, len(reps) * Y.shape[1])))
+    block = Y[k : k + size]
+    if reps:
+        d = dist(block, Y[reps])
+        near, best = np.argmin(d, axis=1), np.min(d, axis=1)
+    else:
+        near, best = np.full(len(block), -1), np.full(len(block), np.inf)
+    i = 0
+    while i < len(block):
+        far = np.flatnonzero(best[i:] > tol)
+        stop = i + int(far[0]) if far.size else len(block)
+        label[k + i : k + stop] = near[i:stop]
+        if stop == len(block):
+            break
+        label[k + stop] = len(reps)  # a new cluster: the rows after it compare with it too
+        reps.append(k + stop)
+        rest = slice(stop + 1, len(block))
+        dn = dist(block[rest], block[stop : stop + 1])[:, 0]
+        closer = dn < best[rest]
+        best[rest] = np.where(closer, dn, best[rest])
+        near[rest] = np.where(closer, len(reps) - 1, near[rest])
+        i = stop + 1
+    return k + len(block)
 
 
 def _distances(model: Model, a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
@@ -416,7 +454,14 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge,
     X0[0] = model.x_home if guess is None else np.asarray(guess, dtype=float)
     newton = search_solver(config)
     res = batch_forward_kinematics(
-        model, np.broadcast_to(qv, (len(X0), c.nq)), newton, X0, backend=backend, threads=threads
+        model,
+        np.broadcast_to(qv, (len(X0), c.nq)),
+        newton,
+        X0,
+        backend=backend,
+        threads=threads,
+        chunk=SEARCH_CHUNK,
+        what="assembly-mode search",
     )
     statuses = [STATUSES[int(k)] for k in res.status]
     real = np.array([s in REAL for s in statuses])

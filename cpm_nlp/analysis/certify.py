@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from ..core import progress
 from ..core.model import LoopClosure, Model
 from ..core.options import Option
 from .intervals import IntervalProgram, UnsupportedOperation
@@ -277,7 +278,9 @@ def certify_box(  # noqa: C901 - the branch-and-bound loop with its proof rules
             counterexample=point,
         )
 
+    report = progress.task("certificate", max_boxes)  # sub-boxes of the budget; Ctrl-C between batches
     while len(pending_L):
+        report.update(boxes)
         L, U, D = pending_L[:BATCH], pending_U[:BATCH], pending_depth[:BATCH]
         rest = (pending_L[BATCH:], pending_U[BATCH:], pending_depth[BATCH:])
         B = len(L)

@@ -42,6 +42,7 @@ import numpy as np
 from ..core.errors import InputError, suggest
 from ..core.model import LoopClosure, Model
 from ..core.multistart import AGREEMENT, best_and_agreement, uniform_starts
+from ..core.progress import track
 from ..core.solver import SolverConfig, run_nlp
 from .workspace import (
     CUBOID_IPOPT,
@@ -226,7 +227,7 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
     z_starts = uniform_starts(np.zeros(len(names)), np.ones(len(names)), starts, seed, (first - lo) / (hi - lo))
     runs: list[tuple[bool, np.ndarray | None, str, int, tuple | None]] = []
     iterations = 0
-    for z0 in z_starts:
+    for z0 in track(z_starts, "synthesis starts"):  # progress; Ctrl-C between starts and inside IPOPT
         params = dict(model.parameters)
         params.update({n: float(v) for n, v in zip(names, lo + (hi - lo) * z0)})
         try:

@@ -15,11 +15,12 @@ from __future__ import annotations
 import argparse
 import contextlib
 import ctypes
+import io
 import json
 import logging
 import os
+import signal
 import sys
-import time
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
@@ -28,7 +29,7 @@ from ..core import blas, progress
 from ..core.errors import CpmError, InputError
 from ..core.version import __version__
 from ..io.atomic import check_output_path, write_atomic
-from ..io.inputs import inputs_scope
+from ..io.inputs import check_input_file, inputs_scope
 
 TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
 if TYPE_CHECKING:
@@ -37,6 +38,8 @@ if TYPE_CHECKING:
     from ..core.result import Result
 
 EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
+#: Ctrl-C (128 + SIGINT), and a reader that closed our stdout (128 + SIGPIPE)
+EXIT_INTERRUPTED, EXIT_BROKEN_PIPE = 130, 141
 
 
 # -- output helpers -------------------------------------------------------------------------------
@@ -178,16 +181,75 @@ def solver_output_to_stderr(active: bool) -> Iterator[None]:
         os.close(saved)
 
 
+@contextlib.contextmanager
+def library_output_quiet() -> Iterator[None]:
+    """While active: what the C libraries print (IPOPT through C stdio on file
+    descriptor 1; CasADi's warnings and messages through Python's
+    ``sys.stdout``/``sys.stderr``) is kept off the terminal, so that stderr
+    carries only our one message.  CasADi's lines are logged at debug level
+    (``-vv`` shows them); ``--debug`` or a solver preset that asks for its log
+    (:func:`solver_log_asked`) shows everything instead."""
+    saved_py = sys.stdout, sys.stderr
+    sink = io.StringIO()
+    try:
+        sys.stdout.flush()
+        saved = os.dup(1)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+    except (OSError, ValueError, AttributeError):  # no file descriptor 1 (embedded use): Python's streams only
+        saved = devnull = None
+    try:
+        if saved is not None:
+            _flush_c_stdio()
+            os.dup2(devnull, 1)
+        sys.stdout = sys.stderr = sink
+        yield
+    finally:
+        sys.stdout, sys.stderr = saved_py
+        if saved is not None:
+            _flush_c_stdio()
+            os.dup2(saved, 1)
+            os.close(saved)
+            os.close(devnull)
+        for line in sink.getvalue().splitlines()[:100]:
+            if line.strip():
+                logging.getLogger("cpm_nlp.solver").debug("%s", line)
+
+
+def solver_log_asked(solver: Any) -> bool:
+    """Whether a solver configuration asks for the solver's own log (a preset
+    such as configs/ipopt_verbose.yaml: an IPOPT print level, CasADi's timings)."""
+    options = getattr(solver, "options", None) or {}
+    level = options.get("ipopt.print_level", 0)
+    return bool(
+        (isinstance(level, int) and level > 0)
+        or options.get("print_time") is True
+        or options.get("verbose") is True
+        or options.get("print_iteration") is True
+    )
+
+
+def solver_output(args: argparse.Namespace, solver: Any = None) -> contextlib.AbstractContextManager[None]:
+    """Where the libraries' output goes while ``args``'s command computes: nowhere
+    (:func:`library_output_quiet`), or with ``--debug`` or a solver that asks for
+    its log, on stdout (on stderr with ``--json``, which keeps stdout for the
+    JSON document)."""
+    if getattr(args, "debug", False) or solver_log_asked(solver):
+        return solver_output_to_stderr(bool(getattr(args, "json", False)))
+    return library_output_quiet()
+
+
 def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     from ..mechanisms.registry import mechanism_type
     from ..problems.file import load_problem, solve
 
     check_output_path(args.output, [args.file])
     _check_plot_args(args, [args.file, args.output])
-    with solver_output_to_stderr(args.json), progress.reporting(_batch_progress(args)):
-        problem = load_problem(args.file, args.set or [])
+    with progress.reporting(_progress_bars(args)):
+        with solver_output(args):
+            problem = load_problem(args.file, args.set or [])
         blas.cap_process()  # small dense algebra only: BLAS threads cost more than they give (core/blas.py)
-        result = solve(problem)
+        with solver_output(args, problem.solver):
+            result = solve(problem)
     # the result first: a plot that cannot be drawn never takes it away
     if args.json:
         out.write(result.to_json() + "\n")
@@ -205,17 +267,50 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     return status
 
 
-def _batch_progress(args: argparse.Namespace) -> progress.Callback | None:
-    """On a terminal (stderr), a progress bar for a batch solved pose by pose."""
-    if args.quiet or not getattr(args.err, "isatty", lambda: False)():
+#: the unit a progress bar counts, by the name of the computation (default: items)
+_UNITS = {
+    "forward kinematics": "poses",
+    "inverse kinematics": "poses",
+    "assembly-mode search": "starts",
+    "merging the converged starts": "poses",
+    "sweep": "points",
+}
+
+
+def _progress_bars(args: argparse.Namespace) -> progress.Callback | None:
+    """On a terminal (stderr), a tqdm progress bar per long computation
+    (:mod:`cpm_nlp.core.progress` reports, the CLI draws); none with ``-q`` or
+    when stderr is not a terminal (a log, a pipe)."""
+    if getattr(args, "quiet", False) or not getattr(args.err, "isatty", lambda: False)():
         return None
-    bars: dict[str, ProgressBar] = {}
+    from tqdm import tqdm
+
+    bars: dict[str, Any] = {}
+    args.bars = bars  # closed by main() on Ctrl-C, so that "interrupted" starts a line
 
     def show(what: str, done: int, total: int) -> None:
-        bar = bars.setdefault(what, ProgressBar(args.err, label=what, unit="poses"))
-        bar(done, total)
+        bar = bars.get(what)
+        if bar is None:
+            unit = _UNITS.get(what, "items")
+            bar = bars[what] = tqdm(
+                total=total or None,
+                desc=what,
+                unit=f" {unit}",
+                file=args.err,
+                dynamic_ncols=True,
+                disable=False,
+                leave=False,  # a finished bar is erased: the result follows on a clean screen
+                mininterval=0,  # cpm_nlp.core.progress reports every 0.2 s at most already
+            )
+        bar.update(done - bar.n)
+        if total and done >= total:
+            bar.close()
+            del bars[what]
 
     return show
+
+
+_batch_progress = _progress_bars  # the name used before the bars were tqdm's
 
 
 # -- plots ------------------------------------------------------------------------------------
@@ -228,8 +323,12 @@ def _plot_options(args: argparse.Namespace) -> Any:
 
 
 def _check_plot_args(args: argparse.Namespace, inputs: Sequence[str | None] = ()) -> None:
-    """Before solving: the figure can be written (not over an input or the
-    results), and its plotting library is there."""
+    """Before solving: the plot type is known, the figure can be written (not
+    over an input or the results), and its plotting library is there."""
+    if getattr(args, "type", None) is not None:
+        from ..plot.figures import check_plot_type
+
+        check_plot_type(args.type)
     if getattr(args, "plot", None):
         from ..plot.draw import check_figure_path, require_backend
 
@@ -272,8 +371,9 @@ def _save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: T
 
 def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
     from ..plot.draw import check_figure_path, require_backend, save
-    from ..plot.figures import figure, load
+    from ..plot.figures import check_plot_type, figure, load
 
+    check_plot_type(args.type)
     check_figure_path(args.output, inputs=[args.result])
     require_backend(args.output)
     try:
@@ -288,44 +388,6 @@ def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
 
 
 # -- sweeps -------------------------------------------------------------------------------------
-
-
-class ProgressBar:
-    """Points done of a sweep (or poses of a batch), on stderr: redrawn in
-    place on a terminal, a line per tenth otherwise (logs)."""
-
-    def __init__(self, stream: TextIO, width: int = 30, label: str = "sweep", unit: str = "points") -> None:
-        self.stream, self.width, self.label, self.unit = stream, width, label, unit
-        self.tty = bool(getattr(stream, "isatty", lambda: False)())
-        self.t0 = time.monotonic()
-        self.first: int | None = None
-        self.last_draw = 0.0
-        self.last_tenth = -1
-
-    def __call__(self, done: int, total: int) -> None:
-        if self.first is None:
-            self.first = done
-        now = time.monotonic()
-        frac = done / total if total else 1.0
-        elapsed = now - self.t0
-        new = done - self.first
-        eta = ""
-        if 0 < new and done < total:
-            eta = f", about {elapsed / new * (total - done):.0f} s left"
-        text = f"{self.label}: {done}/{total} {self.unit} ({frac:.0%}), {elapsed:.1f} s{eta}"
-        if self.tty:
-            if done < total and now - self.last_draw < 0.1:
-                return
-            bar = "#" * int(frac * self.width)
-            self.stream.write(f"\r[{bar:<{self.width}}] {text}\033[K" + ("\n" if done >= total else ""))
-            self.last_draw = now
-        else:
-            tenth = int(frac * 10)
-            if tenth == self.last_tenth:
-                return
-            self.last_tenth = tenth
-            self.stream.write(text + "\n")
-        self.stream.flush()
 
 
 def render_sweep(summary: Any, args: argparse.Namespace, problem: Any) -> str:
@@ -356,7 +418,7 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
         raise InputError(f"expected a positive number of points per task, got {args.chunk}", path=("--chunk",))
     problem = load_problem(args.file, args.set or [])
     job_of(problem)  # a file without a sweep section is bad input, before any cluster starts
-    progress = None if args.quiet else ProgressBar(args.err)
+    bars = _progress_bars(args)
     try:
         summary = run_sweep(
             problem,
@@ -365,9 +427,10 @@ def cmd_sweep(args: argparse.Namespace, out: TextIO) -> int:
             workers=args.workers,
             chunk_size=args.chunk,
             overwrite=args.overwrite,
-            progress=progress,
+            progress=None if bars is None else lambda done, total: bars("sweep", done, total),
         )
     except KeyboardInterrupt:
+        _close_bars(args)
         args.err.write("\n" + _interrupted_message(output) + "\n")
         return 130
     if not args.quiet:
@@ -396,7 +459,8 @@ def _interrupted_message(output: str) -> str:
 def cmd_check(args: argparse.Namespace, out: TextIO) -> int:
     from ..problems.file import load_problem
 
-    problem = load_problem(args.file, args.set or [])
+    with solver_output(args):
+        problem = load_problem(args.file, args.set or [])
     out.write(f"{args.file}: ok ({problem.kind.name} on {problem.model.name}, solver {problem.solver.method})\n")
     return EXIT_OK
 
@@ -463,7 +527,7 @@ def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
 
     check_output_path(args.output, args.paths)
     blas.cap_process()
-    with solver_output_to_stderr(args.json):
+    with solver_output(args):
         rows = reproduce(args.paths or None)
     summary = summarize(rows)
     document = json.dumps({"figures": [r.to_dict() for r in rows], "summary": summary}, indent=2) + "\n"
@@ -506,6 +570,8 @@ def cmd_examples(args: argparse.Namespace, out: TextIO) -> int:
 
 
 def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - one branch per thing described
+    if args.name and _names_a_file(args.name) and not args.mechanism and args.name != "-":
+        check_input_file(args.name, allow_pipe=True)  # a sparse file, a device: refused before the imports
     from ..mechanisms.registry import mechanism_names, mechanism_type
     from ..problems.registry import kind_names, problem_kind
 
@@ -523,10 +589,11 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
         return _describe_kind(args, out)
     if args.mechanism:
         problem_kind(args.name, path=("describe",))  # the unknown kind, with a "did you mean"
-    if args.name.endswith((".yaml", ".yml")) and not args.mechanism:  # a mechanism file: loaded and checked
+    if _names_a_file(args.name) and not args.mechanism:  # a mechanism file: loaded and checked
         from ..mechanisms.described import load_file
 
-        mt = load_file(args.name)
+        with solver_output(args):
+            mt = load_file(args.name, allow_pipe=True)
     else:
         mt = mechanism_type(args.name, path=("describe",))
     out.write(f"{mt.name}: {mt.title}\n{mt.paper}\n[{mt.origin}]\n\nparameters:\n")
@@ -546,6 +613,12 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
     return EXIT_OK
+
+
+def _names_a_file(name: str) -> bool:
+    """Whether ``describe NAME`` names a mechanism file: ``.yaml``/``.yml``, ``-``
+    (standard input), or a path with a folder (``/dev/fd/63`` of ``<(cat m.yaml)``)."""
+    return name.endswith((".yaml", ".yml")) or name == "-" or ("/" in name or os.sep in name)
 
 
 def _describe_kind(args: argparse.Namespace, out: TextIO) -> int:
@@ -719,8 +792,11 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
         err.write(f"error: {exc}\n")
         return EXIT_FAILED
     except KeyboardInterrupt:
+        _close_bars(args)
         err.write("interrupted\n")
-        return 130
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # the reader of our output went away (cpm-nlp describe | head): quietly, as Unix tools
+        return EXIT_BROKEN_PIPE
     except Exception as exc:  # a bug, not a user error: say so, and how to get details
         if args.debug:
             import traceback
@@ -729,12 +805,64 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
         err.write(f"internal error: {exc.__class__.__name__}: {exc} (please report; rerun with --debug)\n")
         return EXIT_INTERNAL
     finally:
+        _close_bars(args)
         root.removeHandler(handler)
 
 
+def _close_bars(args: argparse.Namespace) -> None:
+    """Close the progress bars left open by an interruption (each ends its line)."""
+    for bar in list(getattr(args, "bars", {}).values()):
+        with contextlib.suppress(Exception):
+            bar.close()
+    getattr(args, "bars", {}).clear()
+
+
+def _second_interrupt(_signum: int, _frame: Any) -> None:
+    """A Ctrl-C while the first one is being handled: leave at once, nothing more printed."""
+    os._exit(EXIT_INTERRUPTED)
+
+
+def _on_interrupt(_signum: int, _frame: Any) -> None:
+    """The first Ctrl-C: ``KeyboardInterrupt`` (main() prints one line, exit 130);
+    a second one ends the process without a traceback."""
+    signal.signal(signal.SIGINT, _second_interrupt)
+    raise KeyboardInterrupt
+
+
+def _stdout_gone() -> None:
+    """Point stdout at /dev/null, so that Python's final flush of what is left
+    does not fail again (what the Python docs advise for SIGPIPE)."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+
+
 def main_entry() -> None:
-    """Console-script entry point (``cpm-nlp``)."""
-    sys.exit(main())
+    """Console-script entry point (``cpm-nlp``).
+
+    Ctrl-C: one line "interrupted", exit 130 at once (threads still finishing a
+    piece of work are not waited for); a second Ctrl-C exits without a
+    traceback.  A closed stdout (``cpm-nlp describe | head``): a quiet exit
+    (status 141, as a Unix tool killed by SIGPIPE)."""
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not when started with SIGINT ignored
+        signal.signal(signal.SIGINT, _on_interrupt)
+    try:
+        code = main()
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _stdout_gone()
+        code = EXIT_BROKEN_PIPE
+    except KeyboardInterrupt:  # between main()'s own handlers
+        code = EXIT_INTERRUPTED
+    if code == EXIT_BROKEN_PIPE:
+        _stdout_gone()
+    if code == EXIT_INTERRUPTED:
+        for stream in (sys.stderr, sys.stdout):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os._exit(code)
+    sys.exit(code)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -32,13 +32,14 @@ import os
 import threading
 import time
 from collections import OrderedDict
-from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
 
+from . import progress
 from .compiled import BACKENDS as BACKENDS  # noqa: F401 - re-exported
 from .compiled import NativeLoop, backend_function, native_loop
 from .errors import InputError
@@ -275,11 +276,57 @@ def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Func
     return (native_loop(model.closure, kern), used) if used == "compiled" else (fn, used)
 
 
+def _run_chunks(run: Callable[[int], int], starts: list[int], chunk: int, n: int, threads: int, what: str) -> list[int]:
+    """``run`` each chunk: one thread (Ctrl-C is seen between chunks), a short
+    batch (the caller's thread takes the first chunk, the persistent pool the
+    others) or a long one (:func:`_run_in_pool`)."""
+    if threads == 1 or len(starts) == 1:
+        codes = []
+        with progress.task(what, n) as report:
+            for a in starts:
+                codes.append(run(a))
+                report.update(min(a + chunk, n))
+        return codes
+    if len(starts) <= threads:
+        rest = [thread_pool(threads).submit(run, a) for a in starts[1:]]
+        return [run(starts[0])] + [f.result() for f in rest]
+    return _run_in_pool(run, starts, chunk, n, threads, what)
+
+
+def _run_in_pool(
+    run: Callable[[int], int], starts: list[int], chunk: int, n: int, threads: int, what: str
+) -> list[int]:
+    """A long batch: every chunk on the pool, the caller's thread waiting (in
+    steps of :data:`~cpm_nlp.core.progress.INTERVAL`, so that Ctrl-C is seen at
+    once) and reporting progress.  Interrupted, the chunks not yet started are
+    cancelled and the running ones are the last."""
+    stop = threading.Event()
+
+    def guarded(a: int) -> int:
+        return 0 if stop.is_set() else run(a)
+
+    pool = thread_pool(threads)
+    futures = [pool.submit(guarded, a) for a in starts]
+    try:
+        with progress.task(what, n) as report:
+            pending = set(futures)
+            while pending:
+                finished, pending = wait(pending, timeout=progress.INTERVAL, return_when=FIRST_COMPLETED)
+                report.update(min(n, chunk * (len(futures) - len(pending))))
+        return [f.result() for f in futures]
+    except BaseException:  # KeyboardInterrupt: nothing more starts
+        stop.set()
+        for f in futures:
+            f.cancel()
+        raise
+
+
 def evaluate(
     function: ca.Function | NativeLoop,
     args: Sequence[np.ndarray],
     threads: int | None = None,
     chunk: int = CHUNK,
+    what: str = "batch",
 ) -> list[np.ndarray]:
     """Evaluate a Function (or a compiled kernel's :class:`NativeLoop`) over N poses.
 
@@ -288,7 +335,9 @@ def evaluate(
     (N, nnz_out(k)) arrays (dense, column-major per pose).  Chunks of
     ``chunk`` poses go through ``function.map(chunk)`` (one FunctionBuffer
     each; a NativeLoop runs them in C directly), spread over ``threads``
-    threads of the persistent pool.
+    threads of the persistent pool.  A batch of more chunks than threads
+    reports its progress as ``what`` (:mod:`cpm_nlp.core.progress`) and can be
+    interrupted between chunks.
     """
     native = isinstance(function, NativeLoop)
     per_pose = [a for a in args if a.ndim == 2]
@@ -323,12 +372,7 @@ def evaluate(
             call()
             return buf.ret()
 
-    if threads == 1 or len(starts) == 1:
-        codes = [run(a) for a in starts]
-    else:
-        # the caller's thread takes the first chunk; the persistent pool the others
-        rest = [thread_pool(threads).submit(run, a) for a in starts[1:]]
-        codes = [run(starts[0])] + [f.result() for f in rest]
+    codes = _run_chunks(run, starts, chunk, n, threads, what)
     if any(codes):
         name = function.function.name() if native else function.name()
         raise RuntimeError(f"evaluation of {name} failed")
@@ -432,6 +476,8 @@ def batch_forward_kinematics(
     *,
     backend: str = "map",
     threads: int | None = None,
+    chunk: int = CHUNK,
+    what: str = "forward kinematics",
 ) -> BatchResult:
     """FK of N actuator vectors by Newton's method.
 
@@ -439,6 +485,8 @@ def batch_forward_kinematics(
     (default: the home pose).  solver: a Newton configuration (its
     ``tolerance`` and the options abstol, abstolStep, max_iter; default
     ``SolverConfig("newton")``).  backend: "map", "compiled" or "auto".
+    chunk: poses per mapped call (smaller: a long batch is interrupted sooner);
+    what: the name its progress is reported under (:mod:`cpm_nlp.core.progress`).
 
     Each pose goes through :func:`cpm_nlp.core.kernels.fk_kernel`, the same
     kernel as a single Newton solve (:func:`cpm_nlp.core.kinematics.forward_kinematics`)
@@ -461,7 +509,7 @@ def batch_forward_kinematics(
     fn, used = _backend_function(kern, model, backend)
     nthreads = default_threads() if threads is None else max(1, int(threads))
     shared = shared_values(kern, model, config.tolerance)
-    out = dict(zip(kern.outputs, evaluate(fn, [qa, x0, *shared], nthreads)))
+    out = dict(zip(kern.outputs, evaluate(fn, [qa, x0, *shared], nthreads, chunk, what)))
     return _finish(
         "forward_kinematics",
         model,

@@ -1,8 +1,17 @@
-"""Progress of long loops (a batch solved pose by pose), for whoever shows it.
+"""Progress of long loops (a batch solved pose by pose, the assembly-mode
+search, the starts of a synthesis, the boxes of a certificate), for whoever
+shows it.
 
-Library code never prints: a loop calls :func:`track` and the caller that
-wants to show progress (the CLI, on a terminal) installs a callback with
-:func:`reporting`.  Without one, :func:`track` costs one check per item.
+Library code never prints: a loop calls :func:`track` (or advances a
+:func:`task`) and the caller that wants to show progress (the CLI draws a
+tqdm bar on a terminal) installs a callback with :func:`reporting`.  Without
+one, :func:`track` costs one check per item.
+
+Interruption: a long search returns to Python at least every
+:data:`INTERVAL` seconds in the calling thread (it runs its work in pieces of
+about that size, or waits for worker threads with that timeout), so that a
+Ctrl-C (``KeyboardInterrupt``) is seen at once; the work not yet started is
+then cancelled.
 """
 
 from __future__ import annotations
@@ -34,23 +43,55 @@ def reporting(callback: Callback | None) -> Iterator[None]:
         _CALLBACK.reset(token)
 
 
+class Task:
+    """The progress of one long computation: :meth:`update` as it advances,
+    :meth:`close` at the end.  Reports (what, done, total) to the installed
+    callback about every :data:`INTERVAL` seconds, and once at the end if it
+    reported before (a computation shorter than :data:`INTERVAL` shows nothing)."""
+
+    def __init__(self, what: str, total: int) -> None:
+        self.what, self.total = what, int(total)
+        self.callback = _CALLBACK.get()
+        self.last = time.monotonic()
+        self.reported = False
+        self.done = self.sent = 0
+
+    def update(self, done: int) -> None:
+        """``done`` items of ``total`` are finished."""
+        self.done = done
+        if self.callback is None:
+            return
+        now = time.monotonic()
+        if now - self.last >= INTERVAL:
+            self.callback(self.what, done, self.total)
+            self.last, self.reported, self.sent = now, True, done
+
+    def close(self) -> None:
+        if self.callback is not None and self.reported and self.sent != self.done:
+            self.callback(self.what, self.done, self.total)
+        self.reported = False
+
+    def __enter__(self) -> Task:
+        return self
+
+    def __exit__(self, kind: object, *rest: object) -> None:
+        if kind is None:  # an interrupted or failed computation leaves its bar where it stopped
+            self.close()
+
+
+def task(what: str, total: int) -> Task:
+    """A :class:`Task` reporting to the callback installed here (use as a context manager)."""
+    return Task(what, total)
+
+
 def track(items: Iterable[T], what: str, total: int | None = None) -> Iterator[T]:
     """Yield ``items``, reporting (what, done, total) to the installed callback
     about every :data:`INTERVAL` seconds and once at the end (if it reported before)."""
-    callback = _CALLBACK.get()
-    if callback is None:
+    if _CALLBACK.get() is None:
         yield from items
         return
     n = total if total is not None else (len(items) if isinstance(items, Sized) else 0)
-    last = time.monotonic()
-    reported = False
-    done = 0
-    for item in items:
-        yield item
-        done += 1
-        now = time.monotonic()
-        if now - last >= INTERVAL:
-            callback(what, done, n)
-            last, reported = now, True
-    if reported:
-        callback(what, done, n)
+    with task(what, n) as t:
+        for done, item in enumerate(items, 1):
+            yield item
+            t.update(done)

@@ -220,12 +220,7 @@ def figure(
     if (ok is not None and not ok.any()) or (ok is None and data.status != "solved"):
         raise NothingSolved(f"no point of {data.source or 'the result'} is solved; there is nothing to plot")
     if plot_type is not None:
-        if plot_type not in PLOTS:
-            raise InputError(
-                f"unknown plot type {plot_type!r}; expected one of: {', '.join(sorted(PLOTS))}",
-                path=("--type",),
-                suggestions=suggest(plot_type, PLOTS),
-            )
+        check_plot_type(plot_type)
         return _plot_function(plot_type)(data, options), plot_type
     candidates = SWEEP_PLOTS if data.sweep else _kind_plots(data.problem)
     if not candidates:
@@ -238,6 +233,17 @@ def figure(
         except NotApplicable as exc:
             reasons.append(f"{name}: {exc.message}")
     raise NotApplicable("no plot fits this result (" + "; ".join(reasons) + ")")
+
+
+def check_plot_type(plot_type: str | None) -> None:
+    """An :class:`InputError` (``--type``, with "did you mean") unless ``plot_type``
+    is None or a plot type of :data:`PLOTS` (checked before anything is solved)."""
+    if plot_type is not None and plot_type not in PLOTS:
+        raise InputError(
+            f"unknown plot type {plot_type!r}; expected one of: {', '.join(sorted(PLOTS))}",
+            path=("--type",),
+            suggestions=suggest(plot_type, PLOTS),
+        )
 
 
 def _plot_function(name: str) -> Any:

@@ -8,7 +8,7 @@ One schema family for every problem kind::
       type: prs3                       # cpm-nlp describe lists the types
       parameters: {b: 47.91 mm, L: 109.215 mm, alpha0: 45 deg}
       limits: {s: [-3 mm, 3 mm]}       # optional joint limits
-    inputs: {s1: 1 mm, s2: 0.5 mm, s3: -0.3 mm}
+    inputs: {s1: 1 mm, s2: 0.5 mm, s3: -0.3 mm}   # a large batch: {data: poses.csv} (cpm_nlp.io.datafile)
     solver: newton                     # a preset under configs/, or a mapping:
     #   {preset: ..., method: ipopt|newton, options: {ipopt.tol: 1e-12}, tolerance: 1e-10}
     outputs: {values: [pz, psi, theta]}  # optional selection
@@ -31,6 +31,8 @@ from ..core.kind import ProblemKind
 from ..core.model import Model
 from ..core.result import Result
 from ..core.solver import SolverConfig
+from ..io.datafile import data_file_of, merge_data_file
+from ..io.inputs import display_name, input_dir
 from ..mechanisms.registry import SECTION_KEYS, build_model, section_type
 from .overrides import apply_overrides
 from .published import parse_reproduce
@@ -101,7 +103,10 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
         raise InputError(
             f"problem kind '{kind.name}' does not apply to mechanism '{model.name}': {reason}", path=("problem",)
         )
-    inputs = kind.parse_inputs(data.get("inputs"), model, ("inputs",))
+    raw_inputs = data.get("inputs")
+    if data_file_of(raw_inputs):  # a large batch from a data file beside the problem file
+        raw_inputs = merge_data_file(raw_inputs, kind.input_options(model), base_dir)
+    inputs = kind.parse_inputs(raw_inputs, model, ("inputs",))
     solver = parse_solver(data.get("solver"), base_dir)
     kind.check_solver(solver)
     outputs = _parse_outputs(data.get("outputs"), kind.output_names(model))
@@ -156,14 +161,16 @@ def _parse_outputs(raw: Any, names: list[str]) -> list[str] | None:
 
 
 def load_problem(path: str | os.PathLike, overrides: Sequence[str] = ()) -> Problem:
-    """Read, override (``--set``) and validate a problem file."""
-    file = str(path)
-    data = read_yaml(path)
+    """Read, override (``--set``) and validate a problem file.  ``path`` may be
+    ``-`` (standard input) or a pipe (``<(cat p.yaml)``); the relative paths in
+    such a file are resolved against the working directory."""
+    file = display_name(path)
+    data = read_yaml(path, allow_pipe=True)
     try:
         data = apply_overrides(data, overrides)
     except InputError as exc:
         raise exc.at(file=file) from None
-    return problem_from_dict(data, file=file, base_dir=Path(path).resolve().parent)
+    return problem_from_dict(data, file=file, base_dir=input_dir(path))
 
 
 def solve(problem: Problem) -> Result:

@@ -17,6 +17,7 @@ from ...core.errors import InputError, suggest
 from ...core.model import LoopClosure, Model
 from ...core.multistart import AGREEMENT, best_and_agreement
 from ...core.options import Option
+from ...core.progress import track
 from ...core.solver import SolverConfig, run_nlp
 from ..cuboid_ik import ClosedFormCuboid
 from .membership import Membership, limit_bounds, limited_function, membership, poses
@@ -414,7 +415,7 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
         for k, run in zip(pending, joint):
             runs[k] = run
     else:
-        for k in pending:
+        for k in track(pending, "cuboid starts"):
             runs[k] = engine.start(*boxes[k])
             iterations += runs[k][3]
     volumes = [float(np.prod(size * r[1][d : 2 * d])) if r[0] else None for r in runs]

@@ -23,7 +23,8 @@ from ...analysis.compliance import check_declared
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
-from ...io.yamlfile import load_yaml_text, read_yaml
+from ...io.inputs import display_name, input_dir, read_input_text
+from ...io.yamlfile import load_yaml_text, parse_yaml, read_yaml
 from .chains import chains_function
 from .chains import supported as chains_supported
 from .drawing import geometry_of
@@ -64,19 +65,18 @@ def twin_chains(file_name: str, model: Model) -> Any:
     return twin.chains(twin_model)
 
 
-def load_file(path: str | Path) -> Mechanism:
-    """The mechanism a file describes (errors name the file and the key path)."""
-    path = Path(path)
-    text_key = _file_key(path)
-    data = read_yaml(path)
-    return _cached(text_key, lambda: from_dict(data, file=str(path), base_dir=path.resolve().parent))
+def load_file(path: str | Path, *, allow_pipe: bool = False) -> Mechanism:
+    """The mechanism a file describes (errors name the file and the key path).
 
-
-def _file_key(path: Path) -> str:
-    try:
-        return hashlib.sha256(path.read_bytes() + str(path.resolve()).encode()).hexdigest()
-    except OSError:
-        return "missing:" + str(path)
+    The file is read once, through :func:`cpm_nlp.io.inputs.read_input_text`
+    (its type and size checked before it is opened); ``allow_pipe``: a file
+    named on the command line may be ``-`` or a pipe."""
+    text = read_input_text(path, allow_pipe=allow_pipe)
+    file = display_name(path)
+    base_dir = input_dir(path)
+    text_key = hashlib.sha256(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode()).hexdigest()
+    data = parse_yaml(text, file)
+    return _cached(text_key, lambda: from_dict(data, file=file, base_dir=base_dir))
 
 
 def _cached(key: str, make: Any) -> Mechanism:

@@ -154,6 +154,9 @@ FUNCTIONS: dict[str, tuple[int | None, Callable, Callable, bool]] = {
 CONSTANTS = {"pi": math.pi}
 #: the names an expression may not use for a symbol of its own
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"select"}
+#: Longest expression (characters) and deepest nesting of brackets in one (documented in
+#: docs/site/guide/mechanism-files.md; the longest shipped expression has about 120 characters)
+MAX_LENGTH, MAX_NESTING = 2000, 32
 
 
 def _translate(text: str) -> tuple[str, list[int]]:
@@ -346,8 +349,9 @@ def parse(text: object, symbols: Mapping[str, Value]) -> Value:
         text = "[" + ", ".join(str(t) for t in text) + "]"
     if not isinstance(text, str) or not text.strip():
         raise ExpressionError(f"expected an expression (a string such as 'b + L*cos(alpha0)'), got {text!r}", 1)
-    if len(text) > 2000:
-        raise ExpressionError(f"an expression of {len(text)} characters; at most 2000", 1)
+    if len(text) > MAX_LENGTH:
+        raise ExpressionError(f"an expression of {len(text)} characters; at most {MAX_LENGTH}", 1)
+    _check_nesting(text)
     source, cols = _translate(text)
     try:
         tree = ast.parse(source.strip(), mode="eval")
@@ -362,6 +366,18 @@ def parse(text: object, symbols: Mapping[str, Value]) -> Value:
         return _Evaluator(symbols, cols[lead:]).eval(tree)
     except RecursionError:
         raise ExpressionError("the expression is nested too deeply", 1) from None
+
+
+def _check_nesting(text: str) -> None:
+    """Brackets nested at most :data:`MAX_NESTING` deep (before Python's parser sees the text)."""
+    depth = 0
+    for col, ch in enumerate(text, 1):
+        if ch in "([{":
+            depth += 1
+            if depth > MAX_NESTING:
+                raise ExpressionError(f"brackets nested more than {MAX_NESTING} deep", col)
+        elif ch in ")]}":
+            depth -= 1
 
 
 def names_in(text: object) -> set[str]:

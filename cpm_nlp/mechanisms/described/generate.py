@@ -157,6 +157,8 @@ class Generator:
             hint = None
             if "never closed" in exc.message:
                 hint = "inside a YAML [list] or {mapping}, quote an expression that contains a comma"
+            if len(shown) > 80:  # the reason must fit in the one message line
+                shown = shown[:60] + f"... ({len(shown)} characters)"
             raise InputError(f"in {shown!r}: column {exc.column}: {exc.message}", path=path, hint=hint) from None
         if dimension is not None and not ex.compatible(v.dim, ex.DIMENSION_OF[dimension]):
             raise InputError(

@@ -470,8 +470,23 @@ LEG_KEYS = {
 REPEAT_KEYS = {"index": "symbol", "values": "its values", "rotate": "angle expression", "axis": "x, y or z"}
 
 
-def _legs(raw: Any, path: tuple) -> list[Leg]:
-    legs = []
+#: Most legs of a mechanism (a repeated leg counts once per value of its index), joints of
+#: one leg, and joints in all (documented in docs/site/guide/mechanism-files.md): far above
+#: any parallel mechanism (a hexapod has 6 legs of 3 joints), low enough that a file is
+#: checked and generated in seconds
+MAX_LEGS, MAX_JOINTS_PER_LEG, MAX_JOINTS = 64, 32, 512
+
+
+def _check_size(count: int, limit: int, what: str, path: tuple) -> None:
+    if count > limit:
+        raise InputError(
+            f"{count} {what}; at most {limit} (a limit of cpm_nlp: see the mechanism files guide)", path=path
+        )
+
+
+def _legs(raw: Any, path: tuple) -> list[Leg]:  # noqa: C901 - one check per key and limit
+    legs: list[Leg] = []
+    joints_in_all = 0
     for k, item in enumerate(_list(raw, path, "a list of legs")):
         p = path + (k,)
         item = _mapping(item, p, "a leg {name, repeat, joints}", LEG_KEYS)
@@ -493,6 +508,11 @@ def _legs(raw: Any, path: tuple) -> list[Leg]:
         joints_raw = _list(item.get("joints"), p + ("joints",), "a list of joints, base -> platform")
         if not joints_raw:
             raise InputError("a leg needs at least one joint", path=p + ("joints",))
+        where = p + (("repeat", "values") if rep is not None else ())
+        _check_size(len(legs) + len(variants), MAX_LEGS, "legs (repeats counted)", where)
+        _check_size(len(joints_raw), MAX_JOINTS_PER_LEG, "joints in one leg", p + ("joints",))
+        joints_in_all += len(joints_raw) * len(variants)
+        _check_size(joints_in_all, MAX_JOINTS, "joints in all legs (repeats counted)", where or p)
         for template, index, rotate, axis in variants:
             suffix = "" if index is None else str(template[index])
             joints = [_joint(j, p + ("joints", n), template) for n, j in enumerate(joints_raw)]
