@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .errors import InputError, suggest, unknown_key_error
+from .finite import LARGEST, too_large
 from .units import DIMENSIONS, article, format_quantity, parse_quantity
 
 
@@ -151,16 +152,21 @@ class Option:
                 )
             return value
         if kind == "int":
-            if isinstance(value, bool) or not isinstance(value, int):
-                if isinstance(value, float) and value.is_integer() and math.isfinite(value):
-                    value = int(value)
-                else:
-                    raise InputError(f"expected {self.expectation()}, got {value!r}", path=path)
-            self._check_bounds(float(value), value, path)
-            return int(value)
+            return self._int(value, path)
         number = parse_quantity(value, kind, path)
         self._check_bounds(number, value, path)
         return number
+
+    def _int(self, value: Any, path: tuple) -> int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            if isinstance(value, float) and value.is_integer() and math.isfinite(value):
+                value = int(value)
+            else:
+                raise InputError(f"expected {self.expectation()}, got {value!r}", path=path)
+        if abs(value) > LARGEST:
+            raise InputError(f"{too_large(value)}; expected {self.expectation()}", path=path)
+        self._check_bounds(float(value), value, path)
+        return int(value)
 
     def _check_bounds(self, number: float, raw: Any, path: tuple) -> None:
         lo, hi = self.lower, self.upper

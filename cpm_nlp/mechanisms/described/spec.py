@@ -38,6 +38,7 @@ from typing import Any
 
 from ...analysis.compliance import HINGE_KEYS
 from ...core.errors import InputError, suggest, unknown_key_error
+from ...core.finite import check_numbers
 from ...core.mechanism import JointStiffness
 from ...core.options import REQUIRED
 from ...core.units import parse_quantity
@@ -548,6 +549,7 @@ IK_KEYS = {"let": "definitions in order", "pose": "dependent coordinates", "actu
 def description_from_dict(data: Any, file: str | None = None) -> Description:  # noqa: C901 - one step per section
     """Read a mechanism description from a parsed mechanism file (errors carry key paths)."""
     data = _mapping(data, (), "a mechanism description (a mapping with name, parameters, platform, legs)", TOP)
+    check_numbers(data)  # no inf, NaN or 1500-digit integer anywhere
     for key in ("name", "platform"):
         if key not in data:
             raise InputError(f"missing required key {key!r} ({TOP[key]})")
