@@ -1,11 +1,12 @@
 """Every number is finite, or there is a status.
 
-Input files are untrusted: YAML reads ``.inf``, ``.nan`` and a 400-digit
-``1111...1.5`` as non-finite floats, and a 1500-digit integer as a Python int
-that no float can hold.  :func:`check_numbers` refuses both anywhere in a
-parsed file, naming the key path, before anything is built from it; the
-declared options (:mod:`cpm_nlp.core.options`) and the expression language
-(:mod:`cpm_nlp.mechanisms.described.expr`) check their own values as well.
+Input files are untrusted: YAML reads a 1500-digit integer as a Python int
+that no float can hold, which :func:`check_numbers` refuses anywhere in a
+parsed file, naming the key path, before anything is built from it.  YAML
+reads ``.inf``, ``.nan`` and a 400-digit ``1111...1.5`` as non-finite floats:
+the declared options (:mod:`cpm_nlp.core.options`, :mod:`cpm_nlp.core.units`)
+refuse them with what they expect, and the expression language
+(:mod:`cpm_nlp.mechanisms.described.expr`) refuses an operation that makes one.
 
 On the way out, :func:`nonfinite_paths` finds the non-finite numbers in the
 values of a result, which :func:`cpm_nlp.problems.file.solve` turns into the
@@ -35,33 +36,10 @@ def too_large(value: int) -> str:
     return f"a number of about {digits} digits is too large (the largest is about {LARGEST:.3g})"
 
 
-def to_float(value: int | float, path: tuple = ()) -> float:
-    """``float(value)`` for a number from an input, or an :class:`InputError` naming
-    ``path`` for a number that is not finite or does not fit in a float."""
-    try:
-        number = float(value)
-    except OverflowError:
-        raise InputError(too_large(int(value)), path=path) from None
-    if not math.isfinite(number):
-        raise InputError(f"expected a finite number, got {value!r}", path=path)
-    return number
-
-
-def _nonfinite_number(value: Any) -> str | None:
-    """What is wrong with a number that a float cannot hold, or None."""
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, int):
-        return too_large(value) if abs(value) > LARGEST else None
-    if isinstance(value, float) and not math.isfinite(value):
-        read = " (a number beyond about 1.8e308 is read as inf)" if math.isinf(value) else ""
-        return f"expected a finite number, got {value!r}{read}"
-    return None
-
-
 def check_numbers(data: Any, path: tuple = ()) -> None:
-    """Refuse (:class:`InputError` naming the key path) a non-finite float or an
-    integer too large for a float anywhere in parsed file data."""
+    """Refuse (:class:`InputError` naming the key path) an integer too large for a float
+    anywhere in parsed file data.  A non-finite float (``.inf``, ``.nan``, ``1e999``) is
+    refused by the key that reads it, whose message says what it expects there."""
     stack: list[tuple[Any, tuple]] = [(data, path)]
     while stack:
         node, where = stack.pop()
@@ -69,10 +47,8 @@ def check_numbers(data: Any, path: tuple = ()) -> None:
             stack.extend((v, where + (str(k),)) for k, v in reversed(list(node.items())))
         elif isinstance(node, (list, tuple)):
             stack.extend((v, where + (i,)) for i, v in reversed(list(enumerate(node))))
-        else:
-            problem = _nonfinite_number(node)
-            if problem is not None:
-                raise InputError(problem, path=where)
+        elif isinstance(node, int) and not isinstance(node, bool) and abs(node) > LARGEST:
+            raise InputError(too_large(node), path=where)
 
 
 def _walk(value: Any, name: str) -> Iterator[str]:

@@ -387,14 +387,22 @@ def _construct(node: ast.AST) -> str:
     return names.get(type(node).__name__, f"'{type(node).__name__}'")
 
 
+def _plain_number(number: float) -> Value:
+    """A number given as a number (YAML reads ``1e999`` and ``.nan`` as floats)."""
+    if isinstance(number, int) and abs(number) > LARGEST:
+        raise ExpressionError(too_large(number), 1)
+    if not math.isfinite(number):
+        read = f" (a number beyond about {LARGEST:.3g} is read as inf)" if math.isinf(number) else ""
+        raise ExpressionError(f"expected a finite number, got {number!r}{read}", 1)
+    return Value(ca.SX(float(number)), None)
+
+
 def parse(text: object, symbols: Mapping[str, Value]) -> Value:
     """The CasADi value of an expression (a string, or a plain number)."""
     if isinstance(text, bool):
         raise ExpressionError(f"expected an expression or a number, got {text!r}", 1)
     if isinstance(text, (int, float)):
-        if not math.isfinite(text):
-            raise ExpressionError(f"expected a finite number, got {text!r}", 1)
-        return Value(ca.SX(float(text)), None)
+        return _plain_number(text)
     if isinstance(text, list):
         text = "[" + ", ".join(str(t) for t in text) + "]"
     if not isinstance(text, str) or not text.strip():
