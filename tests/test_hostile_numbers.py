@@ -160,6 +160,16 @@ def test_a_1500_digit_integer_in_an_expression_is_refused(tmp_path):
     assert "too large" in line
 
 
+@pytest.mark.parametrize("published", ["0e400 N", "0e99999999 N"])
+def test_a_published_figure_whose_last_digit_no_float_holds_is_refused(tmp_path, published):
+    """The tolerance of a reproduced row is half a unit of its last printed digit: 10^400."""
+    problem = tmp_path / "t2.yaml"
+    problem.write_text(
+        (PROBLEMS / "prs3_table2_forces.yaml").read_text().replace("published: 20 N", f"published: {published}", 1)
+    )
+    _refused(tmp_path, ["check", str(problem)], problem, "reproduce.rows[0].published")
+
+
 # -- material and hinge values ---------------------------------------------------------------
 
 MATERIAL_NU = {"E": "72 GPa", "nu": -1, "density": "2.81 g/cm^3", "yield_strength": "503 MPa", "allowable": "400 MPa"}
