@@ -170,6 +170,15 @@ def test_a_published_figure_whose_last_digit_no_float_holds_is_refused(tmp_path,
     _refused(tmp_path, ["check", str(problem)], problem, "reproduce.rows[0].published")
 
 
+def test_a_length_whose_products_underflow_is_refused(tmp_path):
+    """1e-320 mm: the 3-PRC lever ratio L2 L4 / (L1 L3) divided by zero."""
+    problem = tmp_path / "fk.yaml"
+    shutil.copy(PROBLEMS / "prc3_forward_kinematics.yaml", problem)
+    argv = ["solve", str(problem), "--set", "mechanism.parameters.L1=1e-320 mm"]
+    line = _refused(tmp_path, argv, problem, "mechanism.parameters.L1")
+    assert "sanity limit" in line
+
+
 # -- material and hinge values ---------------------------------------------------------------
 
 MATERIAL_NU = {"E": "72 GPa", "nu": -1, "density": "2.81 g/cm^3", "yield_strength": "503 MPa", "allowable": "400 MPa"}

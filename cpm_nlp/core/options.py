@@ -22,6 +22,11 @@ class _Required:
 
 REQUIRED: Any = _Required()
 
+#: Smallest nonzero magnitude (SI) of a declared option with a physical dimension: far
+#: below any quantity of this toolkit, it keeps products and quotients of inputs (the
+#: lever ratio L2 L4 / (L1 L3) of 1e-320 mm lengths) from underflowing to 0 or overflowing.
+TINY = 1e-60
+
 #: Largest number of points a grid may have (keeps a typo from exhausting memory).
 MAX_GRID_POINTS = 1_000_000
 
@@ -175,6 +180,13 @@ class Option:
             raise InputError(
                 f"{raw!r} is beyond the sanity limit of {self.format_value(limit)} for "
                 f"{article(self.kind.replace('_', ' '))}; expected {self.expectation()}",
+                path=path,
+            )
+        if number != 0 and abs(number) < TINY and self.kind in DIMENSIONS and self.kind != "dimensionless":
+            raise InputError(
+                f"{raw!r} is below the sanity limit of {self.format_value(TINY)} for a nonzero "
+                f"{self.kind.replace('_', ' ')} (products of such numbers are 0 in floating point); "
+                f"expected {self.expectation()}",
                 path=path,
             )
         bad = (lo is not None and (number < lo or (self.strict and number == lo))) or (
