@@ -55,7 +55,6 @@ from ..core.errors import InputError, suggest
 from ..core.kernels import FastFunction
 from ..core.model import LoopClosure, Model
 from ..core.options import Option, validate_mapping
-from ..core.units import parse_quantity
 from .flexure import Material, circular_notch_stiffness_exact, material
 from .flexure_compliance import circular_notch_compliances, rectangle_torsion_constant
 
@@ -376,11 +375,10 @@ def _members(closure: LoopClosure, name: str, path: tuple) -> list[int]:
 
 
 def _stiffness_value(raw: Any, kind: str, path: tuple) -> float:
+    """A hinge stiffness: positive, and within its dimension's sanity limit (1e9 N*m/rad,
+    1e12 N/m), so that k * deflection^2 and the stresses stay finite."""
     dim = "rotational_stiffness" if kind == "angle" else "stiffness"
-    value = parse_quantity(raw, dim, path)
-    if not value > 0:
-        raise InputError(f"expected a positive stiffness, got {raw!r}", path=path)
-    return value
+    return float(Option("k", dim, "hinge stiffness", lower=0.0, strict=True).parse(raw, path))
 
 
 def _parse_hinge(  # noqa: C901 - one flat check per key of a hinge entry

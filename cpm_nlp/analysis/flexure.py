@@ -105,7 +105,9 @@ MATERIALS: dict[str, Material] = {
 MATERIAL_OPTIONS = (
     Option("name", "str", "a label for the material", default="custom"),
     Option("E", "stress", "Young's modulus", lower=0.0, strict=True),
-    Option("nu", "dimensionless", "Poisson's ratio", default=None, lower=-1.0, upper=0.5),
+    # -1 < nu < 0.5: the bounds of an isotropic elastic material (a positive shear and bulk
+    # modulus); nu = -1 makes G = E / (2 (1 + nu)) infinite
+    Option("nu", "dimensionless", "Poisson's ratio", default=None, lower=-1.0, upper=0.5, strict=True),
     Option("density", "density", "mass density", default=None, lower=0.0, strict=True),
     Option("yield_strength", "stress", "yield strength", default=None, lower=0.0, strict=True),
     Option("allowable", "stress", "allowable (design) stress", default=None, lower=0.0, strict=True),

@@ -522,6 +522,7 @@ def render_reproduce_summary(summary: dict[str, Any]) -> str:
 
 
 def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
+    from ..core.result import jsonable
     from ..problems.published import summarize
     from ..problems.reproduce import reproduce
 
@@ -530,7 +531,8 @@ def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
     with solver_output(args):
         rows = reproduce(args.paths or None)
     summary = summarize(rows)
-    document = json.dumps({"figures": [r.to_dict() for r in rows], "summary": summary}, indent=2) + "\n"
+    report = jsonable({"figures": [r.to_dict() for r in rows], "summary": summary})  # no NaN: null
+    document = json.dumps(report, indent=2, allow_nan=False) + "\n"
     if args.json:
         out.write(document)
     else:

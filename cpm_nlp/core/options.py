@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .errors import InputError, suggest, unknown_key_error
+from .finite import LARGEST, too_large
 from .units import DIMENSIONS, article, format_quantity, parse_quantity
 
 
@@ -20,6 +21,11 @@ class _Required:
 
 
 REQUIRED: Any = _Required()
+
+#: Smallest nonzero magnitude (SI) of a declared option with a physical dimension: far
+#: below any quantity of this toolkit, it keeps products and quotients of inputs (the
+#: lever ratio L2 L4 / (L1 L3) of 1e-320 mm lengths) from underflowing to 0 or overflowing.
+TINY = 1e-60
 
 #: Largest number of points a grid may have (keeps a typo from exhausting memory).
 MAX_GRID_POINTS = 1_000_000
@@ -151,16 +157,21 @@ class Option:
                 )
             return value
         if kind == "int":
-            if isinstance(value, bool) or not isinstance(value, int):
-                if isinstance(value, float) and value.is_integer() and math.isfinite(value):
-                    value = int(value)
-                else:
-                    raise InputError(f"expected {self.expectation()}, got {value!r}", path=path)
-            self._check_bounds(float(value), value, path)
-            return int(value)
+            return self._int(value, path)
         number = parse_quantity(value, kind, path)
         self._check_bounds(number, value, path)
         return number
+
+    def _int(self, value: Any, path: tuple) -> int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            if isinstance(value, float) and value.is_integer() and math.isfinite(value):
+                value = int(value)
+            else:
+                raise InputError(f"expected {self.expectation()}, got {value!r}", path=path)
+        if abs(value) > LARGEST:
+            raise InputError(f"{too_large(value)}; expected {self.expectation()}", path=path)
+        self._check_bounds(float(value), value, path)
+        return int(value)
 
     def _check_bounds(self, number: float, raw: Any, path: tuple) -> None:
         lo, hi = self.lower, self.upper
@@ -169,6 +180,13 @@ class Option:
             raise InputError(
                 f"{raw!r} is beyond the sanity limit of {self.format_value(limit)} for "
                 f"{article(self.kind.replace('_', ' '))}; expected {self.expectation()}",
+                path=path,
+            )
+        if number != 0 and abs(number) < TINY and self.kind in DIMENSIONS and self.kind != "dimensionless":
+            raise InputError(
+                f"{raw!r} is below the sanity limit of {self.format_value(TINY)} for a nonzero "
+                f"{self.kind.replace('_', ' ')} (products of such numbers are 0 in floating point); "
+                f"expected {self.expectation()}",
                 path=path,
             )
         bad = (lo is not None and (number < lo or (self.strict and number == lo))) or (

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import json
 import math
+import sys
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -27,6 +29,7 @@ class Status(str, Enum):
     UNREACHABLE = "unreachable"
     SINGULAR = "singular"
     INFEASIBLE = "infeasible"
+    NOT_FINITE = "not_finite"
 
     def __str__(self) -> str:
         return self.value
@@ -46,6 +49,7 @@ STATUS_TEXT = {
     Status.UNREACHABLE: "the pose cannot be assembled (no real solution of the loop closures)",
     Status.SINGULAR: "the pose is singular (the loop-closure Jacobian is rank deficient)",
     Status.INFEASIBLE: "the problem has no feasible point",
+    Status.NOT_FINITE: "a computed value is not finite (an overflow, a division by zero or a NaN)",
 }
 
 
@@ -69,20 +73,31 @@ class SolverInfo:
         return {"name": self.name, "iterations": int(self.iterations), "seconds": float(self.seconds)}
 
 
-def _jsonable(value: Any) -> Any:
-    """numpy arrays/scalars to lists/floats; non-finite floats to None."""
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, (np.floating, float)):
+def jsonable(value: Any) -> Any:  # noqa: C901 - one branch per kind of value
+    """A copy of ``value`` that :func:`json.dumps` writes with ``allow_nan=False``, at any
+    depth: numpy arrays and scalars to lists and numbers, non-finite floats (NaN, inf) to
+    None (as an integer too large for any float), mapping keys to strings, enums to their
+    values, anything else to its text."""
+    if isinstance(value, Enum):
+        return jsonable(value.value)
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, (np.bool_,)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value) if abs(int(value)) <= sys.float_info.max else None  # no float holds it
+    if isinstance(value, (float, np.floating)):
         v = float(value)
         return v if math.isfinite(v) else None
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, Enum):
-        return value.value
-    return value
+    if isinstance(value, (complex, np.complexfloating)):
+        return jsonable(value.real) if value.imag == 0 else str(value)
+    if isinstance(value, np.ndarray):
+        return jsonable(value.tolist())
+    if isinstance(value, Mapping):
+        return {k if isinstance(k, str) else str(jsonable(k)): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, set, frozenset)):
+        return [jsonable(v) for v in value]
+    return str(value)
 
 
 @dataclass
@@ -108,8 +123,8 @@ class ResultWarning:
             "code": self.code,
             "message": self.message,
             "where": self.where,
-            "value": _jsonable(self.value),
-            "limit": _jsonable(self.limit),
+            "value": jsonable(self.value),
+            "limit": jsonable(self.limit),
         }
 
     @classmethod
@@ -185,17 +200,17 @@ class Result:
         out: dict[str, Any] = {
             "problem": self.problem,
             "status": self.status.value,
-            "values": _jsonable(self.values),
+            "values": jsonable(self.values),
             "solver": self.solver.to_dict(),
             "message": self.message,
-            "units": dict(self.units),
+            "units": jsonable(dict(self.units)),
         }
         if self.statuses is not None:
             out["statuses"] = [s.value for s in self.statuses]
         if self.model:
-            out["model"] = _jsonable(self.model)
+            out["model"] = jsonable(self.model)
         out["warnings"] = [w.to_dict() for w in self.warnings]
         return out
 
     def to_json(self, indent: int | None = 2) -> str:
-        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+        return json.dumps(jsonable(self.to_dict()), indent=indent, allow_nan=False)

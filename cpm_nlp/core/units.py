@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from .errors import InputError, suggest
+from .finite import LARGEST as _LARGEST
+from .finite import too_large
 
 _NUMBER = re.compile(r"^\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(.*?)\s*$")
 
@@ -175,6 +177,8 @@ def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # no
     if isinstance(value, bool) or value is None:
         raise InputError(f"expected {expected}, got {value!r}", path=path)
     if isinstance(value, (int, float)):
+        if isinstance(value, int) and abs(value) > _LARGEST:
+            raise InputError(f"{too_large(value)}; expected {expected}", path=path)
         number = float(value)
         if not math.isfinite(number):
             raise InputError(f"expected a finite number ({expected}), got {value!r}", path=path)

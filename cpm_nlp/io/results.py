@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import InputError
+from ..core.result import jsonable
 from .atomic import check_output_path, replace_atomically
 from .inputs import MAX_RESULTS_BYTES, check_input_file, read_input_text
 
@@ -99,7 +100,7 @@ def _cell(value: Any) -> str:
         return repr(value) if math.isfinite(value) else ""
     if isinstance(value, str):
         return value
-    return json.dumps(value)
+    return json.dumps(jsonable(value), allow_nan=False)
 
 
 def _uncell(text: str) -> Any:
@@ -285,7 +286,7 @@ class ParquetStore(_Store):
     def _write(self, records: list[dict[str, Any]]) -> None:
         for r in records:
             self.rows[r["point"]] = r
-            self._fh.write(json.dumps(r, allow_nan=False) + "\n")
+            self._fh.write(json.dumps(jsonable(r), allow_nan=False) + "\n")
         self._fh.flush()
         self._dirty = True
         if time.monotonic() - self._last > max(self.INTERVAL, 20 * self._cost):
@@ -428,7 +429,7 @@ def write_parquet(path: Path, meta: Mapping[str, Any], columns: list[str], rows:
             values = [None if v is None or not math.isfinite(v) else float(v) for v in values]
         else:
             typ = pa.string()
-            values = [None if v is None else json.dumps(v) for v in values]
+            values = [None if v is None else json.dumps(jsonable(v), allow_nan=False) for v in values]
             json_cols.append(c)
         arrays.append(pa.array(values, type=typ))
         fields.append(pa.field(c, typ))

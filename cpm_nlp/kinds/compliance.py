@@ -327,6 +327,14 @@ class ActuatorForces(_HingeKind):
         lam_lin = sigma / s_end if s_end > 0 else None
         lam_hi = 1.0
         try:
+            s_start = excess(0.0) + sigma
+            if s_start >= sigma:  # no root to bracket: the motion starts at or above the allowable stress
+                raise InputError(
+                    f"the allowable stress {sigma:.6g} Pa is already reached at the start of the motion (home: "
+                    f"largest hinge stress {s_start:.6g} Pa, {s_end:.6g} Pa at its end); give a larger "
+                    "sigma_allow" + (" or a smaller load" if np.any(inputs["load"]) else ""),
+                    path=self._sigma_path(inputs, hs),
+                )
             while excess(lam_hi) < 0:
                 lam_hi *= 2.0
                 if lam_hi > 1e6:
@@ -357,6 +365,16 @@ class ActuatorForces(_HingeKind):
             values[f"{qn}_at_allowable"] = float(sol.q[j])
             dims[f"{qn}_at_allowable"] = c.q[j].kind
         return values, dims, f"first hinge at sigma_allow = {sigma / 1e6:.6g} MPa at scale {lam:.6g} of the motion"
+
+    @staticmethod
+    def _sigma_path(inputs: Mapping[str, Any], hs: cm.HingeSet) -> tuple:
+        """Where the allowable stress was given: inputs.sigma_allow, else the hinge material."""
+        if inputs.get("sigma_allow") is not None:
+            return ("inputs", "sigma_allow")
+        for h in hs.hinges:
+            if h.material is not None and h.material.name in hs.material_at:
+                return hs.material_at[h.material.name][0]
+        return ("inputs", "sigma_allow")
 
     def output_names(self, model: Model) -> list[str]:
         c = model.closure

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import InputError, suggest, unknown_key_error
+from ..core.finite import check_numbers, finite_status
 from ..core.kind import ProblemKind
 from ..core.model import Model
 from ..core.result import Result
@@ -81,6 +82,7 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
     if not isinstance(data, dict):
         kind = "an empty file" if data is None else f"{type(data).__name__} {data!r}"[:80]
         raise InputError(f"expected a mapping with keys {', '.join(TOP_LEVEL)}; got {kind}")
+    check_numbers(data)  # no inf, NaN or 1500-digit integer anywhere, before anything is built
     for key in data:
         if key not in TOP_LEVEL:
             raise unknown_key_error(str(key), TOP_LEVEL, (), "top-level key")
@@ -176,7 +178,11 @@ def load_problem(path: str | os.PathLike, overrides: Sequence[str] = ()) -> Prob
 def solve(problem: Problem) -> Result:
     """Run a validated problem; the result carries its status (never raises
     for a failed solve)."""
-    result = problem.kind.run(problem.model, problem.inputs, problem.solver)
+    try:
+        result = problem.kind.run(problem.model, problem.inputs, problem.solver)
+    except InputError as exc:  # an input found wrong only while solving (e.g. an allowable stress)
+        raise exc.at(file=problem.file) from None
+    result = finite_status(result)  # a NaN or an inf is a failed status, never an answer
     if problem.outputs is not None:
         keep = set(problem.outputs)
         result.values = {k: v for k, v in result.values.items() if k in keep}

@@ -187,8 +187,12 @@ def printed_half_unit(text: str, dimension: str, path: tuple = ()) -> float | No
     if m is None or not (m.group(1) or m.group(2)):
         return None
     decimals = len(m.group(2) or "")
-    exponent = int(m.group(3) or 0)
-    half = 0.5 * 10.0 ** (exponent - decimals)
+    exponent = m.group(3) or "0"
+    if len(exponent.lstrip("+-")) > 4 or int(exponent) - decimals > 300:  # 0e400: no float holds the digit
+        raise InputError(
+            f"{text!r}: a printed digit of 10^{int(exponent) - decimals} is beyond any float (about 1e308)", path=path
+        )
+    half = 0.5 * 10.0 ** (int(exponent) - decimals)
     rest = text[m.end() :].strip()
     if not rest:
         return half

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import math
 import threading
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
 from ...io.inputs import display_name, input_dir, read_input_text
 from ...io.yamlfile import load_yaml_text, parse_yaml, read_yaml
+from . import expr as ex
 from .chains import chains_function
 from .chains import supported as chains_supported
 from .drawing import geometry_of
@@ -132,16 +134,20 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     limits = gen.limit_options()
     examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)
     derived_names = [(n, dim) for n, _sx, dim in gen.derived]
+    symbol_dims = {n: gen.env[n].dim for n in [p.name for p in d.parameters] + [n for n, _ in derived_names]}
+
+    loading = [True]  # while the mechanism is loaded, errors are located in its file by mechanism()
 
     def build(closure_: LoopClosure, parameters: dict, lims: dict) -> Model:
         try:
-            return _build(closure_, parameters, lims, fns, derived_names, d)
-        except InputError as exc:  # a key of the mechanism file, with the problem's parameters
-            if not d.file or exc.file:
+            return _build(closure_, parameters, lims, fns, derived_names, d, symbol_dims)
+        except InputError as exc:
+            if loading[0] or d.file is None or exc.file is not None:
                 raise
+            # the problem's parameters make a value of the mechanism file fail: name both
             inner = InputError(exc.message, path=exc.path, file=d.file).render()
             raise InputError(
-                f"in the mechanism file {inner}", path=("mechanism", "file"), suggestions=exc.suggestions, hint=exc.hint
+                f"in the mechanism file {inner}", path=("mechanism", "parameters"), suggestions=exc.suggestions, hint=exc.hint
             ) from None
 
     mech = Mechanism(
@@ -161,11 +167,18 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults
         model = mech.model(closure, {}, {}, ())
         log.debug("%s: reference configuration checked (%d coordinates)", d.name, len(model.x_home))
+    loading[0] = False
     return mech
 
 
 def _build(
-    closure: LoopClosure, parameters: dict, limits: dict, fns: dict, derived_names: list, d: Description
+    closure: LoopClosure,
+    parameters: dict,
+    limits: dict,
+    fns: dict,
+    derived_names: list,
+    d: Description,
+    symbol_dims: dict,
 ) -> Model:
     p = np.array([float(parameters[n]) for n in closure.parameters])
     values = fns["extras"](p)
@@ -178,6 +191,16 @@ def _build(
             )
     length = float(values[2])
     derived_vals = np.asarray(values[3], dtype=float).ravel()
+    _check_finite(d, parameters, derived_vals, symbol_dims)
+    for k, (lo, hi) in enumerate(zip(np.asarray(values[0]).ravel(), np.asarray(values[1]).ravel())):
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            name = closure.x_names[k]
+            raise InputError(
+                f"the bounds of {name} are not finite ([{lo}, {hi}]) for the parameters given",
+                path=("platform", "bounds"),
+            )
+    if not math.isfinite(length):
+        raise InputError(f"not finite ({length}) for the parameters given", path=("characteristic_length",))
     dims = {par.name: par.dimension for par in d.parameters}
     dims.update({n: dim for n, dim in derived_names})
     model = Model(
@@ -197,6 +220,22 @@ def _build(
             )
     check_reference(model, fns["row_names"])
     return model
+
+
+def _check_finite(d: Description, parameters: dict, derived: np.ndarray, symbol_dims: dict) -> None:
+    """Every derived value is finite for these parameters; else an error naming it, its
+    expression and the operation that made a number that is not finite."""
+    known = {n: (float(v), symbol_dims[n]) for n, v in parameters.items() if n in symbol_dims}
+    for q, v in zip(d.derived, derived):
+        if not math.isfinite(v):
+            exc = ex.diagnose(q.value, known)
+            why = f": column {exc.column}: {exc.message}" if exc is not None else ""
+            given = ", ".join(f"{n} = {val:g}" for n, (val, _dim) in known.items() if n in ex.names_in(q.value))
+            raise InputError(
+                f"{q.value!r} is not finite ({v}) for {given or 'the parameters given'} (SI){why}",
+                path=("derived", q.name),
+            )
+        known[q.name] = (float(v), symbol_dims[q.name])
 
 
 def check_reference(model: Model, row_names: list[str]) -> None:

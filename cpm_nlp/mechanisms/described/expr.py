@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import casadi as ca
 
 from ...core.errors import suggest
+from ...core.finite import LARGEST, too_large
 
 #: dimension of a value: (length exponent, angle exponent); None for a plain number that adapts
 Dim = tuple[float, float] | None
@@ -197,7 +198,22 @@ class _Evaluator:
     def _Constant(self, node: ast.Constant) -> Value:
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
             raise self.fail(node, f"expected a number, got {node.value!r}")
+        if isinstance(node.value, int) and abs(node.value) > LARGEST:
+            raise self.fail(node, too_large(node.value))
+        if not math.isfinite(node.value):
+            raise self.fail(node, f"a number beyond the largest float (about {LARGEST:.3g}) is not finite")
         return Value(ca.SX(float(node.value)), None)
+
+    def finite(self, node: ast.AST, result: Value, args: list[Value], what: str) -> Value:
+        """``result``, or an error naming the operation when it is a known number that is
+        not finite (``1/0``, ``b/0``, ``sqrt(-1)``, ``exp(1000)``; with every symbol a
+        number, as :func:`diagnose` evaluates, any operation on them)."""
+        sx = result.sx
+        for i in range(int(sx.numel())):
+            e = sx[i]
+            if e.is_constant() and not math.isfinite(float(ca.DM(e))):
+                raise self.fail(node, f"{_why(what, args)} (the value is {_text(e)})")
+        return result
 
     def _Name(self, node: ast.Name) -> Value:
         if node.id in self.symbols:
@@ -227,15 +243,16 @@ class _Evaluator:
             if a.size != b.size and 1 not in (a.size, b.size):
                 raise self.fail(node, f"vectors of sizes {a.size} and {b.size} do not add")
             dim = a.dim if a.dim is not None else b.dim
-            return Value(a.sx + b.sx if isinstance(op, ast.Add) else a.sx - b.sx, dim)
+            word = "+" if isinstance(op, ast.Add) else "-"
+            return self.finite(node, Value(a.sx + b.sx if word == "+" else a.sx - b.sx, dim), [a, b], word)
         if isinstance(op, (ast.Mult, ast.Div)):
             if a.size > 1 and b.size > 1:
                 raise self.fail(node, "a product of two vectors: use dot() or cross()")
             if isinstance(op, ast.Div) and b.size > 1:
                 raise self.fail(node, "division by a vector")
             if isinstance(op, ast.Mult):
-                return Value(a.sx * b.sx, _mul(a.dim, b.dim))
-            return Value(a.sx / b.sx, _mul(a.dim, b.dim, -1.0))
+                return self.finite(node, Value(a.sx * b.sx, _mul(a.dim, b.dim)), [a, b], "*")
+            return self.finite(node, Value(a.sx / b.sx, _mul(a.dim, b.dim, -1.0)), [a, b], "/")
         if isinstance(op, ast.Pow):
             if not (isinstance(node.right, ast.Constant) or _is_negated_constant(node.right)):
                 raise self.fail(node.right, "an exponent must be a plain number")
@@ -245,7 +262,7 @@ class _Evaluator:
             dim = None if a.dim is None else (a.dim[0] * e, a.dim[1] * e)
             if a.size > 1:
                 raise self.fail(node, "a power of a vector")
-            return Value(a.sx**e, dim)
+            return self.finite(node, Value(a.sx**e, dim), [a, b], "^")
         raise self.fail(node, f"the operator {_construct(op)} is not allowed (use + - * / ^)")
 
     def _List(self, node: ast.List | ast.Tuple) -> Value:
@@ -294,7 +311,7 @@ class _Evaluator:
             if not vector and arg.size != 1:
                 raise self.fail(a, f"{name}() takes scalars; got a vector of {arg.size}")
         dim = rule(name, args, self.col(node))
-        return Value(impl(*[a.sx for a in args]), dim)
+        return self.finite(node, Value(impl(*[a.sx for a in args]), dim), args, name)
 
     def _select(self, node: ast.Call) -> Value:
         """select(i, a, b, ...): the i-th (from 1) of the values, i a plain number known when the file is read."""
@@ -307,6 +324,42 @@ class _Evaluator:
         if not k.is_integer() or not 1 <= k <= len(node.args) - 1:
             raise self.fail(node.args[0], f"select() index {k:g} is not in 1..{len(node.args) - 1}")
         return self.eval(node.args[int(k)])
+
+
+def _number(v: Value) -> float | None:
+    """The value of a known scalar, else None."""
+    return float(ca.DM(v.sx)) if v.size == 1 and v.sx.is_constant() else None
+
+
+def _text(e: ca.SX) -> str:
+    x = float(ca.DM(e))
+    return "NaN" if math.isnan(x) else "-inf" if x < 0 else "inf"
+
+
+def _why(what: str, args: list[Value]) -> str:  # noqa: C901 - one reason per operation
+    """Which operation made a number that is not finite, and why."""
+    x = [_number(a) for a in args]
+    if what == "/":
+        return "division by zero" if x[1] == 0 else "the quotient overflows"
+    if what == "^":
+        if x[0] == 0 and x[1] is not None and x[1] < 0:
+            return "zero to a negative power"
+        if x[0] is not None and x[0] < 0 and x[1] is not None and not float(x[1]).is_integer():
+            return "a negative number to a fractional power"
+        return "the power overflows"
+    if what == "sqrt":
+        return "sqrt of a negative number"
+    if what == "log":
+        return "log of zero" if x[0] == 0 else "log of a negative number"
+    if what in ("asin", "acos"):
+        return f"{what} of a number outside [-1, 1]"
+    if what == "exp":
+        return "exp overflows (its argument is above about 709)"
+    if what == "unit":
+        return "unit() of a zero vector"
+    if what in ("+", "-", "*"):
+        return f"'{what}' overflows"
+    return f"{what}() gives a number that is not finite"
 
 
 def _is_negated_constant(node: ast.AST) -> bool:
@@ -337,14 +390,22 @@ def _construct(node: ast.AST) -> str:
     return names.get(type(node).__name__, f"'{type(node).__name__}'")
 
 
+def _plain_number(number: float) -> Value:
+    """A number given as a number (YAML reads ``1e999`` and ``.nan`` as floats)."""
+    if isinstance(number, int) and abs(number) > LARGEST:
+        raise ExpressionError(too_large(number), 1)
+    if not math.isfinite(number):
+        read = f" (a number beyond about {LARGEST:.3g} is read as inf)" if math.isinf(number) else ""
+        raise ExpressionError(f"expected a finite number, got {number!r}{read}", 1)
+    return Value(ca.SX(float(number)), None)
+
+
 def parse(text: object, symbols: Mapping[str, Value]) -> Value:
     """The CasADi value of an expression (a string, or a plain number)."""
     if isinstance(text, bool):
         raise ExpressionError(f"expected an expression or a number, got {text!r}", 1)
     if isinstance(text, (int, float)):
-        if not math.isfinite(text):
-            raise ExpressionError(f"expected a finite number, got {text!r}", 1)
-        return Value(ca.SX(float(text)), None)
+        return _plain_number(text)
     if isinstance(text, list):
         text = "[" + ", ".join(str(t) for t in text) + "]"
     if not isinstance(text, str) or not text.strip():
@@ -389,3 +450,15 @@ def names_in(text: object) -> set[str]:
     except (SyntaxError, ValueError, RecursionError):
         return set()
     return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - RESERVED
+
+
+def diagnose(text: object, values: Mapping[str, tuple[float, Dim]]) -> ExpressionError | None:
+    """Why an expression is not finite for these values of its symbols (name -> (value,
+    dimension)): the error naming the first operation that made a number that is not
+    finite (``sqrt of a negative number``, column 6), or None if none did."""
+    symbols = {n: Value(ca.SX(float(v)), dim) for n, (v, dim) in values.items()}
+    try:
+        parse(text, symbols)
+    except ExpressionError as exc:
+        return exc
+    return None

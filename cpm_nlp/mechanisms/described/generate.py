@@ -154,6 +154,8 @@ class Generator:
             v = ex.parse(text, env)
         except ex.ExpressionError as exc:
             shown = "[" + ", ".join(str(t) for t in text) + "]" if isinstance(text, list) else str(text)
+            if len(shown) > 80:  # the message, not the expression, must fit in the line
+                shown = f"{shown[:60]}... ({len(shown) - 60} more characters)"
             hint = None
             if "never closed" in exc.message:
                 hint = "inside a YAML [list] or {mapping}, quote an expression that contains a comma"

@@ -38,6 +38,7 @@ from typing import Any
 
 from ...analysis.compliance import HINGE_KEYS
 from ...core.errors import InputError, suggest, unknown_key_error
+from ...core.finite import check_numbers
 from ...core.mechanism import JointStiffness
 from ...core.options import REQUIRED
 from ...core.units import parse_quantity
@@ -635,6 +636,7 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
             f"got {'an empty file' if data is None else type(data).__name__ + size}"
         )
     data = _mapping(data, (), "a mechanism description (a mapping with name, parameters, platform, legs)", TOP)
+    check_numbers(data)  # no inf, NaN or 1500-digit integer anywhere
     for key in ("name", "platform"):
         if key not in data:
             raise InputError(f"missing required key {key!r} ({TOP[key]})")

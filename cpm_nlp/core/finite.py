@@ -1,0 +1,111 @@
+"""Every number is finite, or there is a status.
+
+Input files are untrusted: YAML reads a 1500-digit integer as a Python int
+that no float can hold, which :func:`check_numbers` refuses anywhere in a
+parsed file, naming the key path, before anything is built from it.  YAML
+reads ``.inf``, ``.nan`` and a 400-digit ``1111...1.5`` as non-finite floats:
+the declared options (:mod:`cpm_nlp.core.options`, :mod:`cpm_nlp.core.units`)
+refuse them with what they expect, and the expression language
+(:mod:`cpm_nlp.mechanisms.described.expr`) refuses an operation that makes one.
+
+On the way out, :func:`nonfinite_paths` finds the non-finite numbers in the
+values of a result, which :func:`cpm_nlp.problems.file.solve` turns into the
+failed status ``not_finite`` (never a printed ``inf`` that looks like an
+answer); JSON output writes a non-finite number as ``null``
+(:func:`cpm_nlp.core.result.jsonable`).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+
+#: the largest finite float (about 1.8e308)
+LARGEST = sys.float_info.max
+
+
+def too_large(value: int) -> str:
+    """The message for an integer no float can hold."""
+    digits = int(abs(value).bit_length() * math.log10(2)) + 1  # str() of a huge int is refused by Python
+    return f"a number of about {digits} digits is too large (the largest is about {LARGEST:.3g})"
+
+
+def check_numbers(data: Any, path: tuple = ()) -> None:
+    """Refuse (:class:`InputError` naming the key path) an integer too large for a float
+    anywhere in parsed file data.  A non-finite float (``.inf``, ``.nan``, ``1e999``) is
+    refused by the key that reads it, whose message says what it expects there."""
+    stack: list[tuple[Any, tuple]] = [(data, path)]
+    while stack:
+        node, where = stack.pop()
+        if isinstance(node, Mapping):
+            stack.extend((v, where + (str(k),)) for k, v in reversed(list(node.items())))
+        elif isinstance(node, (list, tuple)):
+            stack.extend((v, where + (i,)) for i, v in reversed(list(enumerate(node))))
+        elif isinstance(node, int) and not isinstance(node, bool) and abs(node) > LARGEST:
+            raise InputError(too_large(node), path=where)
+
+
+def _walk(value: Any, name: str) -> Iterator[str]:
+    if isinstance(value, Mapping):
+        for k, v in value.items():
+            yield from _walk(v, f"{name}.{k}")
+    elif isinstance(value, np.ndarray) and value.dtype.kind in "fc":
+        bad = np.argwhere(~np.isfinite(value))
+        if bad.size:
+            yield name + "".join(f"[{int(i)}]" for i in bad[0])
+    elif isinstance(value, (list, tuple, np.ndarray)):
+        for i, v in enumerate(value):
+            yield from _walk(v, f"{name}[{i}]")
+    elif isinstance(value, (float, np.floating, complex, np.complexfloating)) and not np.isfinite(value):
+        yield name
+
+
+def nonfinite_paths(values: Mapping[str, Any]) -> list[str]:
+    """The names (with indices) of the values holding a non-finite number, the
+    first such entry of each value."""
+    out = []
+    for key, value in values.items():
+        first = next(_walk(value, str(key)), None)
+        if first is not None:
+            out.append(first)
+    return out
+
+
+def _nulled(value: Any) -> Any:
+    """``value`` with every non-finite number replaced by None (containers as lists)."""
+    if isinstance(value, Mapping):
+        return {k: _nulled(v) for k, v in value.items()}
+    if isinstance(value, np.ndarray):
+        return _nulled(value.tolist())
+    if isinstance(value, (list, tuple)):
+        return [_nulled(v) for v in value]
+    if isinstance(value, (float, np.floating, complex, np.complexfloating)) and not np.isfinite(value):
+        return None
+    return value
+
+
+def finite_status(result: Any) -> Any:
+    """``result`` (a :class:`~cpm_nlp.core.result.Result`) with no non-finite number in its
+    values: each becomes None, and a result that said ``solved`` says ``not_finite``
+    instead, naming the values (a NaN or an inf is never an answer)."""
+    from .result import Status
+
+    bad = nonfinite_paths(result.values)
+    if not bad:
+        return result
+    result.values = {
+        k: _nulled(v) if any(b == k or b.startswith((f"{k}[", f"{k}.")) for b in bad) else v
+        for k, v in result.values.items()
+    }
+    shown = ", ".join(bad[:5]) + (f" and {len(bad) - 5} more" if len(bad) > 5 else "")
+    note = f"not finite (an overflow, a division by zero or a NaN): {shown}"
+    if result.status is Status.SOLVED:
+        result.status = Status.NOT_FINITE
+    result.message = f"{note}; {result.message}" if result.message else note
+    return result
