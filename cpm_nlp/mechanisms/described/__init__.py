@@ -147,7 +147,10 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
             # the problem's parameters make a value of the mechanism file fail: name both
             inner = InputError(exc.message, path=exc.path, file=d.file).render()
             raise InputError(
-                f"in the mechanism file {inner}", path=("mechanism", "parameters"), suggestions=exc.suggestions, hint=exc.hint
+                f"in the mechanism file {inner}",
+                path=("mechanism", "parameters"),
+                suggestions=exc.suggestions,
+                hint=exc.hint,
             ) from None
 
     mech = Mechanism(
