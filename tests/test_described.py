@@ -351,3 +351,21 @@ def test_the_readme_example_solves(tmp_path):
     )
     assert run.returncode == 0, run.stderr
     assert "status  : solved" in run.stdout
+
+
+def test_two_mechanisms_of_one_name_never_share_a_closure(tmp_path):
+    """The shipped 3-PRS file and an edited copy of the same ``name``: the registry's
+    closure of each is its own, in any order (a closure cached by name alone once gave
+    the shipped 3-PRS the spherical angles of a refused copy loaded earlier in the
+    process: beta_m = -45 deg in ``reproduce``)."""
+    from cpm_nlp.mechanisms.described import load_file
+    from cpm_nlp.mechanisms.registry import REGISTRY
+
+    from .conftest import PROBLEMS
+
+    shipped = load_file(PROBLEMS / "mechanisms" / "prs3.yaml")
+    (tmp_path / "prs3.yaml").write_text((PROBLEMS / "mechanisms" / "prs3.yaml").read_text() + "\n# an edited copy\n")
+    copy = load_file(tmp_path / "prs3.yaml")
+    assert copy is not shipped and copy.name == shipped.name
+    for mech in (shipped, copy, shipped, copy):
+        assert REGISTRY.closure(mech).mechanism is mech

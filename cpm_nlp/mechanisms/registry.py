@@ -128,7 +128,9 @@ class _Registry:
     def closure(self, mech: Mechanism) -> LoopClosure:
         with self._lock:
             c = self._closures.get(mech.name)
-            if c is None:
+            # by name, for this very mechanism: two described mechanisms of one name (a file
+            # and an edited copy of it, loaded in turn) never share a closure
+            if c is None or c.mechanism is not mech:
                 try:
                     c = mech.closure()
                 except CpmError:

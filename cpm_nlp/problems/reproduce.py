@@ -38,11 +38,16 @@ def default_problem_dirs() -> list[Path]:
 
 
 def plugin_problem_files() -> list[Path]:
-    """The problem files that mechanisms from plugins ship (``Mechanism.problem_files``, absolute paths)."""
+    """The problem files that mechanisms from plugins ship (``Mechanism.problem_files``, absolute paths).
+
+    Only plugins' (an entry point): a mechanism described in a file is registered when a
+    problem loads it, from wherever that file was, and its examples are problem files of
+    their own folder; the shipped ones are in ``problems/`` already (they were listed
+    twice), and a file loaded earlier in the same process is no plugin."""
     out: list[Path] = []
     for name in mechanism_names():
         mech = mechanism_type(name)
-        if mech.origin != "built-in":
+        if mech.origin.startswith("plugin "):
             out += [Path(f) for f in mech.problem_files if Path(f).is_absolute()]
     return out
 
