@@ -32,7 +32,7 @@ import os
 import select
 import stat
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from ..core.errors import InputError
@@ -265,3 +265,16 @@ def same_file(a: str | os.PathLike, b: str | os.PathLike) -> bool:
 def resolve(path: str | os.PathLike) -> Path:
     """``path`` with symbolic links followed (also a dangling one's target)."""
     return Path(os.path.realpath(path))
+
+
+def unique_paths(paths: Iterable[str | os.PathLike]) -> list[Path]:
+    """``paths`` without repeats: two paths of one file or folder (after symbolic links)
+    count once, the first kept as given."""
+    seen: set[Path] = set()
+    out: list[Path] = []
+    for p in paths:
+        key = Path(p).resolve()
+        if key not in seen:
+            seen.add(key)
+            out.append(Path(p))
+    return out

@@ -8,6 +8,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from ..core.errors import InputError
+from ..io.inputs import unique_paths
 from ..mechanisms.registry import mechanism_names, mechanism_type
 from .file import load_problem, solve
 from .published import Comparison, compare
@@ -53,17 +54,9 @@ def plugin_problem_files() -> list[Path]:
 
 
 def _unique(files: Iterable[Path]) -> list[Path]:
-    """``files`` without repeats: a file reached twice (the shipped problems/ and a
-    plugin's or file mechanism's own list, a path and a symbolic link to it) is
-    compared once, so every published figure is one row of the table."""
-    seen: set[Path] = set()
-    out: list[Path] = []
-    for f in files:
-        key = f.resolve()
-        if key not in seen:
-            seen.add(key)
-            out.append(f)
-    return out
+    """``files`` without repeats (a path and a symbolic link to it, a directory and a
+    file in it): each file is compared once, so every published figure is one row."""
+    return unique_paths(files)
 
 
 def reproduce(paths: Iterable[str | Path] | None = None) -> list[Comparison]:

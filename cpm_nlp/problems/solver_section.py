@@ -22,6 +22,7 @@ from ..core.errors import InputError, suggest
 from ..core.options import Option, validate_mapping
 from ..core.solver import METHODS, SolverConfig
 from ..core.solver_options import check_options
+from ..io.inputs import unique_paths
 from .reader import read_yaml
 from .shipped import shipped_configs_dir
 
@@ -50,13 +51,7 @@ def config_dirs(base_dir: Path | None) -> list[Path]:
     if base_dir is not None:
         dirs += [base_dir / "configs", base_dir.parent / "configs"]
     dirs.append(shipped_configs_dir())  # not the working directory: see the module docstring
-    seen, out = set(), []
-    for d in dirs:
-        r = d.resolve()
-        if r not in seen:
-            seen.add(r)
-            out.append(r)
-    return out
+    return [d.resolve() for d in unique_paths(dirs)]
 
 
 def available_presets(base_dir: Path | None) -> dict[str, Path]:
