@@ -80,7 +80,18 @@ def test_plugin_is_listed_and_solves_through_the_cli(installed):
 
 def test_conformance_suite_runs_over_the_plugin(installed):
     run = _run(
-        ["-m", "pytest", "-q", "-p", "no:cacheprovider", str(ROOT / "tests" / "test_conformance.py"), "-k", "biglide"],
+        [
+            "-m",
+            "pytest",
+            "-q",
+            "-p",
+            "no:cacheprovider",
+            "-o",
+            "addopts=",
+            str(ROOT / "tests" / "test_conformance.py"),
+            "-k",
+            "biglide",
+        ],
         installed,
         cwd=ROOT,
     )

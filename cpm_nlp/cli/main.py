@@ -796,6 +796,9 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
     except KeyboardInterrupt:
         _close_bars(args)
         err.write("interrupted\n")
+        with contextlib.suppress(Exception):
+            err.flush()
+        _INTERRUPT["said"] = True  # a second Ctrl-C from now on adds nothing
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader of our output went away (cpm-nlp describe | head): quietly, as Unix tools
         return EXIT_BROKEN_PIPE
@@ -819,8 +822,16 @@ def _close_bars(args: argparse.Namespace) -> None:
     getattr(args, "bars", {}).clear()
 
 
+#: whether the one line "interrupted" is out (a second Ctrl-C may come before main() wrote it)
+_INTERRUPT = {"said": False}
+
+
 def _second_interrupt(_signum: int, _frame: Any) -> None:
-    """A Ctrl-C while the first one is being handled: leave at once, nothing more printed."""
+    """A Ctrl-C while the first one is being handled: leave at once, the line
+    "interrupted" said once (here, if the first one had not got to it yet)."""
+    if not _INTERRUPT["said"]:
+        with contextlib.suppress(OSError):
+            os.write(2, b"interrupted\n")
     os._exit(EXIT_INTERRUPTED)
 
 
