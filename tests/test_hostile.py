@@ -71,6 +71,14 @@ def assert_refused(run, names: str | Path, key: str | None = None, code: int = 2
     return line
 
 
+#: A refusal that takes longer than this hung, or read what it should not have (a sparse 16 GB file,
+#: /dev/zero, a FIFO, 20 000 legs took from 8 s to forever before the limits).  Not a speed target:
+#: speed targets are never timed assertions in tests (a loaded machine, or xdist's second worker,
+#: makes a 0.3 s refusal take 1 s); the 1 s target of issue 19 is measured, as a ratio to reading a
+#: valid file with the load beside it, by benchmarks/bench_hostile.py.
+HANG_S = 10.0
+
+
 def dump(data) -> str:
     return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, width=10_000)
 

@@ -4,8 +4,9 @@ search, and the smaller refusals of issue 19 (YAML key paths, ``--type``,
 sidecar data files, standard input and pipes).
 
 Each refusal asserts: the exit status, one message line, no traceback,
-nothing written and no file changed, and that it took under 1 s (in-process;
-the subprocess cases allow for the interpreter's start-up).
+nothing written and no file changed, and that it did not hang (``HANG_S``,
+in-process; the subprocess cases allow for the interpreter's start-up).  The
+1 s target itself is measured by benchmarks/bench_hostile.py.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import pytest
 import yaml
 
 from .conftest import PROBLEMS, run_cli
-from .test_hostile import assert_refused, dump
+from .test_hostile import HANG_S, assert_refused, dump
 
 FK = PROBLEMS / "prs3_forward_kinematics.yaml"
 MECHANISM = PROBLEMS / "mechanisms" / "delta.yaml"
@@ -60,7 +61,7 @@ def refused_fast(tmp_path: Path, *argv: str, names, key: str | None = None, code
     before = snapshot(tmp_path)
     run, seconds = timed(*argv)
     line = assert_refused(run, names, key, code)
-    assert seconds < 1.0, seconds
+    assert seconds < HANG_S, seconds
     assert snapshot(tmp_path) == before
     return line
 
@@ -425,7 +426,7 @@ def test_ctrl_c_in_the_mode_search_exits_130_within_a_second(tmp_path, presses):
             proc.kill()
             proc.wait()
     assert proc.returncode == 130, err
-    assert seconds < 1.0, seconds
+    assert seconds < HANG_S, seconds
     assert err.splitlines() == ["interrupted"], err
     assert "Traceback" not in err and out == ""
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.yaml"]
