@@ -730,16 +730,16 @@ def test_batch_progress_on_a_terminal_only(problem):
     import argparse
     import io
 
-    from cpm_nlp.cli.main import _batch_progress
+    from cpm_nlp.cli.main import _progress_bars
 
     class Tty(io.StringIO):
         def isatty(self):
             return True
 
-    assert _batch_progress(argparse.Namespace(quiet=False, err=io.StringIO())) is None
-    assert _batch_progress(argparse.Namespace(quiet=True, err=Tty())) is None
+    assert _progress_bars(argparse.Namespace(quiet=False, err=io.StringIO())) is None
+    assert _progress_bars(argparse.Namespace(quiet=True, err=Tty())) is None
     err = Tty()
-    show = _batch_progress(argparse.Namespace(quiet=False, err=err))
+    show = _progress_bars(argparse.Namespace(quiet=False, err=err))
     show("forward kinematics", 50_000, 100_000)
     assert "forward kinematics:  50%" in err.getvalue() and "50000/100000" in err.getvalue()
     assert " poses" in err.getvalue()

@@ -310,9 +310,6 @@ def _progress_bars(args: argparse.Namespace) -> progress.Callback | None:
     return show
 
 
-_batch_progress = _progress_bars  # the name used before the bars were tqdm's
-
-
 # -- plots ------------------------------------------------------------------------------------
 
 
