@@ -161,6 +161,114 @@ def test_delta_williams_fk_against_numpy_ipk_and_round_trip(delta):
         np.testing.assert_allclose(_williams_ipk(fk.x), q, rtol=0, atol=1e-9)
 
 
+# -- linear Delta: Williams 2016, the Delta Maker 3D printer (pp. 24-25, 36-39) -----------------
+
+SB_L, SP_L, L_ROD = 0.246, 0.127, 0.264
+#: the vertical P joints B_i and the platform vertices P_i (Williams p. 24)
+LIN_B = [(-SB_L / 2, -math.sqrt(3) / 6 * SB_L), (SB_L / 2, -math.sqrt(3) / 6 * SB_L), (0.0, math.sqrt(3) / 3 * SB_L)]
+LIN_P = [(-SP_L / 2, -math.sqrt(3) / 6 * SP_L), (SP_L / 2, -math.sqrt(3) / 6 * SP_L), (0.0, math.sqrt(3) / 3 * SP_L)]
+
+
+def _linear_delta_ipk(p):
+    """Williams's prismatic IPK in numpy: the carriage B_i - L_i z is at distance l from the
+    vertex P + P_i; the "lower solution" (the carriage above the platform):
+    L_i = -z - sqrt(l^2 - |P_xy + P_i - B_i|^2)."""
+    x, y, z = p
+    return np.array(
+        [-z - math.sqrt(L_ROD**2 - (x + pi[0] - bi[0]) ** 2 - (y + pi[1] - bi[1]) ** 2) for bi, pi in zip(LIN_B, LIN_P)]
+    )
+
+
+def test_delta_linear_williams_ipk_snapshots():
+    """Williams p. 36, prismatic IPK snapshots ("the preferred lower solution"): P = (0, 0,
+    -0.5) m -> L = (0.2451, 0.2451, 0.2451) m and P = (0.03, 0.05, -0.40) m -> L = (0.1664,
+    0.1516, 0.1384) m, printed to 0.1 mm: tolerance 0.05 mm, the rounding (measured 0.003 mm
+    at most).  The same lengths from the closed form in numpy to 1e-12 m."""
+    general = _solve("delta_linear_williams_ik.yaml")
+    nominal = _solve("delta_linear_williams_ik.yaml", "inputs.x=0 m", "inputs.y=0 m", "inputs.z=-0.5 m")
+    for values, p, printed in (
+        (nominal, (0.0, 0.0, -0.5), (0.2451, 0.2451, 0.2451)),
+        (general, (0.03, 0.05, -0.40), (0.1664, 0.1516, 0.1384)),
+    ):
+        lengths = np.array([values[f"L{i}"] for i in (1, 2, 3)])
+        np.testing.assert_allclose(lengths, printed, rtol=0, atol=0.05e-3)
+        np.testing.assert_allclose(lengths, _linear_delta_ipk(p), rtol=0, atol=1e-12)
+
+
+def test_delta_linear_williams_fpk_snapshots():
+    """Williams pp. 38-39, prismatic FPK snapshots ("the admissible lower solution"):
+    L = (0.2, 0.2, 0.2) m -> P = (0, 0, -0.4549) m; L = (0.14, 0.15, 0.16) m -> z = -0.4012 m
+    and, for x and y, the magnitudes 0.0363 and 0.0215 m (the PDF's text layer drops the minus
+    signs and scrambles the order of this vector: only the magnitudes are pinned, as a set;
+    the closed form gives x = -0.02153, y = -0.03633).  Printed to 0.1 mm: tolerance 0.05 mm.
+    FK against Williams's IPK in numpy (1e-12 m) and against the tool's IK."""
+    general = _solve("delta_linear_williams_fk.yaml")
+    p = np.array([general["x"], general["y"], general["z"]])
+    assert p[2] == pytest.approx(-0.4012, abs=0.05e-3)
+    np.testing.assert_allclose(np.sort(np.abs(p[:2])), [0.0215, 0.0363], rtol=0, atol=0.05e-3)
+    np.testing.assert_allclose(_linear_delta_ipk(p), [0.14, 0.15, 0.16], rtol=0, atol=1e-12)
+    model = _model("delta_linear_williams")
+    nominal = _fk_ik_round_trip(model, [0.2, 0.2, 0.2], 1e-12)
+    np.testing.assert_allclose(nominal.x, [0.0, 0.0, -0.4549], rtol=0, atol=0.05e-3)
+    _fk_ik_round_trip(model, [0.14, 0.15, 0.16], 1e-12)
+
+
+# -- five-bar: a public five-bar robot project's tests (b = 0.125 m, l = 0.205 m) --------------
+
+#: the four working modes (w1, w2) at P = (0, 0.3) m and the source's (q1, q2), test_inverse
+FIVE_BAR_MODES = {
+    (1, 1): (0.52040625, 1.30998849),
+    (-1, 1): (1.83160416, 1.30998849),
+    (-1, -1): (1.83160416, 2.6211864),
+    (1, -1): (0.52040625, 2.6211864),
+}
+
+
+def _five_bar_ik(p, w1, w2, b=0.125, l=0.205):
+    """The law of cosines per leg (numpy): q_i = atan2(P - A_i) - w_i acos(|P - A_i| / (2 l))."""
+    out = []
+    for a, w in (((-b, 0.0), w1), ((b, 0.0), w2)):
+        v = np.asarray(p, float) - np.asarray(a)
+        out.append(math.atan2(v[1], v[0]) - w * math.acos(math.hypot(*v) / (2 * l)))
+    return np.array(out)
+
+
+@pytest.mark.parametrize(("w1", "w2"), list(FIVE_BAR_MODES))
+def test_five_bar_four_working_modes(w1, w2):
+    """The source's test_inverse: the four working modes at P = (0, 0.3) m, printed to 1e-8
+    rad: tolerance 5e-9 rad, the rounding (pytest.approx's default there is relative 1e-6).
+    Each mode by the file's closed-form IK and by the IK solved on the generated closures
+    (method solve); the numpy law of cosines to 1e-12 rad."""
+    overrides = (f"mechanism.parameters.w1={w1}", f"mechanism.parameters.w2={w2}")
+    values = _solve("five_bar_working_modes_ik.yaml", *overrides)
+    q = np.array([values["q1"], values["q2"]])
+    np.testing.assert_allclose(q, FIVE_BAR_MODES[(w1, w2)], rtol=0, atol=5e-9)
+    np.testing.assert_allclose(q, _five_bar_ik((0.0, 0.3), w1, w2), rtol=0, atol=1e-12)
+    model = _model("five_bar_working_modes", {"w1": w1, "w2": w2})
+    solved = cn.inverse_kinematics(model, [0.0, 0.3], method="solve")
+    assert solved.status == Status.SOLVED, solved.message
+    np.testing.assert_allclose(_wrap(np.asarray(solved.q) - q), 0.0, atol=1e-9)
+    rng = np.random.default_rng(7)
+    for _ in range(4):
+        qr = np.asarray(FIVE_BAR_MODES[(w1, w2)]) + rng.uniform(-0.05, 0.05, 2)
+        fk = _fk_ik_round_trip(model, qr, 1e-9)
+        np.testing.assert_allclose(_five_bar_ik(fk.x, w1, w2), qr, rtol=0, atol=1e-9)
+
+
+def test_five_bar_assembly_modes_of_the_minus_plus_joints():
+    """The source's test_forward and test_forward_ass_2: the -+ joints (1.83160416,
+    1.30998849) rad give P = (0, 0.3) m in the first assembly mode and
+    (-1.98021962e-17, 9.61346135e-02) m in the second (their tolerance 1e-5; printed to 1e-11 m,
+    computed from the same rounded joints): `assembly_modes: all` finds exactly these two,
+    to 1e-9 m (the rounded joints move P by about 4e-10 m from (0, 0.3))."""
+    values = _solve("five_bar_working_modes_fk.yaml")
+    assert values["modes"] == 2
+    modes = np.array([values["modes_x"], values["modes_y"]]).T
+    np.testing.assert_allclose(modes[0], (0.0, 0.3), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(modes[1], (-1.98021962e-17, 9.61346135e-02), rtol=0, atol=1e-9)
+    assert values["modes_designated"] == [True, False]
+
+
 # -- Jansen's linkage: Pyslvs, example "Jansen's linkage (Single)", test/test_core.py -----------
 
 JANSEN = {
