@@ -543,3 +543,26 @@ def test_rssr_linkr_path_and_round_trip():
         roots = _rssr_outputs(deg * DEG)
         assert min(abs(_wrap(fk.x[0] - r)) for r in roots) < 1e-9
         _fk_ik_round_trip(model, [deg * DEG], 1e-8, unique=False)
+
+
+# -- every corpus file: the AD Jacobian against central differences of FK ----------------------
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in CORPUS.glob("*.yaml")))
+def test_corpus_jacobian_against_central_differences(name):
+    """J = -Phi_x^-1 Phi_q (AD) at a pose near home equals the central differences of FK
+    (step 1e-6 of the actuators' unit, truncation O(h^2)): relative 1e-6 of max |J|."""
+    model = _model(name)
+    q = np.asarray(model.q_home, float) + 0.01
+    fk = cn.forward_kinematics(model, q, NEWTON)
+    assert fk.status == Status.SOLVED, fk.message
+    J = np.asarray(cn.jacobians(model, fk.x, fk.q).J)
+    h = 1e-6
+    fd = np.empty_like(J)
+    for k in range(q.size):
+        e = np.zeros_like(q)
+        e[k] = h
+        plus = cn.forward_kinematics(model, q + e, NEWTON, guess=fk.x)
+        minus = cn.forward_kinematics(model, q - e, NEWTON, guess=fk.x)
+        fd[:, k] = (np.asarray(plus.x) - np.asarray(minus.x)) / (2 * h)
+    np.testing.assert_allclose(J, fd, rtol=0, atol=1e-6 * np.max(np.abs(J)))
