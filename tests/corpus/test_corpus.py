@@ -545,6 +545,101 @@ def test_rssr_linkr_path_and_round_trip():
         _fk_ik_round_trip(model, [deg * DEG], 1e-8, unique=False)
 
 
+# -- planar 3-RRR: ARTE's example 3RRR (A. Gil, A Robotics Toolbox for Education) -------------
+
+ARTE_L, ARTE_A, ARTE_B, ARTE_H = 3.0, 1.0, 1.0, 0.5
+ARTE_BASE = np.array([[0.0, 0.0], [ARTE_L, 0.0], [ARTE_L / 2, ARTE_L]])
+
+
+def _arte_platform(x, y, phi):
+    p = np.array([x, y])
+    return [
+        p,
+        p + ARTE_H * np.array([math.cos(phi), math.sin(phi)]),
+        p + ARTE_H * np.array([math.cos(phi + math.pi / 3), math.sin(phi + math.pi / 3)]),
+    ]
+
+
+def _arte_ik(pose, w=(1, 1, 1)):
+    """The law of cosines per arm (numpy): q_i = atan2(C_i - A_i) + w_i acos((a^2 + r^2 - b^2) / (2 a r))."""
+    out = []
+    for a_i, c_i, w_i in zip(ARTE_BASE, _arte_platform(*pose), w):
+        v = c_i - a_i
+        r = math.hypot(*v)
+        out.append(math.atan2(v[1], v[0]) + w_i * math.acos((ARTE_A**2 + r * r - ARTE_B**2) / (2 * ARTE_A * r)))
+    return np.array(out)
+
+
+def _arte_fk_all(q, n=20001):
+    """Every real FK solution (numpy, derived here): for each phi of a fine grid, P is on the
+    circle (elbow D1, b) and on the circle (D2 - h u(phi), b) -- two intersections, each a
+    branch -- and the residual |C3 - D3| - b of arm 3 changes sign at a solution, refined by
+    bisection; the same elimination as ARTE's polynomial in tan(phi/2)."""
+    d = ARTE_BASE + ARTE_A * np.c_[np.cos(q), np.sin(q)]
+
+    def point(phi, side):
+        u = np.array([math.cos(phi), math.sin(phi)])
+        c2 = d[1] - ARTE_H * u
+        v = c2 - d[0]
+        dist = math.hypot(*v)
+        h2 = ARTE_B**2 - (dist / 2) ** 2
+        if h2 < 0:
+            return None
+        return d[0] + v / 2 + side * math.sqrt(h2) * np.array([-v[1], v[0]]) / dist
+
+    def residual(phi, side):
+        p = point(phi, side)
+        if p is None:
+            return math.nan
+        c3 = p + ARTE_H * np.array([math.cos(phi + math.pi / 3), math.sin(phi + math.pi / 3)])
+        return math.hypot(*(c3 - d[2])) - ARTE_B
+
+    grid = np.linspace(-math.pi, math.pi, n)
+    out = []
+    for side in (1.0, -1.0):
+        f = np.array([residual(g, side) for g in grid])
+        for k in np.flatnonzero(np.isfinite(f[:-1]) & np.isfinite(f[1:]) & (f[:-1] * f[1:] < 0)):
+            lo, hi = grid[k], grid[k + 1]
+            for _ in range(60):
+                mid = (lo + hi) / 2
+                if residual(lo, side) * residual(mid, side) <= 0:
+                    hi = mid
+                else:
+                    lo = mid
+            phi = (lo + hi) / 2
+            out.append((*point(phi, side), phi))
+    return np.array(out)
+
+
+def test_rrr3_arte_ik_against_the_law_of_cosines():
+    """IK solved on the generated closures (the file has no closed form) at poses around the
+    reference: the law of cosines in numpy (elbows w = +1), 1e-9 rad; FK against IK."""
+    model = _model("rrr3_arte")
+    for pose in ((1.25, 1.0, 0.0), (1.5, 1.2, 0.2), (1.1, 0.9, -0.15), (1.4, 0.8, 0.1)):
+        ik = cn.inverse_kinematics(model, pose)
+        assert ik.status == Status.SOLVED, ik.message
+        np.testing.assert_allclose(_wrap(np.asarray(ik.q) - _arte_ik(pose)), 0.0, atol=1e-9)
+        _fk_ik_round_trip(model, ik.q, 1e-9)
+
+
+def test_rrr3_arte_assembly_modes_against_a_scan():
+    """`assembly_modes: all` for the actuators of P = (1.75, 0.9) m, phi = -0.1 rad: the same
+    real solutions as the numpy scan (2 with this geometry: the arms' reach, a + b = 2 m,
+    against a base of 3 m, leaves little room), each to 1e-8.  The designated one is the pose:
+    the law of cosines returns the actuators from it (1e-9 rad), and it is (1.75, 0.9, -0.1)
+    to 1e-7 (the problem file gives the actuators to 1e-9 rad: 5e-10 rad of rounding, times
+    |dx/dq| up to about 30 here, moves the pose by 1.6e-8)."""
+    values = _solve("rrr3_arte_modes.yaml")
+    q = np.array([values[k] for k in ("q1", "q2", "q3")])
+    want = _arte_fk_all(q)
+    assert values["modes"] == len(want) == 2
+    found = np.array([values["modes_x"], values["modes_y"], values["modes_phi"]]).T
+    for w in want:
+        assert min(np.max(np.abs(np.r_[f[:2] - w[:2], _wrap(f[2] - w[2])])) for f in found) < 1e-8
+    np.testing.assert_allclose(_wrap(_arte_ik(found[0]) - q), 0.0, atol=1e-9)
+    np.testing.assert_allclose(found[0], (1.75, 0.9, -0.1), rtol=0, atol=1e-7)
+
+
 # -- every corpus file: the AD Jacobian against central differences of FK ----------------------
 
 
