@@ -118,7 +118,10 @@ def render_result(result: Result, title: str = "") -> str:
         for k, v in result.model.items():
             if k == "type":
                 continue
-            parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
+            if isinstance(v, list) and all(isinstance(e, float) for e in v):  # a derived vector
+                parts.append(f"{k} = [" + ", ".join(f"{e:.6g}" for e in v) + "]")
+            else:
+                parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
         lines.append("model   : " + result.model.get("type", "") + ": " + ", ".join(parts) + "  (SI)")
     if not result.values:
         lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
@@ -588,11 +591,12 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
         return _describe_kind(args, out)
     if args.mechanism:
         problem_kind(args.name, path=("describe",))  # the unknown kind, with a "did you mean"
+    description = None
     if _names_a_file(args.name) and not args.mechanism:  # a mechanism file: loaded and checked
-        from ..mechanisms.described import load_file
+        from ..mechanisms.described import load_file_description
 
         with solver_output(args):
-            mt = load_file(args.name, allow_pipe=True)
+            mt, description = load_file_description(args.name, allow_pipe=True)
     else:
         mt = mechanism_type(args.name, path=("describe",))
     out.write(f"{mt.name}: {mt.title}\n{mt.paper}\n[{mt.origin}]\n\nparameters:\n")
@@ -611,6 +615,14 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
             out.write(f"  {hname:<10} {text}\n")
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
+    if description is not None:  # a mechanism file: its derived values, legs, loops and mobility
+        from ..mechanisms.described.summary import summary_text
+        from ..problems.describe import model_of
+
+        with solver_output(args):
+            model, source = model_of(mt)
+            text = summary_text(description, model, source)
+        out.write(text)
     return EXIT_OK
 
 
@@ -627,7 +639,15 @@ def _describe_kind(args: argparse.Namespace, out: TextIO) -> int:
     from ..problems.describe import describe_kind, kind_text
 
     if args.mechanism:
-        out.write(kind_text(describe_kind(args.name, args.mechanism)))
+        name = args.mechanism
+        if _names_a_file(name):  # a mechanism file, wherever a mechanism name is taken
+            from ..mechanisms.described import load_file
+            from ..mechanisms.registry import use_described
+
+            check_input_file(name, allow_pipe=True)
+            with solver_output(args):
+                name = use_described(load_file(name, allow_pipe=True), ("--mechanism",)).name
+        out.write(kind_text(describe_kind(args.name, name)))
         return EXIT_OK
     descriptions = [describe_kind(args.name, m) for m in mechanism_names()]
     applies = [d for d in descriptions if not d.unsupported]
@@ -737,7 +757,11 @@ def build_parser() -> argparse.ArgumentParser:
         "describe", help="list mechanisms and problem kinds, or describe one (a mechanism file: load, check, describe)"
     )
     p.add_argument("name", nargs="?", help="a mechanism, a problem kind or a mechanism file (.yaml)")
-    p.add_argument("--mechanism", metavar="NAME", help="with a problem kind: its inputs and values for this mechanism")
+    p.add_argument(
+        "--mechanism",
+        metavar="NAME",
+        help="with a problem kind: its inputs and values for this mechanism (a name or a mechanism file)",
+    )
     p.set_defaults(func=cmd_describe)
     return parser
 

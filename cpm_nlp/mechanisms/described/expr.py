@@ -612,11 +612,11 @@ def names_in(text: object) -> set[str]:
     return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - RESERVED - set(units)
 
 
-def diagnose(text: object, values: Mapping[str, tuple[float, Dim]]) -> ExpressionError | None:
+def diagnose(text: object, values: Mapping[str, tuple[float | list[float], Dim]]) -> ExpressionError | None:
     """Why an expression is not finite for these values of its symbols (name -> (value,
     dimension)): the error naming the first operation that made a number that is not
     finite (``sqrt of a negative number``, column 6), or None if none did."""
-    symbols = {n: Value(ca.SX(float(v)), dim) for n, (v, dim) in values.items()}
+    symbols = {n: Value(ca.SX(ca.DM(v)), dim) for n, (v, dim) in values.items()}
     try:
         parse(text, symbols)
     except ExpressionError as exc:
