@@ -368,3 +368,32 @@ def test_describe_kind_with_a_bad_mechanism_file_is_exit_2(tmp_path, cli):
     assert str(f) in run.err and "derived.h" in run.err and "write its unit" in run.err
     run = cli("describe", "jacobian", "--mechanism", str(tmp_path / "missing.yaml"))
     assert run.code == 2 and "missing.yaml" in run.err
+
+
+def test_describe_plot_draws_the_body_graph(tmp_path, cli):
+    from cpm_nlp.mechanisms.described.summary import body_graph
+
+    nodes, edges = body_graph(described.read_description(MECH / "prs3.yaml"))
+    assert nodes == ["base", *[f"leg{k}.link{n}" for k in (1, 2, 3) for n in (1, 2)], "platform"]
+    assert [e for e in edges if e[3]] == [("base", f"leg{k}.link1", f"P s{k}", True) for k in (1, 2, 3)]
+    assert [e[2] for e in edges if e[1] == "platform"] == ["S", "S", "S"]
+    out = tmp_path / "graph.png"
+    run = cli("describe", str(MECH / "prs3.yaml"), "--plot", str(out))
+    assert run.code == 0, run.err
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f"body graph: {out}" in run.out
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (("prs3", "--plot", "g.png"), ["--plot", "expected a mechanism file", "'prs3'"]),
+        ((str(MECH / "prs3.yaml"), "--plot", "g.html"), ["--plot", "expected a .png, .svg or .pdf"]),
+        ((str(MECH / "prs3.yaml"), "--plot", "g.txt"), ["--plot", "expected a figure file"]),
+    ],
+)
+def test_describe_plot_bad_arguments_are_exit_2(tmp_path, cli, args, words):
+    run = cli("describe", *[str(tmp_path / a) if a.startswith("g.") else a for a in args])
+    assert run.code == 2 and run.out == "" and "Traceback" not in run.err
+    for w in words:
+        assert w in run.err, run.err
+    assert not list(tmp_path.iterdir())

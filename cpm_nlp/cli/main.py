@@ -574,6 +574,8 @@ def cmd_examples(args: argparse.Namespace, out: TextIO) -> int:
 def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - one branch per thing described
     if args.name and _names_a_file(args.name) and not args.mechanism and args.name != "-":
         check_input_file(args.name, allow_pipe=True)  # a sparse file, a device: refused before the imports
+    if args.plot:
+        _check_graph_plot(args)
     from ..mechanisms.registry import mechanism_names, mechanism_type
     from ..problems.registry import kind_names, problem_kind
 
@@ -623,7 +625,32 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
             model, source = model_of(mt)
             text = summary_text(description, model, source)
         out.write(text)
+        if args.plot:
+            from ..mechanisms.described.summary import body_graph
+            from ..plot.draw import save
+            from ..plot.mechanism_graph import graph_figure
+
+            nodes, edges = body_graph(description)
+            note = "" if edges else "no legs: the loops are written as closures"
+            save(graph_figure(f"{mt.name}: bodies and joints", nodes, edges, note), args.plot, "--plot", [args.name])
+            out.write(f"body graph: {args.plot}\n")
     return EXIT_OK
+
+
+def _check_graph_plot(args: argparse.Namespace) -> None:
+    """``describe FILE --plot FIGURE``: a mechanism file, and a .png, .svg or .pdf to write."""
+    from ..plot.draw import check_figure_path, require_backend
+
+    if not args.name or args.mechanism or not _names_a_file(args.name):
+        raise InputError(
+            f"expected a mechanism file to draw the body graph of (cpm-nlp describe FILE.yaml --plot graph.png), "
+            f"got {args.name!r}" + (" with --mechanism" if args.mechanism else ""),
+            path=("--plot",),
+        )
+    if Path(args.plot).suffix.lower() == ".html":
+        raise InputError(f"expected a .png, .svg or .pdf figure, got {args.plot!r}", path=("--plot",))
+    check_figure_path(args.plot, "--plot", [args.name])
+    require_backend(args.plot)
 
 
 def _names_a_file(name: str) -> bool:
@@ -761,6 +788,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--mechanism",
         metavar="NAME",
         help="with a problem kind: its inputs and values for this mechanism (a name or a mechanism file)",
+    )
+    p.add_argument(
+        "--plot", metavar="FIGURE", help="with a mechanism file: also draw its body graph (.png, .svg, .pdf)"
     )
     p.set_defaults(func=cmd_describe)
     return parser

@@ -145,4 +145,23 @@ def summary_text(d: Description, model: Model | None, source: str) -> str:  # no
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["summary_text"]
+def body_graph(d: Description) -> tuple[list[str], list[tuple[str, str, str, bool]]]:
+    """The bodies (base, each leg's links, platform) and the joints between them as edges
+    (from body, to body, label, actuated), base side first: the graph ``describe --plot`` draws."""
+    nodes = ["base"]
+    edges: list[tuple[str, str, str, bool]] = []
+    for leg in d.legs:
+        prev = "base"
+        for n, j in enumerate(leg.joints):
+            last = n == len(leg.joints) - 1
+            body = j.body or ("platform" if last else f"{leg.name}.link{n + 1}")
+            if body not in nodes and body != "platform":
+                nodes.append(body)
+            label = j.type + (f" {j.actuated}" if j.actuated else "")
+            edges.append((prev, body, label, j.actuated is not None))
+            prev = body
+    nodes.append("platform")
+    return nodes, edges
+
+
+__all__ = ["body_graph", "summary_text"]
