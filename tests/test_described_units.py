@@ -218,6 +218,13 @@ def test_a_bare_number_in_a_sum_is_refused_with_the_unit_to_write(tmp_path):
     data["parameters"]["th0"] = {"dimension": "angle", "default": "10 deg"}
     data["derived"] = {"th1": "th0 + 0.1"}
     _error(tmp_path, data, "derived.th1", "cannot add an angle and the bare number 0.1", "'0.1 deg'")
+    data = _stage("bare_undeclared")  # a derived number without a dimension is a bare number
+    data["derived"] = {"s": 0.01}
+    data["legs"][0]["joints"][1]["to"] = "[l + s, 0, 0]"
+    _error(tmp_path, data, "legs[0].joints[1].to", "the bare number 0.01")
+    data["legs"][0]["joints"][1]["to"] = ["l", 0, 0]
+    data["legs"][0]["joints"][0]["at"] = "[s, 0, 0]"  # standing alone, a vector's element: SI
+    assert _model(_load(tmp_path, data)).derived["s"] == 0.01
 
 
 def test_a_bare_number_standing_alone_is_si(tmp_path):
