@@ -166,12 +166,7 @@ class Generator:
             return v
         want = ex.DIMENSION_OF[dimension]
         if not (ex.adapts(v) or ex.compatible(v.dim, want)):
-            hint = None
-            if v.dim == ex.NUMBER:
-                hint = "a number without a unit stands alone as SI; in an expression write its unit (3 mm, 1 deg)"
-            raise InputError(
-                f"expected {ex.describe(want)}, got {ex.describe(v.dim)} in {text!r}", path=path, hint=hint
-            )
+            raise InputError(f"expected {ex.describe(want)}, got {ex.describe(v.dim)} in {text!r}", path=path)
         # the declared dimension is the value's (a bare number is SI of it; a plain number an angle in rad)
         return ex.Value(v.sx, want)
 
