@@ -44,7 +44,7 @@ def _hinges_of(d: Description) -> dict[str, str]:
 
 
 def _vector(value: Any, model: Model | None, gen: Generator, dimension: str) -> str:
-    """A location or axis at the reference configuration (display units), or '?' without a model."""
+    """A location or axis at the reference configuration (display units); without a model, a note."""
     if value is None:
         return "-"
     if model is None:
