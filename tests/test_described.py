@@ -196,7 +196,7 @@ def test_dimension_mismatch(tmp_path):
 def test_reference_configuration_that_does_not_assemble(tmp_path):
     """Legs given at the reference configuration assemble there by construction; an escape-hatch
     closure that does not vanish at home, or a P joint off its leg's line, does not."""
-    text = DEFAULTS.split("  - name: limb3")[0] + "closures: [z + q3 - 1e-3]\nactuators: {q3: length}\n"
+    text = DEFAULTS.split("  - name: limb3")[0] + "closures: [z + q3 - 1 mm]\nactuators: {q3: length}\n"
     _error(tmp_path, text, "does not assemble", "residual -1.000e-03", "closures[0]")
     rpr = (
         (MECH / "rpr.yaml")

@@ -118,7 +118,10 @@ def render_result(result: Result, title: str = "") -> str:
         for k, v in result.model.items():
             if k == "type":
                 continue
-            parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
+            if isinstance(v, list) and all(isinstance(e, float) for e in v):  # a derived vector
+                parts.append(f"{k} = [" + ", ".join(f"{e:.6g}" for e in v) + "]")
+            else:
+                parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
         lines.append("model   : " + result.model.get("type", "") + ": " + ", ".join(parts) + "  (SI)")
     if not result.values:
         lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
@@ -571,6 +574,8 @@ def cmd_examples(args: argparse.Namespace, out: TextIO) -> int:
 def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - one branch per thing described
     if args.name and _names_a_file(args.name) and not args.mechanism and args.name != "-":
         check_input_file(args.name, allow_pipe=True)  # a sparse file, a device: refused before the imports
+    if args.plot:
+        _check_graph_plot(args)
     from ..mechanisms.registry import mechanism_names, mechanism_type
     from ..problems.registry import kind_names, problem_kind
 
@@ -588,11 +593,12 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
         return _describe_kind(args, out)
     if args.mechanism:
         problem_kind(args.name, path=("describe",))  # the unknown kind, with a "did you mean"
+    description = None
     if _names_a_file(args.name) and not args.mechanism:  # a mechanism file: loaded and checked
-        from ..mechanisms.described import load_file
+        from ..mechanisms.described import load_file_description
 
         with solver_output(args):
-            mt = load_file(args.name, allow_pipe=True)
+            mt, description = load_file_description(args.name, allow_pipe=True)
     else:
         mt = mechanism_type(args.name, path=("describe",))
     out.write(f"{mt.name}: {mt.title}\n{mt.paper}\n[{mt.origin}]\n\nparameters:\n")
@@ -611,7 +617,40 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
             out.write(f"  {hname:<10} {text}\n")
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
+    if description is not None:  # a mechanism file: its derived values, legs, loops and mobility
+        from ..mechanisms.described.summary import summary_text
+        from ..problems.describe import model_of
+
+        with solver_output(args):
+            model, source = model_of(mt)
+            text = summary_text(description, model, source)
+        out.write(text)
+        if args.plot:
+            from ..mechanisms.described.summary import body_graph
+            from ..plot.draw import save
+            from ..plot.mechanism_graph import graph_figure
+
+            nodes, edges = body_graph(description)
+            note = "" if edges else "no legs: the loops are written as closures"
+            save(graph_figure(f"{mt.name}: bodies and joints", nodes, edges, note), args.plot, "--plot", [args.name])
+            out.write(f"body graph: {args.plot}\n")
     return EXIT_OK
+
+
+def _check_graph_plot(args: argparse.Namespace) -> None:
+    """``describe FILE --plot FIGURE``: a mechanism file, and a .png, .svg or .pdf to write."""
+    from ..plot.draw import check_figure_path, require_backend
+
+    if not args.name or args.mechanism or not _names_a_file(args.name):
+        raise InputError(
+            f"expected a mechanism file to draw the body graph of (cpm-nlp describe FILE.yaml --plot graph.png), "
+            f"got {args.name!r}" + (" with --mechanism" if args.mechanism else ""),
+            path=("--plot",),
+        )
+    if Path(args.plot).suffix.lower() == ".html":
+        raise InputError(f"expected a .png, .svg or .pdf figure, got {args.plot!r}", path=("--plot",))
+    check_figure_path(args.plot, "--plot", [args.name])
+    require_backend(args.plot)
 
 
 def _names_a_file(name: str) -> bool:
@@ -627,7 +666,15 @@ def _describe_kind(args: argparse.Namespace, out: TextIO) -> int:
     from ..problems.describe import describe_kind, kind_text
 
     if args.mechanism:
-        out.write(kind_text(describe_kind(args.name, args.mechanism)))
+        name = args.mechanism
+        if _names_a_file(name):  # a mechanism file, wherever a mechanism name is taken
+            from ..mechanisms.described import load_file
+            from ..mechanisms.registry import use_described
+
+            check_input_file(name, allow_pipe=True)
+            with solver_output(args):
+                name = use_described(load_file(name, allow_pipe=True), ("--mechanism",)).name
+        out.write(kind_text(describe_kind(args.name, name)))
         return EXIT_OK
     descriptions = [describe_kind(args.name, m) for m in mechanism_names()]
     applies = [d for d in descriptions if not d.unsupported]
@@ -737,7 +784,14 @@ def build_parser() -> argparse.ArgumentParser:
         "describe", help="list mechanisms and problem kinds, or describe one (a mechanism file: load, check, describe)"
     )
     p.add_argument("name", nargs="?", help="a mechanism, a problem kind or a mechanism file (.yaml)")
-    p.add_argument("--mechanism", metavar="NAME", help="with a problem kind: its inputs and values for this mechanism")
+    p.add_argument(
+        "--mechanism",
+        metavar="NAME",
+        help="with a problem kind: its inputs and values for this mechanism (a name or a mechanism file)",
+    )
+    p.add_argument(
+        "--plot", metavar="FIGURE", help="with a mechanism file: also draw its body graph (.png, .svg, .pdf)"
+    )
     p.set_defaults(func=cmd_describe)
     return parser
 

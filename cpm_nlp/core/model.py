@@ -228,13 +228,14 @@ class Model:
     limits: joint limits ``name -> (low, high)`` (SI) for actuators and
         passive joints; a family name ("s", "alpha") applies to all its members.
     derived: quantities that follow from the parameters (e.g. the 3-PRS
-        actuator circle radius a), reported with results.
+        actuator circle radius a), reported with results; a vector (a
+        mechanism file's derived point) is a list of floats under its name.
     """
 
     closure: LoopClosure
     parameters: Mapping[str, float]
     limits: Mapping[str, tuple[float, float]] = field(default_factory=dict)
-    derived: Mapping[str, float] = field(default_factory=dict)
+    derived: Mapping[str, float | list[float]] = field(default_factory=dict)
     dimensions: Mapping[str, str] = field(default_factory=dict)  # of parameters and derived values
     #: length that converts angle rates to length rates in conditioning measures
     characteristic_length: float = 1.0

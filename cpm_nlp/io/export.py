@@ -303,8 +303,9 @@ def manifest(
     lower, upper = limit_vectors(model)
     joints = list(limited_coordinates(c))
 
-    def quantity(value: float, dim: str) -> dict[str, Any]:
-        return {"value": float(value), "unit": DIMENSIONS[dim].si if dim in DIMENSIONS else ""}
+    def quantity(value: float | list[float], dim: str) -> dict[str, Any]:
+        number = [float(v) for v in value] if isinstance(value, (list, tuple)) else float(value)  # a derived vector
+        return {"value": number, "unit": DIMENSIONS[dim].si if dim in DIMENSIONS else ""}
 
     funcs = []
     for kern, fn in exported:

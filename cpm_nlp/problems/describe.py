@@ -74,6 +74,19 @@ def reference_model(mechanism: str) -> tuple[Model, str]:
     return build_model(mech.name, section.get("parameters"), section.get("limits")), source
 
 
+def model_of(mech: Mechanism) -> tuple[Model | None, str]:
+    """A model of a mechanism (registered or not: a mechanism file being described) from its
+    first example's parameters, else its defaults; None, and why, when a parameter has neither."""
+    section, source = _mechanism_section(mech)
+    missing = [o.name for o in mech.parameters if o.required] if section.get("parameters") is None else []
+    if missing:
+        return None, f"no example and no default for {', '.join(missing)}"
+    try:
+        return mech.model(mech.closure(), section.get("parameters"), section.get("limits"), ("mechanism",)), source
+    except InputError as exc:  # an example that does not build: the text says so, without values
+        return None, f"the parameters of {source} do not build a model: {exc.message}"
+
+
 def _unit(option: Option) -> str:
     if option.kind in DIMENSIONS:
         return DIMENSIONS[option.kind].display or "1"

@@ -35,7 +35,16 @@ from .spec import Description, description_from_dict
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Description", "load_file", "from_dict", "mechanism", "shipped_files", "read_yaml", "load_yaml_text"]
+__all__ = [
+    "Description",
+    "load_file",
+    "load_file_description",
+    "from_dict",
+    "mechanism",
+    "shipped_files",
+    "read_yaml",
+    "load_yaml_text",
+]
 
 #: the shipped mechanism files
 #: the shipped mechanism files: the package data of an installed wheel (setup.py maps
@@ -73,12 +82,18 @@ def load_file(path: str | Path, *, allow_pipe: bool = False) -> Mechanism:
     The file is read once, through :func:`cpm_nlp.io.inputs.read_input_text`
     (its type and size checked before it is opened); ``allow_pipe``: a file
     named on the command line may be ``-`` or a pipe."""
+    return load_file_description(path, allow_pipe=allow_pipe)[0]
+
+
+def load_file_description(path: str | Path, *, allow_pipe: bool = False) -> tuple[Mechanism, Description]:
+    """The mechanism a file describes and its description (the file read once)."""
     text = read_input_text(path, allow_pipe=allow_pipe)
     file = display_name(path)
     base_dir = input_dir(path)
     text_key = hashlib.sha256(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode()).hexdigest()
     data = parse_yaml(text, file)
-    return _cached(text_key, lambda: from_dict(data, file=file, base_dir=base_dir))
+    mech = _cached(text_key, lambda: from_dict(data, file=file, base_dir=base_dir))
+    return mech, description_from_dict(data, file=file)  # read without error: from_dict read it
 
 
 def _cached(key: str, make: Any) -> Mechanism:
@@ -133,8 +148,9 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     params = parameter_options(d)
     limits = gen.limit_options()
     examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)
-    derived_names = [(n, dim) for n, _sx, dim in gen.derived]
-    symbol_dims = {n: gen.env[n].dim for n in [p.name for p in d.parameters] + [n for n, _ in derived_names]}
+    #: (name, dimension, size): a derived vector is reported as a vector under its name
+    derived_names = [(n, dim, int(sx.numel())) for n, sx, dim in gen.derived]
+    symbol_dims = {n: gen.env[n].dim for n in [p.name for p in d.parameters] + [n for n, _, _ in derived_names]}
 
     loading = [True]  # while the mechanism is loaded, errors are located in its file by mechanism()
 
@@ -193,7 +209,9 @@ def _build(
                 path=("platform", "bounds", name),
             )
     length = float(values[2])
-    derived_vals = np.asarray(values[3], dtype=float).ravel()
+    flat = np.asarray(values[3], dtype=float).ravel()
+    ends = np.cumsum([size for _n, _dim, size in derived_names]).tolist()
+    derived_vals = [flat[end - size : end] for (_n, _dim, size), end in zip(derived_names, ends)]
     _check_finite(d, parameters, derived_vals, symbol_dims)
     for k, (lo, hi) in enumerate(zip(np.asarray(values[0]).ravel(), np.asarray(values[1]).ravel())):
         if not (math.isfinite(lo) and math.isfinite(hi)):
@@ -205,12 +223,15 @@ def _build(
     if not math.isfinite(length):
         raise InputError(f"not finite ({length}) for the parameters given", path=("characteristic_length",))
     dims = {par.name: par.dimension for par in d.parameters}
-    dims.update({n: dim for n, dim in derived_names})
+    dims.update({n: dim for n, dim, _size in derived_names})
     model = Model(
         closure,
         parameters={n: parameters[n] for n in closure.parameters},
         limits={k: v for k, v in limits.items() if v is not None},
-        derived={n: float(v) for (n, _), v in zip(derived_names, derived_vals)},
+        derived={
+            n: float(v[0]) if size == 1 else [float(e) for e in v]
+            for (n, _, size), v in zip(derived_names, derived_vals)
+        },
         dimensions=dims,
         characteristic_length=length if length > 0 else 1.0,
     )
@@ -225,20 +246,30 @@ def _build(
     return model
 
 
-def _check_finite(d: Description, parameters: dict, derived: np.ndarray, symbol_dims: dict) -> None:
-    """Every derived value is finite for these parameters; else an error naming it, its
-    expression and the operation that made a number that is not finite."""
-    known = {n: (float(v), symbol_dims[n]) for n, v in parameters.items() if n in symbol_dims}
-    for q, v in zip(d.derived, derived):
-        if not math.isfinite(v):
+def _check_finite(d: Description, parameters: dict, derived: list[np.ndarray], symbol_dims: dict) -> None:
+    """Every derived value (each element of a derived vector) is finite for these parameters; else
+    an error naming it, its expression and the operation that made a number that is not finite."""
+    known: dict[str, tuple[Any, Any]] = {
+        n: (float(v), symbol_dims[n]) for n, v in parameters.items() if n in symbol_dims
+    }
+    for q, vec in zip(d.derived, derived):
+        v = float(vec[0]) if vec.size == 1 else vec.tolist()
+        if not np.all(np.isfinite(vec)):
             exc = ex.diagnose(q.value, known)
             why = f": column {exc.column}: {exc.message}" if exc is not None else ""
-            given = ", ".join(f"{n} = {val:g}" for n, (val, _dim) in known.items() if n in ex.names_in(q.value))
+            given = ", ".join(f"{n} = {_shown(val)}" for n, (val, _dim) in known.items() if n in ex.names_in(q.value))
             raise InputError(
-                f"{q.value!r} is not finite ({v}) for {given or 'the parameters given'} (SI){why}",
+                f"{q.value!r} is not finite ({_shown(v)}) for {given or 'the parameters given'} (SI){why}",
                 path=("derived", q.name),
             )
-        known[q.name] = (float(v), symbol_dims[q.name])
+        known[q.name] = (v, symbol_dims[q.name])
+
+
+def _shown(value: float | list[float]) -> str:
+    """``0.0735`` or ``[0.0735, 0.01152, 0]`` (a derived vector)."""
+    if isinstance(value, list):
+        return "[" + ", ".join(f"{e:g}" for e in value) + "]"
+    return f"{value:g}"
 
 
 def check_reference(model: Model, row_names: list[str]) -> None:

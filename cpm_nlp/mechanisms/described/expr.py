@@ -9,24 +9,34 @@ values, pose and actuator coordinates).  It is parsed with Python's
 evaluated by Python: every other construct (attributes, comparisons,
 lambdas, keywords, strings ...) is an error that names its column.
 
+A number may carry a unit of length or angle (``l + 3 mm``, ``th0 + 1 deg``,
+``-22.22 mm``): it is one value, converted to SI when the file is read.
+
 Each value carries a physical dimension, the exponents of length and of
 angle, so that an angle where a length is expected ("[a, 0, alpha0]" as a
-location) is an error, not a silent mix.  Plain numbers adapt to their
-context (a bare number is SI).  Angles and plain numbers may be added
-(radians are dimensionless in SI); lengths may not be added to either.
+location) is an error, not a silent mix.  The rule (docs/site/guide/mechanism-files.md,
+"Units and dimensions"): a number without a unit is *bare*; where it is a
+whole value (a key's value, an element of a vector) it is read in SI (m,
+rad) like a problem file's bare number; in a sum (``+ -``, ``min max hypot
+atan2``) with a length or an angle a bare number other than 0 is refused
+(write its unit).  Angles and dimensionless values (``pi/2``, ``cos(a)``) may
+be added (radians are dimensionless in SI); lengths may not be added to either.
 """
 
 from __future__ import annotations
 
 import ast
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import casadi as ca
 
-from ...core.errors import suggest
+from ...core.errors import InputError, suggest
 from ...core.finite import LARGEST, too_large
+from ...core.units import DIMENSIONS as UNIT_DIMENSIONS
+from ...core.units import FAST_UNITS, parse_quantity
 
 #: dimension of a value: (length exponent, angle exponent); None for a plain number that adapts
 Dim = tuple[float, float] | None
@@ -62,6 +72,31 @@ def compatible(a: Dim, b: Dim) -> bool:
     return a is None or b is None or a[0] == b[0]
 
 
+def dimensioned(dim: Dim) -> bool:
+    """A dimension a bare number may not be added to: a length, an angle (or a power of them)."""
+    return dim is not None and (dim[0] != 0 or dim[1] != 0)
+
+
+def bare_message(what: str, dim: Dim, v: Value) -> str:
+    """``cannot add a length and the bare number 0.01: ... write its unit, e.g. '0.01 m' or '0.01 mm'``."""
+    number = float(ca.DM(v.sx)) if v.size == 1 and v.sx.is_constant() else None
+    shown = f"the bare number {number:g}" if number is not None else "a vector of bare numbers"
+    return (
+        f"{what} {describe(dim)} and {shown}: {unit_hint(dim, '' if number is None else f'{number:g}')} "
+        "(a number without a unit is read in SI only where it stands alone)"
+    )
+
+
+def unit_hint(dim: Dim, number: str = "") -> str:
+    """How to write a number of ``dim`` with its unit: ``write its unit, e.g. 0.01 m or 10 mm``."""
+    n = number or "3"
+    if dim == LENGTH:
+        return f"write its unit, e.g. '{n} m' or '{n} mm'"
+    if dim == ANGLE:
+        return f"write its unit, e.g. '{n} rad' or '{n} deg'"
+    return "write its unit (e.g. '(10 mm)^2')"
+
+
 @dataclass(frozen=True)
 class Value:
     """A CasADi expression (scalar or column vector) and its dimension."""
@@ -83,6 +118,10 @@ def _mul(a: Dim, b: Dim, sign: float = 1.0) -> Dim:
 
 
 def _same(name: str, args: list[Value], col: int) -> Dim:
+    for k, v in enumerate(args):
+        other = [o.dim for j, o in enumerate(args) if j != k and dimensioned(o.dim)]
+        if v.dim is None and other and not _is_zero(v.sx):
+            raise ExpressionError(bare_message(f"{name}() of", other[0], v), col)
     dims = [a.dim for a in args if a.dim is not None]
     for d in dims[1:]:
         if not compatible(dims[0], d):
@@ -175,9 +214,11 @@ def _translate(text: str) -> tuple[str, list[int]]:
 
 
 class _Evaluator:
-    def __init__(self, symbols: Mapping[str, Value], cols: list[int]) -> None:
+    def __init__(self, symbols: Mapping[str, Value], cols: list[int], units: Mapping[str, Value] | None = None) -> None:
         self.symbols = symbols
         self.cols = cols
+        #: placeholder name -> the value of a number with its unit (see :func:`_units`)
+        self.units = units or {}
 
     def col(self, node: ast.AST) -> int:
         off = getattr(node, "col_offset", 0) or 0
@@ -216,6 +257,8 @@ class _Evaluator:
         return result
 
     def _Name(self, node: ast.Name) -> Value:
+        if node.id in self.units:
+            return self.units[node.id]
         if node.id in self.symbols:
             return self.symbols[node.id]
         if node.id in CONSTANTS:
@@ -237,12 +280,16 @@ class _Evaluator:
         a, b = self.eval(node.left), self.eval(node.right)
         op = node.op
         if isinstance(op, (ast.Add, ast.Sub)):
+            word = "add" if isinstance(op, ast.Add) else "subtract"
+            self.no_bare(f"cannot {word}", [a, b], [node.left, node.right])
             if not compatible(a.dim, b.dim):
-                word = "add" if isinstance(op, ast.Add) else "subtract"
-                raise self.fail(node, f"cannot {word} {describe(a.dim)} and {describe(b.dim)}")
+                known = [v for v in (a, b) if v.dim == NUMBER and bool(v.sx.is_constant())]
+                hint = f"; {unit_hint(a.dim if a.dim != NUMBER else b.dim)}" if known else ""
+                raise self.fail(node, f"cannot {word} {describe(a.dim)} and {describe(b.dim)}{hint}")
             if a.size != b.size and 1 not in (a.size, b.size):
                 raise self.fail(node, f"vectors of sizes {a.size} and {b.size} do not add")
-            dim = a.dim if a.dim is not None else b.dim
+            # an angle plus a plain number (pi/2) is an angle
+            dim = a.dim if dimensioned(a.dim) or b.dim is None else b.dim
             word = "+" if isinstance(op, ast.Add) else "-"
             return self.finite(node, Value(a.sx + b.sx if word == "+" else a.sx - b.sx, dim), [a, b], word)
         if isinstance(op, (ast.Mult, ast.Div)):
@@ -265,6 +312,14 @@ class _Evaluator:
             return self.finite(node, Value(a.sx**e, dim), [a, b], "^")
         raise self.fail(node, f"the operator {_construct(op)} is not allowed (use + - * / ^)")
 
+    def no_bare(self, what: str, args: list[Value], nodes: list[ast.AST]) -> None:
+        """A bare number (no unit, not 0) in a sum with a length or an angle is refused: it
+        would be read in SI where the writer may mean mm or deg."""
+        for k, (v, n) in enumerate(zip(args, nodes)):
+            others = [o.dim for j, o in enumerate(args) if j != k and dimensioned(o.dim)]
+            if v.dim is None and others and not _is_zero(v.sx):
+                raise self.fail(n, bare_message(what, others[0], v))
+
     def _List(self, node: ast.List | ast.Tuple) -> Value:
         if not node.elts:
             raise self.fail(node, "an empty vector")
@@ -273,9 +328,13 @@ class _Evaluator:
         for e, v in zip(node.elts, items):
             if v.size != 1:
                 raise self.fail(e, "a vector's elements must be scalars")
+            if _adapts(v):  # a number without a unit: SI, of the vector's dimension
+                continue
             if not compatible(dim, v.dim):
                 raise self.fail(e, f"a vector mixes {describe(dim)} and {describe(v.dim)}")
             dim = dim if dim is not None else v.dim
+        if dim is None and any(v.dim is not None for v in items):
+            dim = NUMBER  # numbers only, some of them dimensionless (cos(pi/6)): adapts as a whole (see adapts)
         return Value(ca.vertcat(*[v.sx for v in items]), dim)
 
     _Tuple = _List
@@ -324,6 +383,22 @@ class _Evaluator:
         if not k.is_integer() or not 1 <= k <= len(node.args) - 1:
             raise self.fail(node.args[0], f"select() index {k:g} is not in 1..{len(node.args) - 1}")
         return self.eval(node.args[int(k)])
+
+
+def _is_zero(sx: ca.SX) -> bool:
+    return all(sx[i].is_constant() and float(ca.DM(sx[i])) == 0.0 for i in range(int(sx.numel())))
+
+
+def _adapts(v: Value) -> bool:
+    """A value written without a unit that takes the dimension of where it stands (a key's
+    value, an element of a vector), read in SI: a bare number, or a number known when the
+    file is read whose dimension is no length or angle (``0.05*cos(pi/6)``)."""
+    return v.dim is None or (v.dim == NUMBER and bool(v.sx.is_constant()))
+
+
+def adapts(v: Value) -> bool:
+    """Whether a whole value takes the dimension its key declares (see :func:`_adapts`)."""
+    return _adapts(v) or (v.dim == NUMBER and all(v.sx[i].is_constant() for i in range(v.size)))
 
 
 def _number(v: Value) -> float | None:
@@ -414,6 +489,7 @@ def parse(text: object, symbols: Mapping[str, Value]) -> Value:
         raise ExpressionError(f"an expression of {len(text)} characters; at most {MAX_LENGTH}", 1)
     _check_nesting(text)
     source, cols = _translate(text)
+    source, cols, units = _units(source, cols)
     try:
         tree = ast.parse(source.strip(), mode="eval")
     except SyntaxError as exc:
@@ -424,9 +500,91 @@ def parse(text: object, symbols: Mapping[str, Value]) -> Value:
         raise ExpressionError(f"cannot parse the expression ({type(exc).__name__})", 1) from None
     lead = len(source) - len(source.lstrip())
     try:
-        return _Evaluator(symbols, cols[lead:]).eval(tree)
+        return _Evaluator(symbols, cols[lead:], units).eval(tree)
     except RecursionError:
         raise ExpressionError("the expression is nested too deeply", 1) from None
+
+
+#: a number followed by a word (``3 mm``, ``1deg``, ``-22.22 mm``: the sign is an operator): a
+#: number with its unit; not after a name or a number's own characters (``x1 mm`` is no number)
+_UNIT_LITERAL = re.compile(
+    r"(?<![\w.])((?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)(?![eE][+-]?\d)[ \t]*([A-Za-zµ]+)(?![\w(])(?![ \t]*\*\*)"
+)
+#: a number then a word then a power or a call: ``3 mm^2``, ``2 sin(a)`` (refused with a message)
+_UNIT_AMBIGUOUS = re.compile(
+    r"(?<![\w.])((?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)(?![eE][+-]?\d)[ \t]*([A-Za-zµ]+)(?=[ \t]*(\*\*|\())"
+)
+#: the units an expression takes: of length and of angle (others through pint, then checked)
+EXPRESSION_DIMENSIONS = ("length", "angle")
+_EXPRESSION_UNITS = [u for u, (_f, d) in FAST_UNITS.items() if d in EXPRESSION_DIMENSIONS]
+
+
+def _unit_value(number: str, unit: str, column: int) -> Value:
+    """The SI value and dimension of ``<number> <unit>``, a length or an angle."""
+    text = f"{number} {unit}"
+    if not math.isfinite(float(number)):
+        raise ExpressionError(f"'{text}': a number beyond the largest float (about {LARGEST:.3g})", column)
+    fast = FAST_UNITS.get(unit)
+    if fast is not None and fast[1] not in EXPRESSION_DIMENSIONS:
+        raise ExpressionError(
+            f"'{text}' is {_article(fast[1])}; an expression of a mechanism file takes lengths "
+            f"({', '.join(UNIT_DIMENSIONS['length'].common_units)}) and angles "
+            f"({', '.join(UNIT_DIMENSIONS['angle'].common_units)})",
+            column,
+        )
+    dims = [fast[1]] if fast is not None else list(EXPRESSION_DIMENSIONS)
+    for dim in dims:
+        try:
+            si = parse_quantity(text, dim)
+        except InputError:
+            continue
+        if not math.isfinite(si) or abs(si) > LARGEST:
+            raise ExpressionError(f"'{text}' is not a finite number", column)
+        return Value(ca.SX(si), DIMENSION_OF[dim])
+    hint = suggest(unit, _EXPRESSION_UNITS)
+    more = f"; did you mean {' or '.join(repr(f'{number} {h}') for h in hint)}?" if hint else ""
+    raise ExpressionError(
+        f"{unit!r} after the number {number} is not a unit of length or angle (a product is written "
+        f"{number}*{unit}){more}",
+        column,
+    )
+
+
+def _article(dim: str) -> str:
+    noun = dim.replace("_", " ")
+    return ("an " if noun[:1] in "aeiou" else "a ") + noun
+
+
+def _units(source: str, cols: list[int]) -> tuple[str, list[int], dict[str, Value]]:
+    """Each number with its unit (``3 mm``) replaced by a placeholder name (bound to its SI
+    value and dimension), and the column map kept: the placeholder maps to the number's column."""
+    ambiguous = _UNIT_AMBIGUOUS.search(source)
+    if ambiguous is not None:
+        number, unit = ambiguous.group(1), ambiguous.group(2)
+        if ambiguous.group(3) == "**":
+            why = f"'{number} {unit}^...' is ambiguous: write the quantity in brackets, ({number} {unit})^2"
+        else:
+            why = f"a number before a call: a product is written {number}*{unit}(...)"
+        raise ExpressionError(why, cols[ambiguous.start()] + 1)
+    matches = list(_UNIT_LITERAL.finditer(source))
+    if not matches:
+        return source, cols, {}
+    prefix = "_unit"
+    while prefix in source:
+        prefix += "_"
+    out, new_cols, units, last = [], [], {}, 0
+    for k, m in enumerate(matches):
+        name = f"{prefix}{k}"
+        column = cols[m.start()] + 1
+        units[name] = _unit_value(m.group(1), m.group(2), column)
+        out.append(source[last : m.start()])
+        new_cols += cols[last : m.start()]
+        out.append(name)
+        new_cols += [cols[m.start()]] * len(name)
+        last = m.end()
+    out.append(source[last:])
+    new_cols += cols[last:]
+    return "".join(out), new_cols, units
 
 
 def _check_nesting(text: str) -> None:
@@ -446,17 +604,19 @@ def names_in(text: object) -> set[str]:
     if not isinstance(text, str):
         return set()
     try:
-        tree = ast.parse(_translate(text)[0].strip(), mode="eval")
-    except (SyntaxError, ValueError, RecursionError):
+        source, cols = _translate(text)
+        source, _cols, units = _units(source, cols)
+        tree = ast.parse(source.strip(), mode="eval")
+    except (SyntaxError, ValueError, RecursionError, ExpressionError):
         return set()
-    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - RESERVED
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - RESERVED - set(units)
 
 
-def diagnose(text: object, values: Mapping[str, tuple[float, Dim]]) -> ExpressionError | None:
+def diagnose(text: object, values: Mapping[str, tuple[float | list[float], Dim]]) -> ExpressionError | None:
     """Why an expression is not finite for these values of its symbols (name -> (value,
     dimension)): the error naming the first operation that made a number that is not
     finite (``sqrt of a negative number``, column 6), or None if none did."""
-    symbols = {n: Value(ca.SX(float(v)), dim) for n, (v, dim) in values.items()}
+    symbols = {n: Value(ca.SX(ca.DM(v)), dim) for n, (v, dim) in values.items()}
     try:
         parse(text, symbols)
     except ExpressionError as exc:

@@ -162,11 +162,13 @@ class Generator:
             if len(shown) > 80:  # the reason must fit in the one message line
                 shown = shown[:60] + f"... ({len(shown)} characters)"
             raise InputError(f"in {shown!r}: column {exc.column}: {exc.message}", path=path, hint=hint) from None
-        if dimension is not None and not ex.compatible(v.dim, ex.DIMENSION_OF[dimension]):
-            raise InputError(
-                f"expected {ex.describe(ex.DIMENSION_OF[dimension])}, got {ex.describe(v.dim)} in {text!r}", path=path
-            )
-        return v
+        if dimension is None:
+            return v
+        want = ex.DIMENSION_OF[dimension]
+        if not (ex.adapts(v) or ex.compatible(v.dim, want)):
+            raise InputError(f"expected {ex.describe(want)}, got {ex.describe(v.dim)} in {text!r}", path=path)
+        # the declared dimension is the value's (a bare number is SI of it; a plain number an angle in rad)
+        return ex.Value(v.sx, want)
 
     def scalar(self, text: Any, path: tuple, env: Mapping[str, ex.Value], dimension: str | None = None) -> ca.SX:
         v = self.value(text, path, env, dimension)
@@ -246,7 +248,7 @@ class Generator:
         home = j.home[0] if j.home else 0
         qh = self.scalar(home, j.path + ("home",), env, dim)
         self.q_home.append(qh)
-        gain = self.scalar(j.gain, j.path + ("gain",), env)
+        gain = self.scalar(j.gain, j.path + ("gain",), env, "dimensionless")
         if j.range is not None and fam not in self.q_limits:
             self.q_limits[fam] = (dim, j.range, j.path + ("range",))
         return gain * (sym - qh)
