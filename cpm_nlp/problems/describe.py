@@ -132,7 +132,12 @@ def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, so
     """Describe ``kind_name`` on ``mechanism`` (a model is built unless given)."""
     kind: ProblemKind = problem_kind(kind_name, path=("describe",))
     if model is None:
-        model, source = reference_model(mechanism)
+        mechanism_type(mechanism, path=("--mechanism",))  # an unknown name, with a "did you mean"
+        try:
+            model, source = reference_model(mechanism)
+        except InputError as exc:  # a mechanism described without an example or defaults
+            reason = f"no model to describe it on ({exc.message})"
+            return KindDescription(kind.name, kind.description, kind_origin(kind.name), mechanism, "", reason, (), ())
     reason = kind.supports(model)
     if reason:
         return KindDescription(kind.name, kind.description, kind_origin(kind.name), mechanism, source, reason, (), ())
