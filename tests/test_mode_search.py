@@ -95,9 +95,9 @@ def test_without_a_frame_angles_alias():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_round_trip_random_6_6_platforms(seed):
-    """A random 6-6 platform, a random pose, its leg lengths: the default search (2000 starts)
+    """A random 6-6 platform, a random pose, its leg lengths: the default search (12 000 starts)
     finds that pose, and every mode it reports has those leg lengths (numpy IK).  The rate over
-    40 platforms is measured by benchmarks/bench_mode_completeness.py."""
+    40 platforms is measured by benchmarks/bench_assembly_modes.py."""
     platform = Platform66(seed)
     model = platform.model()
     pose = platform.random_pose(np.random.default_rng(1000 + seed))

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.assembly import AssemblyModes, assembly_modes
+from ..analysis.assembly import DEFAULT_STARTS, AssemblyModes, assembly_modes
 from ..analysis.requirements import joint_requirements
 from ..analysis.validity import NEAR_SINGULAR_CONDITION, near_singular_warning
 from ..core.batch import batch_forward_kinematics, batch_inverse_kinematics
@@ -216,7 +216,14 @@ MODE_OPTIONS = (
         default="designated",
         choices=("designated", "all"),
     ),
-    Option("mode_starts", "int", "Newton starts of the assembly-mode search", default=2000, lower=1, upper=1_000_000),
+    Option(
+        "mode_starts",
+        "int",
+        "Newton starts of the assembly-mode search",
+        default=DEFAULT_STARTS,
+        lower=1,
+        upper=1_000_000,
+    ),
     Option("mode_seed", "int", "seed of the assembly-mode search", default=0, lower=0, upper=2**32 - 1),
 )
 
