@@ -90,7 +90,8 @@ COMPLETE_NOTE = (
 INCOMPLETE_NOTE = (
     "probably incomplete: {rare} mode(s) reached by fewer than {few} starts; Chao1 estimates "
     "{unseen:.3g} unseen mode(s) (about {estimate:.3g} in all); the smallest basin found holds "
-    "{p:.2g} of the starts, and a 99 % chance of reaching a basin that small takes {needed} starts"
+    "{p:.2g} of the starts, and a 99 % chance of reaching a basin that small takes {needed} starts "
+    "(more if the modes not found have smaller basins)"
 )
 
 
