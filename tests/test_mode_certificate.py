@@ -20,7 +20,7 @@ from .dietmaier import model as dietmaier_model
 MECHANISMS = ROOT / "problems" / "mechanisms"
 
 
-def _four_bar():
+def four_bar():
     """Freudenstein's four-bar (crank a2 = 1, coupler a3 = 3.5, rocker a4 = 3, ground g = 4),
     as tests/test_mode_search.py writes it."""
     desc = {
@@ -47,7 +47,7 @@ def _four_bar():
     return mech.model(mech.closure(), {}, {}, ())
 
 
-def _file(name):
+def file_model(name):
     mech = load_file(MECHANISMS / f"{name}.yaml")
     return mech.model(mech.closure(), {}, {}, ())
 
@@ -55,7 +55,7 @@ def _file(name):
 def test_four_bar_certified_two_modes_as_the_closed_form():
     """Crank at 70 deg: the closed form has two assembly modes (two circle intersections); the
     search finds 2 and the certificate proves there is no other in (-pi, pi]^2."""
-    model = _four_bar()
+    model = four_bar()
     found = assembly_modes(model, [math.radians(70)], starts=300)
     assert found.count == 2
     cert = certify_modes(model, found)
@@ -64,7 +64,7 @@ def test_four_bar_certified_two_modes_as_the_closed_form():
 
 
 def test_a_missing_mode_is_never_certified_away():
-    model = _four_bar()
+    model = four_bar()
     found = assembly_modes(model, [math.radians(70)], starts=300)
     found.modes = found.modes[:1]
     cert = certify_modes(model, found, max_boxes=20_000)
@@ -73,7 +73,7 @@ def test_a_missing_mode_is_never_certified_away():
 
 def test_five_bar_and_3rrr_certified():
     for name, dq in (("five_bar", 0.1), ("rrr3", 0.0)):
-        model = _file(name)
+        model = file_model(name)
         found = assembly_modes(model, model.q_home + dq, starts=2000)
         cert = certify_modes(model, found)
         assert cert.certified, (name, cert)
