@@ -493,7 +493,7 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge,
     length = reach(model)
     scale = np.array([length if x.kind == "length" else 1.0 for x in c.x])
     w = np.r_[qv, np.asarray(model.p, dtype=float).ravel()]
-    (X0,) = evaluate(damped_newton(model), [X0, w, scale], threads, SEARCH_CHUNK, "assembly-mode search, damped steps")
+    (X0,) = evaluate(damped_newton(model), [X0, w, scale], threads, SEARCH_CHUNK, "assembly-mode search")
     newton = search_solver(config)
     res = batch_forward_kinematics(
         model,
@@ -503,7 +503,7 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge,
         backend=backend,
         threads=threads,
         chunk=SEARCH_CHUNK,
-        what="assembly-mode search",
+        what="assembly-mode search, Newton",
     )
     statuses = [STATUSES[int(k)] for k in res.status]
     real = np.array([s in REAL for s in statuses])
