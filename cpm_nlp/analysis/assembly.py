@@ -17,7 +17,9 @@ Method
    distances of the home pose and the lengths among the actuators).
    ``starts`` initial poses are drawn there (seeded, uniform); the home pose
    is the first.
-2. Newton's method runs from every start at once (the FK kernel of
+2. From every start at once, :data:`DAMPED_STEPS` Newton steps, each shortened
+   to :data:`STEP_LIMIT` (one radian in an angle, one reach in a length;
+   :func:`damped_newton`), then Newton's method (the FK kernel of
    :mod:`cpm_nlp.core.batch`, CasADi ``fast_newton``, mapped over threads).
 3. Angle coordinates of the converged poses are reduced to (-pi, pi] (one
    the closures are not periodic in keeps its value).  Every converged real
