@@ -1,7 +1,7 @@
 """Benchmark: how complete the default assembly-mode search is on general 6-6
 Stewart-Gough platforms (issue 20).
 
-    python benchmarks/bench_mode_completeness.py [--platforms 40] [--starts 2000]
+    python benchmarks/bench_mode_completeness.py [--platforms 40] [--starts 12000]
         [--reference 20000] [--reference-platforms 10] [--json benchmarks/bench_mode_completeness.json]
 
 Round trip: for each of ``--platforms`` random platforms (tests/random_platforms.py,
@@ -32,7 +32,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from cpm_nlp.analysis.assembly import assembly_modes  # noqa: E402
+from cpm_nlp.analysis.assembly import DEFAULT_STARTS, assembly_modes  # noqa: E402
 from tests.random_platforms import Platform66, contains  # noqa: E402
 
 
@@ -62,7 +62,7 @@ def _same(platform: Platform66, a, b) -> bool:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--platforms", type=int, default=40)
-    ap.add_argument("--starts", type=int, default=2000)
+    ap.add_argument("--starts", type=int, default=DEFAULT_STARTS)
     ap.add_argument("--reference", type=int, default=20000)
     ap.add_argument("--reference-platforms", type=int, default=10)
     ap.add_argument("--json", type=Path, default=None)

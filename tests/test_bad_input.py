@@ -211,7 +211,8 @@ def test_unknown_input(cli, tmp_path):
         cli,
         tmp_path,
         GOOD.replace("s3:", "s4: 1 mm, s3:"),
-        "inputs: unknown input 's4'; expected one of: assembly_modes, mode_seed, mode_starts, s1, s2, s3",
+        "inputs: unknown input 's4'; expected one of: "
+        "assembly_modes, mode_certificate, mode_seed, mode_starts, s1, s2, s3",
     )
 
 

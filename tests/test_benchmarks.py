@@ -47,3 +47,19 @@ def test_modes_benchmark_smoke(tmp_path, capsys):
     data = json.loads(out.read_text())
     assert data["modes"] >= 1 and data["seconds"] > 0 and len(data["load_avg_1min"]) == 1
     assert "all assembly modes, 6-UPS" in capsys.readouterr().out
+
+
+def test_assembly_modes_benchmark_smoke(tmp_path, capsys):
+    """benchmarks/bench_assembly_modes.py runs end to end (few starts and boxes; nothing asserted on rates)."""
+    spec = importlib.util.spec_from_file_location(
+        "bench_assembly_modes", ROOT / "benchmarks" / "bench_assembly_modes.py"
+    )
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = tmp_path / "bench_assembly_modes.json"
+    argv = ["--seeds", "1", "--platforms", "1", "--reference", "300", "--starts", "1000", "--certify-boxes", "100"]
+    assert bench.main(argv + ["--before", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["dietmaier"]["searches"] == 1 and data["random_66"]["platforms"] == 1
+    assert [c["certified"] for c in data["certificate"]] == [True, True, True, False]
+    assert "before" in data and "written:" in capsys.readouterr().out

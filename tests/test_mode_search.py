@@ -95,9 +95,9 @@ def test_without_a_frame_angles_alias():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_round_trip_random_6_6_platforms(seed):
-    """A random 6-6 platform, a random pose, its leg lengths: the default search (2000 starts)
+    """A random 6-6 platform, a random pose, its leg lengths: the default search (12 000 starts)
     finds that pose, and every mode it reports has those leg lengths (numpy IK).  The rate over
-    40 platforms is measured by benchmarks/bench_mode_completeness.py."""
+    40 platforms is measured by benchmarks/bench_assembly_modes.py."""
     platform = Platform66(seed)
     model = platform.model()
     pose = platform.random_pose(np.random.default_rng(1000 + seed))
@@ -297,3 +297,21 @@ def test_wrong_branch_names_indicator_leg_joint_and_value():
     assert any("a1.U1 = -" in m and "leg a1, joint 1 (U)" in m for m in msgs) or any("aspect = -" in m for m in msgs)
     below = [md for md in found.modes if md.x[2] < 0]
     assert below and all("<= 0" in md.message for md in below)
+
+
+def test_kernel_checks_see_nan_and_inf():
+    """The kernels' finiteness test: a NaN or inf entry is not finite, and the residual of a
+    vector holding one is inf (before: v * 0 == 0, which CasADi simplifies to true, so a NaN
+    residual entry was skipped by fmax and the residual of [NaN, 1] was 1)."""
+    import casadi as ca
+
+    from cpm_nlp.core.kernels import _all_finite, _robust_max_abs
+
+    for sym in (ca.SX, ca.MX):
+        v = sym.sym("v", 2)
+        f = ca.Function("f", [v], [_robust_max_abs(v), _all_finite(v)])
+        for bad in ([math.nan, 1.0], [1.0, math.inf]):
+            residual, finite = (float(o) for o in f(bad))
+            assert residual == math.inf and finite == 0
+        residual, finite = (float(o) for o in f([1.0, -2.0]))
+        assert residual == 2.0 and finite == 1

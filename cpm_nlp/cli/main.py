@@ -275,6 +275,8 @@ _UNITS = {
     "forward kinematics": "poses",
     "inverse kinematics": "poses",
     "assembly-mode search": "starts",
+    "assembly-mode search, Newton": "starts",
+    "certifying the assembly modes": "sub-boxes",
     "merging the converged starts": "poses",
     "sweep": "points",
 }

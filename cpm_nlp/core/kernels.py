@@ -118,7 +118,8 @@ def is_singular(cond: Any, ops: _Ops, factor: float = 1.0) -> Any:
 
 
 def _all_finite(v: ca.SX) -> ca.SX:
-    return ca.sum1(v * 0) == 0  # x * 0 is NaN for inf and NaN
+    # |v| < inf is false for inf and NaN (not v * 0 == 0: CasADi simplifies v * 0 to 0)
+    return ca.sum1(ca.fabs(ca.vec(v)) < ca.inf) == v.numel()
 
 
 def _robust_max_abs(v: ca.SX) -> ca.SX:
@@ -340,7 +341,7 @@ def _first(failed: Any, status: Status, otherwise: Any) -> Any:
 
 
 def _converged(y: ca.MX, residual: ca.MX, tol: ca.MX) -> ca.MX:
-    return ca.logic_and(ca.sum1(y * 0) == 0, residual <= tol)
+    return ca.logic_and(_all_finite(y), residual <= tol)
 
 
 def _rootfinder(name: str, residual: ca.Function, ny: int, nw: int, opts: Mapping[str, Any]) -> ca.Function:

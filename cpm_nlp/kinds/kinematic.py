@@ -12,7 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.assembly import AssemblyModes, assembly_modes
+from ..analysis.assembly import DEFAULT_STARTS, AssemblyModes, assembly_modes
+from ..analysis.mode_certificate import ModeCertificate, certify_modes
 from ..analysis.requirements import joint_requirements
 from ..analysis.validity import NEAR_SINGULAR_CONDITION, near_singular_warning
 from ..core.batch import batch_forward_kinematics, batch_inverse_kinematics
@@ -193,7 +194,8 @@ class ForwardKinematics(ProblemKind):
             found = assembly_modes(
                 model, qs[0], solver, starts=inputs["mode_starts"], seed=inputs["mode_seed"], guess=guess
             )
-            return _modes_result(self.name, model, found, solver)
+            cert = certify_modes(model, found) if inputs.get("mode_certificate") else None
+            return _modes_result(self.name, model, found, solver, cert)
         if batch and batch_newton_supported(solver):  # one vectorized Newton over every point
             sols = batch_forward_kinematics(model, qs, solver, guess).solutions()
         else:
@@ -216,8 +218,22 @@ MODE_OPTIONS = (
         default="designated",
         choices=("designated", "all"),
     ),
-    Option("mode_starts", "int", "Newton starts of the assembly-mode search", default=2000, lower=1, upper=1_000_000),
+    Option(
+        "mode_starts",
+        "int",
+        "Newton starts of the assembly-mode search",
+        default=DEFAULT_STARTS,
+        lower=1,
+        upper=1_000_000,
+    ),
     Option("mode_seed", "int", "seed of the assembly-mode search", default=0, lower=0, upper=2**32 - 1),
+    Option(
+        "mode_certificate",
+        "bool",
+        "also prove by interval branch and bound that the search region holds no other real mode "
+        "(seconds for a planar linkage; not feasible for a 6-6 platform)",
+        default=False,
+    ),
 )
 
 
@@ -244,10 +260,13 @@ def mode_value_names(model: Model) -> list[str]:
         "mode_region",
         "mode_completeness",
         "mode_search",
+        "mode_certificate",  # with mode_certificate: true
     ]
 
 
-def _modes_result(kind: str, model: Model, found: AssemblyModes, solver: SolverConfig) -> Result:
+def _modes_result(
+    kind: str, model: Model, found: AssemblyModes, solver: SolverConfig, cert: ModeCertificate | None = None
+) -> Result:
     """A forward_kinematics result: the search that ran is ``solved``; the designated pose
     (the ordinary FK) is reported as usual, with its own status, and every mode found beside it."""
     c = model.closure
@@ -284,6 +303,14 @@ def _modes_result(kind: str, model: Model, found: AssemblyModes, solver: SolverC
         + (f"; {found.outside_region} mode(s) found outside it (kept)" if found.outside_region else "")
         + f"; {est.note}"
     )
+    if cert is not None:
+        extra["mode_certificate"] = cert.as_dict()
+        dims["mode_certificate"] = "text"
+        extra["mode_search"] += (
+            f"; certificate: no other real mode in the region ({cert.boxes} sub-boxes, {cert.seconds:.3g} s)"
+            if cert.certified
+            else f"; certificate: not proven ({cert.reason}; {cert.boxes} sub-boxes, {cert.seconds:.3g} s)"
+        )
     dims.update(
         modes_status="text",
         modes_message="text",
