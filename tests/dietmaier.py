@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 MECHANISM = Path(__file__).resolve().parent / "corpus" / "dietmaier_6_6.yaml"
-PROBLEM = Path(__file__).resolve().parent / "corpus" / "dietmaier_6_6_modes.yaml"
+PROBLEM = Path(__file__).resolve().parent / "corpus" / "problems" / "dietmaier_6_6_modes.yaml"
 #: real assembly modes of the platform for LENGTHS (the paper's title); a general 6-6 platform
 #: has at most 40 (complex) ones, so 40 distinct real poses are all there are
 MODES = 40

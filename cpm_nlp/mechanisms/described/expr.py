@@ -15,12 +15,11 @@ A number may carry a unit of length or angle (``l + 3 mm``, ``th0 + 1 deg``,
 Each value carries a physical dimension, the exponents of length and of
 angle, so that an angle where a length is expected ("[a, 0, alpha0]" as a
 location) is an error, not a silent mix.  The rule (docs/site/guide/mechanism-files.md,
-"Units and dimensions"): a number without a unit is *bare*; where it is a
-whole value (a key's value, an element of a vector) it is read in SI (m,
-rad) like a problem file's bare number; in a sum (``+ -``, ``min max hypot
-atan2``) with a length or an angle a bare number other than 0 is refused
-(write its unit).  Angles and dimensionless values (``pi/2``, ``cos(a)``) may
-be added (radians are dimensionless in SI); lengths may not be added to either.
+"Units and dimensions"): a number without a unit is *bare* and read in SI
+(m, rad), like a problem file's bare number: it takes the dimension of what
+it is added to (``l + 0.01`` is l + 10 mm).  Angles and dimensionless values
+(``pi/2``, ``cos(a)``) may be added (radians are dimensionless in SI); lengths
+may not be added to either.
 """
 
 from __future__ import annotations
@@ -77,16 +76,6 @@ def dimensioned(dim: Dim) -> bool:
     return dim is not None and (dim[0] != 0 or dim[1] != 0)
 
 
-def bare_message(what: str, dim: Dim, v: Value) -> str:
-    """``cannot add a length and the bare number 0.01: ... write its unit, e.g. '0.01 m' or '0.01 mm'``."""
-    number = float(ca.DM(v.sx)) if v.size == 1 and v.sx.is_constant() else None
-    shown = f"the bare number {number:g}" if number is not None else "a vector of bare numbers"
-    return (
-        f"{what} {describe(dim)} and {shown}: {unit_hint(dim, '' if number is None else f'{number:g}')} "
-        "(a number without a unit is read in SI only where it stands alone)"
-    )
-
-
 def unit_hint(dim: Dim, number: str = "") -> str:
     """How to write a number of ``dim`` with its unit: ``write its unit, e.g. 0.01 m or 10 mm``."""
     n = number or "3"
@@ -118,10 +107,6 @@ def _mul(a: Dim, b: Dim, sign: float = 1.0) -> Dim:
 
 
 def _same(name: str, args: list[Value], col: int) -> Dim:
-    for k, v in enumerate(args):
-        other = [o.dim for j, o in enumerate(args) if j != k and dimensioned(o.dim)]
-        if v.dim is None and other and not _is_zero(v.sx):
-            raise ExpressionError(bare_message(f"{name}() of", other[0], v), col)
     dims = [a.dim for a in args if a.dim is not None]
     for d in dims[1:]:
         if not compatible(dims[0], d):
@@ -281,7 +266,6 @@ class _Evaluator:
         op = node.op
         if isinstance(op, (ast.Add, ast.Sub)):
             word = "add" if isinstance(op, ast.Add) else "subtract"
-            self.no_bare(f"cannot {word}", [a, b], [node.left, node.right])
             if not compatible(a.dim, b.dim):
                 known = [v for v in (a, b) if v.dim == NUMBER and bool(v.sx.is_constant())]
                 hint = f"; {unit_hint(a.dim if a.dim != NUMBER else b.dim)}" if known else ""
@@ -311,14 +295,6 @@ class _Evaluator:
                 raise self.fail(node, "a power of a vector")
             return self.finite(node, Value(a.sx**e, dim), [a, b], "^")
         raise self.fail(node, f"the operator {_construct(op)} is not allowed (use + - * / ^)")
-
-    def no_bare(self, what: str, args: list[Value], nodes: list[ast.AST]) -> None:
-        """A bare number (no unit, not 0) in a sum with a length or an angle is refused: it
-        would be read in SI where the writer may mean mm or deg."""
-        for k, (v, n) in enumerate(zip(args, nodes)):
-            others = [o.dim for j, o in enumerate(args) if j != k and dimensioned(o.dim)]
-            if v.dim is None and others and not _is_zero(v.sx):
-                raise self.fail(n, bare_message(what, others[0], v))
 
     def _List(self, node: ast.List | ast.Tuple) -> Value:
         if not node.elts:
@@ -383,10 +359,6 @@ class _Evaluator:
         if not k.is_integer() or not 1 <= k <= len(node.args) - 1:
             raise self.fail(node.args[0], f"select() index {k:g} is not in 1..{len(node.args) - 1}")
         return self.eval(node.args[int(k)])
-
-
-def _is_zero(sx: ca.SX) -> bool:
-    return all(sx[i].is_constant() and float(ca.DM(sx[i])) == 0.0 for i in range(int(sx.numel())))
 
 
 def _adapts(v: Value) -> bool:
