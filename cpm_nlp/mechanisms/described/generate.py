@@ -68,10 +68,14 @@ _ASSEMBLY = (
     "over its value at home"
 )
 _WORKING_R = (
-    "working mode: w·((c - a) × (B - c)) of the joint before it (axis w at a), the link c -> B, with its sign at home"
+    "working mode: w·((c - a) × (B - c)) of the joint before it (axis w at a) and the link c -> B, "
+    "over its value at home"
 )
-_WORKING_PLANAR = "working mode: orientation of the triangle (a, c, B) of the joint before it, the link c -> B (elbow)"
-_WORKING_P = "working mode: e·(B - c) of the P joint before it (axis e), the link c -> B, with its sign at home"
+_WORKING_PLANAR = (
+    "working mode (elbow): the signed area of the triangle (a, c, B) of the joint before it and the "
+    "link c -> B, over its value at home"
+)
+_WORKING_P = "working mode: e·(B - c) of the P joint before it (axis e) and the link c -> B, over its value at home"
 
 SPHERE_JOINTS = {"U", "S", "planar_R"}
 #: the letter a drawing marks each joint type with (a distance joint: a rod between two spherical joints)
@@ -477,7 +481,7 @@ class Generator:
             else:
                 rate = Rk @ b.axis
                 what = _WORKING_P
-            working = ca.dot(rate, vp) / (ca.norm_2(rate) * ca.norm_2(vp))
+            working = ca.dot(rate, vp)
         rows = list(range(len(self.rows) - nrows, len(self.rows)))
         self.pending.append((len(self.branch), rows, working, what))
         self.indicator(None, leg, elim, "")
@@ -493,8 +497,8 @@ class Generator:
         assembly modes; for a triangle closed at a revolute it is the triangle's orientation, for
         an S-S link the side of the output crank's plane.  Otherwise the link is one of several
         holding the platform, whose assembly mode is the ``aspect``; its indicator is the leg's
-        working mode, the sign of the closure's rate with respect to the joint before the link
-        relative to home (the Delta's and the five-bar's elbows), changing sign only where the
+        working mode, the closure's rate with respect to the joint before the link over its
+        value at home (the Delta's and the five-bar's elbows), changing sign only where the
         leg is stretched or folded (a singularity of the leg).  A link with neither (fixed c and
         a shared block) gets no indicator."""
         if not self.pending:
@@ -526,7 +530,8 @@ class Generator:
                 d = twist_determinant(phi[brows], ca.vertcat(*[self.x[j] for j in bcols]), self.R)
                 value, what = d / ca.substitute(d, xq, home), _ASSEMBLY
             elif working is not None:
-                value = working * ca.sign(ca.substitute(working, xq, home))
+                # over its value at home: polynomial in the pose (an interval proof of outside stays tight)
+                value = working / ca.substitute(working, xq, home)
             if value is None:
                 drop.append(pos)
                 continue
