@@ -15,6 +15,7 @@ full crank turn in tests/corpus/test_corpus.py.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,6 +29,7 @@ from cpm_nlp.problems.shipped import shipped_problems_dir
 
 DEG = math.pi / 180
 MECHANISMS = shipped_problems_dir() / "mechanisms"
+CORPUS = Path(__file__).resolve().parent / "corpus"
 
 
 def _model(path, parameters=None):
@@ -132,11 +134,12 @@ def test_five_bar_elbows_are_the_triangles_orientation():
 
 
 def test_reduce_angle():
-    """A turn of the angle inside the range (its value in (-180, 180] deg first, then the
-    value itself, then its lowest turn there), else its value in (-180, 180] deg."""
+    """A turn of the angle inside the range (the value itself first, then its value in
+    (-180, 180] deg, then its lowest turn there), else its value in (-180, 180] deg."""
     r = lambda v, lim: reduce_angle(v * DEG, [None if lim is None else (lim[0] * DEG, lim[1] * DEG)]) / DEG  # noqa: E731
     assert r(232.797, (-180, 180)) == pytest.approx(-127.203)
-    assert r(-300, (-360, 360)) == pytest.approx(60)
+    assert r(-300, (-360, 360)) == pytest.approx(-300)
+    assert r(-420, (-360, 360)) == pytest.approx(-60)
     assert r(300, (200, 400)) == pytest.approx(300)
     assert r(-90, (0, 360)) == pytest.approx(270)
     assert r(725, (300, 400)) == pytest.approx(365)
@@ -150,9 +153,7 @@ def test_rssr_ik_of_a_reachable_pose_within_one_turn():
     """The corpus RSSR with its input range [-180, 180] deg: IK of phi = 39.09454637 deg was
     `outside_joint_limits: theta = 4.06309 outside [-3.14159, 3.14159]`; the angle a turn
     away, -2.220 rad, is inside and is the answer (FK of it gives phi back)."""
-    path = shipped_problems_dir().parent / "tests" / "corpus" / "rssr_linkr.yaml"
-    if not path.exists():  # an installed package without the tests
-        pytest.skip("tests/corpus not present")
+    path = CORPUS / "rssr_linkr.yaml"
     model = _model(path)
     ik = cn.inverse_kinematics(model, [39.09454637 * DEG], method="solve")
     assert ik.status == Status.SOLVED, ik.message
@@ -167,9 +168,7 @@ def test_passive_angles_reduced_into_their_range():
     four-bar, negative as computed (atan2) at these crank angles, is reported a turn up and
     the pose is solved; declared in [0, 90] deg, where no turn of it lies, the pose is
     `outside_joint_limits` with the value reduced to (-180, 180] deg."""
-    path = shipped_problems_dir().parent / "tests" / "corpus" / "fourbar_pyslvs.yaml"
-    if not path.exists():
-        pytest.skip("tests/corpus not present")
+    path = CORPUS / "fourbar_pyslvs.yaml"
     data = yaml.safe_load(path.read_text())
     plain = from_dict(data)
     model = plain.model(plain.closure(), {}, {}, ())

@@ -200,15 +200,15 @@ def _turns_off(d: ca.SX) -> ca.SX:
 
 def _into_range(v: ca.SX, low: ca.SX, high: ca.SX) -> ca.SX:
     """A passive joint angle with a finite range [low, high] reduced by whole turns as
-    :func:`cpm_nlp.core.kinematics.reduce_angle` reduces the pose and the actuators: its
-    value in (-pi, pi] if that is in the range, else v if it is, else its lowest turn in the
+    :func:`cpm_nlp.core.kinematics.reduce_angle` reduces the pose and the actuators: v if
+    it is in the range, else its value in (-pi, pi] if that is, else its lowest turn in the
     range, else (outside) its value in (-pi, pi].  Without a finite range: unchanged."""
     finite = ca.logic_and(low > -ca.inf, high < ca.inf)
     base = ca.if_else(finite, low, 0)
     r = v - 2 * ca.pi * ca.ceil((v - ca.pi) / (2 * ca.pi))  # in (-pi, pi]
     lowest = v - 2 * ca.pi * ca.floor((v - base) / (2 * ca.pi))  # in [low, low + 2 pi)
     inside = lambda a: ca.logic_and(a >= low, a <= high)  # noqa: E731
-    reduced = ca.if_else(inside(r), r, ca.if_else(inside(v), v, ca.if_else(inside(lowest), lowest, r)))
+    reduced = ca.if_else(inside(v), v, ca.if_else(inside(r), r, ca.if_else(inside(lowest), lowest, r)))
     return ca.if_else(finite, reduced, v)
 
 

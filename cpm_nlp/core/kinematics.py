@@ -427,16 +427,16 @@ def continued_forward_kinematics(
 
 def reduce_angle(v: float, ranges: Sequence[tuple[float, float] | None]) -> float:
     """The angle v shifted by whole turns into the first finite range of ``ranges`` that
-    holds one of its turns (its value in (-pi, pi] if that lies there, else v itself if it
+    holds one of its turns (v itself if it lies there, else its value in (-pi, pi] if that
     does, else its lowest turn there), else into (-pi, pi]."""
     r = math.pi - (math.pi - v) % (2 * math.pi)  # in (-pi, pi]
     for lim in ranges:
         if lim is None or not (math.isfinite(lim[0]) and math.isfinite(lim[1])):
             continue
-        if lim[0] <= r <= lim[1]:
-            return r
         if lim[0] <= v <= lim[1]:
             return v
+        if lim[0] <= r <= lim[1]:
+            return r
         turns = math.ceil((lim[0] - r) / (2 * math.pi))
         if lim[0] <= r + 2 * math.pi * turns <= lim[1]:
             return r + 2 * math.pi * turns
@@ -447,12 +447,14 @@ def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) 
     """The pose and the actuators with each angle coordinate reduced by whole turns
     (:func:`reduce_angle`) to its declared range (its joint limits, else, for a pose
     coordinate, the bounds of the pose coordinates) if a turn of it lies there, else to
-    (-pi, pi]; a coordinate the closures are not periodic in (the residual grows, e.g. an
-    actuator geared to its joint) keeps its value.  Returns (x, q)."""
+    (-pi, pi]; an actuator without a declared range, and a coordinate the closures are not
+    periodic in (the residual grows, e.g. an actuator geared to its joint), keep their
+    values.  Returns (x, q)."""
     c = model.closure
     out_x, out_q = np.array(x, dtype=float), np.array(q, dtype=float)
     limit = max(tolerance, 1e-12)
-    items = [(out_q, k, coord, (model.limit_of(coord),)) for k, coord in enumerate(c.q)]
+    # an actuator without a declared range keeps its value (the solvers start from its home value)
+    items = [(out_q, k, coord, (model.limit_of(coord),)) for k, coord in enumerate(c.q) if model.limit_of(coord)]
     items += [
         (out_x, k, coord, (model.limit_of(coord), (model.x_lower[k], model.x_upper[k]))) for k, coord in enumerate(c.x)
     ]
