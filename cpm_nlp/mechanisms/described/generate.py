@@ -27,15 +27,16 @@ configuration (:meth:`Generator.elimination_indicators`):
 * the link closes a sub-chain of its own (its rows make a diagonal block of
   Φ_x in block-triangular form with no other elimination: a four-bar's
   coupler and rocker, an RSSR's coupler and output crank, a slider-crank's
-  rod and slider): the sign of that block's determinant, the passive
-  Jacobian of the sub-chain -- its assembly mode (a triangle closed at a
-  revolute: its orientation);
+  rod and slider): that block's determinant (the passive Jacobian of the
+  sub-chain) over its value at home -- its assembly mode (a triangle closed
+  at a revolute: its orientation);
 * the link is one of several holding a platform: the leg's working mode, the
   derivative of its closure with respect to the joint before the eliminated
   one -- for a revolute at a (axis w) moving c: the triple product
   w·((c - a) × (B - c)), the side of B of the plane through the crank and its
   axis (planar: the orientation of the triangle a, c, B, the elbow); for a P
-  along e: e·(B - c); the platform's assembly mode is the ``aspect``;
+  along e: e·(B - c); over its value at home; the platform's assembly mode
+  is the ``aspect``;
 * a P leg: its length over its reference length (its working mode) and the
   cosine of the leg to its reference direction.
 """
