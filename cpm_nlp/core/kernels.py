@@ -154,7 +154,12 @@ def check_expressions(
         out["branch_margin"] = ca.SX(ca.inf)
     if c.ik is not None:
         x_ik, q_ik, reach = c.ik(x[list(c.task_index)], p)
-        err = _robust_max_abs(ca.vertcat(x_ik - x, q_ik - q))
+        # an angle and its value a whole turn away are one joint position (IK reduces angles)
+        kinds = [k.kind for k in c.x] + [k.kind for k in c.q]
+        diff = ca.vertcat(x_ik - x, q_ik - q)
+        err = _robust_max_abs(
+            ca.vertcat(*[_turns_off(diff[k]) if kind == "angle" else diff[k] for k, kind in enumerate(kinds)])
+        )
         out["round_trip_error"] = ca.if_else(reach >= 0, err, ca.inf)
     else:
         out["round_trip_error"] = ca.SX(0)
@@ -167,6 +172,17 @@ def check_expressions(
     else:
         out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
     passive = c.passive(x, q, p) if c.passive is not None else ca.SX(0, 1)
+    n0 = c.nq + c.nx
+    passive = (
+        ca.vertcat(
+            *[
+                _into_range(passive[k], lower[n0 + k], upper[n0 + k]) if coord.kind == "angle" else passive[k]
+                for k, coord in enumerate(c.passive_coords)
+            ]
+        )
+        if passive.numel()
+        else passive
+    )
     out["passive"] = passive
     joints = ca.vertcat(q, x, passive)  # the order of limited_coordinates
     if joints.numel():
@@ -176,6 +192,25 @@ def check_expressions(
     else:  # pragma: no cover - every mechanism has actuators
         out["limit_margin"] = ca.SX(ca.inf)
     return out
+
+
+def _turns_off(d: ca.SX) -> ca.SX:
+    """An angle difference less its whole turns, in [-pi, pi)."""
+    return d - 2 * ca.pi * ca.floor(d / (2 * ca.pi) + 0.5)
+
+
+def _into_range(v: ca.SX, low: ca.SX, high: ca.SX) -> ca.SX:
+    """A passive joint angle with a finite range [low, high] reduced by whole turns as
+    :func:`cpm_nlp.core.kinematics.reduce_angle` reduces the pose and the actuators: v if
+    it is in the range, else its value in (-pi, pi] if that is, else its lowest turn in the
+    range, else (outside) its value in (-pi, pi].  Without a finite range: unchanged."""
+    finite = ca.logic_and(low > -ca.inf, high < ca.inf)
+    base = ca.if_else(finite, low, 0)
+    r = v - 2 * ca.pi * ca.ceil((v - ca.pi) / (2 * ca.pi))  # in (-pi, pi]
+    lowest = v - 2 * ca.pi * ca.floor((v - base) / (2 * ca.pi))  # in [low, low + 2 pi)
+    inside = lambda a: ca.logic_and(a >= low, a <= high)  # noqa: E731
+    reduced = ca.if_else(inside(v), v, ca.if_else(inside(r), r, ca.if_else(inside(lowest), lowest, r)))
+    return ca.if_else(finite, reduced, v)
 
 
 #: the preconditioned residual ‖I - Φ_x B‖₁ must stay below this for :func:`cond1_bound` to certify

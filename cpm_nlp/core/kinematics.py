@@ -350,7 +350,7 @@ def forward_kinematics(
             alt.details["first_attempt"] = f"{sol.status.value}: {sol.message}" if sol.message else sol.status.value
             sol = alt
     if sol.ok:
-        sol.x = reduce_angles(model, sol.x, sol.q, config.tolerance)
+        sol.x, _ = reduce_angles(model, sol.x, sol.q, config.tolerance)
     return sol
 
 
@@ -425,32 +425,50 @@ def continued_forward_kinematics(
     return last
 
 
-def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> np.ndarray:
-    """The pose with each angle coordinate reduced to its declared range (its
-    joint limits, else the bounds of the pose coordinates) if a turn of it lies
-    there, else to (-pi, pi]; a coordinate the
-    closures are not periodic in (the residual grows) keeps its value."""
+def reduce_angle(v: float, ranges: Sequence[tuple[float, float] | None]) -> float:
+    """The angle v shifted by whole turns into the first finite range of ``ranges`` that
+    holds one of its turns (v itself if it lies there, else its value in (-pi, pi] if that
+    does, else its lowest turn there), else into (-pi, pi]."""
+    r = math.pi - (math.pi - v) % (2 * math.pi)  # in (-pi, pi]
+    for lim in ranges:
+        if lim is None or not (math.isfinite(lim[0]) and math.isfinite(lim[1])):
+            continue
+        if lim[0] <= v <= lim[1]:
+            return v
+        if lim[0] <= r <= lim[1]:
+            return r
+        turns = math.ceil((lim[0] - r) / (2 * math.pi))
+        if lim[0] <= r + 2 * math.pi * turns <= lim[1]:
+            return r + 2 * math.pi * turns
+    return r
+
+
+def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+    """The pose and the actuators with each angle coordinate reduced by whole turns
+    (:func:`reduce_angle`) to its declared range (its joint limits, else, for a pose
+    coordinate, the bounds of the pose coordinates) if a turn of it lies there, else to
+    (-pi, pi]; an actuator without a declared range, and a coordinate the closures are not
+    periodic in (the residual grows, e.g. an actuator geared to its joint), keep their
+    values.  Returns (x, q)."""
     c = model.closure
-    out = np.array(x, dtype=float)
-    for k, coord in enumerate(c.x):
+    out_x, out_q = np.array(x, dtype=float), np.array(q, dtype=float)
+    limit = max(tolerance, 1e-12)
+    # an actuator without a declared range keeps its value (the solvers start from its home value)
+    items = [(out_q, k, coord, (model.limit_of(coord),)) for k, coord in enumerate(c.q) if model.limit_of(coord)]
+    items += [
+        (out_x, k, coord, (model.limit_of(coord), (model.x_lower[k], model.x_upper[k]))) for k, coord in enumerate(c.x)
+    ]
+    for vec, k, coord, ranges in items:
         if coord.kind != "angle":
             continue
-        v = out[k]
-        r = math.pi - (math.pi - v) % (2 * math.pi)  # in (-pi, pi]
-        for lim in (model.limit_of(coord), (model.x_lower[k], model.x_upper[k])):
-            if lim is None or not (math.isfinite(lim[0]) and math.isfinite(lim[1])):
-                continue
-            turns = math.ceil((lim[0] - r) / (2 * math.pi))
-            if lim[0] <= r + 2 * math.pi * turns <= lim[1]:
-                r += 2 * math.pi * turns
-                break
-        if r == v:
+        r = reduce_angle(float(vec[k]), ranges)
+        if r == vec[k]:
             continue
-        trial = out.copy()
-        trial[k] = r
-        if np.max(np.abs(residual(model, trial, q)), initial=0.0) <= max(tolerance, 1e-12):
-            out = trial
-    return out
+        old = vec[k]
+        vec[k] = r
+        if not np.max(np.abs(residual(model, out_x, out_q)), initial=0.0) <= limit:
+            vec[k] = old
+    return out_x, out_q
 
 
 def inverse_kinematics(
@@ -484,6 +502,7 @@ def inverse_kinematics(
             details = {"reach": float(reach[0])}
             message = failure_message(model, Status.UNREACHABLE, details, None, None, None, config.tolerance)
             return PoseSolution(Status.UNREACHABLE, seconds=sec, solver="closed_form", message=message, details=details)
+        x, q = reduce_angles(model, np.asarray(x).ravel(), np.asarray(q).ravel(), config.tolerance)
         return _checked(model, x, q, config.tolerance, 0, sec, "closed_form")
     built = c.ik_solver(config)
     nd = len(c.dep_index)
@@ -499,8 +518,8 @@ def inverse_kinematics(
             solver=config.name,
             message=f"{config.name}: {msg or f'no convergence in {iters} iterations'}",
         )
-    x = c.assemble_x(tv, y[:nd])
-    q = y[nd:]
+    # angles reduced by whole turns into their declared ranges before the limit check (issue 20)
+    x, q = reduce_angles(model, c.assemble_x(tv, y[:nd]), y[nd:], config.tolerance)
     return _checked(model, x, q, config.tolerance, iters, sec, config.name)
 
 

@@ -663,3 +663,109 @@ def test_corpus_jacobian_against_central_differences(name):
         minus = cn.forward_kinematics(model, q - e, NEWTON, guess=fk.x)
         fd[:, k] = (np.asarray(plus.x) - np.asarray(minus.x)) / (2 * h)
     np.testing.assert_allclose(J, fd, rtol=0, atol=1e-6 * np.max(np.abs(J)))
+
+
+# -- generated branch indicators: mode invariants over a full crank turn (issue 20, item 5) --------
+
+
+def _branch(model, x, q):
+    g = np.asarray(model.closure.branch(np.asarray(x, float), np.asarray(q, float), model.p)).ravel()
+    return dict(zip(model.closure.branch_names, g.tolist()))
+
+
+def test_fourbar_pyslvs_indicators_over_a_full_turn():
+    """Without a `branch:` override the generated indicators (chain.R2: the coupler-rocker
+    dyad's assembly mode; aspect) are positive at every 15 deg of a full crank turn on the open
+    assembly (numpy: Freudenstein's root with P2 left of P1 -> P4) and negative on the crossed
+    one; chain.R2 has the sign of the triangle (P1, P2, P4)'s orientation there.  Before the
+    fix the old indicator (the coupler's cosine to its reference direction) was -0.255 at
+    0 deg, -0.998 at -60 deg and -0.428 at 180 deg, on the open assembly."""
+    model = _model("fourbar_pyslvs")
+    assert model.closure.branch_names == ("chain.R2", "aspect")
+    for deg in range(0, 360, 15):
+        t2 = deg * DEG
+        roots = _freudenstein(t2)
+        open_ = _fourbar_open(t2, roots)
+        crossed = next(r for r in roots if abs(_wrap(r - open_)) > 1e-6)
+        p1 = FB_A * np.array([math.cos(t2), math.sin(t2)])
+        for t4, sign in ((open_, 1.0), (crossed, -1.0)):
+            p2 = np.array([FB_D, 0.0]) + FB_C * np.array([math.cos(t4), math.sin(t4)])
+            assert math.copysign(1.0, _cross(p2 - p1, np.array([FB_D, 0.0]) - p2)) == -sign  # the mode, numpy
+            g = _branch(model, [t4], [t2])
+            assert all(v * sign > 0 for v in g.values()), (deg, sign, g)
+    for deg in (0.0, -60.0, 180.0):  # the brief's poses: FK solves on the open assembly
+        fk = cn.forward_kinematics(model, [deg * DEG], NEWTON)
+        assert fk.status == Status.SOLVED, fk.message
+        assert _wrap(fk.x[0] - _fourbar_open(deg * DEG, _freudenstein(deg * DEG))) == pytest.approx(0.0, abs=1e-9)
+
+
+def _rssr_mode(theta, phi):
+    """numpy: the sign of dg/dphi, g = |B(phi) - A(theta)|^2 - l^2 (the RSSR's two assembly
+    modes meet where it vanishes)."""
+    n = np.array([1.0, 0.0, 1.0]) / math.sqrt(2)
+    a0 = np.array([0.0, 0.5, 0.0])
+    A = a0 * math.cos(theta) + np.cross(n, a0) * math.sin(theta) + n * (n @ a0) * (1 - math.cos(theta))
+    B = np.array([1.0 - math.sin(phi), math.cos(phi), 0.0])
+    return math.copysign(1.0, 2 * (B - A) @ np.array([-math.cos(phi), -math.sin(phi), 0.0]))
+
+
+def test_rssr_linkr_indicators_over_a_full_turn():
+    """The generated indicators (coupler.S2: the coupler-output sub-chain's assembly mode;
+    aspect) are positive over a full input turn (every 15 deg) on the root with the sign of
+    dg/dphi of home (numpy) and negative on the other root.  The old indicator was -0.223 at
+    theta = -90 deg on the designated mode."""
+    model = _model("rssr_linkr")
+    assert model.closure.branch_names == ("coupler.S2", "aspect")
+    home = _rssr_mode(0.0, 0.0)
+    for deg in range(-180, 180, 15):
+        for phi in _rssr_outputs(deg * DEG):
+            sign = _rssr_mode(deg * DEG, phi) * home
+            g = _branch(model, [phi], [deg * DEG])
+            assert all(v * sign > 0 for v in g.values()), (deg, phi, g)
+    fk = cn.forward_kinematics(model, [-90 * DEG], NEWTON)
+    assert fk.status == Status.SOLVED, fk.message
+
+
+def _slider_pose(angle, right, side):
+    """numpy: the pose (x, y, phi, s) of L3 in metres and radians, the slider right (or left)
+    of the crank pin, J3 on the initial (or the other) side of J2 -> J4 (phi None: the rocker
+    does not reach L3 there)."""
+    p = {k: np.array(v) for k, v in SLIDER.items()}
+    d = lambda a, b: float(np.linalg.norm(p[a] - p[b]))  # noqa: E731
+    p1 = p[0] + d(0, 1) * np.array([math.cos(angle), math.sin(angle)])
+    p2 = np.array([p1[0] + (1 if right else -1) * math.sqrt(d(1, 2) ** 2 - p1[1] ** 2), 0.0])
+    s0 = math.copysign(1.0, _cross(p[4] - p[2], p[3] - p[2]))
+    try:
+        p3 = _circle(p2, d(2, 3), p[4], d(3, 4), s0 if side else -s0)
+    except ValueError:
+        return np.array([p2[0] * MM, 0.0, 0.0, (p2[0] - p[2][0]) * MM]), None
+    ang = lambda v: math.atan2(v[1], v[0])  # noqa: E731
+    phi = ang(p3 - p2) - ang(p[3] - p[2])
+    return np.array([p2[0] * MM, 0.0, phi, (p2[0] - p[2][0]) * MM]), phi
+
+
+def test_crank_slider_sixbar_pyslvs_indicators_over_a_full_turn():
+    """The generated indicators: crank.R2 (the rod and slider: positive with the slider right
+    of the crank pin, as in Pyslvs), rocker.R1 (L3 and the rocker: positive with J3 on the
+    initial side of J2 -> J4), aspect (their product): at every 15 deg of a full turn each has
+    the sign of its own mode in the numpy model.  With the slider left of the crank pin the
+    rocker never reaches L3 (this geometry), so there crank.R2 is checked on the rod-slider
+    sub-chain alone (its rows closed; it does not depend on phi).  The old indicator of the
+    rod was -0.302 at 0 deg on the designated mode."""
+    model = _model("crank_slider_sixbar_pyslvs")
+    assert model.closure.branch_names == ("crank.R2", "rocker.R1", "aspect")
+    for deg in range(0, 360, 15):
+        q = [deg * DEG]
+        for side in (True, False):
+            x, phi = _slider_pose(deg * DEG, True, side)
+            assert phi is not None
+            assert np.max(np.abs(cn.residual(model, x, q))) < 1e-12
+            g = _branch(model, x, q)
+            want = 1 if side else -1
+            assert g["crank.R2"] > 0 and math.copysign(1, g["rocker.R1"]) == want, (deg, g)
+            assert math.copysign(1, g["aspect"]) == want
+        x, phi = _slider_pose(deg * DEG, False, True)
+        assert phi is None
+        closed = np.abs(cn.residual(model, x, q)) < 1e-12
+        assert closed.sum() == 3, deg  # the rod and the slider's two rows; not the rocker's
+        assert _branch(model, x, q)["crank.R2"] < 0, deg

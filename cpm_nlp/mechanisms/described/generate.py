@@ -19,9 +19,26 @@ eliminating them from the platform end (the classical leg constraints):
   move c by known amounts.
 
 The eliminated joints' values (the passive joint angles) are recovered from
-the chain afterwards, and each elimination gives an assembly-branch indicator:
-the cosine of the eliminated link's angle to its reference direction, positive
-on the reference configuration's branch (plus the length of a P leg).
+the chain afterwards, and each elimination gives a branch indicator, an
+invariant of a mode (it changes sign only at a singularity of the sub-chain
+it separates, never because a link turned far), positive at the reference
+configuration (:meth:`Generator.elimination_indicators`):
+
+* the link closes a sub-chain of its own (its rows make a diagonal block of
+  Φ_x in block-triangular form with no other elimination: a four-bar's
+  coupler and rocker, an RSSR's coupler and output crank, a slider-crank's
+  rod and slider): that block's determinant (the passive Jacobian of the
+  sub-chain) over its value at home -- its assembly mode (a triangle closed
+  at a revolute: its orientation);
+* the link is one of several holding a platform: the leg's working mode, the
+  derivative of its closure with respect to the joint before the eliminated
+  one -- for a revolute at a (axis w) moving c: the triple product
+  w·((c - a) × (B - c)), the side of B of the plane through the crank and its
+  axis (planar: the orientation of the triangle a, c, B, the elbow); for a P
+  along e: e·(B - c); over its value at home; the platform's assembly mode
+  is the ``aspect``;
+* a P leg: its length over its reference length (its working mode) and the
+  cosine of the leg to its reference direction.
 """
 
 from __future__ import annotations
@@ -35,7 +52,7 @@ from typing import Any
 import casadi as ca
 
 from ...analysis import flexure
-from ...core.aspect import ASPECT, ASPECT_DESCRIPTION, ASPECT_MAX_NX
+from ...core.aspect import ASPECT, ASPECT_DESCRIPTION, ASPECT_MAX_NX, twist_determinant
 from ...core.aspect import aspect as aspect_indicator
 from ...core.errors import InputError, format_key_path, suggest
 from ...core.model import Coordinate
@@ -47,7 +64,19 @@ from .spec import Description, Joint, Leg
 POINT_JOINTS = {"S", "planar_R"}
 #: what the generated indicators measure
 _COSINE = "cosine of the link to the platform joint to its reference direction"
-_COSINE_AXIS = "cosine of the link about the joint's axis to its reference direction"
+_ASSEMBLY = (
+    "assembly mode of the sub-chain this link closes: det of its passive Jacobian (a block of Φ_x) "
+    "over its value at home"
+)
+_WORKING_R = (
+    "working mode: w·((c - a) × (B - c)) of the joint before it (axis w at a) and the link c -> B, "
+    "over its value at home"
+)
+_WORKING_PLANAR = (
+    "working mode (elbow): the signed area of the triangle (a, c, B) of the joint before it and the "
+    "link c -> B, over its value at home"
+)
+_WORKING_P = "working mode: e·(B - c) of the P joint before it (axis e) and the link c -> B, over its value at home"
 
 SPHERE_JOINTS = {"U", "S", "planar_R"}
 #: the letter a drawing marks each joint type with (a distance joint: a rod between two spherical joints)
@@ -133,6 +162,8 @@ class Generator:
         self.rows: list[tuple[ca.SX, str]] = []
         #: the assembly-branch indicators: (expression, name, what it measures)
         self.branch: list[tuple[ca.SX, str, str]] = []
+        #: eliminated links whose indicator waits for Φ_x: (position in branch, rows, working mode, what)
+        self.pending: list[tuple[int, list[int], ca.SX | None, str]] = []
         self.q_coords: list[Coordinate] = []
         self.q_syms: list[ca.SX] = []
         self.q_home: list[ca.SX] = []
@@ -410,7 +441,7 @@ class Generator:
             up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
             self.rows.append((ca.dot(v, w) - h, f"leg {leg.name}: plane of the R joint"))
             self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: radius about the R joint"))
-            self.indicator(ca.dot(up, vp) / ca.dot(up, up), leg, elim, _COSINE_AXIS)
+            self.eliminated(leg, elim, before, c, vp, 2)
             theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
             self.report(elim, [theta], leg.name)
             Rb = _rot(w, theta) @ Rm
@@ -419,23 +450,96 @@ class Generator:
             up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
             rp = ca.norm_2(u0 - ca.dot(u0, elim.axis) * elim.axis)
             self.rows.append(((ca.dot(vp, vp) - rp**2) / (2 * rp), f"leg {leg.name}: cylinder of the C joint"))
-            self.indicator(ca.dot(up, vp) / ca.dot(up, up), leg, elim, _COSINE_AXIS)
+            self.eliminated(leg, elim, before, c, vp, 1)
             theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
             self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0, elim.axis)], leg.name)
             Rb = _rot(w, theta) @ Rm
         else:
             self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: distance"))
-            self.indicator(ca.dot(u, v) / ca.dot(u0, u0), leg, elim, _COSINE)
+            self.eliminated(leg, elim, before, c, v, 1)
             Rb = self.report_sphere(elim, Rm, u0, v, leg)
         self.report_tip(last, Rb, R_rel, leg.name)
 
-    def indicator(self, value: ca.SX, leg: Leg, j: _Joint, what: str) -> None:
+    def indicator(self, value: ca.SX | None, leg: Leg, j: _Joint, what: str) -> None:
         """A generated branch indicator, named after its leg and joint (``a1.U1``: leg a1, its
-        first joint, a U)."""
+        first joint, a U); value None: filled in by :meth:`elimination_indicators`."""
         n = j.spec.path[-1] + 1 if j.spec.path and isinstance(j.spec.path[-1], int) else 0
         letter = "R" if j.type == "planar_R" else "P" if j.type == "planar_P" else j.type
         name = f"{leg.name}.{letter}{n}"
         self.branch.append((value, name, f"leg {leg.name}, joint {n} ({j.type}): {what}"))
+
+    def eliminated(self, leg: Leg, elim: _Joint, before: list[_Joint], c: ca.SX, vp: ca.SX, nrows: int) -> None:
+        """Record an eliminated link c -> B (its last ``nrows`` closure rows; vp: c -> B, for an R or
+        C normal to its axis) and its working-mode expression: the closure's rate with respect to
+        the joint before it, w·((c - a) × vp) for a revolute (axis w at a), e·vp for a P along e
+        (None: no joint before it, or one with several motions).  The indicator itself is chosen
+        once Φ_x is known (:meth:`elimination_indicators`)."""
+        working, what = None, ""
+        if before and before[-1].type in ("R", "planar_R", "P", "planar_P"):
+            b = before[-1]
+            Rk, tk = self.chain(before[:-1])  # the joint before, moved by the joints before it
+            if b.type in ("R", "planar_R"):
+                rate = ca.cross(Rk @ b.axis, c - (Rk @ b.at + tk))
+                what = _WORKING_PLANAR if self.d.platform.planar else _WORKING_R
+            else:
+                rate = Rk @ b.axis
+                what = _WORKING_P
+            working = ca.dot(rate, vp)
+        rows = list(range(len(self.rows) - nrows, len(self.rows)))
+        self.pending.append((len(self.branch), rows, working, what))
+        self.indicator(None, leg, elim, "")
+
+    def elimination_indicators(self, q: ca.SX) -> None:
+        """The indicator of each eliminated link (recorded by :meth:`eliminated`), a mode invariant.
+
+        If the link's rows make a diagonal block of Φ_x (block-triangular form, Dulmage-Mendelsohn)
+        holding no other elimination, the link closes a sub-chain of its own (a four-bar's coupler
+        with the rocker, a slider-crank's rod with the slider): its indicator is the determinant of
+        that block -- the sub-chain's passive Jacobian -- over its value at home.  It changes sign
+        only where the sub-chain is singular (the coupler and rocker aligned), i.e. between its
+        assembly modes; for a triangle closed at a revolute it is the triangle's orientation, for
+        an S-S link the side of the output crank's plane.  Otherwise the link is one of several
+        holding the platform, whose assembly mode is the ``aspect``; its indicator is the leg's
+        working mode, the closure's rate with respect to the joint before the link over its
+        value at home (the Delta's and the five-bar's elbows), changing sign only where the
+        leg is stretched or folded (a singularity of the leg).  A link with neither (fixed c and
+        a shared block) gets no indicator."""
+        if not self.pending:
+            return
+        phi = ca.vertcat(*[r[0] for r in self.rows])
+        J = ca.jacobian(phi, self.x)
+        xq, home = ca.vertcat(self.x, q), ca.vertcat(self.x_home, *self.q_home)
+        block_of, blocks = {}, []
+        if ca.sprank(J.sparsity()) == J.size1() == J.size2():
+            nb, rowperm, colperm, rowblock, colblock, *_ = J.sparsity().btf()
+            for k in range(nb):
+                rows, cols = rowperm[rowblock[k] : rowblock[k + 1]], colperm[colblock[k] : colblock[k + 1]]
+                blocks.append((rows, cols))
+                block_of.update({r: k for r in rows})
+        owners: dict[int, int] = {}
+        for _pos, rows, _w, _what in self.pending:
+            ks = {block_of.get(r) for r in rows}
+            if len(ks) == 1 and None not in ks:
+                k = ks.pop()
+                owners[k] = owners.get(k, 0) + 1
+        drop = []
+        for pos, rows, working, what in self.pending:
+            _v, name, desc = self.branch[pos]
+            ks = {block_of.get(r) for r in rows}
+            k = next(iter(ks)) if len(ks) == 1 else None
+            value = None
+            if k is not None and owners.get(k) == 1 and len(blocks[k][1]) <= ASPECT_MAX_NX:
+                brows, bcols = blocks[k]
+                d = twist_determinant(phi[brows], ca.vertcat(*[self.x[j] for j in bcols]), self.R)
+                value, what = d / ca.substitute(d, xq, home), _ASSEMBLY
+            elif working is not None:
+                # over its value at home: polynomial in the pose (an interval proof of outside stays tight)
+                value = working / ca.substitute(working, xq, home)
+            if value is None:
+                drop.append(pos)
+                continue
+            self.branch[pos] = (value, name, desc + what)
+        self.branch = [b for k, b in enumerate(self.branch) if k not in drop]
 
     def draw_leg(
         self,
@@ -634,6 +738,7 @@ class Generator:
                 path=("platform", "coordinates"),
                 hint="declare the coordinates the structure fixes under platform.fixed, or add legs",
             )
+        self.elimination_indicators(q)
         self.aspect(q)
         self.select_branch(added)
         if len(d.platform.task) != len(self.q_coords):
