@@ -109,6 +109,22 @@ class _Registry:
             self.version += 1
         return mech
 
+    def entry(self, name: str) -> tuple[Any, Any, Any]:
+        """What the registry holds under ``name`` (to put back with :meth:`restore`)."""
+        with self._lock:
+            return self._discover().get(name), self._loaded.get(name), self._closures.get(name)
+
+    def restore(self, name: str, entry: tuple[Any, Any, Any]) -> None:
+        """Put back what :meth:`entry` returned (nothing, if it held nothing)."""
+        spec, loaded, closure = entry
+        with self._lock:
+            for table, value in ((self._discover(), spec), (self._loaded, loaded), (self._closures, closure)):
+                if value is None:
+                    table.pop(name, None)
+                else:
+                    table[name] = value
+            self.version += 1
+
     def unregister(self, name: str) -> None:
         with self._lock:
             self._discover().pop(name, None)
@@ -243,9 +259,9 @@ def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
 SECTION_KEYS = ("type", "file", "description", "parameters", "limits")
 
 
-def section_type(section: Mapping[str, Any], base_dir: Any = None, path: tuple = ("mechanism",)) -> str:
-    """The mechanism type a problem file's ``mechanism:`` section names: ``type`` (registered),
-    ``file`` (a mechanism file, relative to the problem file) or ``description`` (inline)."""
+def _section_described(section: Mapping[str, Any], base_dir: Any, path: tuple) -> Mechanism | None:
+    """The mechanism a section's ``file`` or ``description`` describes (not registered), or
+    None for a ``type``."""
     given = [k for k in ("type", "file", "description") if section.get(k) is not None]
     if len(given) != 1:
         raise InputError(
@@ -254,7 +270,7 @@ def section_type(section: Mapping[str, Any], base_dir: Any = None, path: tuple =
             path=path,
         )
     if given[0] == "type":
-        return section["type"]
+        return None
     if given[0] == "file":
         raw = section["file"]
         if not isinstance(raw, str) or not raw.strip():
@@ -274,12 +290,29 @@ def section_type(section: Mapping[str, Any], base_dir: Any = None, path: tuple =
             raise InputError(
                 f"in the mechanism file {inner}", path=path + ("file",), suggestions=exc.suggestions, hint=exc.hint
             ) from None
-        return use_described(mech, path).name
+        return mech
     try:
         mech = described.from_dict(section["description"], base_dir=Path(base_dir) if base_dir else None)
     except InputError as exc:
         raise exc.at(prefix=path + ("description",)) from None
-    return use_described(mech, path).name
+    return mech
+
+
+def section_model(section: Mapping[str, Any], base_dir: Any = None, path: tuple = ("mechanism",)) -> Model:
+    """The model of a problem file's ``mechanism:`` section.  A mechanism file or inline
+    description is registered under its name only if its model builds: a refused one (an
+    edited copy of a shipped file, of the same name) leaves the registry as it was, so that a
+    later problem in the same process gets the mechanism that name had before."""
+    described_mech = _section_described(section, base_dir, path)
+    if described_mech is None:
+        return build_model(section["type"], section.get("parameters"), section.get("limits"))
+    before = REGISTRY.entry(described_mech.name)
+    name = use_described(described_mech, path).name
+    try:
+        return build_model(name, section.get("parameters"), section.get("limits"))
+    except BaseException:
+        REGISTRY.restore(name, before)
+        raise
 
 
 def closure_of(mech: Mechanism) -> LoopClosure:

@@ -34,7 +34,7 @@ from ..core.result import Result
 from ..core.solver import SolverConfig
 from ..io.datafile import data_file_of, merge_data_file
 from ..io.inputs import display_name, input_dir
-from ..mechanisms.registry import SECTION_KEYS, build_model, section_type
+from ..mechanisms.registry import SECTION_KEYS, section_model
 from .overrides import apply_overrides
 from .published import parse_reproduce
 from .reader import read_yaml
@@ -99,7 +99,7 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
     for key in mech:
         if key not in SECTION_KEYS:
             raise unknown_key_error(str(key), SECTION_KEYS, ("mechanism",), "mechanism key")
-    model = build_model(section_type(mech, base_dir), mech.get("parameters"), mech.get("limits"))
+    model = section_model(mech, base_dir)
     reason = kind.supports(model)
     if reason:
         raise InputError(
