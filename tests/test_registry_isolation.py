@@ -22,7 +22,8 @@ def test_a_refused_copy_of_a_shipped_file_does_not_take_its_name(tmp_path):
     assert old in text
     (tmp_path / "mechanisms").mkdir()
     bad = tmp_path / "mechanisms" / "prs3.yaml"
-    bad.write_text(text.replace(old, "axes: [[0, -1, 0], [sin(alpha0), 0, cos(alpha0)], [sin(alpha0), 0, cos(alpha0)]]"))
+    dependent = "axes: [[0, -1, 0], [sin(alpha0), 0, cos(alpha0)], [sin(alpha0), 0, cos(alpha0)]]"
+    bad.write_text(text.replace(old, dependent))
     problem = tmp_path / "p.yaml"
     problem.write_text((PROBLEMS / "prs3_file_forward_kinematics.yaml").read_text())
     with pytest.raises(cn.InputError, match="linearly dependent"):
