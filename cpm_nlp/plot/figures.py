@@ -530,7 +530,7 @@ def _stroke_edges(data: ResultData, closure: Any) -> list[np.ndarray]:
     return [T[ok]] if ok.sum() > 1 else []
 
 
-def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any) -> Any:
+def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any) -> Any:  # noqa: C901 - one branch per kind
     """A planar workspace (two task coordinates, e.g. the five-bar's x, y) in its plane:
     the points, the rectangle (inscribed_cuboid) or the bounding box (actuator_workspace),
     and the boundary: the zero level of the membership margin (workspace,
