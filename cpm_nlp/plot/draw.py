@@ -212,12 +212,17 @@ class BoundarySlice:
     y: Any
     inside: Any
     at: float
+    #: the boundary as polylines (K x 2, SI) placed more finely than the grid's contour
+    #: (e.g. bisected onto it), drawn instead of the contour
+    lines: Any = None
 
 
 def _slice_lines(sl: BoundarySlice) -> list[np.ndarray]:
     """The boundary of the reachable part of a slice: polylines (K x 2, SI) of the 0.5 level."""
     from contourpy import contour_generator
 
+    if sl.lines is not None:
+        return [np.asarray(line, dtype=float).reshape(-1, 2) for line in sl.lines]
     raw = np.asarray(sl.inside)
     level = 0.5 if raw.dtype == bool else 0.0
     z = raw.astype(float)
@@ -271,6 +276,7 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
     boxes: Sequence[tuple[Sequence[float], Sequence[float], str]] = (),
     slices: Sequence[BoundarySlice] = (),
     hull: Any = None,
+    slices_label: str = "workspace boundary (slices through the box centre)",
 ) -> Any:
     """A point cloud (N x 3, SI) in 3-D and its three projections, with an
     optional cuboid ``(lower corner, upper corner)`` drawn in, further
@@ -339,7 +345,7 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
             ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label=None if drawn_boundary else "_b")
             drawn_boundary = True
     if drawn_boundary:
-        ax.plot([], [], color="k", lw=1.2, label="workspace boundary (slices through the box centre)")
+        ax.plot([], [], color="k", lw=1.2, label=slices_label)
     B = None
     if box is not None:
         B = box * f

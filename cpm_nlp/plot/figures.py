@@ -351,7 +351,17 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
             hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
             centre = np.clip(data.live.task_of(data.live.x_home), lo, hi)
             slices = _boundary_slices(data.live, lo, hi, centre)
-            return workspace_figure(pts, names=task, dimensions=kinds, title=title, points_label=label, slices=slices)
+            if data.live.closure.ik is not None:  # membership is cheap: each vertex bisected onto the boundary
+                slices = [replace(sl, lines=_refined_boundary(data.live, sl, centre)) for sl in slices]
+            return workspace_figure(
+                pts,
+                names=task,
+                dimensions=kinds,
+                title=title,
+                points_label=label,
+                slices=slices,
+                slices_label="workspace boundary (slices through the home pose)",
+            )
     elif cuboid is not None:  # inscribed_cuboid: the workspace around it from the model, if at hand
         pts, label, slices = np.zeros((0, 3)), "", ()
         boxes = _paper_boxes(data)
@@ -417,7 +427,11 @@ def _workspace_around(model: Any, cuboid: tuple) -> tuple[np.ndarray, list[Bound
     margin = 0.25 * (hi - lo)
     lo, hi = lo - margin, hi + margin
     cloud = sample_workspace(model, CLOUD_SAMPLE, 0, (lo, hi))[0]
-    return cloud, _boundary_slices(model, lo, hi, centre)
+    slices = _boundary_slices(model, lo, hi, centre)
+    if model.closure.ik is not None and model.closure.x[model.closure.task_index[-1]].kind == "angle":
+        # a planar x, y, phi (the 3-RRR): cheap membership, each vertex bisected onto the boundary
+        slices = [replace(sl, lines=_refined_boundary(model, sl, centre)) for sl in slices]
+    return cloud, slices
 
 
 def _boundary_slices(
