@@ -1081,6 +1081,7 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
 
 
 def _legend_below(fig: Any, ax: Any, note: str = "") -> None:
+    note = _wrap(note, 140) if len(note) > 140 else note  # a long note in lines, not past the figure's edges
     handles, labels = ax.get_legend_handles_labels()
     keep = [(h, lab) for h, lab in zip(handles, labels) if not lab.startswith("_")]
     if keep:
