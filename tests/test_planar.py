@@ -178,6 +178,7 @@ def test_every_plot_of_the_planar_problems_is_drawn(solved, name, tmp_path):
     three_d = _three_d(fig)
     if name.startswith("rrr3") and kind == "workspace":  # (x, y, phi): one 3-D view and three planes
         assert len(three_d) == 1 and len(fig.axes) == 4
+        assert three_d[0].get_zlabel() == r"$\phi$ (deg)", three_d[0].get_zlabel()  # not "z (mm)"
     else:  # the drawing in its plane, the five-bar's workspace in its plane
         assert not three_d, f"{name}: a planar figure drawn in 3-D"
 

@@ -316,6 +316,22 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
     title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
     if data.problem == "actuator_workspace" and len(_closure(data).task) == 2:  # its points are x, y
         return _planar_workspace_plot(data, options, _closure(data))
+    if data.problem == "actuator_workspace" and isinstance(v.get("points"), list):  # task coordinates
+        closure = _closure(data)
+        task = list(closure.task)
+        lo, hi = [v.get(f"{t}_min") for t in task], [v.get(f"{t}_max") for t in task]
+        box = (lo, hi) if all(isinstance(b, (int, float)) for b in lo + hi) else None
+        # no hull: the faces between the corners' images are curved (the grid's images lie outside
+        # the corners' hull), and the images themselves show the shape
+        return workspace_figure(
+            np.asarray(v["points"], dtype=float),
+            cuboid=box,
+            names=task,
+            dimensions=[closure.x[i].kind for i in closure.task_index],
+            title=title,
+            points_label="images of the stroke grid",
+            cuboid_label="bounding box",
+        )
     if v.get("points") is not None:
         pts = np.asarray(v["points"], dtype=float)
         if pts.ndim != 2 or pts.shape[1] != 3:
