@@ -1292,6 +1292,8 @@ def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, 
         a.plot(t0[0] * fx, t0[1] * fy, "*", color="tab:red", ms=14, mec="k", label="the pose")
         a.set_xlabel(axis_label(names[0], ux))
         a.set_ylabel(axis_label(names[1], uy))
+        if kinds[0] == kinds[1] == "length" and ux == uy:  # a plane of the workspace: equal scales
+            a.set_aspect("equal", adjustable="box")
         at = ""
         for k in range(2, len(names)):  # the task coordinates held at the pose (none for a 2-D task)
             fk, uk = display_unit(kinds[k], [t0[k]])
