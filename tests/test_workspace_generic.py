@@ -47,7 +47,7 @@ def test_prs3_inscribed_cuboid_from_its_limits(tmp_path):
     assert result.status is Status.SOLVED, result.message
     v = result.values
     assert v["check_outside"] == 0 and v["starts_agreed"] == 2
-    assert result.units["volume"] == "m*rad*rad"
+    assert result.units["volume"] == "m*rad^2"  # a length times two angles (size_dimension)
     model = problem.model
     # every corner assembles by the closed-form IK within the limits (kinematics.assess)
     lower = np.array([v["pz_min"], v["psi_min"], v["theta_min"]])

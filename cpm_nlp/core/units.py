@@ -57,6 +57,10 @@ DIMENSIONS: dict[str, Dimension] = {
         Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg"), 1e4),
         Dimension("area", "m^2", "mm^2", "12 mm^2", ("m^2", "mm^2", "cm^2", "um^2"), 1e6),
         Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3"), 1e3),
+        # sizes of boxes of task coordinates with angles among them (size_dimension)
+        Dimension("length_angle", "m*rad", "mm*deg", "2 mm*deg", ("m*rad", "mm*deg"), 1e4),
+        Dimension("area_angle", "m^2*rad", "mm^2*deg", "12 mm^2*deg", ("m^2*rad", "mm^2*deg"), 1e7),
+        Dimension("length_angle2", "m*rad^2", "mm*deg^2", "2 mm*deg^2", ("m*rad^2", "mm*deg^2"), 1e5),
         Dimension("density", "kg/m^3", "kg/m^3", "2810 kg/m^3", ("kg/m^3", "g/cm^3"), 1e5),
         Dimension("time", "s", "s", "5 ms", ("s", "ms", "us"), 1e7),
         Dimension("frequency", "Hz", "Hz", "93.8 Hz", ("Hz", "kHz"), 1e12),
@@ -240,8 +244,56 @@ def to_display(value: float, dimension: str) -> tuple[float, str]:
     return value * f_si / f_disp, dim.display
 
 
+#: the size of a box of task coordinates by its numbers of lengths and angles
+#: (a length, an area or a volume by the number of translational coordinates)
+SIZE_DIMENSIONS: dict[tuple[int, int], str] = {
+    (1, 0): "length",
+    (2, 0): "area",
+    (3, 0): "volume",
+    (0, 1): "angle",
+    (1, 1): "length_angle",
+    (2, 1): "area_angle",
+    (1, 2): "length_angle2",
+}
+#: (powers of length, of angle) of the sizes whose printed unit takes an SI prefix
+_SIZE_POWERS = {d: k for k, d in SIZE_DIMENSIONS.items() if k[0] > 1 or (k[0] and k[1])}
+_PREFIXES = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
+
+
+def size_dimension(kinds: Any) -> tuple[str, str]:
+    """Dimension and SI unit of the size of a box whose sides have the dimensions
+    ``kinds`` (task coordinates): ``["length", "length"]`` -> ``("area", "m^2")``,
+    ``["length", "length", "angle"]`` -> ``("area_angle", "m^2*rad")``; other
+    mixes: ``"task volume"`` and the product of the SI units."""
+    kinds = list(kinds)
+    key = (kinds.count("length"), kinds.count("angle"))
+    if sum(key) == len(kinds) and key in SIZE_DIMENSIONS:
+        dim = SIZE_DIMENSIONS[key]
+        return dim, DIMENSIONS[dim].si
+    return "task volume", "*".join(DIMENSIONS[k].si for k in kinds)
+
+
+def _size_display(value: float, dimension: str) -> tuple[float, str]:
+    """An area, a volume or a length-angle product for people: in mm (mm^2, mm^3, mm*deg)
+    unless the number would be below 1e-3 (then µm, else nm) or at or above 1e9 (then m);
+    angles in degrees."""
+    n_len, n_ang = _SIZE_POWERS[dimension]
+    shown = value * (180.0 / math.pi) ** n_ang
+    prefix, size = "mm", 1e-3
+    if math.isfinite(value) and value != 0.0:
+        if abs(shown) >= 1e9 * 1e-3**n_len:
+            prefix, size = "m", 1.0
+        else:
+            prefix, size = next((p for p in _PREFIXES[1:] if abs(shown) >= 1e-3 * p[1] ** n_len), _PREFIXES[-1])
+    unit = prefix + (f"^{n_len}" if n_len > 1 else "")
+    unit += ("*deg" + (f"^{n_ang}" if n_ang > 1 else "")) if n_ang else ""
+    return shown / size**n_len, unit
+
+
 def format_quantity(value: float, dimension: str, digits: int = 6) -> str:
-    """``0.04791, "length"`` -> ``"47.91 mm"`` (for people, never for files)."""
-    shown, unit = to_display(value, dimension)
+    """``0.04791, "length"`` -> ``"47.91 mm"`` (for people, never for files); a size
+    (area, volume, area times angle) in mm unless tiny or huge: ``2.68e-7 m^2`` ->
+    ``"0.268133 mm^2"``, ``2.7e-14 m^3`` -> ``"27000 µm^3"``."""
+    shown, unit = _size_display(value, dimension) if dimension in _SIZE_POWERS else to_display(value, dimension)
     text = f"{shown:.{digits}g}"
     return f"{text} {unit}".strip()

@@ -23,7 +23,7 @@ from ..core.model import Model
 from ..core.options import Option, validate_mapping
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS
+from ..core.units import DIMENSIONS, size_dimension
 from .compliance import STRESS_LIMIT_OPTION, split_stress_limit
 from .kinematic import _model_info, _si
 
@@ -75,8 +75,8 @@ class ActuatorWorkspace(ProblemKind):
         for i in c.task_index:
             coord = c.x[i]
             dims.update({f"{coord.name}_min": coord.kind, f"{coord.name}_max": coord.kind})
-        kinds = [c.x[i].kind for i in c.task_index]
-        vol = "volume" if c.nq == 3 and all(k == "length" for k in kinds) else "*".join(_si(k) for k in kinds)
+        vol, si = size_dimension(c.x[i].kind for i in c.task_index)  # an area for a planar x, y
+        vol = vol if vol in DIMENSIONS else si
         dims.update({"volume": vol, "linear_volume": vol, "box_volume": vol, "volume_ratio": "dimensionless"})
         dims["vertices"] = "matrix"
         dims["jacobian_deviation"] = "dimensionless"

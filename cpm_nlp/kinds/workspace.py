@@ -35,7 +35,7 @@ from ..core.multistart import start_options
 from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS
+from ..core.units import DIMENSIONS, size_dimension
 from .compliance import STRESS_LIMIT_OPTION, split_stress_limit
 from .kinematic import _model_info
 
@@ -79,20 +79,11 @@ def _region(inputs: Mapping[str, Any], model: Model, path: tuple) -> tuple[np.nd
     return np.array([inputs[n][0] for n in names]), np.array([inputs[n][1] for n in names])
 
 
-#: the size of a box or a region by its number of translational task coordinates
-SIZE_DIMENSIONS = {1: "length", 2: "area", 3: "volume"}
-
-
 def _volume_dimension(model: Model) -> tuple[str, str]:
-    """Dimension and SI unit of the size of a box in the task coordinates: a length,
-    an area or a volume when every task coordinate is a length (by their number),
-    else the product of their units (a "task volume")."""
-    kinds = [model.closure.x[i].kind for i in model.closure.task_index]
-    if all(k == "length" for k in kinds) and len(kinds) in SIZE_DIMENSIONS:
-        dim = SIZE_DIMENSIONS[len(kinds)]
-        return dim, DIMENSIONS[dim].si
-    unit = "*".join(DIMENSIONS[k].si for k in kinds)
-    return "task volume", unit
+    """Dimension and SI unit of the size of a box in the task coordinates: a length, an
+    area or a volume by the number of translational task coordinates, times the angles'
+    (:func:`~cpm_nlp.core.units.size_dimension`)."""
+    return size_dimension(model.closure.x[i].kind for i in model.closure.task_index)
 
 
 class InscribedCuboid(ProblemKind):

@@ -212,19 +212,28 @@ class BoundarySlice:
     y: Any
     inside: Any
     at: float
+    #: the boundary as polylines (K x 2, SI) placed more finely than the grid's contour
+    #: (e.g. bisected onto it), drawn instead of the contour
+    lines: Any = None
 
 
 def _slice_lines(sl: BoundarySlice) -> list[np.ndarray]:
     """The boundary of the reachable part of a slice: polylines (K x 2, SI) of the 0.5 level."""
     from contourpy import contour_generator
 
+    if sl.lines is not None:
+        return [np.asarray(line, dtype=float).reshape(-1, 2) for line in sl.lines]
     raw = np.asarray(sl.inside)
     level = 0.5 if raw.dtype == bool else 0.0
     z = raw.astype(float)
     finite = z[np.isfinite(z)]
-    if not finite.size or finite.min() >= level or finite.max() <= level:
+    if not finite.size:
         return []
-    z = np.where(np.isfinite(z), z, finite.min())
+    # a point that does not assemble (margin -inf or nan) is outside, below every finite margin
+    low = min(float(finite.min()), level) - (float(np.ptp(finite)) or 1.0)
+    z = np.where(np.isfinite(z), z, np.where(z == np.inf, float(finite.max()), low))
+    if z.min() >= level or z.max() <= level:
+        return []
     gen = contour_generator(np.asarray(sl.x, dtype=float), np.asarray(sl.y, dtype=float), z)
     return [np.asarray(line) for line in gen.lines(level)]
 
@@ -267,6 +276,7 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
     boxes: Sequence[tuple[Sequence[float], Sequence[float], str]] = (),
     slices: Sequence[BoundarySlice] = (),
     hull: Any = None,
+    slices_label: str = "workspace boundary (slices through the box centre)",
 ) -> Any:
     """A point cloud (N x 3, SI) in 3-D and its three projections, with an
     optional cuboid ``(lower corner, upper corner)`` drawn in, further
@@ -335,7 +345,7 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
             ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label=None if drawn_boundary else "_b")
             drawn_boundary = True
     if drawn_boundary:
-        ax.plot([], [], color="k", lw=1.2, label="workspace boundary (slices through the box centre)")
+        ax.plot([], [], color="k", lw=1.2, label=slices_label)
     B = None
     if box is not None:
         B = box * f
@@ -392,6 +402,89 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
         a2.set_ylabel(labels[j])
         a2.grid(True, alpha=0.3)
         a2.autoscale_view()
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def workspace_figure_2d(
+    points: Any,
+    *,
+    cuboid: tuple[Sequence[float], Sequence[float]] | None = None,
+    names: Sequence[str] = ("x", "y"),
+    dimensions: Sequence[str | None] = ("length", "length"),
+    title: str = "",
+    points_label: str = "reachable points",
+    cuboid_label: str = "maximal inscribed rectangle",
+    slices: Sequence[BoundarySlice] = (),
+    outline: Sequence[Any] = (),
+    boundary_label: str = "workspace boundary",
+    corners: Any = None,
+    note: str = "",
+) -> Any:
+    """A planar workspace (two task coordinates): the points (N x 2, SI), an optional
+    rectangle ``(lower, upper)``, its boundary as the zero level of the membership
+    margin of ``slices`` (axes (0, 1)) and/or as given polylines ``outline`` (K x 2, SI,
+    e.g. the image of the stroke square's edges), the ``corners`` (K x 2) marked; one
+    axes, equal scales where both axes are of one dimension; ``note`` under the legend
+    says what the boundary is."""
+    Figure = _figure_class()
+    from matplotlib.patches import Rectangle
+
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    lines = [np.asarray(line, dtype=float).reshape(-1, 2) for line in outline]
+    for sl in slices:
+        lines += _slice_lines(sl)
+    box = None if cuboid is None else np.array([np.asarray(c, dtype=float).ravel()[:2] for c in cuboid])
+    cor = None if corners is None else np.asarray(corners, dtype=float).reshape(-1, 2)
+    parts = [pts, *lines] + ([] if box is None else [box]) + ([] if cor is None else [cor])
+    both = np.vstack([p for p in parts if len(p)]) if any(len(p) for p in parts) else np.zeros((0, 2))
+    if not len(both):
+        raise InputError("no finite points to plot")
+    same = dimensions[0] == dimensions[1]
+    scales = [display_unit(dimensions[i], both if same else both[:, i]) for i in range(2)]
+    f = np.array([s[0] for s in scales])
+    fig = Figure(figsize=(8, 7.5), layout="constrained")
+    ax = fig.add_subplot(1, 1, 1)
+    if len(pts):
+        P = pts * f
+        size = float(np.clip(3000 / max(len(P), 1), 2, 25))
+        ax.scatter(P[:, 0], P[:, 1], s=size, color="tab:blue", alpha=0.35, lw=0, label=f"{points_label} ({len(P)})")
+    for n, line in enumerate(lines):
+        ax.plot(line[:, 0] * f[0], line[:, 1] * f[1], color="k", lw=1.4, label="_" if n else boundary_label)
+    if cor is not None:
+        ax.plot(cor[:, 0] * f[0], cor[:, 1] * f[1], "s", color="k", ms=6, mfc="white", label="corners (images)")
+    if box is not None:
+        lo, hi = box.min(axis=0) * f, box.max(axis=0) * f
+        ax.add_patch(
+            Rectangle(
+                (lo[0], lo[1]),
+                hi[0] - lo[0],
+                hi[1] - lo[1],
+                fill=False,
+                edgecolor="tab:red",
+                lw=2,
+                label=f"{cuboid_label} ({_box_sizes(lo, hi, scales)})",
+            )
+        )
+    ax.set_xlabel(axis_label(names[0], scales[0][1]))
+    ax.set_ylabel(axis_label(names[1], scales[1][1]))
+    ax.grid(True, alpha=0.3)
+    if same:
+        ax.set_aspect("equal", adjustable="datalim")
+    ax.margins(0.05)
+    handles = [(h, lab) for h, lab in zip(*ax.get_legend_handles_labels()) if not lab.startswith("_")]
+    if handles:
+        fig.legend(
+            [h for h, _ in handles],
+            [lab for _, lab in handles],
+            loc="outside lower center",
+            ncols=min(2, len(handles)),
+            fontsize="small",
+            title=_wrap(note, 95) or None,
+            title_fontsize="x-small",
+        )
     if title:
         fig.suptitle(title)
     return fig
@@ -753,6 +846,74 @@ def draw_mechanism(
         ax.quiver(*o, *v, color=arrow.colour, lw=2, arrow_length_ratio=0.15, label=arrow.label or "_")
 
 
+def is_planar(*drawings: Any) -> bool:
+    """Every point of the drawings in the plane z = 0 (to 1e-9 of their size): a planar
+    mechanism, drawn in 2-D."""
+    pts = np.array([np.asarray(v, dtype=float).ravel()[:3] for d in drawings for v in d.points.values()])
+    if not len(pts) or pts.shape[1] < 3:
+        return False
+    span = float(np.ptp(pts[:, :2], axis=0).max()) or 1.0
+    return bool(np.all(np.abs(pts[:, 2]) <= 1e-9 * span))
+
+
+def draw_mechanism_2d(
+    ax: Any,
+    drawing: Any,
+    *,
+    factor: float,
+    faint: bool = False,
+    label_points: bool = True,
+    arrows: Sequence[Arrow] = (),
+) -> None:
+    """:func:`draw_mechanism` for a planar mechanism, in a 2-D axes (its plane z = 0)."""
+    from matplotlib.patches import Polygon
+
+    pts = {k: np.asarray(v, dtype=float).ravel()[:2] * factor for k, v in drawing.points.items()}
+    seen: set[str] = set()
+    for part, corners in drawing.faces:
+        colour = "0.85" if faint else _FACE_COLOUR[part]
+        poly = np.array([pts[c] for c in corners])
+        label = "_" if faint or part in seen else part
+        seen.add(part)
+        ax.add_patch(
+            Polygon(
+                poly,
+                closed=True,
+                facecolor=colour,
+                edgecolor="0.5" if faint else colour,
+                alpha=0.12 if faint else 0.3,
+                label=label,
+            )
+        )
+    for a, b, part in drawing.segments:
+        colour, width = _PART_STYLE[part]
+        xy = np.array([pts[a], pts[b]])
+        label = "_" if faint or part in seen else part
+        seen.add(part)
+        ax.plot(
+            *xy.T, color="0.7" if faint else colour, lw=1.0 if faint else width, ls="--" if faint else "-", label=label
+        )
+    if faint:
+        ax.plot([], [], color="0.7", lw=1.0, ls="--", label="home pose")
+        return
+    kinds: set[str] = set()
+    for name, letter in drawing.joints.items():
+        face = "white" if letter == "S" else "k"
+        label = "_" if letter in kinds else f"{_JOINT_NAME[letter]} joint ({letter})"
+        kinds.add(letter)
+        ax.scatter(*pts[name], marker=_JOINT_MARKER[letter], s=40, facecolor=face, edgecolor="k", zorder=5, label=label)
+    if label_points:
+        for p, names in _coincident(pts):
+            ax.annotate(
+                " = ".join(names), p, xytext=(4, 4), textcoords="offset points", fontsize="x-small", color="0.2"
+            )
+    for arrow in arrows:
+        o = np.asarray(arrow.origin, dtype=float).ravel()[:2] * factor
+        v = np.asarray(arrow.vector, dtype=float).ravel()[:2] * factor
+        ax.annotate("", o + v, xytext=o, arrowprops={"arrowstyle": "-|>", "color": arrow.colour, "lw": 2}, zorder=6)
+        ax.plot([], [], color=arrow.colour, lw=2, label=arrow.label or "_")
+
+
 def _coincident(pts: Mapping[str, np.ndarray]) -> list[tuple[np.ndarray, list[str]]]:
     """The points grouped where they coincide (one label each: "A1 = C1")."""
     allpts = np.array(list(pts.values())) if pts else np.zeros((0, 3))
@@ -791,12 +952,26 @@ def mechanism_axes(
     label_points: bool = True,
 ) -> Any:
     """A 3-D axes of ``fig`` (subplot ``position``) with the mechanism drawn at
-    its pose (and faintly at ``home``), axes in one length unit, equal scales."""
-    ax = fig.add_subplot(*position, projection="3d")
+    its pose (and faintly at ``home``), axes in one length unit, equal scales; a
+    planar mechanism (every point in z = 0) in a 2-D axes of its plane."""
     allpts = np.array([np.asarray(v, dtype=float).ravel()[:3] for v in drawing.points.values()])
     if home is not None:
         allpts = np.vstack([allpts, [np.asarray(v, dtype=float).ravel()[:3] for v in home.points.values()]])
     factor, unit = display_unit("length", allpts)
+    if is_planar(drawing, *([home] if home is not None else [])):
+        ax = fig.add_subplot(*position)
+        if home is not None:
+            draw_mechanism_2d(ax, home, factor=factor, faint=True)
+        draw_mechanism_2d(ax, drawing, factor=factor, arrows=arrows, label_points=label_points)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.margins(0.12)
+        ax.set_xlabel(f"x ({unit})")
+        ax.set_ylabel(f"y ({unit})")
+        ax.grid(True, alpha=0.3)
+        if title:
+            ax.set_title(title, fontsize="small")
+        return ax
+    ax = fig.add_subplot(*position, projection="3d")
     if home is not None:
         draw_mechanism(ax, home, factor=factor, faint=True)
     draw_mechanism(ax, drawing, factor=factor, arrows=arrows, label_points=label_points)
@@ -876,6 +1051,17 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
     """The ellipsoid {S f : |f| = 1} (or the ellipse of a 2x2 S, in the plane z = centre)
     drawn in shown units at ``centre``, ``scale`` shown units per m/N."""
     n = S.shape[0]
+    if not hasattr(ax, "zaxis"):  # a planar mechanism in its plane: the ellipse of the x, y block
+        S2 = S[:2, :2]
+        t = np.linspace(0, 2 * np.pi, 200)
+        pts = np.stack([np.cos(t), np.sin(t)], axis=-1) @ S2.T * scale
+        ax.plot(pts[:, 0] + centre[0], pts[:, 1] + centre[1], color="tab:purple", lw=2, zorder=9)
+        w, V = principal_axes(S2)
+        for k in range(2):
+            a = V[:, k] * w[k] * scale
+            ax.plot(*np.array([centre[:2] - a, centre[:2] + a]).T, color="tab:purple", lw=3, zorder=10)
+        ax.plot([], [], color="tab:purple", lw=3, label="compliance ellipse (scaled)")
+        return
     if n == 3:
         u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
         dirs = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
@@ -895,6 +1081,7 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
 
 
 def _legend_below(fig: Any, ax: Any, note: str = "") -> None:
+    note = _wrap(note, 140) if len(note) > 140 else note  # a long note in lines, not past the figure's edges
     handles, labels = ax.get_legend_handles_labels()
     keep = [(h, lab) for h, lab in zip(handles, labels) if not lab.startswith("_")]
     if keep:
@@ -1105,6 +1292,8 @@ def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, 
         a.plot(t0[0] * fx, t0[1] * fy, "*", color="tab:red", ms=14, mec="k", label="the pose")
         a.set_xlabel(axis_label(names[0], ux))
         a.set_ylabel(axis_label(names[1], uy))
+        if kinds[0] == kinds[1] == "length" and ux == uy:  # a plane of the workspace: equal scales
+            a.set_aspect("equal", adjustable="box")
         at = ""
         for k in range(2, len(names)):  # the task coordinates held at the pose (none for a 2-D task)
             fk, uk = display_unit(kinds[k], [t0[k]])

@@ -55,6 +55,7 @@ from .draw import (
     BoundarySlice,
     Comparison,
     Panel,
+    _slice_lines,
     as_floats,
     comparison_figure,
     design_map_figure,
@@ -68,6 +69,7 @@ from .draw import (
     modes_mechanism_figure,
     panels_figure,
     pretty,
+    workspace_figure_2d,
 )
 from .draw import workspace_figure as workspace_figure_png
 from .interactive import mechanism_html, workspace_html
@@ -312,6 +314,24 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
     workspace_figure = workspace_html if options.interactive else workspace_figure_png
     v = data.values
     title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
+    if data.problem == "actuator_workspace" and len(_closure(data).task) == 2:  # its points are x, y
+        return _planar_workspace_plot(data, options, _closure(data))
+    if data.problem == "actuator_workspace" and isinstance(v.get("points"), list):  # task coordinates
+        closure = _closure(data)
+        task = list(closure.task)
+        lo, hi = [v.get(f"{t}_min") for t in task], [v.get(f"{t}_max") for t in task]
+        box = (lo, hi) if all(isinstance(b, (int, float)) for b in lo + hi) else None
+        # no hull: the faces between the corners' images are curved (the grid's images lie outside
+        # the corners' hull), and the images themselves show the shape
+        return workspace_figure(
+            np.asarray(v["points"], dtype=float),
+            cuboid=box,
+            names=task,
+            dimensions=[closure.x[i].kind for i in closure.task_index],
+            title=title,
+            points_label="images of the stroke grid",
+            cuboid_label="bounding box",
+        )
     if v.get("points") is not None:
         pts = np.asarray(v["points"], dtype=float)
         if pts.ndim != 2 or pts.shape[1] != 3:
@@ -323,8 +343,10 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
         return workspace_figure(pts, cuboid=cuboid, names=names, dimensions=(dim,) * 3, title=title)
     closure = _closure(data)
     task = list(closure.task)
+    if len(task) == 2:
+        return _planar_workspace_plot(data, options, closure)
     if len(task) != 3:
-        raise NotApplicable(f"a workspace cloud needs 3 task coordinates; {closure.name} has {len(task)}")
+        raise NotApplicable(f"a workspace cloud needs 2 or 3 task coordinates; {closure.name} has {len(task)}")
     kinds = [closure.x[i].kind for i in closure.task_index]
     cuboid = None
     if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
@@ -340,6 +362,22 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
     if all(_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
         pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
         label = "reachable points (seeded sample)"
+        if data.live is not None and all(isinstance(v.get(f"{t}_range"), list) for t in task):
+            lo = np.array([v[f"{t}_range"][0] for t in task], dtype=float)
+            hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
+            centre = np.clip(data.live.task_of(data.live.x_home), lo, hi)
+            slices = _boundary_slices(data.live, lo, hi, centre)
+            if data.live.closure.ik is not None:  # membership is cheap: each vertex bisected onto the boundary
+                slices = [replace(sl, lines=_refined_boundary(data.live, sl, centre)) for sl in slices]
+            return workspace_figure(
+                pts,
+                names=task,
+                dimensions=kinds,
+                title=title,
+                points_label=label,
+                slices=slices,
+                slices_label="workspace boundary (slices through the home pose)",
+            )
     elif cuboid is not None:  # inscribed_cuboid: the workspace around it from the model, if at hand
         pts, label, slices = np.zeros((0, 3)), "", ()
         boxes = _paper_boxes(data)
@@ -405,18 +443,199 @@ def _workspace_around(model: Any, cuboid: tuple) -> tuple[np.ndarray, list[Bound
     margin = 0.25 * (hi - lo)
     lo, hi = lo - margin, hi + margin
     cloud = sample_workspace(model, CLOUD_SAMPLE, 0, (lo, hi))[0]
+    slices = _boundary_slices(model, lo, hi, centre)
+    if model.closure.ik is not None and model.closure.x[model.closure.task_index[-1]].kind == "angle":
+        # a planar x, y, phi (the 3-RRR): cheap membership, each vertex bisected onto the boundary
+        slices = [replace(sl, lines=_refined_boundary(model, sl, centre)) for sl in slices]
+    return cloud, slices
+
+
+def _boundary_slices(
+    model: Any, lo: np.ndarray, hi: np.ndarray, centre: np.ndarray, grid: int = SLICE_GRID
+) -> list[BoundarySlice]:
+    """The workspace's boundary in the planes of two task axes through ``centre`` (one
+    plane for two task coordinates, three for three): the membership margin on a grid
+    of the box (lo, hi), positive inside; its zero level is the boundary (where a leg
+    stops reaching, the branch changes or a joint limit binds), traced, not a hull."""
+    n = len(lo)
+    pairs = ((0, 1),) if n == 2 else ((0, 1), (0, 2), (1, 2))
     slices = []
-    for i, j in ((0, 1), (0, 2), (1, 2)):
-        k = 3 - i - j
-        gx, gy = np.linspace(lo[i], hi[i], SLICE_GRID), np.linspace(lo[j], hi[j], SLICE_GRID)
+    for i, j in pairs:
+        gx, gy = np.linspace(lo[i], hi[i], grid), np.linspace(lo[j], hi[j], grid)
         X, Y = np.meshgrid(gx, gy)
-        T = np.empty((X.size, 3))
-        T[:, i], T[:, j], T[:, k] = X.ravel(), Y.ravel(), centre[k]
+        T = np.tile(np.asarray(centre, dtype=float), (X.size, 1))
+        T[:, i], T[:, j] = X.ravel(), Y.ravel()
         member = membership(model, T)
         margin = np.where(np.isfinite(member.margin), member.margin, -np.inf)  # does not assemble: outside
         margin = np.where(member.inside, np.maximum(margin, 0.0), np.minimum(margin, -1e-300))
-        slices.append(BoundarySlice((i, j), gx, gy, margin.reshape(X.shape), float(centre[k])))
-    return cloud, slices
+        at = float(centre[3 - i - j]) if n == 3 else 0.0
+        slices.append(BoundarySlice((i, j), gx, gy, margin.reshape(X.shape), at))
+    return slices
+
+
+def _refined_boundary(model: Any, sl: BoundarySlice, centre: Any, iterations: int = 14) -> list[np.ndarray]:
+    """The boundary of a slice (polylines, SI) with each vertex moved onto the true
+    boundary: contour vertices lie on grid edges between an inside and an outside node
+    (where the margin is -inf, i.e. the pose does not assemble, the contour would sit
+    anywhere between them); bisection on membership along that edge places it to
+    2^-iterations of the grid step."""
+    i, j = sl.axes
+    gx, gy = np.asarray(sl.x, dtype=float), np.asarray(sl.y, dtype=float)
+    dy = float(np.diff(gy).min())
+
+    def inside(uv: np.ndarray) -> np.ndarray:
+        T = np.tile(np.asarray(centre, dtype=float), (len(uv), 1))
+        T[:, i], T[:, j] = uv[:, 0], uv[:, 1]
+        return np.asarray(membership(model, T).inside, dtype=bool)
+
+    out = []
+    for line in _slice_lines(sl):
+        P = np.asarray(line, dtype=float).copy()
+        ky = np.abs(gy[None, :] - P[:, 1:2]).argmin(axis=1)
+        horizontal = np.abs(gy[ky] - P[:, 1]) <= 1e-6 * dy
+        kx = np.clip(np.searchsorted(gx, P[:, 0]) - 1, 0, len(gx) - 2)
+        ky0 = np.clip(np.searchsorted(gy, P[:, 1]) - 1, 0, len(gy) - 2)
+        a = np.where(horizontal[:, None], np.c_[gx[kx], P[:, 1]], np.c_[P[:, 0], gy[ky0]])
+        b = np.where(horizontal[:, None], np.c_[gx[kx + 1], P[:, 1]], np.c_[P[:, 0], gy[ky0 + 1]])
+        ina, inb = inside(a), inside(b)
+        move = ina != inb
+        lo = np.where(ina[:, None], a, b)[move]  # the inside end
+        hi = np.where(ina[:, None], b, a)[move]
+        for _ in range(iterations if move.any() else 0):
+            mid = 0.5 * (lo + hi)
+            m = inside(mid)
+            lo = np.where(m[:, None], mid, lo)
+            hi = np.where(m[:, None], hi, mid)
+        P[move] = 0.5 * (lo + hi)
+        out.append(P)
+    return out
+
+
+#: grid lines per axis of the boundary of a planar (two task coordinates) workspace
+PLANAR_GRID = 121
+#: what the boundary of a planar workspace is, under its legend
+MEMBERSHIP_BOUNDARY = (
+    "boundary: the zero level of the membership margin on a {g} x {g} grid, each vertex bisected onto "
+    "the boundary (where a leg stops reaching, the branch changes or a joint limit binds): traced, not "
+    "a hull, so a non-convex workspace keeps its holes and dents"
+)
+STROKE_BOUNDARY = (
+    "boundary: the image of the stroke square's edges under the forward kinematics (the workspace's "
+    "boundary where no singularity lies inside the strokes)"
+)
+
+
+def _stroke_edges(data: ResultData, closure: Any) -> list[np.ndarray]:
+    """The image of the stroke square's edges (polylines, SI) of a 2-actuator
+    actuator_workspace: its ``points`` grid (samples per actuator, first actuator
+    slowest) walked round the edges, else FK along the edges of the live model's strokes."""
+    v = data.values
+    pts = np.asarray(v["points"], dtype=float) if isinstance(v.get("points"), list) else None
+    if closure.nq != 2:
+        return []
+    if pts is not None and pts.ndim == 2 and pts.shape[1] == 2:
+        n = math.isqrt(len(pts))
+        if n >= 2 and n * n == len(pts):
+            G = pts.reshape(n, n, 2)  # [i of q1, j of q2]
+            loop = np.vstack([G[0, :], G[:, -1], G[-1, ::-1], G[::-1, 0]])
+            return [loop]
+    if data.live is None:
+        return []
+    from ..analysis.workspace import joint_box
+    from ..core.batch import batch_forward_kinematics
+
+    lo, hi = joint_box(data.live)
+    s = np.linspace(0.0, 1.0, 41)
+    walk = np.vstack(
+        [
+            np.c_[np.full_like(s, lo[0]), lo[1] + s * (hi[1] - lo[1])],
+            np.c_[lo[0] + s * (hi[0] - lo[0]), np.full_like(s, hi[1])],
+            np.c_[np.full_like(s, hi[0]), hi[1] - s * (hi[1] - lo[1])],
+            np.c_[hi[0] - s * (hi[0] - lo[0]), np.full_like(s, lo[1])],
+        ]
+    )
+    res = batch_forward_kinematics(data.live, walk)
+    T = np.asarray(res.x, dtype=float)[:, closure.task_index]
+    ok = np.asarray(res.ok, dtype=bool)
+    return [T[ok]] if ok.sum() > 1 else []
+
+
+def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any) -> Any:  # noqa: C901 - one branch per kind
+    """A planar workspace (two task coordinates, e.g. the five-bar's x, y) in its plane:
+    the points, the rectangle (inscribed_cuboid) or the bounding box (actuator_workspace),
+    and the boundary: the zero level of the membership margin (workspace,
+    inscribed_cuboid, with the model at hand) or the image of the stroke square's edges
+    (actuator_workspace)."""
+    if options.interactive:
+        raise NotApplicable("a planar workspace is drawn as .png, .svg or .pdf (no interactive .html figure)")
+    v = data.values
+    task = list(closure.task)
+    kinds = [closure.x[i].kind for i in closure.task_index]
+    title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
+    cuboid = None
+    if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
+        cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
+    common = {"names": task, "dimensions": kinds, "title": title}
+    if data.problem == "actuator_workspace":
+        pts = np.asarray(v["points"], dtype=float) if isinstance(v.get("points"), list) else np.zeros((0, 2))
+        corners = np.asarray(v["vertices"], dtype=float) if isinstance(v.get("vertices"), list) else None
+        edges = _stroke_edges(data, closure)
+        return workspace_figure_2d(
+            pts,
+            cuboid=cuboid,
+            cuboid_label="bounding box",
+            points_label="images of the stroke grid",
+            outline=edges,
+            corners=corners,
+            note=STROKE_BOUNDARY if edges else "no boundary: give inputs.points: true or plot with solve --plot",
+            **common,
+        )
+    note = MEMBERSHIP_BOUNDARY.format(g=PLANAR_GRID)
+    if all(_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
+        pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
+        slices: list[BoundarySlice] = []
+        if data.live is not None and all(isinstance(v.get(f"{t}_range"), list) for t in task):
+            lo = np.array([v[f"{t}_range"][0] for t in task], dtype=float)
+            hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
+            slices = _boundary_slices(data.live, lo, hi, (lo + hi) / 2, PLANAR_GRID)
+        return workspace_figure_2d(
+            pts,
+            points_label="reachable points (seeded sample)",
+            outline=[line for sl in slices for line in _refined_boundary(data.live, sl, (lo + hi) / 2)],
+            note=note if slices else "no boundary: plot with solve --plot (the model at hand)",
+            **common,
+        )
+    if cuboid is not None:  # inscribed_cuboid (or synthesis): the workspace around it, if the model is at hand
+        pts, slices, label = np.zeros((0, 2)), [], ""
+        if data.live is not None:
+            lo, hi = (np.asarray(c, dtype=float) for c in cuboid)
+            centre = (lo + hi) / 2
+            for probed in (probe_region(data.live, centre=centre), probe_region(data.live)):
+                if probed is not None:  # the box, the region probed from its centre and from home
+                    lo, hi = np.minimum(lo, probed[0]), np.maximum(hi, probed[1])
+            pad = 0.1 * (hi - lo)
+            lo, hi = lo - pad, hi + pad
+            pts = sample_workspace(data.live, CLOUD_SAMPLE, 0, (lo, hi))[0]
+            slices = _boundary_slices(data.live, lo, hi, centre, PLANAR_GRID)
+            label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+        else:
+            title += "\n(the rectangle alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
+        common["title"] = title
+        return workspace_figure_2d(
+            pts,
+            cuboid=cuboid,
+            cuboid_label="maximal inscribed rectangle",
+            points_label=label,
+            outline=[line for sl in slices for line in _refined_boundary(data.live, sl, centre)],
+            note=note if slices else "",
+            **common,
+        )
+    names = [_pose_name(data, closure, t) for t in task]  # a batch of poses
+    _require_lists(data, names, "a workspace plot")
+    pts = np.array([as_floats(v[n]) for n in names]).T
+    if data.ok is not None:
+        pts = pts[data.ok]
+    return workspace_figure_2d(pts, points_label="solved poses", **common)
 
 
 # -- map ---------------------------------------------------------------------------------------------
@@ -738,7 +957,7 @@ def _drawings(model: Any, x: np.ndarray, q: np.ndarray) -> tuple[Any, Any, float
     H = {k: np.asarray(v, dtype=float) for k, v in home.points.items()}
     span = float(np.ptp(np.array(list(H.values())), axis=0).max())
     move = max(float(np.linalg.norm(P[k] - H[k])) for k in P)
-    if move == 0.0 or span == 0.0 or move >= SMALL_MOTION * span:
+    if move <= TITLE_NOISE * span or span == 0.0 or move >= SMALL_MOTION * span:  # at home: no exaggeration
         return pose, home, 1.0
     k = 0.1 * span / move
     k = float(10 ** math.floor(math.log10(k)))
@@ -746,12 +965,32 @@ def _drawings(model: Any, x: np.ndarray, q: np.ndarray) -> tuple[Any, Any, float
     return replace(pose, points=shown), home, k
 
 
-def _pose_title(model: Any, x: np.ndarray, k: float) -> str:
+def _span(drawing: Any) -> float:
+    """The size of a drawing (SI): the largest extent of its points."""
+    pts = np.array([np.asarray(v, dtype=float).ravel()[:3] for v in drawing.points.values()])
+    return float(np.ptp(pts, axis=0).max()) if len(pts) > 1 else 0.0
+
+
+#: a pose coordinate below this fraction of the mechanism's size (lengths) or of a degree
+#: (angles) is rounding noise of the solve: its title shows 0
+TITLE_NOISE = 1e-9
+
+
+def _pose_title(model: Any, x: np.ndarray, k: float, size: float = 0.0) -> str:
+    """ "five_bar at x = 0 mm, y = 203.8 mm": the task coordinates of the pose, each in its
+    own unit; a value below :data:`TITLE_NOISE` of the mechanism's ``size`` (SI: the span
+    of its drawing; lengths) or of a degree (angles) is rounding noise, shown as 0 in the
+    unit of the size (not "x = -7.939e-12 nm")."""
     c = model.closure
+    lengths = [abs(x[i]) for i in c.task_index if c.x[i].kind == "length"]
+    size = max([size, *lengths]) if lengths or size else 0.0
     parts = []
     for i in c.task_index:
-        f, unit = display_unit(c.x[i].kind, [x[i]])
-        parts.append(f"{c.x[i].name} = {x[i] * f:.4g} {unit}".rstrip())
+        kind = c.x[i].kind
+        scale = size if kind == "length" else math.radians(1.0) if kind == "angle" else 0.0
+        v = 0.0 if abs(x[i]) <= TITLE_NOISE * scale else x[i]
+        f, unit = display_unit(kind, [scale] if v == 0.0 and kind == "length" else [v])
+        parts.append(f"{c.x[i].name} = {v * f:.4g} {unit}".rstrip())
     lines = [", ".join(parts[n : n + 3]) for n in range(0, len(parts), 3)]  # three coordinates a line
     text = f"{model.name} at " + ",\n".join(lines)
     return text + (f"\n(displacements from home drawn ×{k:g})" if k != 1.0 else "")
@@ -765,7 +1004,7 @@ def mechanism_plot(data: ResultData, options: PlotOptions) -> Any:
     x, q = _single_pose(data, model)
     pose, home, k = _drawings(model, x, q)
     draw = mechanism_html if options.interactive else mechanism_figure
-    return draw(pose, home=home, title=_pose_title(model, x, k) + f" ({data.problem})", note=pose.note)
+    return draw(pose, home=home, title=_pose_title(model, x, k, _span(home)) + f" ({data.problem})", note=pose.note)
 
 
 def design_plot(data: ResultData, options: PlotOptions) -> Any:
@@ -843,11 +1082,13 @@ def jacobian_plot(data: ResultData, options: PlotOptions) -> Any:
     x, q = _single_pose(data, model)
     pose, home, k = _drawings(model, x, q)
     if options.interactive:
-        return mechanism_html(pose, home=home, title=_pose_title(model, x, k) + f" ({data.problem})", note=pose.note)
+        return mechanism_html(
+            pose, home=home, title=_pose_title(model, x, k, _span(home)) + f" ({data.problem})", note=pose.note
+        )
     got = _conditioning_slice(model, x)
     panels = [("cond", 2), ("manipulability", 3)] if got is not None else []
     fig = jacobian_figure(pose, home, got, panels, data.values)
-    fig.suptitle(_pose_title(model, x, k) + f" ({data.problem})")
+    fig.suptitle(_pose_title(model, x, k, _span(home)) + f" ({data.problem})")
     return fig
 
 

@@ -942,6 +942,15 @@ class Generator:
                 seen[c.group] = Option(
                     c.group, c.kind, f"range [low, high] of every actuator {c.group}*", default=None, shape="range"
                 )
+        for c in self.q_coords:  # one actuator alone (its homes may differ: the 3-RRR's cranks)
+            if c.name not in seen and sum(o.group == c.group for o in self.q_coords) > 1:
+                seen[c.name] = Option(
+                    c.name,
+                    c.kind,
+                    f"range [low, high] of {c.name} alone (overrides {c.group})",
+                    default=None,
+                    shape="range",
+                )
         for fam, (dim, lim, desc) in self.extra_limits.items():
             if fam not in seen:
                 seen[fam] = Option(fam, dim, f"range [low, high] of every {fam}* ({desc})", default=lim, shape="range")
