@@ -220,7 +220,9 @@ def test_the_five_bar_rectangle_sits_inside_its_drawn_boundary(solved):
     assert ax.get_aspect() == 1.0  # equal scales: x and y are both lengths
     assert "mm" in ax.get_xlabel() and "mm" in ax.get_ylabel()
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert any(t.startswith("maximal inscribed rectangle (244 × 118 mm)") for t in labels), labels
+    v = result.values
+    w, h = (v["x_max"] - v["x_min"]) * 1e3, (v["y_max"] - v["y_min"]) * 1e3
+    assert any(t.startswith(f"maximal inscribed rectangle ({w:.0f} × {h:.0f} mm)") for t in labels), labels
     assert "workspace boundary" in labels
     assert "not a hull" in fig.legends[0].get_title().get_text().replace("\n", " ")
 
