@@ -5,10 +5,10 @@ the Delta written here in numpy (issue 20).
 The reference: in the frame of arm i (turned by 2π(i-1)/3 about z) the platform joint is
 B = R_z(-θ_i) t + (rp, 0, 0) and the elbow A(q) = (rb + la cos q, 0, -la sin q); |B - A| = lb
 is a cos q + b sin q = K with a = -2 la (B_x - rb), b = 2 la B_z, K = lb² - |B - (rb, 0, 0)|²
-- la², solved by q = atan2(b, a) + acos(K / hypot(a, b)) (the root of home, q = 0).  The
-file's branch indicators are the generated ones (mechanism-files.md: the eliminated link's
-cosine to its reference direction, which turns with the arm), so the reference also asks
-(B - A)·R_y(q)(B0 - A0) > 0 of each strut, B0 - A0 = (rp - rb - la, 0, z0) at home.
+- la², solved by q = atan2(b, a) + acos(K / hypot(a, b)) (the root of home, q = 0: the elbow
+of home).  The file's branch indicators are the generated ones (mechanism-files.md: for an arm
+driven by one actuator, the strut's sense to the elbow's velocity along the actuator, positive
+at home), so the reference also asks (B - A)·dA/dq > 0 of each strut: the same elbow.
 """
 
 from __future__ import annotations
@@ -29,7 +29,6 @@ def delta_ik(T, rb=0.1, rp=0.04, la=0.12, lb=0.25, qlo=-np.pi / 3, qhi=np.pi / 2
     T = np.atleast_2d(T)
     Q = np.full((len(T), 3), np.nan)
     branch = np.ones(len(T), dtype=bool)
-    z0 = -np.sqrt(lb**2 - (rb + la - rp) ** 2)
     for i in range(3):
         th = 2 * np.pi * i / 3
         c, s = np.cos(th), np.sin(th)
@@ -43,10 +42,8 @@ def delta_ik(T, rb=0.1, rp=0.04, la=0.12, lb=0.25, qlo=-np.pi / 3, qhi=np.pi / 2
             Q[:, i] = np.arctan2(b, a) + np.arccos(K / np.hypot(a, b))
             f_x = bx - rb - la * np.cos(Q[:, i])
             f_z = bz + la * np.sin(Q[:, i])
-            c0, s0 = np.cos(Q[:, i]), np.sin(Q[:, i])
-            d_x = c0 * (rp - rb - la) + s0 * z0
-            d_z = -s0 * (rp - rb - la) + c0 * z0
-            branch &= f_x * d_x + f_z * d_z > 0
+            # the elbow's velocity along q is la (-sin q, 0, -cos q); the strut's sense to it
+            branch &= -f_x * np.sin(Q[:, i]) - f_z * np.cos(Q[:, i]) > 0
     Q = (Q + np.pi) % (2 * np.pi) - np.pi
     inside = np.all(np.isfinite(Q), axis=1) & np.all((Q >= qlo) & (Q <= qhi), axis=1) & branch
     return Q, inside

@@ -48,6 +48,10 @@ POINT_JOINTS = {"S", "planar_R"}
 #: what the generated indicators measure
 _COSINE = "cosine of the link to the platform joint to its reference direction"
 _COSINE_AXIS = "cosine of the link about the joint's axis to its reference direction"
+_ELBOW = (
+    "working mode: cosine of the link to the platform joint to its proximal end's velocity along the actuator, "
+    "as at the reference (else: that link's cosine to its reference direction)"
+)
 
 SPHERE_JOINTS = {"U", "S", "planar_R"}
 #: the letter a drawing marks each joint type with (a distance joint: a rod between two spherical joints)
@@ -423,9 +427,30 @@ class Generator:
             Rb = _rot(w, theta) @ Rm
         else:
             self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: distance"))
-            self.indicator(ca.dot(u, v) / ca.dot(u0, u0), leg, elim, _COSINE)
+            self.indicator(self.working_mode(before, c, v, ca.dot(u, v) / ca.dot(u0, u0)), leg, elim, _ELBOW)
             Rb = self.report_sphere(elim, Rm, u0, v, leg)
         self.report_tip(last, Rb, R_rel, leg.name)
+
+    def working_mode(self, before: list[_Joint], c: ca.SX, v: ca.SX, cosine: ca.SX) -> ca.SX:
+        """The working-mode (elbow) indicator of a leg closed by a sphere (distance) about c:
+        for a proximal chain driven by one actuator alone, the cosine of the link c -> B to the
+        velocity of c along that actuator, signed to be positive at the reference configuration.
+        The closure's derivative along the actuator is -(v . dc/dq) / r, so the two roots of the
+        leg's IK (the two elbows) have opposite signs and the indicator vanishes only at the leg's
+        own (type I) singularity.  Otherwise (passive joints before the sphere, several actuators,
+        or the reference itself singular) the link's cosine to its reference direction."""
+        driven = [j for j in before if j.value is not None]
+        if not before or len(driven) != len(before) or sum(j.spec.actuated is not None for j in before) != 1:
+            return cosine
+        q = ca.vertcat(*self.q_syms)
+        dc = ca.jacobian(c, q) @ ca.DM.ones(q.numel())
+        g = ca.dot(v, dc) / (ca.norm_2(v) * ca.norm_2(dc))
+        ref = ca.substitute(g, ca.vertcat(self.x, q), ca.vertcat(self.x_home, *self.q_home))
+        # ref / |ref|: the sign without OP_SIGN, which the interval proofs of outside do not take
+        return ca.if_else(ca.fabs(ref) > self.SINGULAR_REFERENCE, ref / ca.fabs(ref) * g, cosine)
+
+    #: |working-mode cosine| at the reference below which the reference counts as a leg singularity
+    SINGULAR_REFERENCE = 1e-6
 
     def indicator(self, value: ca.SX, leg: Leg, j: _Joint, what: str) -> None:
         """A generated branch indicator, named after its leg and joint (``a1.U1``: leg a1, its
