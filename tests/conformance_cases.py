@@ -66,10 +66,13 @@ class Subject:
         return all(self.model.limit_of(q) is not None for q in self.model.closure.q)
 
     def actuators_near_home(self, count: int, seed: int) -> np.ndarray:
-        """``count`` seeded actuator vectors about home: uniform in the strokes shrunk
-        towards the home actuators by the factor :data:`MOVE`."""
+        """``count`` seeded actuator vectors about home: uniform in the strokes (cut to home
+        plus or minus :func:`half_stroke`) shrunk towards the home actuators by :data:`MOVE`."""
         lo, hi = self.stroke()
-        q0 = self.model.q_home
+        m = self.model
+        q0 = m.q_home
+        half = np.array([half_stroke(m, co) for co in m.closure.q])
+        lo, hi = np.maximum(lo, q0 - half), np.minimum(hi, q0 + half)
         rng = np.random.default_rng(seed)
         return q0 + MOVE * ((lo - q0) + (hi - lo) * rng.random((count, q0.size)))
 
