@@ -46,9 +46,12 @@ from ..core.progress import track
 from ..core.solver import SolverConfig, run_nlp
 from .workspace import (
     CUBOID_IPOPT,
+    DEFAULT_CHECK_POINTS,
+    DEFAULT_NLP_SAMPLES,
     NLP_MARGIN,
     CuboidCheck,
     check_box,
+    default_per_edge,
     inscribed_cuboid,
     limit_bounds,
     limited_function,
@@ -175,8 +178,8 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
     *,
     starts: int = 4,
     seed: int = 0,
-    samples_per_edge: int = 3,
-    check_per_edge: int = 9,
+    samples_per_edge: int | None = None,
+    check_per_edge: int | None = None,
     rebuild: Callable[[dict[str, float]], Model] | None = None,
 ) -> SynthesisResult:
     """The design that maximises the inscribed cuboid per unit of footprint (see
@@ -212,6 +215,11 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
     design_idx = tuple(c.parameters.index(n) for n in names)
     exps = tuple(float(footprint.get(n, 0.0)) for n in names)
     d = c.nq
+    if samples_per_edge is None:  # 3 per edge, fewer in more than 3 task coordinates
+        samples_per_edge = default_per_edge(d, 3, DEFAULT_NLP_SAMPLES)
+    if check_per_edge is None:
+        check_per_edge = default_per_edge(d, 9, DEFAULT_CHECK_POINTS)
+    start_check = default_per_edge(d, 5, DEFAULT_CHECK_POINTS)
     S = surface_grid(d, samples_per_edge)
     N = len(S)
     lo_b, hi_b = limit_bounds(model)
@@ -235,7 +243,15 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
         except (InputError, ValueError) as exc:
             runs.append((False, None, f"design not buildable: {exc}", 0, None))
             continue
-        box = inscribed_cuboid(m0, config, starts=1, seed=seed, check_per_edge=5, refinements=0)
+        box = inscribed_cuboid(  # the start box on the synthesis's own grid (in 6-D 5 per edge: 14896 samples)
+            m0,
+            config,
+            starts=1,
+            seed=seed,
+            samples_per_edge=samples_per_edge,
+            check_per_edge=start_check,
+            refinements=0,
+        )
         if not box.found:
             runs.append((False, None, f"no cuboid at the start design ({box.message})", 0, None))
             continue

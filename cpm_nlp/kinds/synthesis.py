@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..analysis.synthesis import cuboid_synthesis
+from ..analysis.workspace import check_grid_sizes, check_per_edge_option
 from ..core.errors import InputError, suggest
 from ..core.kind import ProblemKind, require_ipopt
 from ..core.model import Model
@@ -60,15 +61,15 @@ class CuboidSynthesis(SynthesisFormulation):
 
     def input_options(self, model: Model) -> list[Option]:
         return start_options(default=4) + [
-            Option("samples_per_edge", "int", "sample points per box edge in the NLP", default=3, lower=2, upper=7),
             Option(
-                "check_per_edge",
+                "samples_per_edge",
                 "int",
-                "points per box edge of the membership check of the optimum",
-                default=9,
+                "sample points per box edge in the NLP (default: 3 for up to 3 task coordinates, fewer above)",
+                default=None,
                 lower=2,
-                upper=65,
+                upper=7,
             ),
+            check_per_edge_option(9),
         ]
 
     def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
@@ -85,6 +86,7 @@ class CuboidSynthesis(SynthesisFormulation):
         design = self._design(raw.pop("design"), model, path + ("design",))
         footprint = self._footprint(raw.pop("footprint", None), model, path + ("footprint",))
         inputs = validate_mapping(raw, self.input_options(model), path, what="input")
+        check_grid_sizes(model.closure.nq, inputs["samples_per_edge"], inputs["check_per_edge"], path)
         inputs["design"], inputs["footprint"] = design, footprint
         for name, e in footprint.items():
             low = design[name][0] if name in design else model.parameters[name]

@@ -22,7 +22,9 @@ from ..analysis.certify import CERTIFICATE_NAMES, CERTIFY_OPTION, certificate_va
 from ..analysis.workspace import (
     ADDED_PER_ROUND,
     CHECK_OPTION,
+    DEFAULT_NLP_SAMPLES,
     EXTRA_SLOTS,
+    check_grid_sizes,
     inscribed_cuboid,
     membership,
     workspace_cloud,
@@ -103,8 +105,9 @@ class InscribedCuboid(ProblemKind):
             Option(
                 "samples_per_edge",
                 "int",
-                "sample points per box edge in the NLP (odd keeps face centres)",
-                default=5,
+                "sample points per box edge in the NLP (odd keeps face centres; default: 5 for up to 3 task "
+                f"coordinates, fewer above, at most {DEFAULT_NLP_SAMPLES} samples)",
+                default=None,
                 lower=2,
                 upper=9,
             ),
@@ -134,6 +137,7 @@ class InscribedCuboid(ProblemKind):
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _region(inputs, model, path)
+        check_grid_sizes(model.closure.nq, inputs["samples_per_edge"], inputs["check_per_edge"], path)
 
     def check_solver(self, solver: SolverConfig) -> None:
         require_ipopt(solver, self.name)
@@ -283,7 +287,7 @@ class Workspace(ProblemKind):
         return (
             ["inside", "status", "margin", "binding", "inside_paper", "count_inside", "count_undecided"]
             + [f"cloud_{t}" for t in task]
-            + ["cloud_count", "cloud_undecided", "volume_estimate", "volume_estimate_upper"]
+            + ["cloud_count", "cloud_undecided", "volume_estimate", "volume_estimate_error", "volume_estimate_upper"]
             + [f"{t}_range" for t in task]
         )
 
@@ -329,12 +333,14 @@ class Workspace(ProblemKind):
                 values["cloud_count"] = len(cloud.points)
                 values["cloud_undecided"] = cloud.undecided
                 values["volume_estimate"] = cloud.volume
+                values["volume_estimate_error"] = cloud.volume_error
                 values["volume_estimate_upper"] = cloud.volume_upper
                 dims.update(cloud_count="dimensionless", cloud_undecided="dimensionless")
-                dims["volume_estimate"] = dims["volume_estimate_upper"] = vdim
+                dims["volume_estimate"] = dims["volume_estimate_upper"] = dims["volume_estimate_error"] = vdim
                 message = (
                     f"{cloud.inside} of {cloud.drawn} points of the search region inside, "
-                    f"{cloud.drawn - cloud.inside - cloud.undecided} outside, {cloud.undecided} undecided"
+                    f"{cloud.drawn - cloud.inside - cloud.undecided} outside, {cloud.undecided} undecided; "
+                    f"volume_estimate's standard error (Monte Carlo) is {cloud.volume_error:.3g}"
                 )
                 if cloud.undecided:
                     message += " (volume_estimate counts them outside, volume_estimate_upper inside)"

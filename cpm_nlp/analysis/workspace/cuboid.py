@@ -66,16 +66,80 @@ def surface_grid(d: int, n: int) -> np.ndarray:
     return _grid(d, n, None).copy()
 
 
+#: the most points a default grid gives: the cuboid NLP's samples, the membership check's
+#: surface, the membership check's interior (per edge counts fall with the dimension: a 6-axis
+#: platform's 5 samples per edge would be 14896 samples, each with its own pose unknowns)
+DEFAULT_NLP_SAMPLES = 100
+DEFAULT_CHECK_POINTS = 2000
+#: explicit per-edge counts may give at most this many points
+MAX_NLP_SAMPLES = 2000
+MAX_CHECK_POINTS = 200_000
+
+
+def surface_count(d: int, n: int) -> int:
+    """Points of :func:`surface_grid` (d, n): n^d - (n - 2)^d."""
+    return n**d - max(n - 2, 0) ** d
+
+
+def default_per_edge(d: int, largest: int, budget: int) -> int:
+    """The most points per edge, up to ``largest`` (at least 2), whose surface grid in d
+    dimensions has at most ``budget`` points (3 task coordinates: ``largest`` itself for the
+    defaults used here)."""
+    n = largest
+    while n > 2 and surface_count(d, n) > budget:
+        n -= 1
+    return n
+
+
+def check_interior(d: int) -> int:
+    """Interior points per edge of the membership check: 5, fewer where 5^d would pass
+    :data:`DEFAULT_CHECK_POINTS`."""
+    n = 5
+    while n > 1 and n**d > DEFAULT_CHECK_POINTS:
+        n -= 1
+    return n
+
+
+def check_per_edge_of(d: int, per_edge: int | None) -> int:
+    """The membership check's points per edge: as given, else 17 (fewer in more than 3 dimensions)."""
+    return per_edge if per_edge is not None else default_per_edge(d, 17, DEFAULT_CHECK_POINTS)
+
+
+def check_per_edge_option(default_3d: int) -> Option:
+    return Option(
+        "check_per_edge",
+        "int",
+        f"points per box edge of the membership check afterwards (default: {default_3d} for up to 3 task "
+        f"coordinates, fewer above, at most {DEFAULT_CHECK_POINTS} surface points)",
+        default=None,
+        lower=2,
+        upper=65,
+    )
+
+
 #: the input that sets the density of the membership check of a box
-CHECK_OPTION = Option(
-    "check_per_edge", "int", "points per box edge of the membership check afterwards", default=17, lower=2, upper=65
-)
+CHECK_OPTION = check_per_edge_option(17)
 
 
-def check_grid(d: int, per_edge: int, interior: int = 5) -> np.ndarray:
+def check_grid(d: int, per_edge: int, interior: int | None = None) -> np.ndarray:
     """Dense check sample of the unit box: its surface on a grid of ``per_edge``
-    points per edge, plus the interior points of a grid of ``interior + 2``."""
-    return _grid(d, per_edge, interior).copy()
+    points per edge, plus the interior points of a grid of ``interior + 2``
+    (default: :func:`check_interior`)."""
+    return _grid(d, per_edge, check_interior(d) if interior is None else interior).copy()
+
+
+def check_grid_sizes(d: int, samples_per_edge: int | None, check_per_edge: int | None, path: tuple) -> None:
+    """Refuse explicit per-edge counts whose grids are too large in d task coordinates."""
+    for key, n, most in (
+        ("samples_per_edge", samples_per_edge, MAX_NLP_SAMPLES),
+        ("check_per_edge", check_per_edge, MAX_CHECK_POINTS),
+    ):
+        if n is not None and surface_count(d, n) > most:
+            raise InputError(
+                f"{n} points per edge in {d} task coordinates give {surface_count(d, n)} points on the box's "
+                f"surface; expected at most {most} (leave it out for a default that suits {d} coordinates)",
+                path=path + (key,),
+            )
 
 
 # -- the cuboid NLP ------------------------------------------------------------------------------
@@ -151,12 +215,12 @@ class CuboidCheck:
 
 
 def check_box(
-    model: Model, lower, upper, per_edge: int = 17, solver: SolverConfig | None = None
+    model: Model, lower, upper, per_edge: int | None = None, solver: SolverConfig | None = None
 ) -> tuple[CuboidCheck, np.ndarray, Membership]:
     """Check a box against :func:`membership` on :func:`check_grid`; also returns
     the unit-box positions checked and the membership report."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    S = check_grid(lower.size, per_edge)
+    S = check_grid(lower.size, check_per_edge_of(lower.size, per_edge))
     mem = membership(model, lower + S * (upper - lower), solver)
     margin, binding = mem.worst()
     return CuboidCheck(len(S), mem.count_outside, margin, binding), S, mem
@@ -318,8 +382,8 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
     *,
     starts: int = 8,
     seed: int = 0,
-    samples_per_edge: int = 5,
-    check_per_edge: int = 17,
+    samples_per_edge: int | None = None,
+    check_per_edge: int | None = None,
     refinements: int = 3,
     region: tuple[np.ndarray, np.ndarray] | None = None,
     cloud: int = 2000,
@@ -330,7 +394,8 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
 
     starts: IPOPT starts (the first at the home pose, the others at points of
     a seeded point cloud of ``region``); samples_per_edge: the NLP's surface
-    grid; check_per_edge: the dense check's surface grid; refinements: the
+    grid (default 5, fewer in more than 3 task coordinates, see :func:`default_per_edge`);
+    check_per_edge: the dense check's surface grid (:func:`check_per_edge_of`); refinements: the
     largest number of exchange rounds; region: the box the starts are drawn
     from (default: probed around home); formulation: "poses" (pose unknowns at
     every sample, any mechanism), "closed_form" (the limited quantities through
@@ -384,6 +449,8 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
             region=(lo_r, hi_r),
             seconds=time.perf_counter() - t_start,
         )
+    if samples_per_edge is None:
+        samples_per_edge = default_per_edge(d, 5, DEFAULT_NLP_SAMPLES)
     base = surface_grid(d, samples_per_edge)
     # auto: the closed form unless the IK's own reach limit shapes the workspace in the
     # region (a cloud point that does not assemble): its derivatives are unbounded there
@@ -465,6 +532,22 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
         shrink = good
         lower, upper = mid - shrink * half, mid + shrink * half
         check = check_box(model, lower, upper, check_per_edge, config)[0]
+    if shrink == 0.0:  # a point, not a box: no shrink about the centre passes (a hole or a boundary there)
+        return CuboidResult(
+            False,
+            "no box passes the membership check: the best start's box passes it only when shrunk to its centre "
+            f"(a point); {check.points} points checked",
+            starts=len(runs),
+            converged=len(ok_vols),
+            agreed=agreed,
+            refinements=rounds,
+            shrink=0.0,
+            check=check,
+            iterations=iterations,
+            seconds=time.perf_counter() - t_start,
+            region=(lo_r, hi_r),
+            start_volumes=[v for v in volumes if v is not None],
+        )
     volume = float(np.prod(upper - lower))
     msg = f"best of {len(runs)} starts ({agreed} agree within {AGREEMENT:g})"
     if rounds:

@@ -96,7 +96,8 @@ class Cloud:
 
     points: the points inside (M, nq); region: the box they were drawn from (None if
     the home pose is outside and no region was given); drawn, inside, undecided:
-    counts; volume: the Monte-Carlo estimate (region volume × inside / drawn);
+    counts; volume: the Monte-Carlo estimate (region volume × inside / drawn), with its
+    standard error ``volume_error``;
     volume_upper: the same with the undecided points counted inside (equal to
     ``volume`` when none is undecided); undecided_points: those points (U, nq).
     """
@@ -109,6 +110,15 @@ class Cloud:
     volume: float = 0.0
     volume_upper: float = 0.0
     undecided_points: np.ndarray | None = None
+
+    @property
+    def volume_error(self) -> float:
+        """The standard error of ``volume``: region volume × sqrt(p (1 - p) / drawn), p = inside / drawn
+        (a binomial count; the Monte Carlo's own error, beside any undecided points)."""
+        if not self.drawn or self.region is None:
+            return 0.0
+        p = self.inside / self.drawn
+        return float(np.prod(self.region[1] - self.region[0])) * float(np.sqrt(p * (1.0 - p) / self.drawn))
 
 
 def workspace_cloud(
