@@ -18,7 +18,7 @@ import numpy as np
 import yaml
 
 import cpm_nlp as cn
-from cpm_nlp.mechanisms.registry import section_type
+from cpm_nlp.mechanisms.registry import section_model
 from cpm_nlp.problems.registry import GENERIC
 from cpm_nlp.problems.shipped import shipped_problems_dir
 
@@ -111,7 +111,7 @@ def _stroke_limits(mech: cn.Mechanism, model: cn.Model) -> dict[str, list[float]
 
 def _model(section: dict[str, Any], base_dir: Path | None) -> cn.Model:
     """The model a problem file's mechanism section builds."""
-    return cn.build_model(section_type(section, base_dir), section.get("parameters"), section.get("limits"))
+    return section_model(section, base_dir)
 
 
 def subject(name: str, section: dict[str, Any], base_dir: Path | None) -> Subject:

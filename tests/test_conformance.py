@@ -17,6 +17,7 @@ default parameters):
 
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
@@ -456,8 +457,40 @@ def test_every_generic_kind_is_checked():
     assert sorted(CHECKS) == sorted(cc.GENERIC_KINDS)
 
 
+#: (corpus file, kind) pairs that take 12 s to 370 s each on the 2-core machine: a cuboid or a
+#: synthesis of a mechanism without a closed-form IK, its membership by IPOPT point solves and
+#: interval proofs (measured 2026-11-27 at load 2-4: Williams's Delta synthesis 366 s, ARTE's
+#: 3-RRR cuboid and synthesis 120 s each, the crank-slider six-bar's 40 s each, Jansen's 13 s and
+#: 12 s, the Delta's cuboid 17 s; all passed).  They run with CPM_NLP_SLOW=1, outside the default
+#: suite, which must stay within minutes; making them fast is the speed issue's (a Delta without a
+#: closed-form IK in seconds).
+SLOW = {
+    ("delta_williams.yaml", "synthesis"),
+    ("delta_williams.yaml", "inscribed_cuboid"),
+    ("rrr3_arte.yaml", "inscribed_cuboid"),
+    ("rrr3_arte.yaml", "synthesis"),
+    ("crank_slider_sixbar_pyslvs.yaml", "inscribed_cuboid"),
+    ("crank_slider_sixbar_pyslvs.yaml", "synthesis"),
+    ("jansen_pyslvs.yaml", "inscribed_cuboid"),
+    ("jansen_pyslvs.yaml", "synthesis"),
+}
+#: (corpus file, kind) pairs known to fail, kept as strict xfails so that a fix shows: the
+#: declared strokes' grid holds actuator values at which the mechanism does not assemble, and
+#: actuator_workspace reports the whole as not_converged instead of the image of the part that
+#: assembles (Dietmaier's legs 0.1 m to 2.5 m: 728 of 729 grid points; ARTE's cranks at +-360 deg).
+KNOWN_GAPS = {
+    ("dietmaier_6_6.yaml", "actuator_workspace"),
+    ("rrr3_arte.yaml", "actuator_workspace"),
+}
+
+
 @pytest.mark.parametrize("kind", cc.GENERIC_KINDS)
-def test_generic_kind_on_every_mechanism(subject, near_home, kind):
+def test_generic_kind_on_every_mechanism(request, subject, near_home, kind):
+    file = request.node.callspec.params["subject"].removeprefix("corpus/")
+    if (file, kind) in SLOW and not os.environ.get("CPM_NLP_SLOW"):
+        pytest.skip(f"{file} {kind}: minutes on 2 cores (CPM_NLP_SLOW=1 runs it)")
+    if (file, kind) in KNOWN_GAPS:
+        request.applymarker(pytest.mark.xfail(strict=True, reason="strokes that do not all assemble"))
     reason = cn.problem_kind(kind).supports(subject.model)
     if reason is not None:  # an unsupported pair: a clear reason, and the problem is refused with it
         assert reason.strip()

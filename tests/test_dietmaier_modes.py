@@ -49,7 +49,9 @@ def test_a_rare_mode_warning_says_how_many_starts_and_following_it_finds_all():
     the note says "probably incomplete" and how many starts a 99 % chance of reaching the
     smallest basin found takes, N = ceil(ln 0.01 / ln(1 - p)), the least N with
     (1 - p)^N <= 0.01; Chao1 counts unseen modes (its estimate is above the count).  A search
-    with those N starts (another seed) finds all 40."""
+    with those N starts (another seed) finds more modes, each a solution; "more if the modes
+    not found have smaller basins" (the note) is why it need not find all 40 -- the default
+    search does (test_default_search_finds_all_40_real_modes)."""
     m = model()
     found = assembly_modes(m, LENGTHS, starts=500, seed=0)
     est = found.completeness
@@ -60,6 +62,6 @@ def test_a_rare_mode_warning_says_how_many_starts_and_following_it_finds_all():
     assert "probably incomplete" in est.note and f"takes {n} starts" in est.note
     assert est.estimate > found.count
     more = assembly_modes(m, LENGTHS, starts=n, seed=1)
-    assert more.count == MODES
+    assert found.count < more.count <= MODES
     for md in more.modes:
         assert np.max(np.abs(lengths(md.x) - LENGTHS)) < 1e-9
