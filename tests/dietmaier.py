@@ -11,10 +11,11 @@ of global inverse kinematics (see tests/corpus/dietmaier_6_6.yaml); the paper it
 available here.
 """
 
-import math
 from pathlib import Path
 
 import numpy as np
+
+from .gallery_reference import rot_x, rot_y, rot_z
 
 MECHANISM = Path(__file__).resolve().parent / "corpus" / "dietmaier_6_6.yaml"
 PROBLEM = Path(__file__).resolve().parent / "corpus" / "problems" / "dietmaier_6_6_modes.yaml"
@@ -49,18 +50,8 @@ LENGTHS = np.array([1, 0.645275, 1.086284, 1.503439, 1.281933, 0.771071])
 
 
 def rotation(psi: float, theta: float, phi: float) -> np.ndarray:
-    cx, sx, cy, sy, cz, sz = (
-        math.cos(psi),
-        math.sin(psi),
-        math.cos(theta),
-        math.sin(theta),
-        math.cos(phi),
-        math.sin(phi),
-    )
-    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    return rz @ ry @ rx
+    """R = Rz(phi) Ry(theta) Rx(psi), the file's rotation [[z, phi], [y, theta], [x, psi]]."""
+    return rot_z(phi) @ rot_y(theta) @ rot_x(psi)
 
 
 def lengths(pose: np.ndarray) -> np.ndarray:

@@ -22,7 +22,7 @@ MECHANISMS = ROOT / "problems" / "mechanisms"
 
 def four_bar():
     """Freudenstein's four-bar (crank a2 = 1, coupler a3 = 3.5, rocker a4 = 3, ground g = 4),
-    as tests/test_mode_search.py writes it."""
+    closed by two expressions (also tests/test_mode_search.py's)."""
     desc = {
         "name": "four_bar_certificate",
         "parameters": {

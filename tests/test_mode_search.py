@@ -24,6 +24,7 @@ from . import gallery_closures as gc
 from . import watt_six_bar as watt
 from .conftest import PAPER_PRS3, ROOT
 from .random_platforms import Platform66, contains
+from .test_mode_certificate import four_bar
 
 UPS6 = ROOT / "problems" / "mechanisms" / "ups6.yaml"
 #: the shipped problems/ups6_forward_kinematics.yaml inputs (la1..la3, lb1..lb3), m
@@ -122,31 +123,7 @@ def test_freudenstein_four_bar_both_modes_without_bounds():
     """Freudenstein's four-bar (crank a2 = 1, coupler a3 = 3.5, rocker a4 = 3, ground g = 4):
     both assembly modes (open and crossed) without any bounds, against the closed form (the
     two intersections of the coupler's and the rocker's circles)."""
-    desc = {
-        "name": "four_bar_test",
-        "parameters": {
-            k: {"dimension": "length", "default": f"{v} m"} for k, v in (("a2", 1), ("a3", 3.5), ("a4", 3), ("g", 4))
-        },
-        "platform": {
-            "coordinates": {"theta3": "angle", "theta4": "angle"},
-            "position": "[0*g, 0*g, 0*g]",
-            "rotation": [],
-            "task": ["theta4"],
-            "home": {},
-        },
-        "actuators": {"theta2": {"dimension": "angle", "home": 0}},
-        "closures": [
-            "a2*cos(theta2) + a3*cos(theta3) - a4*cos(theta4) - g",
-            "a2*sin(theta2) + a3*sin(theta3) - a4*sin(theta4)",
-        ],
-    }
-    # home: theta2 = 0, B = (1, 0); C on both circles |C - B| = 3.5, |C - (4, 0)| = 3
-    cx = (3.5**2 - 3**2 + 3**2 - 0) / (2 * 3)  # from B: d = 3
-    cx = 1 + (3.5**2 - 3**2 + 9) / 6
-    cy = math.sqrt(3.5**2 - (cx - 1) ** 2)
-    desc["platform"]["home"] = {"theta3": math.atan2(cy, cx - 1), "theta4": math.atan2(cy, cx - 4)}
-    mech = from_dict(desc)
-    model = mech.model(mech.closure(), {}, {}, ())
+    model = four_bar()  # the same four-bar, written once (tests/test_mode_certificate.py)
     t2 = math.radians(70)
     B = np.array([math.cos(t2), math.sin(t2)])
     O4 = np.array([4.0, 0])
