@@ -475,9 +475,11 @@ SLOW = {
     ("jansen_pyslvs.yaml", "synthesis"),
 }
 #: (corpus file, kind) pairs known to fail, kept as strict xfails so that a fix shows: the
-#: declared strokes' grid holds actuator values at which the mechanism does not assemble, and
-#: actuator_workspace reports the whole as not_converged instead of the image of the part that
-#: assembles (Dietmaier's legs 0.1 m to 2.5 m: 728 of 729 grid points; ARTE's cranks at +-360 deg).
+#: declared strokes' grid (3 per actuator here) does not resolve the part that assembles, and
+#: actuator_workspace says so (not_converged) instead of a volume: Dietmaier's legs 0.1 m to
+#: 2.5 m (1 of 729 grid points assembles; volume 0 against 2170 m^3 in the cells across the
+#: border of assembly); ARTE's cranks at -360, 0, +360 deg are one angle, which does not
+#: assemble (0 of 27).  A box that partly assembles: tests/test_actuator_workspace_partial.py.
 KNOWN_GAPS = {
     ("dietmaier_6_6.yaml", "actuator_workspace"),
     ("rrr3_arte.yaml", "actuator_workspace"),
@@ -490,7 +492,7 @@ def test_generic_kind_on_every_mechanism(request, subject, near_home, kind):
     if (file, kind) in SLOW and not os.environ.get("CPM_NLP_SLOW"):
         pytest.skip(f"{file} {kind}: minutes on 2 cores (CPM_NLP_SLOW=1 runs it)")
     if (file, kind) in KNOWN_GAPS:
-        request.applymarker(pytest.mark.xfail(strict=True, reason="strokes that do not all assemble"))
+        request.applymarker(pytest.mark.xfail(strict=True, reason="grid does not resolve the assembling part"))
     reason = cn.problem_kind(kind).supports(subject.model)
     if reason is not None:  # an unsupported pair: a clear reason, and the problem is refused with it
         assert reason.strip()

@@ -156,6 +156,7 @@ WARNING_CODES = {
     "hinge_geometry": "a hinge geometry outside its formula's validity",
     "beyond_linear_range": "compliant FK: linear and nonlinear deflection differ by more than 10 %",
     "near_singular": "a pose near a singularity (ill-conditioned Jacobian)",
+    "strokes_partly_assemble": "part of the stroke box does not assemble: the workspace is the image of the rest",
 }
 
 

@@ -21,7 +21,7 @@ from ..core.kind import ProblemKind
 from ..core.mechanism import DynamicsModel
 from ..core.model import Model
 from ..core.options import Option, validate_mapping
-from ..core.result import Result, SolverInfo, Status
+from ..core.result import Result, ResultWarning, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS, size_dimension
 from .compliance import STRESS_LIMIT_OPTION, split_stress_limit
@@ -83,6 +83,7 @@ class ActuatorWorkspace(ProblemKind):
         for i in c.task_index:
             dims[f"{c.x[i].name}_linear_error"] = c.x[i].kind
         dims["n_points"] = "dimensionless"
+        dims.update(n_not_assembled="dimensionless", not_assembled_fraction="dimensionless", volume_border=vol)
         return dims
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
@@ -113,14 +114,33 @@ class ActuatorWorkspace(ProblemKind):
         for k, n in enumerate(names):
             values[f"{n}_linear_error"] = float(rep.linear_error[k])
         values["n_points"] = len(rep.q)
+        missing = int(rep.details.get("not_assembled", 0))
+        values.update(
+            n_not_assembled=missing,
+            not_assembled_fraction=missing / len(rep.q),
+            volume_border=float(rep.details.get("volume_border", 0.0)),
+        )
         res = closed_form_result(self.name, model, values, dims, rep.status, rep.message, info)
-        res.units["vertices"] = "rows: box corners; columns " + ", ".join(
+        if missing:
+            res.warn(
+                ResultWarning(
+                    "strokes_partly_assemble",
+                    f"{missing} of {len(rep.q)} grid points of the stroke box do not assemble; the workspace "
+                    "and its volume are those of the rest (the volume's error from the border of assembly "
+                    f"is of the order of volume_border = {values['volume_border']:.6g})",
+                    "inputs.samples",
+                    missing / len(rep.q),
+                )
+            )
+        corners = "box corners that assemble" if missing else "box corners"
+        res.units["vertices"] = f"rows: {corners}; columns " + ", ".join(
             f"{n} [{_si(dims[n + '_min'])}]" for n in names
         )
         if inputs["points"]:
-            res.values["points"] = rep.t.tolist()
+            res.values["points"] = rep.t[np.all(np.isfinite(rep.t), axis=1)].tolist()
             res.dimensions["points"] = "matrix"
-            res.units["points"] = res.units["vertices"].replace("box corners", "grid points")
+            grid = "grid points that assemble" if missing else "grid points"
+            res.units["points"] = res.units["vertices"].replace(corners, grid)
         return res
 
     def output_names(self, model: Model) -> list[str]:

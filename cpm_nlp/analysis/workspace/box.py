@@ -19,6 +19,10 @@ from ..requirements import full_factorial
 
 log = logging.getLogger(__name__)
 
+#: FK statuses of an actuator value where no pose was found: taken as not assembling
+#: (see :func:`_partial`); any other failure (a branch change, a singularity) is reported as such
+NOT_ASSEMBLED = (Status.NOT_CONVERGED, Status.INFEASIBLE)
+
 # -- the image of the actuator-stroke box (FK) ----------------------------------------------------
 
 
@@ -122,6 +126,10 @@ def reachable_workspace(
     ts = np.array([model.task_of(s.x) if s.ok else np.full(c.nq, np.nan) for s in sols])
     report = WorkspaceReport(qs, ts, sols, worst_status([s.status for s in sols]))
     bad = [k for k, s in enumerate(sols) if not s.ok]
+    if bad and all(sols[k].status in NOT_ASSEMBLED for k in bad):  # no pose found (a fold or branch change: below)
+        _partial(model, report, low, high, samples, config, J0, Jinv0)
+        report.seconds = time.perf_counter() - t0
+        return report
     if bad:
         k = bad[0]
         report.message = (
@@ -159,3 +167,137 @@ def reachable_workspace(
     report.message = f"{len(sols)} grid points ({samples} per actuator) and {len(nsols)} quadrature points solved by FK"
     report.seconds = time.perf_counter() - t0
     return report
+
+
+# -- strokes that partly assemble -----------------------------------------------------------------
+
+
+def _grid_index(qs: np.ndarray, low: np.ndarray, high: np.ndarray, samples: int) -> dict[tuple, int]:
+    """multi-index (one 0..samples-1 per actuator) -> row of the grid."""
+    step = np.where(high > low, (high - low) / (samples - 1), 1.0)
+    return {tuple(i): k for k, i in enumerate(np.rint((qs - low) / step).astype(int))}
+
+
+def _continue_from_neighbours(model, qs, sols, index, config) -> None:
+    """Retry FK at each unsolved grid point from the pose of every solved grid neighbour
+    (one step along one actuator), until no retry succeeds (in place)."""
+    changed = True
+    while changed:
+        changed = False
+        for i, k in index.items():
+            if sols[k].ok:
+                continue
+            for j in _neighbours(i, index):
+                if sols[j].ok:
+                    s = forward_kinematics(model, qs[k], config, guess=sols[j].x)
+                    if s.ok:
+                        sols[k], changed = s, True
+                        break
+
+
+def _neighbours(i: tuple, index: dict[tuple, int]) -> list[int]:
+    out = []
+    for a in range(len(i)):
+        for d in (-1, 1):
+            n = i[:a] + (i[a] + d,) + i[a + 1 :]
+            if n in index:
+                out.append(index[n])
+    return out
+
+
+def _partial(model, report, low, high, samples, config, J0, Jinv0) -> None:
+    """The workspace of a stroke box that partly assembles (fills ``report``).
+
+    FK at an unsolved grid point is retried from the poses of its solved neighbours; what
+    is still unsolved is taken as not assembling, unless every grid neighbour of it
+    assembles (a hole: an FK failure cannot be told from non-assembly there), or no grid
+    point assembles: both keep a failure status.  The volume is the midpoint rule on the
+    grid's cells: |det(dt/dq)| at the centre of every cell whose centre assembles, times
+    the cell's volume.  A cell whose corners do not all assemble straddles the border of
+    assembly; the sum over those cells of the cell volume times the largest |det| at its
+    assembled corners and centre is ``details["volume_border"]``: the volume's error
+    from the border is of that order (it shrinks with the cell size, as 1/samples); where it
+    is not below the volume, the grid does not resolve the part that assembles: a failure."""
+    c = model.closure
+    qs, sols = report.q, report.solutions
+    index = _grid_index(qs, low, high, samples)
+    _continue_from_neighbours(model, qs, sols, index, config)
+    ok = np.array([s.ok for s in sols])
+    report.t = np.array([model.task_of(s.x) if s.ok else np.full(c.nq, np.nan) for s in sols])
+    bad = np.flatnonzero(~ok)
+    first = f"first, q = {qs[bad[0]].tolist()}: {sols[bad[0]].status.value}" if bad.size else ""
+    if not ok.any():
+        report.status = worst_status([s.status for s in sols])
+        report.message = f"no grid point of the stroke box assembles ({len(sols)} tried; {first})"
+        return
+    holes = [k for i, k in index.items() if not ok[k] and all(ok[j] for j in _neighbours(i, index))]
+    if holes:
+        report.status = Status.NOT_CONVERGED
+        report.message = (
+            f"FK did not converge at q = {qs[holes[0]].tolist()}, where every grid neighbour assembles: "
+            "an FK failure cannot be told from non-assembly there"
+        )
+        return
+    step = (high - low) / (samples - 1)
+    cell_volume = float(np.prod(step))
+    det = lambda s: float(np.linalg.det(np.asarray(c.jacobian(s.x, s.q, model.p))[c.task_index, :]))  # noqa: E731
+    dets = [det(sols[k]) for k in np.flatnonzero(ok)]
+    volume, border = 0.0, 0.0
+    for base in itertools.product(range(samples - 1), repeat=c.nq):
+        corners = [index[tuple(b + o for b, o in zip(base, off))] for off in itertools.product((0, 1), repeat=c.nq)]
+        assembled = [k for k in corners if ok[k]]
+        if not assembled:
+            continue
+        centre = low + (np.array(base) + 0.5) * step
+        s = forward_kinematics(model, centre, config, guess=sols[assembled[0]].x)
+        local = [abs(dets[int(np.sum(ok[:k]))]) for k in assembled]
+        if s.ok:
+            d = det(s)
+            dets.append(d)
+            volume += abs(d) * cell_volume
+            local.append(abs(d))
+        elif s.status not in NOT_ASSEMBLED or len(assembled) == len(corners):
+            report.status = s.status if s.status not in NOT_ASSEMBLED else Status.NOT_CONVERGED
+            report.message = f"FK at the cell centre q = {centre.tolist()}: {s.status.value}" + (
+                ""
+                if s.status not in NOT_ASSEMBLED
+                else ", though the cell's corners all assemble: an FK failure cannot be told from non-assembly"
+            )
+            return
+        if len(assembled) < len(corners):
+            border += max(local) * cell_volume
+    dets = np.array(dets)
+    if not (np.all(dets > 0) or np.all(dets < 0)):
+        report.status = Status.SINGULAR
+        report.message = "det(dt/dq) changes sign (or vanishes) where the stroke box assembles: the workspace folds"
+        return
+    if border >= volume:
+        report.status = Status.NOT_CONVERGED
+        report.message = (
+            f"{bad.size} of {len(sols)} grid points do not assemble and the grid does not resolve the part "
+            f"that does (volume {volume:.6g} against {border:.6g} in cells across its border): raise inputs.samples"
+        )
+        return
+    ts = report.t[ok]
+    report.status = Status.SOLVED
+    report.volume = volume
+    report.linear_volume = float(abs(np.linalg.det(J0[c.task_index, :])) * np.prod(high - low))
+    corner_idx = [index[tuple(int(v) for v in o)] for o in itertools.product((0, samples - 1), repeat=c.nq)]
+    report.vertices = report.t[[k for k in corner_idx if ok[k]]]
+    report.lower, report.upper = ts.min(axis=0), ts.max(axis=0)
+    t_lin = model.task_of(model.x_home) + (qs[ok] - model.q_home) @ J0[c.task_index, :].T
+    report.linear_error = np.max(np.abs(ts - t_lin), axis=0)
+    scale = np.max(np.abs(Jinv0), axis=0)
+    dev = [np.max(np.abs(np.asarray(c.inverse_jacobian(s.x, s.q, model.p)) - Jinv0) / scale) for s in sols if s.ok]
+    report.jacobian_deviation = float(max(dev))
+    report.details = {
+        "det_min": float(np.min(np.abs(dets))),
+        "det_max": float(np.max(np.abs(dets))),
+        "not_assembled": int(bad.size),
+        "not_assembled_fraction": float(bad.size / len(sols)),
+        "volume_border": border,
+    }
+    report.message = (
+        f"{bad.size} of {len(sols)} grid points ({samples} per actuator) do not assemble ({first}); "
+        f"the workspace is the image of the rest, its volume the midpoint rule on the {samples - 1}^{c.nq} cells"
+    )
