@@ -579,7 +579,11 @@ def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any)
     if data.problem == "actuator_workspace":
         pts = np.asarray(v["points"], dtype=float) if isinstance(v.get("points"), list) else np.zeros((0, 2))
         corners = np.asarray(v["vertices"], dtype=float) if isinstance(v.get("vertices"), list) else None
-        edges = _stroke_edges(data, closure)
+        partial = bool(v.get("n_not_assembled"))  # the stroke edges' image is not the boundary then
+        edges = [] if partial else _stroke_edges(data, closure)
+        note = STROKE_BOUNDARY if edges else "no boundary: give inputs.points: true or plot with solve --plot"
+        if partial:
+            note = "no boundary drawn: part of the stroke box does not assemble (images of the grid points that do)"
         return workspace_figure_2d(
             pts,
             cuboid=cuboid,
@@ -587,7 +591,7 @@ def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any)
             points_label="images of the stroke grid",
             outline=edges,
             corners=corners,
-            note=STROKE_BOUNDARY if edges else "no boundary: give inputs.points: true or plot with solve --plot",
+            note=note,
             **common,
         )
     note = MEMBERSHIP_BOUNDARY.format(g=PLANAR_GRID)
