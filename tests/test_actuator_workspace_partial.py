@@ -98,3 +98,19 @@ def test_a_stroke_box_where_nothing_assembles_fails(tmp_path):
     r = cn.solve(_problem(tmp_path, [160.0, -20.0], [200.0, 20.0], 5))
     assert r.status != Status.SOLVED
     assert "no grid point of the stroke box assembles" in r.message
+
+
+def test_the_volume_against_a_seeded_monte_carlo_of_membership(tmp_path):
+    """As tests/test_conformance.py::_actuator_workspace: membership (the library's own IK
+    and limits, not the grid's FK) on 4000 seeded points of the padded bounding box."""
+    problem = _problem(tmp_path, np.degrees(LOW), np.degrees(HIGH), 41)
+    r = cn.solve(problem)
+    lo = np.array([r.values["x_min"], r.values["y_min"]])
+    hi = np.array([r.values["x_max"], r.values["y_max"]])
+    lo, hi = lo - 0.25 * (hi - lo), hi + 0.25 * (hi - lo)
+    n = 4000
+    T = lo + (hi - lo) * np.random.default_rng(3).random((n, 2))
+    p = cn.membership(problem.model, T).inside.mean()
+    box = float(np.prod(hi - lo))
+    se = box * np.sqrt(p * (1 - p) / n)
+    assert abs(r.values["volume"] - box * p) < 4 * se, (r.values["volume"], box * p, se)
