@@ -818,25 +818,8 @@ def draw_mechanism(
                 [poly], facecolor=colour, edgecolor="0.5" if faint else colour, alpha=0.12 if faint else 0.3
             )
         )
-    seen: set[str] = set()
-    for a, b, part in drawing.segments:
-        colour, width = _PART_STYLE[part]
-        xyz = np.array([pts[a], pts[b]])
-        label = "_" if faint or part in seen else part
-        seen.add(part)
-        ax.plot(
-            *xyz.T, color="0.7" if faint else colour, lw=1.0 if faint else width, ls="--" if faint else "-", label=label
-        )
-    if faint:
-        ax.plot([], [], color="0.7", lw=1.0, ls="--", label="home pose")
+    if not _links_and_joints(ax, drawing, pts, set(), faint, {"depthshade": False}):
         return
-    kinds: set[str] = set()
-    for name, letter in drawing.joints.items():
-        p = pts[name]
-        face = "white" if letter == "S" else "k"
-        label = "_" if letter in kinds else f"{_JOINT_NAME[letter]} joint ({letter})"
-        kinds.add(letter)
-        ax.scatter(*p, marker=_JOINT_MARKER[letter], s=40, facecolor=face, edgecolor="k", depthshade=False, label=label)
     if label_points:
         for p, names in _coincident(pts):
             ax.text(*p, " " + " = ".join(names), fontsize="x-small", color="0.2")
@@ -844,6 +827,31 @@ def draw_mechanism(
         o = np.asarray(arrow.origin, dtype=float) * factor
         v = np.asarray(arrow.vector, dtype=float) * factor
         ax.quiver(*o, *v, color=arrow.colour, lw=2, arrow_length_ratio=0.15, label=arrow.label or "_")
+
+
+def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: bool, joint_style: dict) -> bool:
+    """The links of a drawing (one legend entry per part not in ``seen``) and, unless
+    ``faint``, its joints (one legend entry per joint type), in 2-D or 3-D axes alike (the
+    points ``pts`` have 2 or 3 coordinates); False for a faint drawing (nothing more to draw)."""
+    for a, b, part in drawing.segments:
+        colour, width = _PART_STYLE[part]
+        ends = np.array([pts[a], pts[b]])
+        label = "_" if faint or part in seen else part
+        seen.add(part)
+        style = {"color": "0.7", "lw": 1.0, "ls": "--"} if faint else {"color": colour, "lw": width, "ls": "-"}
+        ax.plot(*ends.T, label=label, **style)
+    if faint:
+        ax.plot([], [], color="0.7", lw=1.0, ls="--", label="home pose")
+        return False
+    kinds: set[str] = set()
+    for name, letter in drawing.joints.items():
+        face = "white" if letter == "S" else "k"
+        label = "_" if letter in kinds else f"{_JOINT_NAME[letter]} joint ({letter})"
+        kinds.add(letter)
+        ax.scatter(
+            *pts[name], marker=_JOINT_MARKER[letter], s=40, facecolor=face, edgecolor="k", label=label, **joint_style
+        )
+    return True
 
 
 def is_planar(*drawings: Any) -> bool:
@@ -885,23 +893,8 @@ def draw_mechanism_2d(
                 label=label,
             )
         )
-    for a, b, part in drawing.segments:
-        colour, width = _PART_STYLE[part]
-        xy = np.array([pts[a], pts[b]])
-        label = "_" if faint or part in seen else part
-        seen.add(part)
-        ax.plot(
-            *xy.T, color="0.7" if faint else colour, lw=1.0 if faint else width, ls="--" if faint else "-", label=label
-        )
-    if faint:
-        ax.plot([], [], color="0.7", lw=1.0, ls="--", label="home pose")
+    if not _links_and_joints(ax, drawing, pts, seen, faint, {"zorder": 5}):
         return
-    kinds: set[str] = set()
-    for name, letter in drawing.joints.items():
-        face = "white" if letter == "S" else "k"
-        label = "_" if letter in kinds else f"{_JOINT_NAME[letter]} joint ({letter})"
-        kinds.add(letter)
-        ax.scatter(*pts[name], marker=_JOINT_MARKER[letter], s=40, facecolor=face, edgecolor="k", zorder=5, label=label)
     if label_points:
         for p, names in _coincident(pts):
             ax.annotate(
