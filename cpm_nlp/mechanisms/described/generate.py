@@ -142,6 +142,11 @@ class _Reported:
     path: tuple = ()
 
 
+def family(name: str) -> str:
+    """The limit family of a coordinate name: the name less its trailing digits (``s1`` -> ``s``)."""
+    return re.sub(r"\d+$", "", name) or name
+
+
 class Generator:
     """Builds the symbolic closure of one description (errors carry key paths)."""
 
@@ -272,7 +277,7 @@ class Generator:
             raise InputError(
                 f"a {j.type} joint cannot be actuated (P, R, planar_P, planar_R can)", path=j.path + ("actuated",)
             )
-        fam = j.limit or (re.sub(r"\d+$", "", name) or name)
+        fam = j.limit or family(name)
         self.q_coords.append(Coordinate(name, dim, f"actuator of the {j.type} joint at {_where(j.path)}", fam))
         sym = ca.SX.sym(name)
         self.q_syms.append(sym)
@@ -603,7 +608,7 @@ class Generator:
             dim = "length" if kind == "P" else "angle"
             sym = ca.SX.sym(name)
             home = j.home[n] if n < len(j.home) else ca.SX(0)
-            fam = j.spec.limit or re.sub(r"\d+$", "", name) or name
+            fam = j.spec.limit or family(name)
             coord = Coordinate(name, dim, f"passive {j.type} joint of leg {leg.name} (an unknown of the loops)", fam)
             self.extra.append((coord, sym, home, self._limit(j, dim), j.spec.path))
             j.motions.append((kind, axis, sym - home))
@@ -615,7 +620,7 @@ class Generator:
         for k, (name, val) in enumerate(zip(names, values)):
             home = j.home[k] if k < len(j.home) else 0
             dim = "length" if (j.type == "C" and k == 1) or j.type in ("P", "planar_P") else "angle"
-            fam = j.spec.limit or re.sub(r"\d+$", "", name) or name
+            fam = j.spec.limit or family(name)
             desc = f"{j.type} joint of leg {leg}" + (f", axis {k + 1}" if len(names) > 1 else "")
             self.reported.append(
                 _Reported(Coordinate(name, dim, desc, fam), home + val, self._flexure_range(j, dim, home), j.spec.path)
@@ -706,7 +711,7 @@ class Generator:
             self.leg(leg)
         for name, (dim, home) in d.actuators.items():
             if name not in [c.name for c in self.q_coords]:
-                self.q_coords.append(Coordinate(name, dim, "actuator", re.sub(r"\d+$", "", name) or name))
+                self.q_coords.append(Coordinate(name, dim, "actuator", family(name)))
                 self.q_syms.append(ca.SX.sym(name))
                 self.q_home.append(self.scalar(home, ("actuators", name, "home"), self.env, dim))
         if not self.q_coords:
@@ -723,7 +728,7 @@ class Generator:
         for qty in d.passive:
             v = self.value(qty.value, ("passive", qty.name), full, qty.dimension)
             dim = qty.dimension or _dim_name(v.dim)
-            fam = qty.family or re.sub(r"\d+$", "", qty.name) or qty.name
+            fam = qty.family or family(qty.name)
             self.reported.append(
                 _Reported(Coordinate(qty.name, dim, qty.description, fam), v.sx, None, ("passive", qty.name))
             )

@@ -9,7 +9,6 @@ the CLI prints it.
 
 from __future__ import annotations
 
-import re
 from typing import Any
 
 import casadi as ca
@@ -17,15 +16,11 @@ import numpy as np
 
 from ...core.model import Model
 from ...core.units import format_quantity
-from .generate import Generator, closure_parts
+from .generate import Generator, closure_parts, family
 from .spec import JOINT_TYPES, Description, Joint
 
 #: a joint's degrees of freedom (the table of spec.JOINT_TYPES)
 _DOF = {name: dof for name, (dof, _text) in JOINT_TYPES.items()}
-
-
-def _family(name: str) -> str:
-    return re.sub(r"\d+$", "", name) or name
 
 
 def _hinges_of(d: Description) -> dict[str, str]:
@@ -69,7 +64,7 @@ def _joint_line(k: int, spec: Joint, resolved: Any, gen: Generator, model: Model
         parts.append("coordinates: " + ", ".join(names))
     elif _DOF.get(spec.type):
         parts.append(f"{_DOF[spec.type]} passive dof (eliminated)")
-    keys = [key for name in [*names, spec.actuated or ""] for key in (name, _family(name))]
+    keys = [key for name in [*names, spec.actuated or ""] for key in (name, family(name))]
     found = sorted({hinges[key] for key in keys if key in hinges})
     if spec.flexure is not None:
         found.append(f"flexure {spec.flexure.values.get('hinge', '?')}")
