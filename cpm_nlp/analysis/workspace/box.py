@@ -242,6 +242,7 @@ def _partial(model, report, low, high, samples, config, J0, Jinv0) -> None:
     cell_volume = float(np.prod(step))
     det = lambda s: float(np.linalg.det(np.asarray(c.jacobian(s.x, s.q, model.p))[c.task_index, :]))  # noqa: E731
     dets = [det(sols[k]) for k in np.flatnonzero(ok)]
+    rank = np.cumsum(ok) - 1  # grid row -> its place among the assembled rows (in dets)
     volume, border = 0.0, 0.0
     for base in itertools.product(range(samples - 1), repeat=c.nq):
         corners = [index[tuple(b + o for b, o in zip(base, off))] for off in itertools.product((0, 1), repeat=c.nq)]
@@ -250,7 +251,7 @@ def _partial(model, report, low, high, samples, config, J0, Jinv0) -> None:
             continue
         centre = low + (np.array(base) + 0.5) * step
         s = forward_kinematics(model, centre, config, guess=sols[assembled[0]].x)
-        local = [abs(dets[int(np.sum(ok[:k]))]) for k in assembled]
+        local = [abs(dets[rank[k]]) for k in assembled]
         if s.ok:
             d = det(s)
             dets.append(d)
