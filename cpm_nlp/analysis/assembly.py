@@ -382,8 +382,8 @@ DAMPED_STEPS = 30
 #: longest step of those (max-norm, lengths divided by the reach): one radian, or one reach.
 #: Undamped Newton from a random start often jumps far (|Φ| of 1e37 on Dietmaier's platform):
 #: there 114 of 2000 starts converged and 23 of its 40 modes were found; after the shortened
-#: steps 91 % of the starts converge and every mode's basin holds at least 0.06 % of them
-#: (benchmarks/bench_assembly_modes.py)
+#: steps 91 % of the starts converge (measured with its home lifted 1 m) and every mode's basin holds at least
+#: 0.06 % of them (benchmarks/bench_assembly_modes.py)
 STEP_LIMIT = 1.0
 #: starts of a search: all 40 modes of Dietmaier's platform with probability 0.999 (estimated
 #: from the basins of 100 000 starts; benchmarks/bench_assembly_modes.py measures it over seeds)
