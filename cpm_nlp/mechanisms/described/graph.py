@@ -373,7 +373,10 @@ class GraphGenerator(Generator):
                 rows.append((ca.cross(Ra @ g.axis, d)[2], "offset across the axis"))
             else:
                 n1, n2 = self.normals(g)
-                rows += [(ca.dot(Ra @ n1, d), "offset across the axis, 1"), (ca.dot(Ra @ n2, d), "offset across the axis, 2")]
+                rows += [
+                    (ca.dot(Ra @ n1, d), "offset across the axis, 1"),
+                    (ca.dot(Ra @ n2, d), "offset across the axis, 2"),
+                ]
         if g.type in ("R", "C"):
             n1, n2 = self.normals(g)
             wa_axis = Ra @ g.axis
@@ -629,7 +632,9 @@ class GraphGenerator(Generator):
         somewhere along the motion, where the rows it left out would not)."""
         r = ca.vertcat(*[row[0] for row in self.loop_rows])
         tree = [
-            k for k, n in enumerate(self.x_names) if n not in self.d.platform.coordinates and n not in self.actuated_coords
+            k
+            for k, n in enumerate(self.x_names)
+            if n not in self.d.platform.coordinates and n not in self.actuated_coords
         ]
         xt = ca.vertcat(*[self.x[k] for k in tree])
         g = ca.jacobian(r, xt).T @ r / scale
