@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 import yaml
@@ -229,3 +230,35 @@ def test_the_hinges_the_files_declare_sit_where_the_table_allows():
         seen.add((hinge, jt))
     # prs3 (notch at R, filleted rod at S), the five-bar and the 3-RRR (notches at planar R)
     assert {("circular_notch", "R"), ("filleted_rod", "S"), ("circular_notch", "planar_R")} <= seen
+
+
+def test_the_guide_table_is_the_table():
+    """docs/site/guide/mechanism-files.md lists every joint type as the table has it."""
+    text = (ROOT / "docs" / "site" / "guide" / "mechanism-files.md").read_text()
+    rows = [[c.strip() for c in line.strip().strip("|").split("|")] for line in text.splitlines()]
+    rows = [r for r in rows if len(r) == 6 and r[0].startswith("`") and r[0].strip("`") in JOINT_TYPES]
+    assert [r[0].strip("`") for r in rows] == list(JOINT_TYPES)
+    words = {0: "none", 1: "1", 2: "2", 3: "3"}
+    for name, coords, _axes, where, actuated, hinges in rows:
+        t = JOINT_TYPES[name.strip("`")]
+        if len(set(t.dims)) <= 1:
+            assert coords.startswith(words[t.dof]) and (not t.dof or t.dims[0] in coords), (name, coords)
+        else:
+            assert coords == ", ".join(t.dims), (name, coords)
+        assert where == ("both" if t.planar and t.spatial else "planar" if t.planar else "spatial"), name
+        assert actuated == ("yes" if t.actuable else "no"), name
+        listed = [h.split(" (")[0] for h in hinges.split(", ")] if hinges != "none" else []
+        assert listed == list(t.hinges), name
+
+
+def test_home_values_take_each_coordinates_dimension():
+    """A C joint's home is (angle, length), as its motions say; the generator checks each."""
+    gen = generate.Generator(described.read_description(MECH / "prs3.yaml"))
+    gen.platform()
+    eye = ca.SX.eye(3)
+    ok = spec.Joint("C", at=[0, 0, 0], axis=[0, 0, 1], home=("10 deg", "1 mm"), path=("legs", 0, "joints", 0))
+    home = [float(ca.DM(h)) for h in gen.resolve(ok, gen.env, eye).home]
+    np.testing.assert_allclose(home, [np.radians(10), 1e-3], rtol=1e-15)
+    bad = spec.Joint("C", at=[0, 0, 0], axis=[0, 0, 1], home=("1 mm", 0), path=("legs", 0, "joints", 0))
+    with pytest.raises(cn.InputError, match=r"legs\[0\]\.joints\[0\]\.home\[0\]: expected an angle"):
+        gen.resolve(bad, gen.env, eye)
