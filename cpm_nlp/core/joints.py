@@ -13,13 +13,20 @@ frame's x, y, z).
 
 The flexure hinges that can sit at a joint are given by name (the hinge types
 of :data:`cpm_nlp.analysis.compliance.HINGE_TYPES` and of
-:data:`cpm_nlp.analysis.flexure.HINGES`), as the project's mechanisms use them:
-a circular notch, a corner-filleted (cantilever) notch or a leaf spring as a
-revolute (prs3-ruiz.md section 5; the pantograph, pantograph-3d-elgammal-2016.md
-eq 30-38; the five-bar's elbows), a circular notch on each axis of a U
-(rpr-2rpu-upr-zhang-2022.md Table 1), a round neck as a spherical joint
-(prs3-ruiz.md section 5: the filleted rod) or as a U.  No hinge of the library
-is a prismatic or cylindrical joint.
+:data:`cpm_nlp.analysis.flexure.HINGES`): where the project's mechanisms put
+them, and by a hinge's geometry where none does.
+
+* As a revolute: a circular notch (prs3-ruiz.md section 5; the pantograph,
+  pantograph-3d-elgammal-2016.md eq 38; the five-bar's and 3-RRR's elbows in
+  problems/), a corner-filleted (cantilever) notch (pantograph eq 30-31), a
+  leaf spring (offered for the pantograph's joints by flexure.HINGES; it bends
+  about one axis).
+* As a U: a circular notch on each axis (rpr-2rpu-upr-zhang-2022.md Table 1 as
+  cpm_nlp.mechanisms.rpr reads it); a round neck (circular or filleted rod), which bends
+  about two axes (geometry: no shipped mechanism has one there).
+* As an S: a filleted rod (prs3-ruiz.md section 5), a circular rod (the same
+  neck without fillets: geometry).
+* No hinge of the library is a prismatic or a cylindrical joint, nor a distance.
 """
 
 from __future__ import annotations
