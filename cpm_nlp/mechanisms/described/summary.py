@@ -14,13 +14,11 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from ...core.joints import JOINT_TYPES
 from ...core.model import Model
 from ...core.units import format_quantity
 from .generate import Generator, closure_parts, family
-from .spec import JOINT_TYPES, Description, Joint
-
-#: a joint's degrees of freedom (the table of spec.JOINT_TYPES)
-_DOF = {name: dof for name, (dof, _text) in JOINT_TYPES.items()}
+from .spec import Description, Joint
 
 
 def _hinges_of(d: Description) -> dict[str, str]:
@@ -55,15 +53,15 @@ def _joint_line(k: int, spec: Joint, resolved: Any, gen: Generator, model: Model
     parts.append(f"at {_vector(resolved.at, model, gen, 'length')}")
     if resolved.to is not None:
         parts.append(f"to {_vector(resolved.to, model, gen, 'length')}")
-    if resolved.axis is not None and spec.type not in ("planar_R",):
+    if resolved.axis is not None and JOINT_TYPES[spec.type].axis == "given":
         parts.append(f"axis {_vector(resolved.axis, model, gen, 'axis')}")
     names = list(spec.coordinates) or list(resolved.names)
     if spec.actuated:
         parts.append(f"actuated: {spec.actuated}")
     elif names:
         parts.append("coordinates: " + ", ".join(names))
-    elif _DOF.get(spec.type):
-        parts.append(f"{_DOF[spec.type]} passive dof (eliminated)")
+    elif JOINT_TYPES[spec.type].dof:
+        parts.append(f"{JOINT_TYPES[spec.type].dof} passive dof (eliminated)")
     keys = [key for name in [*names, spec.actuated or ""] for key in (name, family(name))]
     found = sorted({hinges[key] for key in keys if key in hinges})
     if spec.flexure is not None:
