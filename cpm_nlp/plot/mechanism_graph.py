@@ -15,17 +15,14 @@ def _graph_layout(nodes: list[str], edges: list[tuple[str, str, str, bool]]) -> 
     """A body graph of any topology: the ground (the first node) at the bottom, each body one row
     above the nearest body it is joined to (breadth first), the bodies of a row side by side in
     the order of the file."""
+    pairs = [(u, v) for a, b, _label, _act in edges for u, v in ((a, b), (b, a))]
     depth = {nodes[0]: 0}
     frontier = [nodes[0]]
     while frontier:
-        nxt = []
-        for body in frontier:
-            for a, b, _label, _act in edges:
-                for u, v in ((a, b), (b, a)):
-                    if u == body and v not in depth:
-                        depth[v] = depth[u] + 1
-                        nxt.append(v)
-        frontier = nxt
+        nxt = [v for u, v in pairs if u in frontier and v not in depth]
+        for v in nxt:
+            depth.setdefault(v, depth[next(u for u, w in pairs if w == v and u in frontier)] + 1)
+        frontier = list(dict.fromkeys(nxt))
     for body in nodes:
         depth.setdefault(body, max(depth.values()) + 1)
     rows: dict[int, list[str]] = {}
@@ -38,7 +35,7 @@ def _graph_layout(nodes: list[str], edges: list[tuple[str, str, str, bool]]) -> 
             below = {b: pos[b][0] for b in pos if depth[b] == level - 1}
 
             def mean(body: str, below: dict = below) -> float:
-                xs = [below[v] for a, b, _l, _t in edges for u, v in ((a, b), (b, a)) if u == body and v in below]
+                xs = [below[v] for u, v in pairs if u == body and v in below]
                 return sum(xs) / len(xs) if xs else 0.0
 
             row = sorted(row, key=mean)

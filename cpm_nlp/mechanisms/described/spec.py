@@ -708,7 +708,8 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
             for k, n in enumerate(raw):
                 if n not in points:
                     raise InputError(
-                        f"unknown point {n!r}; the drawing's points: {', '.join(points) or 'none (declare them under points)'}",
+                        f"unknown point {n!r}; the drawing's points: "
+                        f"{', '.join(points) or 'none (declare them under points)'}",
                         path=path + (k,),
                         suggestions=suggest(str(n), points),
                     )
@@ -754,7 +755,7 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
         for key in ("at", "to"):
             v = getattr(j, key)
             if isinstance(v, str) and v.isidentifier():
-                for n, b in enumerate(j.between):
+                for b in j.between:
                     body = bodies[names.index(b)]
                     if v not in body.points and v not in points:
                         raise InputError(
