@@ -122,7 +122,8 @@ def render_result(result: Result, title: str = "") -> str:
                 parts.append(f"{k} = [" + ", ".join(f"{e:.6g}" for e in v) + "]")
             else:
                 parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
-        lines.append("model   : " + result.model.get("type", "") + ": " + ", ".join(parts) + "  (SI)")
+        shown = ": " + ", ".join(parts) + "  (SI)" if parts else " (no parameters)"
+        lines.append("model   : " + result.model.get("type", "") + shown)
     if not result.values:
         lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
         return "\n".join(lines + _warning_lines(result))

@@ -187,7 +187,15 @@ def check_expressions(
         else passive
     )
     out["passive"] = passive
-    joints = ca.vertcat(q, x, passive)  # the order of limited_coordinates
+    # an actuator or pose angle a whole turn from its range is the same joint position: its limit
+    # is checked on its value reduced into the range, as the passive joints' (the value is kept)
+    nq = c.nq
+    turned = [
+        _into_range(v[k], lower[off + k], upper[off + k]) if coord.kind == "angle" else v[k]
+        for v, coords, off in ((q, c.q, 0), (x, c.x, nq))
+        for k, coord in enumerate(coords)
+    ]
+    joints = ca.vertcat(*turned, passive)  # the order of limited_coordinates
     if joints.numel():
         inside = ca.logic_and(joints >= lower, joints <= upper)
         margins = ca.if_else(inside, ca.fmin(joints - lower, upper - joints), -ca.inf)

@@ -327,7 +327,8 @@ class GraphGenerator(Generator):
                 fam = j.limit or family(name)
                 what = "its actuator's joint" if actuated is not None else "a tree coordinate"
                 coord = Coordinate(name, dim, f"{j.type} joint {g.name} ({g.a} - {g.b}), {what}", fam)
-                limit = None if actuated is not None else self._limit(g, dim)  # type: ignore[arg-type]
+                # a flexure's limits are a deflection about the joint's value in the drawing
+                limit = None if actuated is not None else self._flexure_range(g, dim, home)  # type: ignore[arg-type]
                 self.extra.append((coord, sym, home, limit, j.path))
                 g.values.append(sym - home)
                 if actuated is not None:
@@ -439,7 +440,12 @@ class GraphGenerator(Generator):
             home = self.scalar(j.home[k], j.path + ("home", k), self.env, dim) if k < len(j.home) else 0
             desc = f"{j.type} joint {g.name} ({g.a} - {g.b}), closing loop {g.loop}"
             self.reported.append(
-                _Reported(Coordinate(name, dim, desc, j.limit or family(name)), home + v, self._limit(g, dim), j.path)  # type: ignore[arg-type]
+                _Reported(
+                    Coordinate(name, dim, desc, j.limit or family(name)),
+                    home + v,
+                    self._flexure_range(g, dim, home),  # type: ignore[arg-type]
+                    j.path,
+                )
             )
 
     def platform_graph(self, scale: ca.SX) -> None:
@@ -524,6 +530,8 @@ class GraphGenerator(Generator):
                 ]
                 self.report_cut(g)
         self.platform_graph(scale)
+        if self.platform_body == self.ground:  # no platform body: the linkage's size is its drawing's
+            self.platform_radius.append(span / 2)
         self.add_unknowns()
         q = ca.vertcat(*self.q_syms)
         for name, (body, point, desc) in d.outputs.items():
@@ -576,8 +584,8 @@ class GraphGenerator(Generator):
         for k, t in enumerate(d.platform.task):
             if t not in self.x_names:
                 raise InputError(
-                    f"unknown task coordinate {t!r}; the pose coordinates are {', '.join(self.x_names)} (an "
-                    "actuated joint's value is an input, not a task coordinate)",
+                    f"unknown task coordinate {t!r}; the pose coordinates are {', '.join(self.x_names)} (the "
+                    "platform's coordinates and the joints' values; an actuator's name is an input)",
                     path=("platform", "task", k),
                     suggestions=suggest(t, self.x_names),
                 )
@@ -621,6 +629,9 @@ class GraphGenerator(Generator):
             sign = self.assembler.reference_sign(d)
             scale = ca.fmax(ca.fabs(ca.substitute(d, xq, draw)), 1e-300)
             name = "loop" + "_".join(str(n) for n in loops)
+            taken = [b[1] for b in self.branch]
+            if name in taken:  # one loop's rows in two blocks: a sub-chain each (a, b, ...)
+                name += "abcdefghijklmnopqrstuvwxyz"[sum(t.startswith(name) for t in taken) % 26]
             what = (
                 f"assembly mode of loop{'s' if len(loops) > 1 else ''} {', '.join(map(str, loops))}: det of "
                 f"{'their' if len(loops) > 1 else 'its'} block of Φ_x, signed as at the reference configuration"
@@ -805,6 +816,7 @@ class Assembler:
                 keep.append(k)
                 basis = np.vstack([basis, rest / np.linalg.norm(rest)])
         self.keep = keep
+        self.J_ref, self.tree_names = J, [gen.x_names[k] for k in cols]
         rank = len(keep)
         mobility = ntree - rank
         lam = 3 if gen.d.platform.planar else 6
@@ -837,7 +849,14 @@ class Assembler:
             f"({', '.join(c.name for c in gen.q_coords)})"
         )
         if info.mobility > nq:
-            text += "; actuate more joints, or join the bodies that move freely"
+            # the joints the free motions move: the rows of the whole null space (not one basis vector)
+            _u, sv, vt = (
+                np.linalg.svd(self.J_ref) if self.J_ref.size else (None, np.zeros(0), np.eye(len(self.tree_names)))
+            )
+            rank = int(np.sum(sv > RANK_TOL * max(float(sv[0]) if sv.size else 1.0, 1e-300)))
+            share = np.linalg.norm(vt[rank:], axis=0)
+            moving = [n for n, v in zip(self.tree_names, share) if v > 1e-6 * max(float(np.max(share)), 1e-300)]
+            text += f"; the free motions move {', '.join(moving)}: actuate more joints, or join those bodies"
         else:
             text += "; actuate fewer joints (an actuated joint is locked against the others)"
         return text
@@ -899,7 +918,8 @@ def graph_geometry(fn: ca.Function, layout: list, gen: GraphGenerator) -> Callab
             if name not in pts:
                 pts[name] = V[:, k].copy()
             of_body.setdefault(body, []).append(name)
-        pts["P" if "P" not in pts else "P0"] = V[:, -1].copy()
+        if platform != ground:  # the platform point (none when the pose is the joints' alone)
+            pts["P" if "P" not in pts else "P0"] = V[:, -1].copy()
         span = float(np.ptp(np.array(list(pts.values())), axis=0).max()) or 1.0
         segments, faces = [], []
         for body in [b.name for b in d.bodies]:

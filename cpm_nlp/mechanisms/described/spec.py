@@ -684,12 +684,13 @@ GROUND_NAMES = ("ground", "base")
 
 def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa: C901 - one check per key
     """The ``points``, ``bodies``, ``joints`` and ``outputs`` of a bodies-and-joints file."""
-    for key in ("legs", "closures"):
+    for key in ("legs", "closures", "actuators"):
         if data.get(key):
             raise InputError(
                 f"a file describes its mechanism by bodies and joints or by {key}, not both",
                 path=(key,),
-                hint="write every loop as joints between bodies (the loops are found from the graph)",
+                hint="write every loop as joints between bodies (the loops are found from the graph), and mark "
+                "the actuated joints 'actuated: name'",
             )
     points = {}
     for name, v in _mapping(data.get("points") or {}, ("points",), "name -> vector").items():
