@@ -14,7 +14,7 @@ of the page may read them):
 * ``python``: executed, the blocks of a page sharing one namespace.
 * ``yaml``: a problem file, written (to the path of a preceding ``<!-- file: PATH -->``
   comment, else a temporary name) and validated with ``cpm-nlp check``; a mechanism file
-  (with ``legs``) is written and loaded, and one marked ``<!-- file: PATH invalid -->``
+  (with ``legs``, or ``bodies`` and ``joints``) is written and loaded, and one marked ``<!-- file: PATH invalid -->``
   (a deliberate mistake the page shows) must fail to load as bad input.
 * a ``bash`` block may be followed by ``<!-- output: TEXT -->`` lines: each claim the
   prose makes about that block's output, which must then contain TEXT (runs of
@@ -217,7 +217,8 @@ def _run_yaml(block: Block, k: int) -> None:
     where = f"{_name(block.page)}:{block.line}"
     data = yaml.safe_load(block.body)
     path = Path(block.file) if block.file else Path("problems") / f"_doc_block_{k}.yaml"
-    if isinstance(data, dict) and "legs" in data and block.file:  # a mechanism file, used by the blocks after it
+    mechanism = isinstance(data, dict) and ("legs" in data or "bodies" in data)  # legs, or bodies and joints
+    if mechanism and block.file:  # a mechanism file, used by the blocks after it
         path.write_text(block.body, encoding="utf-8")
         if block.invalid:  # the page shows its error next; loading must fail as bad input
             with pytest.raises(cn.InputError):
