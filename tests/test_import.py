@@ -1,0 +1,382 @@
+"""cpm-nlp import: a URDF and its Extended URDF sidecar as a mechanism file of bodies and joints.
+
+The fixtures (tests/data/import/) are written for these tests, in the layout of the public
+examples of Gepetto/example-parallel-robots (robots/5bar_linkage/robot.urdf + robot.yaml: a 6d
+closure between two dummy links; robots/5bar_linkage_iso3d: a 3d closure between two links on
+fixed joints).  The expected drawing is derived here by hand from each fixture's stated
+geometry (crank angles and link lengths), not from the importer's frame arithmetic.
+"""
+
+from __future__ import annotations
+
+import builtins
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from cpm_nlp.core.errors import InputError
+from cpm_nlp.io.import_urdf import import_urdf
+
+DATA = Path(__file__).resolve().parent / "data" / "import"
+FIVE, FIVE_SIDE = str(DATA / "five_bar.urdf"), str(DATA / "five_bar.yaml")
+FOUR, FOUR_SIDE = str(DATA / "four_bar.urdf"), str(DATA / "four_bar.yaml")
+
+# five_bar.urdf (its header): A1, A2 = (-/+0.05, 0), cranks 0.1 at 120 and 60 deg, distal 0.15
+FIVE_D, FIVE_L1, FIVE_L2 = 0.1, 0.1, 0.15
+# four_bar.urdf (its header): O = (0, 0), D = (0.06, 0); crank a at 60 deg, coupler b, rocker c;
+# the tracer at (0.035, 0.02) in the coupler's frame (x along the coupler)
+FOUR_A, FOUR_B, FOUR_C, FOUR_D, FOUR_TH2 = 0.02, 0.07, 0.05, 0.06, math.radians(60)
+TRACER = np.array([0.035, 0.02])
+
+
+def five_bar_drawing(q1: float = 0.0, q2: float = 0.0) -> dict[str, np.ndarray]:
+    """The five-bar by hand: crank angles 120 deg + q1 and 60 deg + q2, P the upper
+    intersection of the two circles of radius l2 about the elbows."""
+    a1, a2 = np.array([-FIVE_D / 2, 0.0]), np.array([FIVE_D / 2, 0.0])
+    c1 = a1 + FIVE_L1 * np.array([math.cos(2 * math.pi / 3 + q1), math.sin(2 * math.pi / 3 + q1)])
+    c2 = a2 + FIVE_L1 * np.array([math.cos(math.pi / 3 + q2), math.sin(math.pi / 3 + q2)])
+    m, half = (c1 + c2) / 2, np.linalg.norm(c2 - c1) / 2
+    u = (c2 - c1) / (2 * half)
+    p = m + math.sqrt(FIVE_L2**2 - half**2) * np.array([-u[1], u[0]])  # left of c1 -> c2: above
+    return {"A1": a1, "A2": a2, "C1": c1, "C2": c2, "P": p}
+
+
+def four_bar_drawing(q: float = 0.0) -> dict[str, np.ndarray]:
+    """The four-bar by hand: crank at 60 deg + q, the open assembly (C left of B -> D)."""
+    o, d = np.zeros(2), np.array([FOUR_D, 0.0])
+    b = FOUR_A * np.array([math.cos(FOUR_TH2 + q), math.sin(FOUR_TH2 + q)])
+    dist = np.linalg.norm(d - b)
+    e = (d - b) / dist
+    x = (FOUR_B**2 - FOUR_C**2 + dist**2) / (2 * dist)
+    c = b + x * e + math.sqrt(FOUR_B**2 - x**2) * np.array([-e[1], e[0]])
+    th3 = math.atan2(c[1] - b[1], c[0] - b[0])
+    rot = np.array([[math.cos(th3), -math.sin(th3)], [math.sin(th3), math.cos(th3)]])
+    return {"O": o, "D": d, "B": b, "C": c, "T": b + rot @ TRACER, "th3": th3}
+
+
+def load(text: str) -> dict:
+    return yaml.safe_load(text)
+
+
+def point(data: dict, body: str, name: str) -> np.ndarray:
+    """A body's point: its own coordinates, else the drawing's."""
+    raw = data["bodies"][body]
+    own = raw["points"].get(name) if isinstance(raw, dict) else None
+    if isinstance(raw, list):
+        assert name in raw
+    else:
+        assert name in raw["points"]
+    return np.array(own if own is not None else data["points"][name], dtype=float)
+
+
+# -- what is written ---------------------------------------------------------------------------
+
+
+def test_five_bar_bodies_joints_and_drawing():
+    imported = import_urdf(FIVE, FIVE_SIDE)
+    data = load(imported.text)
+    assert imported.planar and data["platform"]["planar"] is True
+    assert data["name"] == "five_bar"
+    # the dummy links welded by the 6d closure are gone: one R joint between the distal links
+    assert set(data["bodies"]) == {"ground", "crank1", "crank2", "distal1", "distal2"}
+    joints = {j["name"]: j for j in data["joints"]}
+    assert {n: (j["type"], tuple(j["between"])) for n, j in joints.items()} == {
+        "mot1": ("planar_R", ("ground", "crank1")),
+        "free1": ("planar_R", ("crank1", "distal1")),
+        "closedloop1_A": ("planar_R", ("distal1", "distal2")),
+        "mot2": ("planar_R", ("ground", "crank2")),
+        "free2": ("planar_R", ("crank2", "distal2")),
+    }
+    assert joints["mot1"]["actuated"] == "mot1" and joints["mot2"]["actuated"] == "mot2"
+    assert "actuated" not in joints["free1"] and joints["free1"]["coordinates"] == ["free1"]
+    assert joints["mot1"]["range"] == [-3.14, 3.14]  # the URDF's limit, axis +n: not flipped
+    # the plane is the URDF's y-z plane (every axis along x); the 0.01 layer offset is dropped
+    hand = five_bar_drawing()
+    expect = {
+        ("ground", "P_mot1"): hand["A1"],
+        ("ground", "P_mot2"): hand["A2"],
+        ("crank1", "P_mot1"): hand["A1"],
+        ("crank1", "P_free1"): hand["C1"],
+        ("crank2", "P_free2"): hand["C2"],
+        ("distal1", "P_free1"): hand["C1"],
+        ("distal1", "P_closedloop1_A"): hand["P"],
+        ("distal1", "P_effector"): hand["P"],
+        ("distal2", "P_closedloop1_A"): hand["P"],
+        ("distal2", "P_free2"): hand["C2"],
+    }
+    for (body, name), value in expect.items():
+        np.testing.assert_allclose(point(data, body, name), value, rtol=0, atol=1e-12, err_msg=f"{body}.{name}")
+    assert data["platform"]["body"] == "distal1" and data["platform"]["point"] == "P_effector"
+    assert data["platform"]["task"] == ["x", "y"]
+    np.testing.assert_allclose([data["platform"]["home"]["x"], data["platform"]["home"]["y"]], hand["P"], atol=1e-12)
+    # free2's URDF axis is -x: its angle in the plane is minus the URDF's, and the header says so
+    assert any("free2" in n and "-n" in n for n in imported.notes)
+    assert "# Planar: every R axis is n = [1.0, 0, 0]" in imported.text
+
+
+def test_four_bar_bodies_joints_and_drawing():
+    imported = import_urdf(FOUR, FOUR_SIDE, platform="tracer")
+    data = load(imported.text)
+    assert imported.planar
+    # world and base (a fixed joint) are one body, the ground; coupler_end, tracer on the coupler
+    assert set(data["bodies"]) == {"ground", "crank_link", "coupler", "rocker"}
+    joints = {j["name"]: j for j in data["joints"]}
+    assert {n: (j["type"], tuple(j["between"])) for n, j in joints.items()} == {
+        "crank": ("planar_R", ("ground", "crank_link")),
+        "coupler_pin": ("planar_R", ("crank_link", "coupler")),
+        "rocker_pivot": ("planar_R", ("ground", "rocker")),
+        "coupler_end": ("planar_R", ("coupler", "rocker")),  # the 3d closure: S, planar_R in the plane
+    }
+    assert joints["crank"]["actuated"] == "crank"
+    assert joints["rocker_pivot"]["range"] == [-1.0, 1.0]
+    hand = four_bar_drawing()
+    expect = {
+        ("ground", "P_crank"): hand["O"],
+        ("ground", "P_rocker_pivot"): hand["D"],
+        ("crank_link", "P_coupler_pin"): hand["B"],
+        ("coupler", "P_coupler_pin"): hand["B"],
+        ("coupler", "P_coupler_end"): hand["C"],
+        ("rocker", "P_coupler_end"): hand["C"],
+        ("coupler", "P_tracer"): hand["T"],
+    }
+    for (body, name), value in expect.items():
+        np.testing.assert_allclose(point(data, body, name), value, rtol=0, atol=1e-12, err_msg=f"{body}.{name}")
+    assert data["platform"]["body"] == "coupler" and data["platform"]["task"] == ["phi"]
+    assert data["platform"]["home"]["phi"] == 0
+
+
+def test_numbers_are_written_exactly():
+    """Every coordinate is written with repr: the file reads back the very floats computed."""
+    imported = import_urdf(FOUR, FOUR_SIDE, platform="tracer")
+    data = load(imported.text)
+    for body, own in imported.bodies.items():
+        for name, value in own.items():
+            if value is not None:
+                assert data["bodies"][body]["points"][name] == value
+    for v in data["points"].values():
+        assert all(isinstance(x, (int, float)) for x in v)
+
+
+def test_spatial_file_keeps_axes_and_the_spherical_closure():
+    imported = import_urdf(FOUR, FOUR_SIDE, platform="tracer", planar=False, task=["phi"])
+    data = load(imported.text)
+    assert not imported.planar and "planar" not in data["platform"]
+    joints = {j["name"]: j for j in data["joints"]}
+    assert joints["crank"]["type"] == "R" and joints["crank"]["axis"] == [0, 0, 1.0]
+    assert joints["coupler_end"]["type"] == "S" and "axis" not in joints["coupler_end"]
+    hand = four_bar_drawing()
+    np.testing.assert_allclose(data["points"]["P_coupler_end"], [*hand["C"], 0.0], atol=1e-12)
+
+
+def test_actuated_joints_from_the_option():
+    data = load(import_urdf(FOUR, FOUR_SIDE, platform="tracer", actuated=["rocker_pivot"]).text)
+    joints = {j["name"]: j for j in data["joints"]}
+    assert joints["rocker_pivot"]["actuated"] == "rocker_pivot"
+    assert "actuated" not in joints["crank"] and joints["crank"]["coordinates"] == ["crank"]
+
+
+def test_names_are_made_valid_and_said(tmp_path):
+    text = (DATA / "four_bar.urdf").read_text().replace('"coupler"', '"coupler link"')
+    text = text.replace('name="crank"', 'name="2-crank"').replace('"world"', '"on"')
+    path = tmp_path / "names.urdf"
+    path.write_text(text)
+    imported = import_urdf(str(path), FOUR_SIDE, actuated=["2-crank"], platform="tracer")
+    data = load(imported.text)
+    assert "coupler_link" in data["bodies"]
+    assert [j["name"] for j in data["joints"]][0] == "n_2_crank"
+    assert any("'2-crank' -> n_2_crank" in n for n in imported.notes)
+
+
+def test_nothing_but_the_two_named_files_is_opened(monkeypatch):
+    """four_bar.urdf names /etc/passwd as a mesh: only the URDF and the sidecar are opened."""
+    opened = []
+    real_open = builtins.open
+
+    def spy(file, *args, **kwargs):
+        opened.append(str(file))
+        return real_open(file, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "open", spy)
+    import_urdf(FOUR, FOUR_SIDE, platform="tracer")
+    assert sorted(opened) == sorted([FOUR, FOUR_SIDE])
+
+
+# -- bad and hostile input ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "where", "what"),
+    [
+        ("hostile_entities.urdf", "robot", "<!DOCTYPE>"),
+        ("hostile_external.urdf", "robot", "<!DOCTYPE>"),
+        ("missing_parent.urdf", "joint[mot1].parent.link", "did you mean 'base_link'"),
+        ("cycle.urdf", "joint[", "cycle: b -> c -> a -> b"),
+        ("unknown_type.urdf", "joint[mot1].type", "did you mean 'revolute'"),
+        ("xacro_include.urdf", "robot.include", "macro or an include"),
+    ],
+)
+def test_hostile_urdf_is_refused_naming_the_file_and_element(name, where, what):
+    path = str(DATA / name)
+    with pytest.raises(InputError) as info:
+        import_urdf(path)
+    message = str(info.value)
+    assert message.startswith(path + ": " + where), message
+    assert what in message
+
+
+@pytest.mark.parametrize(
+    ("name", "where", "what"),
+    [
+        ("bad_frame.yaml", "closed_loop[0][1]", "did you mean 'closedloop1_B'"),
+        ("bad_type.yaml", "type[0]", "expected '6d'"),
+    ],
+)
+def test_bad_sidecar_is_refused_naming_its_key_path(name, where, what):
+    path = str(DATA / name)
+    with pytest.raises(InputError) as info:
+        import_urdf(FIVE, path)
+    assert str(info.value).startswith(f"{path}: {where}: ")
+    assert what in str(info.value)
+
+
+ROBOT = """<?xml version="1.0"?>
+<robot name="r">
+  <link name="base"/><link name="a"/><link name="b"/>
+  {joints}
+</robot>
+"""
+
+
+@pytest.mark.parametrize(
+    ("joints", "where", "what"),
+    [
+        (
+            '<joint name="j1" type="revolute"><parent link="base"/><child link="a"/></joint>'
+            '<joint name="j2" type="revolute"><parent link="b"/><child link="a"/></joint>'
+            '<joint name="j3" type="revolute"><parent link="base"/><child link="b"/></joint>',
+            "joint[j2].child.link",
+            "child of two joints",
+        ),
+        (
+            '<joint name="j1" type="revolute"><origin xyz="0 nan 0"/><parent link="base"/><child link="a"/></joint>',
+            "joint[j1].origin.xyz",
+            "3 finite numbers",
+        ),
+        (
+            '<joint name="j1" type="floating"><parent link="base"/><child link="a"/></joint>',
+            "joint[j1].type",
+            "unsupported joint type 'floating'",
+        ),
+        (
+            '<joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 0"/></joint>',
+            "joint[j1].axis.xyz",
+            "nonzero axis",
+        ),
+        (
+            '<joint name="j1" type="revolute"><parent link="base"/><child link="a"/><mimic joint="j2"/></joint>',
+            "joint[j1].mimic",
+            "mimic",
+        ),
+        (
+            '<joint name="j1" type="revolute"><parent link="base"/><child link="a"/></joint>',
+            "robot",
+            "not one tree: base, b have no parent joint",
+        ),
+        ("<joint name='j1' type='revolute'><parent link='base'/>", "", "malformed XML: line"),
+    ],
+)
+def test_bad_urdf_elements(tmp_path, joints, where, what):
+    path = tmp_path / "r.urdf"
+    path.write_text(ROBOT.format(joints=joints))
+    with pytest.raises(InputError) as info:
+        import_urdf(str(path))
+    message = str(info.value)
+    assert message.startswith(f"{path}: {where}" if where else f"{path}: "), message
+    assert what in message
+
+
+def test_a_large_file_is_refused_before_it_is_read(tmp_path):
+    path = tmp_path / "big.urdf"
+    with open(path, "wb") as fh:
+        fh.truncate(2 << 20)  # sparse: 2 MiB of nothing
+    with pytest.raises(InputError, match="the limit is 1 MiB"):
+        import_urdf(str(path))
+
+
+def test_sidecar_errors(tmp_path):
+    side = tmp_path / "robot.yaml"
+    side.write_text("closed_loops: [[closedloop1_A, closedloop1_B]]\n")
+    with pytest.raises(InputError, match=r"closed_loops: unknown key .*did you mean 'closed_loop'"):
+        import_urdf(FIVE, str(side))
+    side.write_text("closed_loop: [[closedloop1_A, closedloop1_B]]\ntype: [6d]\nname_mot: [mot3]\n")
+    with pytest.raises(InputError, match=r"name_mot\[0\]: no joint of the URDF is named 'mot3'; did you mean"):
+        import_urdf(FIVE, str(side))
+    side.write_text("closed_loop: [[closedloop1_A, closedloop1_B]]\ntype: [6d]\n")
+    with pytest.raises(InputError, match="no actuated joint"):
+        import_urdf(FIVE, str(side))
+    side.write_text("closed_loop: [[free1, effector_frame]]\ntype: [3d]\nname_mot: [mot1, mot2]\n")
+    with pytest.raises(InputError, match=r"closed_loop\[0\]: the frames .* are on one rigid body"):
+        import_urdf(FIVE, str(side))
+
+
+def test_option_errors():
+    with pytest.raises(InputError, match=r"--actuated: the joint 'effector_frame' is fixed"):
+        import_urdf(FIVE, FIVE_SIDE, actuated=["effector_frame"])
+    with pytest.raises(InputError, match=r"--task\[1\]: unknown task coordinate 'w'"):
+        import_urdf(FIVE, FIVE_SIDE, task=["x", "w"])
+    with pytest.raises(InputError, match=r"--task: expected 2 different task coordinates"):
+        import_urdf(FIVE, FIVE_SIDE, task=["x"])
+    with pytest.raises(InputError, match=r"--task: which task coordinates for 1 actuated joint"):
+        import_urdf(FOUR, FOUR_SIDE, platform="tracer", planar=False)
+    with pytest.raises(InputError, match=r"--platform: no joint or link of the URDF is named 'tracr'"):
+        import_urdf(FOUR, FOUR_SIDE, platform="tracr")
+    with pytest.raises(InputError, match=r"four_bar.urdf: robot: which body is the platform"):
+        import_urdf(FOUR, FOUR_SIDE)
+    with pytest.raises(InputError, match=r"--name: expected a mechanism name"):
+        import_urdf(FIVE, FIVE_SIDE, name="five bar")
+
+
+# -- the command line --------------------------------------------------------------------------
+
+
+def test_cli_writes_the_file(cli, tmp_path):
+    out = tmp_path / "five.yaml"
+    run = cli("import", FIVE, "--sidecar", FIVE_SIDE, "-o", str(out), "--name", "five_bar_urdf")
+    assert run.code == 0, run.err
+    assert run.out == f"{out}: 5 bodies, 5 joints (planar) from {FIVE}\n"
+    assert out.read_text() == import_urdf(FIVE, FIVE_SIDE, name="five_bar_urdf").text
+    assert not [p for p in tmp_path.iterdir() if p.name != "five.yaml"]  # no temporary left
+
+
+def test_cli_prints_without_output(cli):
+    run = cli("import", FOUR, "--sidecar", FOUR_SIDE, "--platform", "tracer", "--actuated", "crank")
+    assert run.code == 0, run.err
+    assert run.out == import_urdf(FOUR, FOUR_SIDE, platform="tracer", actuated=["crank"]).text
+
+
+def test_cli_bad_input_exits_2_and_writes_nothing(cli, tmp_path):
+    out = tmp_path / "x.yaml"
+    for argv in (
+        ("import", str(DATA / "hostile_entities.urdf"), "-o", str(out)),
+        ("import", FIVE, "--sidecar", str(DATA / "bad_type.yaml"), "-o", str(out)),
+        ("import", FIVE, "--sidecar", FIVE_SIDE, "--task", "x,", "-o", str(out)),
+        ("import", str(tmp_path / "missing.urdf"), "-o", str(out)),
+    ):
+        run = cli(*argv)
+        assert run.code == 2, (argv, run.err)
+        assert run.err.startswith("error: ") and run.err.count("\n") == 1 and "Traceback" not in run.err
+    assert not out.exists()
+
+
+def test_cli_refuses_to_overwrite_an_input(cli, tmp_path):
+    urdf, side = tmp_path / "r.urdf", tmp_path / "r.yaml"
+    urdf.write_bytes(Path(FIVE).read_bytes())
+    side.write_bytes(Path(FIVE_SIDE).read_bytes())
+    for target in (urdf, side):
+        before = target.read_bytes()
+        run = cli("import", str(urdf), "--sidecar", str(side), "-o", str(target))
+        assert run.code == 2 and "refusing to overwrite it" in run.err
+        assert target.read_bytes() == before
