@@ -31,6 +31,7 @@ from .chains import chains_function
 from .chains import supported as chains_supported
 from .drawing import geometry_of
 from .generate import closure_parts, parameter_options
+from .graph import graph_geometry
 from .spec import Description, description_from_dict
 
 log = logging.getLogger(__name__)
@@ -132,7 +133,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         parameters=[p.name for p in d.parameters],
         phi=fns["phi"],
         task=d.platform.task,
-        home=lambda p: tuple(np.asarray(v, dtype=float).ravel() for v in fns["home"](p)),
+        home=fns.get("assemble") or (lambda p: tuple(np.asarray(v, dtype=float).ravel() for v in fns["home"](p))),
         bounds=lambda p: tuple(np.asarray(v, dtype=float).ravel() for v in fns["extras"](p)[:2]),
         ik=fns["ik"],
         passive=fns["passive"],
@@ -179,9 +180,11 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         build=build,
         problem_files=examples,
         stiffness=d.stiffness,
-        geometry=geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
+        geometry=graph_geometry(*fns["graph_drawing"], gen)
+        if d.is_graph
+        else geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
         origin=f"file {d.file}" if d.file else "described in code",
-        chains=chains_function(gen) if chains_supported(gen) else None,
+        chains=chains_function(gen) if not d.is_graph and chains_supported(gen) else None,
     )
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults
         model = mech.model(closure, {}, {}, ())

@@ -247,7 +247,10 @@ class Generator:
         for name, text in pf.fixed.items():
             v = self.value(text, ("platform", "fixed", name), self.env, pf.coordinates[name])
             self._bind(self.xenv, name, v, ("platform", "fixed", name))
-        self.P = self.vector(pf.position, ("platform", "position"), self.xenv, "length")
+        if self.d.is_graph and pf.position == []:  # the platform body's point is the position (graph)
+            self.P = None
+        else:
+            self.P = self.vector(pf.position, ("platform", "position"), self.xenv, "length")
         R = ca.SX.eye(3)
         for k, (axis, angle) in enumerate(pf.rotation):
             if pf.planar and axis != "z":
@@ -259,7 +262,7 @@ class Generator:
             text = pf.home.get(name, 0)
             home.append(self.scalar(text, ("platform", "home", name), self.env, pf.coordinates[name]))
         self.x_home = ca.vertcat(*home)
-        self.P_home = ca.substitute(self.P, self.x, self.x_home)
+        self.P_home = ca.SX.zeros(3) if self.P is None else ca.substitute(self.P, self.x, self.x_home)
         self.R_home = ca.substitute(self.R, self.x, self.x_home)
 
     def platform_point(self, B0: ca.SX) -> ca.SX:
@@ -891,7 +894,8 @@ class Generator:
                 lo.append(self.scalar(a, ("platform", "bounds", name, 0), self.env, dim))
                 hi.append(self.scalar(b, ("platform", "bounds", name, 1), self.env, dim))
             elif dim == "angle":
-                half = math.pi / 3 if name in pf.coordinates else math.pi / 2
+                # a passive joint of a graph turns up to a half turn either way from the drawing
+                half = math.pi / 3 if name in pf.coordinates else math.pi if self.d.is_graph else math.pi / 2
                 lo.append(self.x_home[k] - half)
                 hi.append(self.x_home[k] + half)
             else:
@@ -983,7 +987,13 @@ def _dim_name(dim: ex.Dim) -> str:
 
 
 def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
-    g = Generator(d)
+    """The generator of a description (legs, or bodies and joints) and its built functions."""
+    if d.is_graph:
+        from .graph import GraphGenerator  # the graph form builds on this module
+
+        g: Generator = GraphGenerator(d)
+    else:
+        g = Generator(d)
     return g, g.build()
 
 

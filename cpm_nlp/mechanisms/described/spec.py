@@ -121,6 +121,11 @@ class Joint:
     flexure: Flexure | None = None
     body: str | None = None  # the body it carries (distal side); optional, for connectivity checks
     path: tuple = ()
+    #: a joint of a bodies-and-joints file: its name, the two bodies it joins (proximal first)
+    #: and, for a distance joint, the rod's length (default: the distance in the drawing)
+    name: str | None = None
+    between: tuple[str, ...] = ()
+    length: Expr = None
 
 
 @dataclass
@@ -152,6 +157,21 @@ class Platform:
     descriptions: dict[str, str] = field(default_factory=dict)
     planar: bool = False
     offsets: dict[str, str] = field(default_factory=dict)
+    #: a bodies-and-joints file: the body whose frame the pose coordinates locate, and its point
+    #: that ``position`` locates (None: the body's frame origin, the world origin in the drawing)
+    body: str | None = None
+    point: str | None = None
+
+
+@dataclass
+class Body:
+    """A rigid body of a bodies-and-joints file: its named points in the drawing (world frame at
+    the drawing configuration, which is also the body's own frame); None: the global point."""
+
+    name: str
+    points: dict[str, Expr]
+    description: str = ""
+    path: tuple = ()
 
 
 @dataclass
@@ -191,6 +211,17 @@ class Description:
     #: the compliant joints (hinges, material, source): the compliance kinds' defaults
     stiffness: JointStiffness | None = None
     file: str | None = None
+    #: a bodies-and-joints file (see :mod:`.graph`): the drawing's named points, the bodies, the
+    #: joints between any two of them, and points of any body reported as outputs (name -> (body, point))
+    points: dict[str, Expr] = field(default_factory=dict)
+    bodies: list[Body] = field(default_factory=list)
+    joints: list[Joint] = field(default_factory=list)
+    outputs: dict[str, tuple[str, str, str]] = field(default_factory=dict)
+
+    @property
+    def is_graph(self) -> bool:
+        """Whether the mechanism is a graph of bodies and joints (not legs)."""
+        return bool(self.bodies)
 
 
 # -- reading a mapping ---------------------------------------------------------------------------
@@ -211,6 +242,10 @@ TOP = {
     "characteristic_length": "length expression for conditioning measures",
     "examples": "problem files that use the mechanism (relative to this file)",
     "stiffness": "{hinges, material, source}: the compliant joints, defaults of the compliance kinds",
+    "points": "name -> vector: named points of the drawing (bodies-and-joints files)",
+    "bodies": "name -> [point names] or {points, description}: the rigid bodies (the ground is 'ground')",
+    "joints": "list of {type, between: [body, body], at, axis, ...}: joints between any two bodies",
+    "outputs": "name -> body.point: points of any body reported with every result",
 }
 
 
@@ -318,6 +353,8 @@ PLATFORM_KEYS = {
     "bounds": "name -> [low, high]: the box IPOPT keeps the pose in",
     "planar": "true for a planar mechanism (P in the plane, R about z)",
     "offsets": "name -> coordinate: inputs/outputs measured from the home pose (dz: pz)",
+    "body": "the body the pose coordinates locate (bodies-and-joints files; default 'platform')",
+    "point": "the point of that body that position locates (default: its frame origin)",
 }
 
 
@@ -371,7 +408,11 @@ def _platform(raw: Any, path: tuple) -> Platform:  # noqa: C901 - one check per 
         _name(name, path + ("offsets", name), "an offset name")
         if target not in coords or target in fixed:
             raise InputError(f"expected a pose coordinate, got {target!r}", path=path + ("offsets", name))
-    return Platform(coords, raw["position"], rotation, tuple(task), fixed, home, bounds, descs, planar, offsets)
+    body = None if raw.get("body") is None else _name(raw["body"], path + ("body",), "a body name")
+    point = None if raw.get("point") is None else _name(raw["point"], path + ("point",), "a point name")
+    return Platform(
+        coords, raw["position"], rotation, tuple(task), fixed, home, bounds, descs, planar, offsets, body, point
+    )
 
 
 JOINT_KEYS = {
@@ -389,10 +430,17 @@ JOINT_KEYS = {
     "flexure": "{hinge, t, r, l, material, E, sigma_all}",
     "body": "the body it carries (distal side)",
 }
+#: the keys of a joint of a bodies-and-joints file
+GRAPH_JOINT_KEYS = {
+    "name": "the joint's name (default J1, J2, ... in file order)",
+    "between": "[proximal body, distal body]",
+    "length": "the rod's length (a distance joint; default: its length in the drawing)",
+    **{k: v for k, v in JOINT_KEYS.items() if k != "body"},
+}
 
 
-def _joint(raw: Any, path: tuple, template: dict) -> Joint:  # noqa: C901 - one check per key
-    raw = _mapping(raw, path, "a joint {type, at, axis, ...}", JOINT_KEYS)
+def _joint(raw: Any, path: tuple, template: dict, graph: bool = False) -> Joint:  # noqa: C901 - one check per key
+    raw = _mapping(raw, path, "a joint {type, at, axis, ...}", GRAPH_JOINT_KEYS if graph else JOINT_KEYS)
     kind = raw.get("type")
     if kind not in JOINT_TYPES:
         raise InputError(
@@ -438,7 +486,24 @@ def _joint(raw: Any, path: tuple, template: dict) -> Joint:  # noqa: C901 - one 
         if raw.get("body") is None
         else _name(_fill(raw["body"], template, path + ("body",)), path + ("body",), "a body name"),
         path,
+        None if raw.get("name") is None else _name(raw["name"], path + ("name",), "a joint name"),
+        _between(raw, path) if graph else (),
+        raw.get("length"),
     )
+
+
+def _between(raw: Mapping, path: tuple) -> tuple[str, str]:
+    pair = raw.get("between")
+    if not isinstance(pair, list) or len(pair) != 2:
+        raise InputError(
+            f"expected [proximal body, distal body], got {pair!r:.60}",
+            path=path + ("between",),
+            hint="a joint of a bodies-and-joints file joins two bodies: between: [ground, crank]",
+        )
+    a, b = (_name(v, path + ("between", k), "a body name") for k, v in enumerate(pair))
+    if a == b:
+        raise InputError(f"a joint joins two different bodies, got {a!r} twice", path=path + ("between",))
+    return a, b
 
 
 _PLACEHOLDER = re.compile(r"\{(\w+)\}")
@@ -625,6 +690,117 @@ def _stiffness(raw: Any, path: tuple) -> JointStiffness:
 
 
 IK_KEYS = {"let": "definitions in order", "pose": "dependent coordinates", "actuators": "", "reach": ""}
+BODY_KEYS = {"points": "name -> vector (null: the global point), or a list of global point names", "description": ""}
+#: the names the ground body may take
+GROUND_NAMES = ("ground", "base")
+
+
+def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa: C901 - one check per key
+    """The ``points``, ``bodies``, ``joints`` and ``outputs`` of a bodies-and-joints file."""
+    for key in ("legs", "closures"):
+        if data.get(key):
+            raise InputError(
+                f"a file describes its mechanism by bodies and joints or by {key}, not both",
+                path=(key,),
+                hint="write every loop as joints between bodies (the loops are found from the graph)",
+            )
+    points = {}
+    for name, v in _mapping(data.get("points") or {}, ("points",), "name -> vector").items():
+        points[_name(name, ("points", name), "a point name")] = v
+    bodies: list[Body] = []
+    for name, raw in _mapping(data["bodies"], ("bodies",), "name -> the points it carries").items():
+        path = ("bodies", name)
+        _name(name, path, "a body name")
+        desc = ""
+        if isinstance(raw, Mapping):
+            raw = _mapping(raw, path, "{points, description}", BODY_KEYS)
+            desc = _text(raw.get("description"), path + ("description",))
+            raw, path = raw.get("points") or [], path + ("points",)
+        if isinstance(raw, list):
+            own = {}
+            for k, n in enumerate(raw):
+                if n not in points:
+                    raise InputError(
+                        f"unknown point {n!r}; the drawing's points: {', '.join(points) or 'none (declare them under points)'}",
+                        path=path + (k,),
+                        suggestions=suggest(str(n), points),
+                    )
+                own[n] = None
+        else:
+            own = _mapping(raw, path, "name -> vector (null: the global point)")
+            for n, v in own.items():
+                _name(n, path + (n,), "a point name")
+                if v is None and n not in points:
+                    raise InputError(
+                        f"{n!r} is not a point of the drawing; give its coordinates",
+                        path=path + (n,),
+                        suggestions=suggest(str(n), points),
+                    )
+        bodies.append(Body(name, own, desc, ("bodies", name)))
+    names = [b.name for b in bodies]
+    if not any(n in GROUND_NAMES for n in names):
+        raise InputError(
+            f"no ground: name the fixed body 'ground' (or 'base'); the bodies are {', '.join(names)}",
+            path=("bodies",),
+            suggestions=suggest("ground", names),
+        )
+    if all(n in names for n in GROUND_NAMES):
+        raise InputError("two grounds: 'ground' and 'base' name the same fixed body; keep one", path=("bodies", "base"))
+    joints_raw = _list(data.get("joints"), ("joints",), "a list of joints {type, between: [body, body], at, ...}")
+    _check_size(len(joints_raw), MAX_JOINTS, "joints", ("joints",))
+    _check_size(len(bodies), MAX_JOINTS, "bodies", ("bodies",))
+    joints = [_joint(j, ("joints", k), {}, graph=True) for k, j in enumerate(joints_raw)]
+    seen: dict[str, int] = {}
+    for k, j in enumerate(joints):
+        for n, b in enumerate(j.between):
+            if b not in names:
+                raise InputError(
+                    f"unknown body {b!r}; the bodies are {', '.join(names)}",
+                    path=("joints", k, "between", n),
+                    suggestions=suggest(b, names),
+                )
+        name = j.name or f"J{k + 1}"
+        if name in seen:
+            raise InputError(f"the joint name {name!r} is also joint {seen[name] + 1}'s", path=("joints", k, "name"))
+        seen[name] = k
+        j.name = name
+        for key in ("at", "to"):
+            v = getattr(j, key)
+            if isinstance(v, str) and v.isidentifier():
+                for n, b in enumerate(j.between):
+                    body = bodies[names.index(b)]
+                    if v not in body.points and v not in points:
+                        raise InputError(
+                            f"{v!r} is not a point of {b!r} nor of the drawing; {b!r} carries "
+                            f"{', '.join(body.points) or 'no points'}",
+                            path=("joints", k, key),
+                            suggestions=suggest(v, list(body.points) + list(points)),
+                        )
+    outputs = {}
+    for name, raw in _mapping(data.get("outputs") or {}, ("outputs",), "name -> body.point").items():
+        path = ("outputs", name)
+        _name(name, path, "an output name")
+        desc = ""
+        if isinstance(raw, Mapping):
+            raw = _mapping(raw, path, "{point, description}", {"point": "body.point", "description": ""})
+            desc = _text(raw.get("description"), path + ("description",))
+            raw, path = raw.get("point"), path + ("point",)
+        body, _, point = str(raw).partition(".")
+        if body not in names:
+            raise InputError(
+                f"expected body.point with a body of the file, got {raw!r}",
+                path=path,
+                suggestions=suggest(body, names),
+            )
+        b = bodies[names.index(body)]
+        if point not in b.points:
+            raise InputError(
+                f"{point!r} is not a point of {body!r}; it carries {', '.join(b.points) or 'no points'}",
+                path=path,
+                suggestions=suggest(point, b.points),
+            )
+        outputs[name] = (body, point, desc)
+    return points, bodies, joints, outputs
 
 
 def description_from_dict(data: Any, file: str | None = None) -> Description:  # noqa: C901 - one step per section
@@ -674,6 +850,17 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
     examples = _list(data.get("examples") or [], ("examples",), "a list of problem files")
     legs = _legs(data.get("legs") or [], ("legs",))
     check_bodies(legs)
+    graph: tuple = ({}, [], [], {})
+    if data.get("bodies") is not None:
+        graph = _graph(data)
+    else:
+        for key in ("points", "joints", "outputs"):
+            if data.get(key) is not None:
+                raise InputError(
+                    f"{key!r} belongs to a file of bodies and joints, and this file has no 'bodies'",
+                    path=(key,),
+                    hint="declare the bodies (name -> the points it carries), or describe the legs",
+                )
     return Description(
         name=name,
         title=_text(data.get("title"), ("title",)) or name,
@@ -691,4 +878,8 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
         examples=tuple(str(e) for e in examples),
         stiffness=None if data.get("stiffness") is None else _stiffness(data["stiffness"], ("stiffness",)),
         file=file,
+        points=graph[0],
+        bodies=graph[1],
+        joints=graph[2],
+        outputs=graph[3],
     )
