@@ -17,8 +17,11 @@ import numpy as np
 import pytest
 import yaml
 
+import cpm_nlp as cn
 from cpm_nlp.core.errors import InputError
+from cpm_nlp.core.result import Status
 from cpm_nlp.io.import_urdf import import_urdf
+from cpm_nlp.mechanisms.described import load_file
 
 DATA = Path(__file__).resolve().parent / "data" / "import"
 FIVE, FIVE_SIDE = str(DATA / "five_bar.urdf"), str(DATA / "five_bar.yaml")
@@ -53,8 +56,9 @@ def four_bar_drawing(q: float = 0.0) -> dict[str, np.ndarray]:
     x = (FOUR_B**2 - FOUR_C**2 + dist**2) / (2 * dist)
     c = b + x * e + math.sqrt(FOUR_B**2 - x**2) * np.array([-e[1], e[0]])
     th3 = math.atan2(c[1] - b[1], c[0] - b[0])
+    th4 = math.atan2(c[1] - d[1], c[0] - d[0])
     rot = np.array([[math.cos(th3), -math.sin(th3)], [math.sin(th3), math.cos(th3)]])
-    return {"O": o, "D": d, "B": b, "C": c, "T": b + rot @ TRACER, "th3": th3}
+    return {"O": o, "D": d, "B": b, "C": c, "T": b + rot @ TRACER, "th3": th3, "th4": th4}
 
 
 def load(text: str) -> dict:
@@ -380,3 +384,46 @@ def test_cli_refuses_to_overwrite_an_input(cli, tmp_path):
         run = cli("import", str(urdf), "--sidecar", str(side), "-o", str(target))
         assert run.code == 2 and "refusing to overwrite it" in run.err
         assert target.read_bytes() == before
+
+
+# -- the imported files load, and their kinematics is the linkage's -------------------------------
+
+NEWTON = cn.SolverConfig("newton")
+
+
+def _model(tmp_path, text: str):
+    path = tmp_path / "imported.yaml"
+    path.write_text(text)
+    mech = load_file(path)
+    return mech.model(mech.closure(), {}, {}, ())
+
+
+@pytest.mark.parametrize("q", [(0.0, 0.0), (0.3, -0.2), (-0.4, 0.5), (0.8, 0.6)])
+def test_imported_five_bar_forward_kinematics_is_the_closed_form(tmp_path, q):
+    """FK of the imported file (2 degrees of freedom, task x, y: the effector P) against the
+    two-circle construction of five_bar_drawing (numpy) to 1e-9 m; the plane's angles are the
+    URDF's (mot1, mot2 turn about +x, the plane's normal)."""
+    model = _model(tmp_path, import_urdf(FIVE, FIVE_SIDE).text)
+    assert model.closure.nq == 2 and list(model.closure.x_names[:2]) == ["x", "y"]
+    fk = cn.forward_kinematics(model, list(q), NEWTON)
+    assert fk.status == Status.SOLVED, fk.message
+    np.testing.assert_allclose(fk.x[:2], five_bar_drawing(*q)["P"], rtol=0, atol=1e-9)
+    ik = cn.inverse_kinematics(model, list(fk.x[:2]))  # FK against IK: the actuators come back
+    assert ik.status == Status.SOLVED, ik.message
+    np.testing.assert_allclose(ik.q, q, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("q", [0.0, 0.5, -0.7, 1.0])
+def test_imported_four_bar_forward_kinematics_is_the_closed_form(tmp_path, q):
+    """FK of the imported four-bar (1 degree of freedom, task phi: the coupler's turn from the
+    drawing; x, y: the tracer) against the circle intersection of four_bar_drawing to 1e-9."""
+    model = _model(tmp_path, import_urdf(FOUR, FOUR_SIDE, platform="tracer").text)
+    hand, drawn = four_bar_drawing(q), four_bar_drawing()
+    assert abs(hand["th4"] - drawn["th4"]) < 1.0  # inside the rocker's URDF limit [-1, 1]
+    fk = cn.forward_kinematics(model, [q], NEWTON)
+    assert fk.status == Status.SOLVED, fk.message
+    x = dict(zip(model.closure.x_names, fk.x))
+    np.testing.assert_allclose([x["x"], x["y"]], hand["T"], rtol=0, atol=1e-9)
+    assert x["phi"] == pytest.approx(hand["th3"] - drawn["th3"], abs=1e-9)
+    assert x["rocker_pivot"] == pytest.approx(hand["th4"] - drawn["th4"], abs=1e-9)
+
