@@ -511,6 +511,7 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         body_of[lk] = body_of[j.parent] if j is not None and j.kind == "fixed" else lk
     points: dict[str, dict[str, np.ndarray]] = {body_of[lk]: {} for lk in order}
     names = _Names()
+    names.used.add("ground")
     body_names: dict[str, str] = {}
     for key in points:
         body_names[key] = "ground" if key == root else names.take(key, avoid=_GROUND_NAMES)
@@ -575,6 +576,8 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         lb = _frame(fb, links, by_name, side, path + (1,))
         ba, bb = find(body_of[la]), find(body_of[lb])
         wa, wb = placed(la), placed(lb)
+        if kind == "6d" and bb == root:  # the ground stays: the other body is welded to it
+            fa, fb, la, lb, ba, bb, wa, wb = fb, fa, lb, la, bb, ba, wb, wa
         gap = float(np.linalg.norm(wa[:3, 3] - wb[:3, 3]))
         if ba == bb:
             raise InputError(
