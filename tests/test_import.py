@@ -501,3 +501,50 @@ def test_imported_slider_crank_forward_kinematics(tmp_path, q):
     assert fk.status == Status.SOLVED, fk.message
     x = dict(zip(model.closure.x_names, fk.x))
     assert x["x"] == pytest.approx(s, abs=1e-9) and x["slide"] == pytest.approx(s - SC_S0, abs=1e-9)
+
+
+def test_sidecar_joint_types(tmp_path):
+    """joint_name/joint_type: SPHERICAL is an S joint (a planar R in a planar file); UJOINT_ZX a
+    U joint about the joint frame's z then x axis, in world directions (the coupler's frame is
+    turned by theta3 about z: x -> (cos theta3, sin theta3, 0)), and the file is spatial."""
+    side = tmp_path / "robot.yaml"
+    side.write_text(Path(FOUR_SIDE).read_text() + "joint_name: [rocker_pivot]\njoint_type: [SPHERICAL]\n")
+    data = load(import_urdf(FOUR, str(side), platform="tracer").text)
+    rocker = next(j for j in data["joints"] if j["name"] == "rocker_pivot")
+    assert data["platform"]["planar"] is True and rocker["type"] == "planar_R" and "range" not in rocker
+    side.write_text(Path(FOUR_SIDE).read_text() + "joint_name: [coupler_pin]\njoint_type: [UJOINT_ZX]\n")
+    imported = import_urdf(FOUR, str(side), platform="tracer", task=["phi"])
+    assert not imported.planar
+    pin = next(j for j in load(imported.text)["joints"] if j["name"] == "coupler_pin")
+    th3 = four_bar_drawing()["th3"]
+    assert pin["type"] == "U" and "axis" not in pin
+    np.testing.assert_allclose(pin["axes"], [[0, 0, 1], [math.cos(th3), math.sin(th3), 0]], rtol=0, atol=1e-12)
+    side.write_text(Path(FOUR_SIDE).read_text() + "joint_name: [crank]\njoint_type: [SPHERE]\n")
+    with pytest.raises(InputError, match=r"joint_type\[0\]: unknown joint type 'SPHERE'.*did you mean 'SPHERICAL'"):
+        import_urdf(FOUR, str(side), platform="tracer")
+
+
+def test_a_6d_closure_to_the_ground_welds_the_body_to_the_ground(tmp_path):
+    """The ground is never welded onto another body: [rocker_end, base] welds the rocker to the
+    ground, its drawing moved so that the frame rocker_end is base's (C onto the origin), and
+    the rocker's pivot, now inside one body, is left out (each said so)."""
+    side = tmp_path / "robot.yaml"
+    side.write_text("closed_loop: [[coupler_end, rocker_end], [rocker_end, base]]\ntype: [3d, 6d]\nname_mot: [crank]\n")
+    imported = import_urdf(FOUR, str(side), platform="tracer")
+    data = load(imported.text)
+    assert set(data["bodies"]) == {"ground", "crank_link", "coupler"}
+    assert [j["name"] for j in data["joints"]] == ["crank", "coupler_pin", "coupler_end"]
+    assert data["joints"][2]["between"] == ["coupler", "ground"]
+    np.testing.assert_allclose(point(data, "ground", "P_coupler_end"), [0.0, 0.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(point(data, "coupler", "P_coupler_end"), four_bar_drawing()["C"], rtol=0, atol=1e-12)
+    assert any(
+        "'rocker' is welded to 'ground' (the frames are 0.0873 m and 75.2 deg apart" in n for n in imported.notes
+    )
+    assert any("'rocker_pivot' is locked by the weld" in n for n in imported.notes)
+
+
+def test_too_many_elements_are_refused(tmp_path):
+    path = tmp_path / "flat.urdf"
+    path.write_text('<robot name="r">' + "<a/>" * 60_000 + "</robot>")
+    with pytest.raises(InputError, match="robot: more than 50000 XML elements"):
+        import_urdf(str(path))
