@@ -136,12 +136,12 @@ def shipped_subject(name: str) -> Subject:
 
 
 def is_mechanism_file(path: Path) -> bool:
-    """A mechanism file: a mapping with a ``name`` and ``legs`` or ``closures`` at the top."""
+    """A mechanism file: a mapping with a ``name`` and ``legs``, ``closures`` or ``bodies`` at the top."""
     try:
         raw = yaml.safe_load(path.read_text(encoding="utf-8"))
     except (OSError, yaml.YAMLError):
         return False
-    return isinstance(raw, dict) and "name" in raw and ("legs" in raw or "closures" in raw)
+    return isinstance(raw, dict) and "name" in raw and any(k in raw for k in ("legs", "closures", "bodies"))
 
 
 def corpus_files(folder: Path) -> list[Path]:

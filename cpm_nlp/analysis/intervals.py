@@ -298,11 +298,17 @@ class IntervalProgram:
         self.const_nodes = np.array(sorted(const), dtype=int)
         self.const_values = np.array([const[n] for n in sorted(const)])
         self.inputs = [
-            (np.array([n for n, i, _ in inputs if i == j], dtype=int), np.array([z for _, i, z in inputs if i == j]))
+            (
+                np.array([n for n, i, _ in inputs if i == j], dtype=int),
+                np.array([z for _, i, z in inputs if i == j], dtype=int),  # int even when empty (no parameters)
+            )
             for j in range(fn.n_in())
         ]
         self.outputs = [
-            (np.array([n for n, o, _ in outputs if o == j], dtype=int), np.array([z for _, o, z in outputs if o == j]))
+            (
+                np.array([n for n, o, _ in outputs if o == j], dtype=int),
+                np.array([z for _, o, z in outputs if o == j], dtype=int),
+            )
             for j in range(fn.n_out())
         ]
         groups: dict[tuple, list] = {}

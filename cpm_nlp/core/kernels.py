@@ -146,7 +146,10 @@ def check_expressions(
     """
     c = closure
     out: dict[str, ca.SX] = {"finite": _all_finite(ca.vertcat(x, q))}
-    out["residual"] = _robust_max_abs(c.phi(x, q, p))
+    res = c.phi(x, q, p)
+    if c.loops is not None:  # phi combines the closure equations (normal equations): check each of them
+        res = ca.vertcat(res, c.loops(x, q, p))
+    out["residual"] = _robust_max_abs(res)
     if c.branch is not None:
         g = c.branch(x, q, p)
         out["branch_margin"] = ca.if_else(_all_finite(g), ca.mmin(g), -ca.inf)

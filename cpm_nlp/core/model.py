@@ -113,8 +113,12 @@ class LoopClosure:
         branch_names: Sequence[str] = (),
         branch_descriptions: Sequence[str] = (),
         frame: ca.Function | None = None,
+        loops: ca.Function | None = None,
     ) -> None:
         self.name = name
+        #: every closure equation, when phi holds a square combination of them (an overconstrained
+        #: linkage's normal equations): a pose is checked against these too (None: phi's own)
+        self.loops = loops
         self.x = tuple(x)
         self.q = tuple(q)
         self.parameters = tuple(parameters)

@@ -248,6 +248,8 @@ class Synthesis(ProblemKind):
     def supports(self, model: Model) -> str | None:
         if formulation(model) is None:
             return f"the model '{model.name}' has no mechanism declaration (built by hand)"
+        if model.mechanism is not None and model.mechanism.synthesis is None and not model.closure.parameters:
+            return f"the mechanism '{model.name}' has no parameters: there is no dimension to synthesize"
         return None
 
     def input_options(self, model: Model) -> list[Option]:

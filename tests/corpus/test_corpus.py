@@ -485,9 +485,12 @@ def test_watt2_pyslvs_four_assembly_modes():
     one on both four-bars' initial assembly."""
     values = _solve("watt2_pyslvs_modes.yaml")
     assert values["modes"] == 4
-    found = np.array([[values[f"modes_a{k}"][m] for k in (2, 3, 4, 5)] for m in range(4)])
+    # the file is bodies and joints: a5 is the output rocker's angle (its platform coordinate),
+    # P2 the first four-bar's coupler point (an output); the numpy model's a2, a3 give P2
+    found = np.array([[values["modes_a5"][m], values["modes_P2_x"][m] / MM, values["modes_P2_y"][m] / MM] for m in range(4)])
     for want, initial in _watt_modes(120 * DEG):
-        hit = [m for m in range(4) if np.max(np.abs(_wrap(found[m] - want))) < 1e-9]
+        p2 = np.array(WATT[3]) + math.dist(WATT[2], WATT[3]) * np.array([math.cos(want[1]), math.sin(want[1])])
+        hit = [m for m in range(4) if abs(_wrap(found[m, 0] - want[3])) < 1e-9 and np.allclose(found[m, 1:], p2, atol=1e-9)]
         assert len(hit) == 1, want
         assert values["modes_designated"][hit[0]] == initial
 
@@ -500,7 +503,10 @@ def test_watt2_pyslvs_path_and_round_trip():
         fk = cn.forward_kinematics(model, [deg * DEG], NEWTON)
         assert fk.status == Status.SOLVED, (deg, fk.message)
         want = next(a for a, initial in _watt_modes(deg * DEG) if initial)
-        np.testing.assert_allclose(_wrap(np.asarray(fk.x[:4]) - want), 0.0, atol=1e-9)
+        assert _wrap(fk.x[0] - want[3]) == pytest.approx(0.0, abs=1e-9)  # a5, the output rocker
+        k = _passive_index(model, "P2_x")
+        p2 = np.array(WATT[3]) + math.dist(WATT[2], WATT[3]) * np.array([math.cos(want[1]), math.sin(want[1])])
+        np.testing.assert_allclose(np.array(fk.passive[k : k + 2]) / MM, p2, rtol=0, atol=1e-9)
     for deg in (80.0, 100.0, 120.0):
         _fk_ik_round_trip(model, [deg * DEG], 1e-8)
 

@@ -125,6 +125,9 @@ class GraphGenerator(Generator):
         self.parent: dict[str, tuple[str, _GJoint] | None] = {}
         self.loop_rows: list[tuple[ca.SX, str, int]] = []
         self.platform_rows: list[tuple[ca.SX, str]] = []
+        #: (joint value - its actuator's, what, dimension): one per actuated joint
+        self.actuation_rows: list[tuple[ca.SX, str, str]] = []
+        self.actuated_coords: set[str] = set()
         self.info: GraphInfo | None = None
         self.assembler: Assembler | None = None
 
@@ -284,46 +287,41 @@ class GraphGenerator(Generator):
 
     # -- coordinates and poses -------------------------------------------------------------------
     def tree_coordinates(self) -> None:
-        """Each tree joint's displacements: an actuator's (q) or passive unknowns (pose coordinates)."""
+        """Each tree joint's values become pose coordinates (unknowns); an actuated joint's also
+        gets its actuator (q) and a row that ties the two (:attr:`actuation_rows`), so that every
+        body's pose is a function of the pose coordinates alone."""
         for g in self.gjoints:
             if not g.tree:
                 continue
             j = g.spec
-            if j.actuated is not None:
-                if _DOF[g.type] != 1:
-                    raise InputError(
-                        f"a {j.type} joint cannot be actuated (P, R and the planar joints can)",
-                        path=j.path + ("actuated",),
-                    )
-                g.values = [
-                    self.actuator(
-                        Joint(
-                            g.type,
-                            home=j.home,
-                            actuated=j.actuated,
-                            gain=j.gain,
-                            limit=j.limit,
-                            range=j.range,
-                            path=j.path,
-                        ),
-                        self.env,
-                    )
-                ]
-                g.names = (j.actuated,)
-                continue
             motions = elementary_motions(g)  # type: ignore[arg-type]
             names = j.coordinates or (
                 (g.name,) if len(motions) == 1 else tuple(f"{g.name}_{n + 1}" for n in range(len(motions)))
             )
             g.names = tuple(names)
+            actuated = None
+            if j.actuated is not None:
+                if len(motions) != 1:
+                    raise InputError(
+                        f"a {j.type} joint cannot be actuated (P, R and the planar joints can)",
+                        path=j.path + ("actuated",),
+                    )
+                spec = Joint(g.type, home=j.home, actuated=j.actuated, gain=j.gain, limit=j.limit, range=j.range)
+                spec.path = j.path
+                actuated = self.actuator(spec, self.env)  # gain (q - q_home)
             for n, ((kind, _axis), name) in enumerate(zip(motions, names)):
                 dim = "length" if kind == "P" else "angle"
                 home = self.scalar(j.home[n], j.path + ("home", n), self.env, dim) if n < len(j.home) else ca.SX(0)
                 sym = ca.SX.sym(name)
                 fam = j.limit or family(name)
-                coord = Coordinate(name, dim, f"{j.type} joint {g.name} ({g.a} - {g.b}), a tree coordinate", fam)
-                self.extra.append((coord, sym, home, self._limit(g, dim), j.path))  # type: ignore[arg-type]
+                what = "its actuator's joint" if actuated is not None else "a tree coordinate"
+                coord = Coordinate(name, dim, f"{j.type} joint {g.name} ({g.a} - {g.b}), {what}", fam)
+                limit = None if actuated is not None else self._limit(g, dim)  # type: ignore[arg-type]
+                self.extra.append((coord, sym, home, limit, j.path))
                 g.values.append(sym - home)
+                if actuated is not None:
+                    self.actuation_rows.append((sym - home - actuated, f"actuator {j.actuated}: joint {g.name}", dim))
+                    self.actuated_coords.add(name)
 
     def motion(self, g: _GJoint) -> tuple[ca.SX, ca.SX]:
         """The pose of b relative to a (both frames the world at the drawing): b's point onto a's,
@@ -337,6 +335,7 @@ class GraphGenerator(Generator):
     def poses(self) -> None:
         ground = self.ground
         self.pose[ground] = (ca.SX.eye(3), ca.SX.zeros(3))
+        self.angle = {ground: ca.SX(0)}
         order = [ground]
         k = 0
         while k < len(order):
@@ -348,6 +347,8 @@ class GraphGenerator(Generator):
                     if g.reversed:  # a = child: T_a = T_b M^-1
                         R, t = R.T, -R.T @ t
                     self.pose[child] = _compose(self.pose[body], (R, t))
+                    turn = g.values[0] if g.type == "planar_R" else 0  # planar: a body's angle, summed exactly
+                    self.angle[child] = self.angle[body] + (-turn if g.reversed else turn)
                     order.append(child)
             k += 1
 
@@ -368,16 +369,15 @@ class GraphGenerator(Generator):
         if g.type in ("S", "planar_R", "R", "U"):
             rows += [(d[k], f"point {'xyz'[k]}") for k in range(2 if planar else 3)]
         if g.type in ("C", "P", "planar_P"):
-            wa_axis = Ra @ g.axis
-            c = ca.cross(wa_axis, d)
-            rows += (
-                [(c[2], "offset across the axis")]
-                if planar
-                else [(c[k], f"offset across the axis, {'xyz'[k]}") for k in range(3)]
-            )
+            if planar:
+                rows.append((ca.cross(Ra @ g.axis, d)[2], "offset across the axis"))
+            else:
+                n1, n2 = self.normals(g)
+                rows += [(ca.dot(Ra @ n1, d), "offset across the axis, 1"), (ca.dot(Ra @ n2, d), "offset across the axis, 2")]
         if g.type in ("R", "C"):
-            c = ca.cross(Ra @ g.axis, Rb @ g.axis) * scale
-            rows += [(c[k], f"axes parallel, {'xyz'[k]}") for k in range(3)]
+            n1, n2 = self.normals(g)
+            wa_axis = Ra @ g.axis
+            rows += [(ca.dot(wa_axis, Rb @ n) * scale, f"axes parallel, {k + 1}") for k, n in enumerate((n1, n2))]
         if g.type == "U":
             rows.append((ca.dot(Ra @ g.axes[0], Rb @ g.axes[1]) * scale, "axes normal"))
         if g.type == "P":
@@ -386,6 +386,17 @@ class GraphGenerator(Generator):
         if g.type == "planar_P":
             rows.append(((Ra.T @ Rb)[1, 0] * scale, "no relative rotation"))
         return rows
+
+    def normals(self, g: _GJoint) -> tuple[ca.SX, ca.SX]:
+        """Two unit vectors normal to a joint's axis (and to each other): n1 = unit(w × e), n2 = w × n1,
+        e the basis vector least aligned with w (with the parameters' defaults)."""
+        w = g.axis
+        value = np.abs(np.asarray(ca.Function("axis", [self.p], [w])(self.p_default), dtype=float).ravel())
+        e = ca.DM.zeros(3)
+        e[int(np.argmin(value))] = 1.0
+        n1 = ca.cross(w, e)
+        n1 = n1 / ca.norm_2(n1)
+        return n1, ca.cross(w, n1)
 
     def report_cut(self, g: _GJoint) -> None:
         """A cut joint's values (when named): home + its displacement from the drawing."""
@@ -421,6 +432,10 @@ class GraphGenerator(Generator):
         """The rows that say the platform coordinates locate the platform body (and its point)."""
         pf = self.d.platform
         names = [b.name for b in self.d.bodies]
+        if not pf.coordinates and pf.body is None:  # the pose is the joints': the platform is the ground
+            self.platform_body = self.ground
+            self.P, self.R = ca.SX.zeros(3), ca.SX.eye(3)
+            return
         body = pf.body or "platform"
         if body not in names:
             raise InputError(
@@ -435,6 +450,7 @@ class GraphGenerator(Generator):
                 suggestions=suggest(pf.point, self.body_points[body]),
             )
         self.platform_body = body
+        self.x_pf = self.x  # the platform coordinates alone (the tree coordinates come later)
         point = self.body_points[body][pf.point] if pf.point is not None else ca.SX.zeros(3)
         Rb, _t = self.pose[body]
         where = self.world(body, point)
@@ -448,12 +464,24 @@ class GraphGenerator(Generator):
         if not pf.rotation:
             self.R = Rb
         else:
-            M = self.R.T @ Rb @ self.R_home
-            if pf.planar:
-                self.platform_rows.append((M[1, 0] * scale, f"platform: rotation of {body}"))
+            if pf.planar:  # the body's angle is a sum of joint values: a linear row, no spurious half turn
+                path = ("platform", "rotation")
+                phi = sum(self.scalar(a, path + (k, 1), self.xenv, "angle") for k, (_axis, a) in enumerate(pf.rotation))
+                phi_home = ca.substitute(phi, self.x_pf, self.x_home)
+                self.platform_rows.append(((self.angle[body] + phi_home - phi) * scale, f"platform: angle of {body}"))
             else:
+                M = self.R.T @ Rb @ self.R_home
                 v = _vee(M) * scale
                 self.platform_rows += [(v[k], f"platform: rotation of {body}, {'xyz'[k]}") for k in range(3)]
+                # the rows also vanish at a half turn: that solution is not the platform's
+                self.branch.append(
+                    (
+                        (ca.trace(M) - 1) / 2,
+                        "platform_rotation",
+                        f"cos of the turn between the platform coordinates' rotation and the body {body}'s "
+                        "(negative: the spurious solution half a turn away)",
+                    )
+                )
         self.platform_radius.append(
             ca.mmax(ca.vertcat(*[ca.norm_2(p - point) for p in self.body_points[body].values()] or [ca.SX(0)]))
         )
@@ -461,6 +489,7 @@ class GraphGenerator(Generator):
     # -- the whole closure ---------------------------------------------------------------------
     def build(self) -> dict[str, Any]:  # noqa: C901 - one step per section of the description
         d = self.d
+        self.p_default = _defaults(d)
         self.platform()
         self.read_bodies()
         self.read_joints()
@@ -472,6 +501,7 @@ class GraphGenerator(Generator):
         pts = [p for pts in self.body_points.values() for p in pts.values()]
         span = ca.mmax(ca.vertcat(*[ca.norm_2(p - pts[0]) for p in pts])) if pts else ca.SX(1)
         scale = ca.fmax(span, 1e-9)
+        self.scale = scale
         for g in self.gjoints:
             if not g.tree:
                 self.loop_rows += [
@@ -509,7 +539,12 @@ class GraphGenerator(Generator):
         self._unique_names()
         self.assembler = Assembler(self, q, span)
         keep = self.assembler.select_rows()
-        self.rows = [(r, name) for k, (r, name, _loop) in enumerate(self.loop_rows) if k in keep] + self.platform_rows
+        self.normal_form = len(keep) < len(self.loop_rows)
+        act = self.actuation()
+        if self.normal_form:  # overconstrained: the normal equations of every loop row (see normal_rows)
+            self.rows = self.normal_rows(scale) + act + self.platform_rows
+        else:
+            self.rows = [(r, name) for r, name, _loop in self.loop_rows] + act + self.platform_rows
         npf = len([n for n in self.x_names if n in d.platform.coordinates])
         if len(self.platform_rows) != npf:
             raise InputError(
@@ -520,7 +555,16 @@ class GraphGenerator(Generator):
             )
         if len(self.rows) != len(self.x_names):
             raise InputError(self.assembler.mobility_message(), path=("joints",))
-        self.graph_indicators(q)
+        for k, t in enumerate(d.platform.task):
+            if t not in self.x_names:
+                raise InputError(
+                    f"unknown task coordinate {t!r}; the pose coordinates are {', '.join(self.x_names)} (an "
+                    "actuated joint's value is an input, not a task coordinate)",
+                    path=("platform", "task", k),
+                    suggestions=suggest(t, self.x_names),
+                )
+        if not self.normal_form:
+            self.graph_indicators(q)
         self.select_branch(added)
         if len(d.platform.task) != len(self.q_coords):
             raise InputError(
@@ -530,6 +574,9 @@ class GraphGenerator(Generator):
             )
         fns = self.functions(q)
         fns["assemble"] = self.assembler
+        if self.normal_form:  # the normal equations also vanish where |r| is least but not zero: check r
+            r = ca.vertcat(*[row[0] for row in self.loop_rows])
+            fns["loops"] = ca.Function("loops", [self.x, q, self.p], [r], ["x", "q", "p"], ["r"])
         fns["graph_drawing"] = self.drawing_function(q)
         self.info = self.assembler.info
         return fns
@@ -562,6 +609,32 @@ class GraphGenerator(Generator):
             )
             self.branch.append((sign * d / scale, name, what))
 
+    def limit_options(self) -> tuple:
+        """As the legs', less the families of the actuated joints' own coordinates (their actuators' limits hold)."""
+        own = {c.group for c in self.x_coords if c.name in self.actuated_coords}
+        others = {c.group for c in self.x_coords if c.name not in self.actuated_coords} | {
+            r.coord.group for r in self.reported
+        }
+        return tuple(o for o in super().limit_options() if o.name not in own - others)
+
+    def actuation(self) -> list[tuple[ca.SX, str]]:
+        """The actuation rows, in the units of the loops' (an angle times the drawing's size)."""
+        return [(r * self.scale if dim == "angle" else r, name) for r, name, dim in self.actuation_rows]
+
+    def normal_rows(self, scale: ca.SX) -> list[tuple[ca.SX, str]]:
+        """An overconstrained graph (loop rows that repeat others at the reference configuration,
+        as the Bennett linkage's): Φ's loop part is J_tᵀ r / size, r every loop row, J_t its
+        Jacobian in the passive tree coordinates -- square, zero on the mechanism's motion, and
+        regular wherever the loops' Jacobian keeps its rank (any fixed choice of rows loses rank
+        somewhere along the motion, where the rows it left out would not)."""
+        r = ca.vertcat(*[row[0] for row in self.loop_rows])
+        tree = [
+            k for k, n in enumerate(self.x_names) if n not in self.d.platform.coordinates and n not in self.actuated_coords
+        ]
+        xt = ca.vertcat(*[self.x[k] for k in tree])
+        g = ca.jacobian(r, xt).T @ r / scale
+        return [(g[k], f"loops, normal equation of {self.x_names[tree[k]]}") for k in range(len(tree))]
+
     # -- drawing ---------------------------------------------------------------------------
     def drawing_function(self, q: ca.SX) -> tuple[ca.Function, list]:
         """Every body's points at the pose (x, q, p), and what to draw: the layout."""
@@ -590,8 +663,9 @@ class Assembler:
     def __init__(self, gen: GraphGenerator, q: ca.SX, span: ca.SX) -> None:
         self.gen = gen
         x, p = gen.x, gen.p
-        rows = ca.vertcat(*[r[0] for r in gen.loop_rows], *[r[0] for r in gen.platform_rows])
-        self.names = [r[1] for r in gen.loop_rows] + [r[1] for r in gen.platform_rows]
+        act = gen.actuation()
+        rows = ca.vertcat(*[r[0] for r in gen.loop_rows], *[r[0] for r in act], *[r[0] for r in gen.platform_rows])
+        self.names = [r[1] for r in gen.loop_rows] + [r[1] for r in act] + [r[1] for r in gen.platform_rows]
         self.nloop = len(gen.loop_rows)
         self.F = ca.Function(
             "assembly_rows",
@@ -603,23 +677,11 @@ class Assembler:
         self.draw = ca.Function(
             "drawing_pose", [p], [gen.x_home, ca.vertcat(*gen.q_home), span], ["p"], ["x", "q", "span"]
         )
-        self.defaults = self._defaults()
+        self.defaults = gen.p_default
         self.keep: list[int] = []
         self.info: GraphInfo | None = None
         self._cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
         self.last: dict[str, Any] = {}
-
-    def _defaults(self) -> np.ndarray:
-        vals = []
-        for par in self.gen.d.parameters:
-            if par.default is REQUIRED:
-                raise InputError(
-                    f"a file of bodies and joints needs a default for every parameter ({par.name!r} has none): "
-                    "the loops' rank is taken at the reference configuration with the defaults",
-                    path=("parameters", par.name, "default"),
-                )
-            vals.append(float(par.default))
-        return np.array(vals)
 
     # -- assembly ----------------------------------------------------------------------------
     def solve(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
@@ -697,12 +759,9 @@ class Assembler:
                 hint="draw the mechanism closer to an assembled configuration, or check the link lengths",
             )
         _r, Jx, Jq = (np.asarray(v, dtype=float) for v in self.F(x, q, self.defaults))
-        J = np.hstack([Jx, Jq])[: self.nloop]
-        ntree = sum(1 for n in gen.x_names if n not in gen.d.platform.coordinates) + len(gen.q_coords)
-        cols = [k for k, n in enumerate(gen.x_names) if n not in gen.d.platform.coordinates] + [
-            len(gen.x_names) + k for k in range(len(gen.q_coords))
-        ]
-        J = J[:, cols]
+        cols = [k for k, n in enumerate(gen.x_names) if n not in gen.d.platform.coordinates]
+        ntree = len(cols)
+        J = Jx[: self.nloop][:, cols]
         keep, basis = [], np.zeros((0, J.shape[1]))
         for k in range(J.shape[0]):
             row = J[k]
@@ -758,6 +817,20 @@ class Assembler:
                 path=("joints",),
             )
         return 1.0 if v > 0 else -1.0
+
+
+def _defaults(d: Description) -> np.ndarray:
+    """The parameters' defaults: the loops' rank is taken with them at the reference configuration."""
+    vals = []
+    for par in d.parameters:
+        if par.default is REQUIRED:
+            raise InputError(
+                f"a file of bodies and joints needs a default for every parameter ({par.name!r} has none): "
+                "the loops' rank is taken at the reference configuration with the defaults",
+                path=("parameters", par.name, "default"),
+            )
+        vals.append(float(par.default))
+    return np.array(vals)
 
 
 def graph_geometry(fn: ca.Function, layout: list, gen: GraphGenerator) -> Callable[[Any, Any, Any], Drawing]:

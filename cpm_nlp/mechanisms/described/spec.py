@@ -358,8 +358,11 @@ PLATFORM_KEYS = {
 }
 
 
-def _platform(raw: Any, path: tuple) -> Platform:  # noqa: C901 - one check per key
+def _platform(raw: Any, path: tuple, graph: bool = False) -> Platform:  # noqa: C901 - one check per key
     raw = _mapping(raw, path, "a mapping {coordinates, position, rotation, task ...}", PLATFORM_KEYS)
+    if graph:  # the pose may be the joints' alone: no platform coordinates, no position
+        raw.setdefault("coordinates", {})
+        raw.setdefault("position", [])
     coords, descs = {}, {}
     for name, spec in _mapping(raw.get("coordinates"), path + ("coordinates",), "name -> dimension").items():
         p = path + ("coordinates", name)
@@ -379,7 +382,7 @@ def _platform(raw: Any, path: tuple) -> Platform:  # noqa: C901 - one check per 
         rotation.append((item[0], item[1]))
     task = _list(raw["task"], path + ("task",), "a list of coordinate names")
     for k, t in enumerate(task):
-        if t not in coords:
+        if t not in coords and not graph:  # a graph's task may name a joint coordinate (checked when built)
             raise InputError(
                 f"unknown coordinate {t!r}; declared: {', '.join(coords)}",
                 path=path + ("task", k),
@@ -865,7 +868,7 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
         name=name,
         title=_text(data.get("title"), ("title",)) or name,
         parameters=params,
-        platform=_platform(data["platform"], ("platform",)),
+        platform=_platform(data["platform"], ("platform",), graph=data.get("bodies") is not None),
         legs=legs,
         derived=derived,
         actuators=actuators,
