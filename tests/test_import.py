@@ -488,8 +488,9 @@ def test_imported_slider_crank_prismatic_joint(tmp_path):
 @pytest.mark.xfail(
     strict=True,
     raises=InputError,
-    reason="the loader of main e562a47 refuses it: 'branch: the branch indicator name loop1 is used twice' "
-    "(a loop through a planar_P joint); the file itself is checked above",
+    reason="the loader of main f7b2f45 refuses it: 'branch: the branch indicator name loop1 is used twice' "
+    "(loop 1's two rows fall in two diagonal blocks of Phi_x, each indicator named loop1); the file itself "
+    "is checked above",
 )
 @pytest.mark.parametrize("q", [0.0, 0.6, -1.2, 2.5])
 def test_imported_slider_crank_forward_kinematics(tmp_path, q):

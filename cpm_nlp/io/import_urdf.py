@@ -419,6 +419,7 @@ class _GJoint:
     name: str = ""
     source: str = ""  # the URDF joint or closure it comes from
     limits: tuple[float, float] | None = None
+    coordinate: str = ""  # an actuated joint's own coordinate (its actuator is named after the joint)
 
 
 @dataclass
@@ -549,6 +550,8 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         points[a][point] = pos
         points[b][point] = pos
         g = _GJoint(j.kind, a, b, point, name=name, source=f"joint {j.name!r}", actuated=j.name in act)
+        if g.actuated:
+            g.coordinate = names.take(name + "_joint")
         if j.kind in ("R", "P"):
             g.axis = frame[:3, :3] @ j.axis
             g.limits = j.limits
@@ -841,8 +844,8 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
             entry["axes"] = [[float(x) for x in a] for a in g.axes]
             fields.append(f"axes: [{_vec(g.axes[0], 1.0)}, {_vec(g.axes[1], 1.0)}]")
         if g.actuated:
-            entry["actuated"] = g.name
-            fields.append(f"actuated: {_word(g.name)}")
+            entry["actuated"], entry["coordinates"] = g.name, [g.coordinate]
+            fields.append(f"actuated: {_word(g.name)}, coordinates: [{_word(g.coordinate)}]")
         elif g.kind in ("R", "P") and g.source.startswith("joint ") and " and " not in g.source:
             entry["coordinates"] = [g.name]
             fields.append(f"coordinates: [{_word(g.name)}]")
