@@ -505,14 +505,23 @@ def test_imported_slider_crank_forward_kinematics(tmp_path, q):
 
 
 def test_sidecar_joint_types(tmp_path):
-    """joint_name/joint_type: SPHERICAL is an S joint (a planar R in a planar file); UJOINT_ZX a
-    U joint about the joint frame's z then x axis, in world directions (the coupler's frame is
-    turned by theta3 about z: x -> (cos theta3, sin theta3, 0)), and the file is spatial."""
+    """joint_name/joint_type: SPHERICAL is an S joint -- the rocker, now between two S joints, is a
+    rod: a distance joint ground-coupler of the rocker's length c (by hand); UJOINT_ZX a U joint
+    about the joint frame's z then x axis, in world directions (the coupler's frame is turned by
+    theta3 about z: x -> (cos theta3, sin theta3, 0)), and the file is spatial."""
     side = tmp_path / "robot.yaml"
     side.write_text(Path(FOUR_SIDE).read_text() + "joint_name: [rocker_pivot]\njoint_type: [SPHERICAL]\n")
-    data = load(import_urdf(FOUR, str(side), platform="tracer").text)
-    rocker = next(j for j in data["joints"] if j["name"] == "rocker_pivot")
-    assert data["platform"]["planar"] is True and rocker["type"] == "planar_R" and "range" not in rocker
+    imported = import_urdf(FOUR, str(side), platform="tracer")
+    data = load(imported.text)
+    assert data["platform"]["planar"] is True and "rocker" not in data["bodies"]
+    rod = data["joints"][-1]
+    assert rod["type"] == "distance" and rod["between"] == ["ground", "coupler"]
+    assert (rod["at"], rod["to"]) == ("P_rocker_pivot", "P_coupler_end")
+    assert rod["length"] == pytest.approx(FOUR_C, abs=1e-15)
+    assert any("'rocker' is a rod between joint 'rocker_pivot'" in n for n in imported.notes)
+    fk = cn.forward_kinematics(_model(tmp_path, imported.text), [0.5], NEWTON)  # still the four-bar
+    assert fk.status == Status.SOLVED, fk.message
+    np.testing.assert_allclose(fk.x[:2], four_bar_drawing(0.5)["T"], rtol=0, atol=1e-9)
     side.write_text(Path(FOUR_SIDE).read_text() + "joint_name: [coupler_pin]\njoint_type: [UJOINT_ZX]\n")
     imported = import_urdf(FOUR, str(side), platform="tracer", task=["phi"])
     assert not imported.planar

@@ -420,6 +420,8 @@ class _GJoint:
     source: str = ""  # the URDF joint or closure it comes from
     limits: tuple[float, float] | None = None
     coordinate: str = ""  # an actuated joint's own coordinate (its actuator is named after the joint)
+    to: str = ""  # a distance joint: its point on b
+    rod: np.ndarray | None = None  # ... and the rod (b's end less a's end, in the rod's drawing)
 
 
 @dataclass
@@ -636,71 +638,83 @@ def _build(  # noqa: C901 - one pass per step of the conversion
     return graph, pbody, ppoint, pframe
 
 
-def _simplify(graph: _Graph, keep: set[str]) -> None:  # noqa: C901 - two rules, applied until none applies
-    """Remove the bodies that only add a free spin: a body (not the ground nor the platform)
-    joined by one passive joint and nothing else; a body joined by two passive joints that
-    turn about one axis (R, R coaxial) or one point (S, with an R through it), whose two
-    joints then become one between its neighbours."""
-    tol = TOL * graph.scale
-    changed = True
-    while changed:
-        changed = False
+def _simplify(graph: _Graph, keep: set[str]) -> None:
+    """Remove the bodies (not the ground nor the platform's) that only carry passive joints
+    adding a free spin, until none is left: a body on one joint and nothing else; a body joined
+    by two joints that turn about one axis (R, R coaxial) or one point (S, S concentric, or S
+    with an R through it), whose two joints become one between its neighbours; a rod between
+    two S joints, which becomes a distance joint of its length."""
+    while True:
         for key in list(graph.points):
             if key in keep:
                 continue
             js = [g for g in graph.joints if key in (g.a, g.b)]
-            if len(js) == 1 and not js[0].actuated:
+            if any(g.actuated for g in js):
+                continue
+            if len(js) == 1:
                 graph.joints.remove(js[0])
                 graph.notes.append(
                     f"{graph.names[key]!r} turns freely on {js[0].source} and carries nothing else: left out"
                 )
                 del graph.points[key]
-                changed = True
                 break
-            if len(js) != 2 or any(g.actuated or g.kind not in ("R", "S") for g in js):
-                continue
-            j1, j2 = js
-            d = graph.points[key]
-            p1, p2 = d[j1.point], d[j2.point]
-            if j1.kind == "R" and j2.kind == "R":
-                if np.linalg.norm(np.cross(j1.axis, j2.axis)) > TOL or np.linalg.norm(np.cross(p2 - p1, j1.axis)) > tol:
-                    continue
-                centre = j1.point
-            else:
-                rs = [g for g in js if g.kind == "R"]
-                ss = [g for g in js if g.kind == "S"]
-                c = d[ss[0].point]
-                if rs and np.linalg.norm(np.cross(c - d[rs[0].point], rs[0].axis)) > tol:
-                    continue
-                if len(ss) == 2 and np.linalg.norm(d[ss[1].point] - c) > tol:
-                    continue
-                centre = ss[0].point
-            ends = [g.b if g.a == key else g.a for g in (j1, j2)]
-            if ends[0] == ends[1]:
-                continue
-            for g, other in zip((j1, j2), ends):
-                shift = d[centre] - d[g.point]  # along the joint's axis (or zero): the same in both bodies
-                graph.points[other][centre] = graph.points[other][g.point] + shift
-            kind = "R" if j1.kind == j2.kind == "R" else "S"
-            # the proximal side first: the body of the first joint's proximal end
-            a, b = (ends[0], ends[1]) if j1.b == key else (ends[1], ends[0])
-            new = _GJoint(kind, a, b, centre, axis=j1.axis if kind == "R" else None, name=j1.name)
-            new.source = f"{j1.source} and {j2.source}"
-            graph.joints[graph.joints.index(j1)] = new
-            graph.joints.remove(j2)
-            graph.notes.append(
-                f"{graph.names[key]!r} only joins {j1.source} and {j2.source} about one "
-                f"{'axis' if kind == 'R' else 'point'}: one {kind} joint"
-            )
-            del graph.points[key]
-            for other in ends:  # a point no joint uses any more is dropped
-                used = {g.point for g in graph.joints if other in (g.a, g.b)}
-                for p in [
-                    p for p in graph.points[other] if p not in used and p in (j1.point, j2.point) and p != centre
-                ]:
-                    del graph.points[other][p]
-            changed = True
-            break
+            if len(js) == 2 and all(g.kind in ("R", "S") for g in js) and _join(graph, key, *js):
+                break
+        else:
+            return
+
+
+def _join(graph: _Graph, key: str, j1: _GJoint, j2: _GJoint) -> bool:  # noqa: C901 - one test per pair of types
+    """Replace the body ``key`` and its joints j1, j2 by one joint between its neighbours, if
+    they turn about one axis or point, or are two S joints (a rod); False if not."""
+    tol = TOL * graph.scale
+    d = graph.points[key]
+    ends = [g.b if g.a == key else g.a for g in (j1, j2)]
+    if ends[0] == ends[1]:
+        return False
+    rs = [g for g in (j1, j2) if g.kind == "R"]
+    ss = [g for g in (j1, j2) if g.kind == "S"]
+    if len(rs) == 2:
+        if np.linalg.norm(np.cross(j1.axis, j2.axis)) > TOL:
+            return False
+        if np.linalg.norm(np.cross(d[j2.point] - d[j1.point], j1.axis)) > tol:
+            return False
+        centre = j1.point
+    elif rs:
+        centre = ss[0].point
+        if np.linalg.norm(np.cross(d[centre] - d[rs[0].point], rs[0].axis)) > tol:
+            return False
+    elif np.linalg.norm(d[j2.point] - d[j1.point]) > tol:  # a rod S-S: a distance joint
+        centre = ""
+    else:
+        centre = j1.point
+    # the proximal side first: the body of the first joint's proximal end
+    a, b = (ends[0], ends[1]) if j1.b == key else (ends[1], ends[0])
+    ja, jb = (j1, j2) if a == ends[0] else (j2, j1)
+    if centre:
+        for g, other in zip((j1, j2), ends):
+            shift = d[centre] - d[g.point]  # along the joint's axis (or zero): the same in both bodies
+            graph.points[other][centre] = graph.points[other][g.point] + shift
+        kind = "R" if rs and len(rs) == 2 else "S"
+        new = _GJoint(kind, a, b, centre, axis=j1.axis if kind == "R" else None, name=j1.name)
+        graph.notes.append(
+            f"{graph.names[key]!r} only joins {j1.source} and {j2.source} about one "
+            f"{'axis' if kind == 'R' else 'point'}: one {kind} joint"
+        )
+    else:
+        new = _GJoint("distance", a, b, ja.point, name=j1.name, to=jb.point, rod=d[jb.point] - d[ja.point])
+        graph.notes.append(
+            f"{graph.names[key]!r} is a rod between {j1.source} and {j2.source}: a distance joint of its length"
+        )
+    new.source = f"{j1.source} and {j2.source}"
+    graph.joints[graph.joints.index(j1)] = new
+    graph.joints.remove(j2)
+    del graph.points[key]
+    for other in ends:  # a point no joint uses any more is dropped
+        used = {p for g in graph.joints if other in (g.a, g.b) for p in (g.point, g.to)}
+        for p in [p for p in graph.points[other] if p not in used and p in (j1.point, j2.point)]:
+            del graph.points[other][p]
+    return True
 
 
 # -- writing ----------------------------------------------------------------------------------------
@@ -825,7 +839,7 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
         entry: dict[str, Any] = {"name": g.name}
         flip = 1.0
         if basis is not None:
-            kind = {"R": "planar_R", "S": "planar_R", "P": "planar_P"}[kind]
+            kind = {"R": "planar_R", "S": "planar_R", "P": "planar_P", "distance": "distance"}[kind]
             if g.kind == "R" and float(np.dot(g.axis, basis[2])) < 0:
                 flip = -1.0
                 if g.actuated or g.limits is not None or " and " not in g.source:
@@ -835,6 +849,10 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
         entry["at"] = g.point
         fields = [f"name: {_word(g.name)}", f"type: {kind}", f"between: [{', '.join(map(_word, entry['between']))}]"]
         fields.append(f"at: {_word(g.point)}")
+        if g.kind == "distance":
+            length = float(np.linalg.norm(coords(g.rod)))  # in a planar file, the rod's length in the plane
+            entry["to"], entry["length"] = g.to, length
+            fields += [f"to: {_word(g.to)}", f"length: {_num(length, scale)}"]
         if g.kind == "P" or (g.kind == "R" and basis is None):
             axis = coords(g.axis)
             axis = axis / np.linalg.norm(axis)
