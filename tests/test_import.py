@@ -558,3 +558,61 @@ def test_too_many_elements_are_refused(tmp_path):
     path.write_text('<robot name="r">' + "<a/>" * 60_000 + "</robot>")
     with pytest.raises(InputError, match="robot: more than 50000 XML elements"):
         import_urdf(str(path))
+
+
+# delta.urdf (its header): base radius R, platform radius r, crank L, rod l, parallelogram half
+# width w, arms at 0, 120, 240 deg, cranks 20 deg below the horizontal at joint value 0
+DELTA, DELTA_SIDE = str(DATA / "delta.urdf"), str(DATA / "delta.yaml")
+DR, DRP, DL, DLR, DW, DTH0 = 0.1, 0.03, 0.1, 0.25, 0.02, math.radians(20)
+
+
+def delta_platform(q) -> np.ndarray:
+    """The Delta by hand: crank i at 20 deg + q_i below the horizontal (a positive turn about the
+    tangent u_i = (-sin g, cos g, 0) lowers it), and the translating platform's centre P at
+    distance l from every C_i = E_i - r e_i (a parallelogram keeps the platform's orientation):
+    the lower intersection of three spheres (trilateration)."""
+    c = []
+    for g, qi in zip((0.0, 2 * math.pi / 3, 4 * math.pi / 3), q):
+        e = np.array([math.cos(g), math.sin(g), 0.0])
+        th = DTH0 + qi
+        c.append(DR * e + DL * (math.cos(th) * e - math.sin(th) * np.array([0.0, 0.0, 1.0])) - DRP * e)
+    ex = (c[1] - c[0]) / np.linalg.norm(c[1] - c[0])
+    i = float(ex @ (c[2] - c[0]))
+    ey = (c[2] - c[0] - i * ex) / np.linalg.norm(c[2] - c[0] - i * ex)
+    ez = np.cross(ex, ey)
+    d, j = float(np.linalg.norm(c[1] - c[0])), float(ey @ (c[2] - c[0]))
+    x = d / 2  # equal radii: (l^2 - l^2 + d^2) / (2 d)
+    y = (i * i + j * j) / (2 * j) - i * x / j
+    z = math.sqrt(DLR**2 - x * x - y * y)
+    p = c[0] + x * ex + y * ey
+    return min((p + z * ez, p - z * ez), key=lambda v: v[2])
+
+
+def test_imported_delta_rods_and_forward_kinematics(tmp_path):
+    """A spatial Delta from a URDF whose rods end in SPHERICAL joints and 3d closures: each rod
+    between two S joints is a distance joint of length l, but the last one the platform would
+    otherwise hang on only, which keeps its body with a U (no spin) and an S; 3 degrees of
+    freedom; FK equals the trilateration of delta_platform (numpy) to 1e-9 m, the platform does
+    not turn, and IK gives the actuators back."""
+    imported = import_urdf(DELTA, DELTA_SIDE, platform="effector")
+    data = load(imported.text)
+    assert not imported.planar and data["platform"]["task"] == ["x", "y", "z"]
+    kinds = [j["type"] for j in data["joints"]]
+    assert kinds.count("R") == 3 and kinds.count("distance") == 5 and kinds.count("U") == kinds.count("S") == 1
+    for j in data["joints"]:
+        if j["type"] == "distance":
+            assert j["length"] == pytest.approx(DLR, abs=1e-15)
+    elbow = DR + DL * math.cos(DTH0)  # crank 1 (arm at 0 deg): its elbow pins at (elbow, +-w, -L sin 20 deg)
+    np.testing.assert_allclose(point(data, "crank1", "P_rod1a"), [elbow, DW, -DL * math.sin(DTH0)], atol=1e-15)
+    np.testing.assert_allclose(point(data, "crank1", "P_rod1b"), [elbow, -DW, -DL * math.sin(DTH0)], atol=1e-15)
+    np.testing.assert_allclose(point(data, "platform", "P_effector"), delta_platform((0, 0, 0)), rtol=0, atol=1e-15)
+    model = _model(tmp_path, imported.text)
+    for q in ((0.0, 0.0, 0.0), (0.2, -0.1, 0.3), (-0.3, 0.25, 0.1)):
+        fk = cn.forward_kinematics(model, list(q), NEWTON)
+        assert fk.status == Status.SOLVED, fk.message
+        x = dict(zip(model.closure.x_names, fk.x))
+        np.testing.assert_allclose([x["x"], x["y"], x["z"]], delta_platform(q), rtol=0, atol=1e-9)
+        np.testing.assert_allclose([x["psi"], x["theta"], x["phi"]], 0.0, atol=1e-9)
+        ik = cn.inverse_kinematics(model, [x["x"], x["y"], x["z"]])
+        assert ik.status == Status.SOLVED, ik.message
+        np.testing.assert_allclose(ik.q, q, rtol=0, atol=1e-9)

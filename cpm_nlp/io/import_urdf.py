@@ -513,11 +513,11 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         j = parent_joint.get(lk)
         body_of[lk] = body_of[j.parent] if j is not None and j.kind == "fixed" else lk
     points: dict[str, dict[str, np.ndarray]] = {body_of[lk]: {} for lk in order}
-    names = _Names()
-    names.used.add("ground")
+    names, bnames, pnames = _Names(), _Names(), _Names()  # joints and coordinates, bodies, points
+    bnames.used.add("ground")
     body_names: dict[str, str] = {}
     for key in points:
-        body_names[key] = "ground" if key == root else names.take(key, avoid=_GROUND_NAMES)
+        body_names[key] = "ground" if key == root else bnames.take(key, avoid=_GROUND_NAMES)
     # actuated joints: the option, else the sidecar
     if actuated is not None:
         wanted = [(a, ("--actuated",)) for a in actuated]
@@ -546,7 +546,7 @@ def _build(  # noqa: C901 - one pass per step of the conversion
             continue
         frame = world[j.child]
         name = names.take(j.name)
-        point = names.take(name, prefix="P_")
+        point = pnames.take(name, prefix="P_")
         pos = frame[:3, 3].copy()
         a, b = body_of[j.parent], body_of[j.child]
         points[a][point] = pos
@@ -592,7 +592,7 @@ def _build(  # noqa: C901 - one pass per step of the conversion
             )
         if kind == "3d":
             name = names.take(fa)
-            point = names.take(name, prefix="P_")
+            point = pnames.take(name, prefix="P_")
             points[ba][point] = wa[:3, 3].copy()
             points[bb][point] = wb[:3, 3].copy()
             gjoints.append(_GJoint("S", ba, bb, point, name=name, source=f"closure {fa!r}-{fb!r} (3d)"))
@@ -630,20 +630,22 @@ def _build(  # noqa: C901 - one pass per step of the conversion
     pbody = find(body_of[plink])
     if pbody == root:
         raise InputError(f"the platform frame {platform!r} is on the ground", file=pfile, path=ppath)
-    ppoint = names.take(platform, prefix="P_")
+    ppoint = pnames.take(platform, prefix="P_")
     pframe = placed(plink)
     points[pbody][ppoint] = pframe[:3, 3].copy()
-    graph = _Graph(body_names, points, gjoints, notes, scale, names.renamed)
-    _simplify(graph, keep={root, pbody})
+    graph = _Graph(body_names, points, gjoints, notes, scale, {**bnames.renamed, **names.renamed})
+    _simplify(graph, root, keep={root, pbody})
     return graph, pbody, ppoint, pframe
 
 
-def _simplify(graph: _Graph, keep: set[str]) -> None:
+def _simplify(graph: _Graph, ground: str, keep: set[str]) -> None:
     """Remove the bodies (not the ground nor the platform's) that only carry passive joints
     adding a free spin, until none is left: a body on one joint and nothing else; a body joined
     by two joints that turn about one axis (R, R coaxial) or one point (S, S concentric, or S
     with an R through it), whose two joints become one between its neighbours; a rod between
-    two S joints, which becomes a distance joint of its length."""
+    two S joints, which becomes a distance joint of its length -- unless a body would then hang
+    on distance joints only (a mechanism file joins every body to the ground by joints): then
+    its S joint on the side of the ground is a U normal to it (the rod's spin is gone)."""
     while True:
         for key in list(graph.points):
             if key in keep:
@@ -658,13 +660,13 @@ def _simplify(graph: _Graph, keep: set[str]) -> None:
                 )
                 del graph.points[key]
                 break
-            if len(js) == 2 and all(g.kind in ("R", "S") for g in js) and _join(graph, key, *js):
+            if len(js) == 2 and all(g.kind in ("R", "S") for g in js) and _join(graph, key, ground, *js):
                 break
         else:
             return
 
 
-def _join(graph: _Graph, key: str, j1: _GJoint, j2: _GJoint) -> bool:  # noqa: C901 - one test per pair of types
+def _join(graph: _Graph, key: str, ground: str, j1: _GJoint, j2: _GJoint) -> bool:  # noqa: C901 - one test per pair
     """Replace the body ``key`` and its joints j1, j2 by one joint between its neighbours, if
     they turn about one axis or point, or are two S joints (a rod); False if not."""
     tol = TOL * graph.scale
@@ -685,6 +687,18 @@ def _join(graph: _Graph, key: str, j1: _GJoint, j2: _GJoint) -> bool:  # noqa: C
         if np.linalg.norm(np.cross(d[centre] - d[rs[0].point], rs[0].axis)) > tol:
             return False
     elif np.linalg.norm(d[j2.point] - d[j1.point]) > tol:  # a rod S-S: a distance joint
+        reach = _reached(graph, ground, without=(j1, j2))
+        if any(b not in reach for b in graph.points if b != key):
+            near = j1 if (j1.a if j1.b == key else j1.b) in reach else j2
+            rod = d[(j2 if near is j1 else j1).point] - d[near.point]
+            ref = np.eye(3)[int(np.argmin(np.abs(rod)))]
+            a1 = np.cross(rod, ref) / np.linalg.norm(np.cross(rod, ref))
+            near.kind, near.axes = "U", (a1, np.cross(rod, a1) / np.linalg.norm(np.cross(rod, a1)))
+            graph.notes.append(
+                f"{graph.names[key]!r} is a rod between two S joints that the mechanism hangs on: "
+                f"{near.source} is a U normal to it (without the rod's spin)"
+            )
+            return True
         centre = ""
     else:
         centre = j1.point
@@ -715,6 +729,18 @@ def _join(graph: _Graph, key: str, j1: _GJoint, j2: _GJoint) -> bool:  # noqa: C
         for p in [p for p in graph.points[other] if p not in used and p in (j1.point, j2.point)]:
             del graph.points[other][p]
     return True
+
+
+def _reached(graph: _Graph, ground: str, without: tuple) -> set[str]:
+    """The bodies joined to the ground by joints (distance joints and ``without`` left out)."""
+    reach, grew = {ground}, True
+    while grew:
+        grew = False
+        for g in graph.joints:
+            if g.kind != "distance" and all(g is not w for w in without) and (g.a in reach) != (g.b in reach):
+                reach |= {g.a, g.b}
+                grew = True
+    return reach
 
 
 # -- writing ----------------------------------------------------------------------------------------
@@ -926,7 +952,7 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
     notes = list(graph.notes)
     if flipped:
         notes.append("the URDF axis of " + ", ".join(flipped) + " is -n: the angle here (about n) is minus the URDF's")
-    renamed = {k: v for k, v in graph.renamed.items() if not k.startswith("P_")}
+    renamed = graph.renamed
     if renamed:
         notes.append("renamed: " + ", ".join(f"{k!r} -> {v}" for k, v in renamed.items()))
     header += [f"# - {n}" for n in notes]
