@@ -26,8 +26,10 @@ between the bodies of its parent and child links, at the origin of its frame, it
 direction; each 3d closure is an S joint, each 6d closure merges the two bodies.  A body that
 only links two joints turning about one axis or point (the dummy links at which example files
 close their loops) is removed and its two joints become one; a passive joint to a body that
-carries nothing else (a free spin) is dropped.  All R axes parallel (and P axes normal to
-them): a planar file, in the plane normal to the axes.
+carries nothing else (a free spin) is dropped; a rod between two S joints is a distance joint
+(or, where the mechanism hangs on it, keeps its body with a U instead of one S).  An actuated
+joint's actuator is named after it, its own coordinate ``<name>_joint``.  All R axes parallel
+(and P axes normal to them): a planar file, in the plane normal to the axes.
 
 The URDF is data: it is parsed with :mod:`xml.etree.ElementTree` after refusing any document
 type declaration or entity (``<!DOCTYPE``, ``<!ENTITY``), nothing it names (meshes, xacro
