@@ -616,3 +616,15 @@ def test_imported_delta_rods_and_forward_kinematics(tmp_path):
         ik = cn.inverse_kinematics(model, [x["x"], x["y"], x["z"]])
         assert ik.status == Status.SOLVED, ik.message
         np.testing.assert_allclose(ik.q, q, rtol=0, atol=1e-9)
+
+
+def test_cli_spatial_and_task(cli, tmp_path):
+    out = tmp_path / "four.yaml"
+    run = cli(
+        "import", FOUR, "--sidecar", FOUR_SIDE, "--platform", "tracer", "--spatial", "--task", "phi", "-o", str(out)
+    )
+    assert run.code == 0, run.err
+    assert run.out == f"{out}: 4 bodies, 4 joints (spatial) from {FOUR}\n"
+    assert out.read_text() == import_urdf(FOUR, FOUR_SIDE, platform="tracer", planar=False, task=["phi"]).text
+    run = cli("import", FOUR, "--sidecar", FOUR_SIDE, "--platform", "tracer", "--spatial", "-o", str(out))
+    assert run.code == 2 and "--task: which task coordinates for 1 actuated joint(s)?" in run.err
