@@ -23,8 +23,11 @@ from typing import Any
 
 import numpy as np
 
-#: degrees of freedom of each joint type the chains take
-JOINT_DOF = {"P": 1, "R": 1, "C": 2, "U": 2, "S": 3}
+from .joints import JOINT_TYPES
+
+#: degrees of freedom of each joint type the chains take: the spatial joints with
+#: coordinates (the joint table's P, R, C, U, S)
+JOINT_DOF = {n: t.dof for n, t in JOINT_TYPES.items() if t.spatial and t.dof}
 
 
 @dataclass(frozen=True)

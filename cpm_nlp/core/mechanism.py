@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from .errors import suggest
+from .joints import JOINT_LETTERS
 from .options import Option, validate_mapping
 
 
@@ -93,8 +94,9 @@ class DynamicsModel:
 
 #: parts a :class:`Drawing` may join or fill, in the order they are drawn
 DRAWING_PARTS = ("base", "actuator", "link", "leg", "platform")
-#: joint letters a :class:`Drawing` may mark (prismatic, revolute, universal, spherical, cylindrical)
-JOINT_TYPES = ("P", "R", "U", "S", "C")
+#: joint letters a :class:`Drawing` may mark (prismatic, revolute, cylindrical, universal, spherical):
+#: the letters of the joint table
+JOINT_TYPES = JOINT_LETTERS
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -11,8 +11,43 @@ from typing import Any
 ACTUATED, PASSIVE, BODY = "#c0392b", "#555555", "#d6eaf8"
 
 
+def _graph_layout(nodes: list[str], edges: list[tuple[str, str, str, bool]]) -> dict[str, tuple[float, float]]:
+    """A body graph of any topology: the ground (the first node) at the bottom, each body one row
+    above the nearest body it is joined to (breadth first), the bodies of a row side by side in
+    the order of the file."""
+    pairs = [(u, v) for a, b, _label, _act in edges for u, v in ((a, b), (b, a))]
+    depth = {nodes[0]: 0}
+    frontier = [nodes[0]]
+    while frontier:
+        nxt = [v for u, v in pairs if u in frontier and v not in depth]
+        for v in nxt:
+            depth.setdefault(v, depth[next(u for u, w in pairs if w == v and u in frontier)] + 1)
+        frontier = list(dict.fromkeys(nxt))
+    for body in nodes:
+        depth.setdefault(body, max(depth.values()) + 1)
+    rows: dict[int, list[str]] = {}
+    for body in nodes:
+        rows.setdefault(depth[body], []).append(body)
+    pos: dict[str, tuple[float, float]] = {}
+    for level in sorted(rows):
+        row = rows[level]
+        if level:  # fewer crossings: each body under the mean of its neighbours in the row below (stable)
+            below = {b: pos[b][0] for b in pos if depth[b] == level - 1}
+
+            def mean(body: str, below: dict = below) -> float:
+                xs = [below[v] for u, v in pairs if u == body and v in below]
+                return sum(xs) / len(xs) if xs else 0.0
+
+            row = sorted(row, key=mean)
+        for k, body in enumerate(row):
+            pos[body] = ((k - (len(row) - 1) / 2) * 1.8, float(level))
+    return pos
+
+
 def _layout(nodes: list[str], edges: list[tuple[str, str, str, bool]]) -> dict[str, tuple[float, float]]:
     """Base at (0, 0), platform at (0, top); a leg's links in its own column, evenly up."""
+    if nodes and nodes[0] != "base":  # a bodies-and-joints file: any topology
+        return _graph_layout(nodes, edges)
     chains: list[list[str]] = []
     for a, b, _label, _act in edges:
         if a == "base":
@@ -40,13 +75,14 @@ def graph_figure(title: str, nodes: list[str], edges: list[tuple[str, str, str, 
     width = max(6.0, 1.6 * max(1, sum(1 for a, *_ in edges if a == "base")) + 2)
     fig = Figure(figsize=(width, 5.5))
     ax = fig.add_subplot()
-    for a, b, label, actuated in edges:
+    for k, (a, b, label, actuated) in enumerate(edges):
         (x0, y0), (x1, y1) = pos[a], pos[b]
         colour = ACTUATED if actuated else PASSIVE
         ax.plot([x0, x1], [y0, y1], color=colour, lw=3.0 if actuated else 1.4, zorder=1)
+        f = 0.5 if abs(y1 - y0) < 1e-9 else (0.38, 0.62)[k % 2]  # crossing links: labels apart
         ax.text(
-            (x0 + x1) / 2,
-            (y0 + y1) / 2,
+            x0 + f * (x1 - x0),
+            y0 + f * (y1 - y0),
             label,
             fontsize=8,
             color=colour,
@@ -56,7 +92,7 @@ def graph_figure(title: str, nodes: list[str], edges: list[tuple[str, str, str, 
             zorder=3,
         )
     for body, (x, y) in pos.items():
-        wide = body in ("base", "platform")
+        wide = body in ("base", "platform", "ground")
         ax.text(
             x,
             y,

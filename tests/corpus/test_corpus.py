@@ -487,10 +487,14 @@ def test_watt2_pyslvs_four_assembly_modes():
     assert values["modes"] == 4
     # the file is bodies and joints: a5 is the output rocker's angle (its platform coordinate),
     # P2 the first four-bar's coupler point (an output); the numpy model's a2, a3 give P2
-    found = np.array([[values["modes_a5"][m], values["modes_P2_x"][m] / MM, values["modes_P2_y"][m] / MM] for m in range(4)])
+    found = np.array(
+        [[values["modes_a5"][m], values["modes_P2_x"][m] / MM, values["modes_P2_y"][m] / MM] for m in range(4)]
+    )
     for want, initial in _watt_modes(120 * DEG):
         p2 = np.array(WATT[3]) + math.dist(WATT[2], WATT[3]) * np.array([math.cos(want[1]), math.sin(want[1])])
-        hit = [m for m in range(4) if abs(_wrap(found[m, 0] - want[3])) < 1e-9 and np.allclose(found[m, 1:], p2, atol=1e-9)]
+        hit = [
+            m for m in range(4) if abs(_wrap(found[m, 0] - want[3])) < 1e-9 and np.allclose(found[m, 1:], p2, atol=1e-9)
+        ]
         assert len(hit) == 1, want
         assert values["modes_designated"][hit[0]] == initial
 

@@ -55,13 +55,16 @@ from ...analysis import flexure
 from ...core.aspect import ASPECT, ASPECT_DESCRIPTION, ASPECT_MAX_NX, twist_determinant
 from ...core.aspect import aspect as aspect_indicator
 from ...core.errors import InputError, format_key_path, suggest
+from ...core.joints import JOINT_TYPES, joint_types
 from ...core.model import Coordinate
 from ...core.options import Option, validate_mapping
 from ...core.units import parse_quantity
 from . import expr as ex
 from .spec import Description, Joint, Leg
 
-POINT_JOINTS = {"S", "planar_R"}
+# Aliases derived from the joint table (cpm_nlp.core.joints.JOINT_TYPES), for the modules that import them:
+#: point joints (a leg reaches its platform point through one: S; planar R)
+POINT_JOINTS = {n for n, t in JOINT_TYPES.items() if t.point}
 #: what the generated indicators measure
 _COSINE = "cosine of the link to the platform joint to its reference direction"
 _ASSEMBLY = (
@@ -78,10 +81,14 @@ _WORKING_PLANAR = (
 )
 _WORKING_P = "working mode: e·(B - c) of the P joint before it (axis e) and the link c -> B, over its value at home"
 
-SPHERE_JOINTS = {"U", "S", "planar_R"}
+#: joints about a point: the link after it sweeps a sphere (circle): U, S, planar R
+SPHERE_JOINTS = {n for n, t in JOINT_TYPES.items() if t.sphere}
 #: the letter a drawing marks each joint type with (a distance joint: a rod between two spherical joints)
-_LETTER = {"P": "P", "planar_P": "P", "R": "R", "planar_R": "R", "C": "C", "U": "U", "S": "S", "distance": "S"}
-JOINT_DIMS = {"P": "length", "planar_P": "length", "R": "angle", "planar_R": "angle", "U": "angle", "S": "angle"}
+_LETTER = {n: t.letter for n, t in JOINT_TYPES.items()}
+#: the dimension of the coordinates of each joint type whose coordinates share one (not C, not distance)
+JOINT_DIMS = {n: t.dims[0] for n, t in JOINT_TYPES.items() if len(set(t.dims)) == 1}
+#: the base frame's axes, for an S joint given without its ``axes``
+_BASE_AXES = {"x": ca.DM([1.0, 0, 0]), "y": ca.DM([0, 1.0, 0]), "z": ca.DM([0, 0, 1.0])}
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
@@ -121,17 +128,11 @@ class _Joint:
 
 def elementary_motions(j: _Joint) -> list[tuple[str, Any]]:
     """A joint's degrees of freedom as elementary motions ("P" | "R", axis), in the order
-    of its coordinates (product of exponentials about its reference axes)."""
-    e = [ca.DM([1.0, 0, 0]), ca.DM([0, 1.0, 0]), ca.DM([0, 0, 1.0])]
-    return {
-        "P": [("P", j.axis)],
-        "planar_P": [("P", j.axis)],
-        "R": [("R", j.axis)],
-        "planar_R": [("R", j.axis)],
-        "C": [("R", j.axis), ("P", j.axis)],
-        "U": [("R", a) for a in j.axes],
-        "S": [("R", a) for a in (j.axes or e)],
-    }[j.type]
+    of its coordinates (product of exponentials about its reference axes): the joint table's
+    motions (:data:`cpm_nlp.core.joints.JOINT_TYPES`) with the joint's axes."""
+    t = JOINT_TYPES[j.type]
+    axes = j.axes or [_BASE_AXES[a] for a in t.default_axes]
+    return [(kind, j.axis if source == "axis" else axes[source]) for kind, source in t.motion]
 
 
 @dataclass
@@ -276,10 +277,9 @@ class Generator:
         if name in [c.name for c in self.q_coords]:
             raise InputError(f"actuator {name!r} drives two joints", path=j.path + ("actuated",))
         dim = JOINT_DIMS.get(j.type)
-        if j.type not in ("P", "R", "planar_P", "planar_R"):
-            raise InputError(
-                f"a {j.type} joint cannot be actuated (P, R, planar_P, planar_R can)", path=j.path + ("actuated",)
-            )
+        if not JOINT_TYPES[j.type].actuable:
+            can = ", ".join(n for n, t in JOINT_TYPES.items() if t.actuable)
+            raise InputError(f"a {j.type} joint cannot be actuated ({can} can)", path=j.path + ("actuated",))
         fam = j.limit or family(name)
         self.q_coords.append(Coordinate(name, dim, f"actuator of the {j.type} joint at {_where(j.path)}", fam))
         sym = ca.SX.sym(name)
@@ -309,9 +309,10 @@ class Generator:
     def resolve(self, j: Joint, env: Mapping[str, ex.Value], turn: ca.SX) -> _Joint:  # noqa: C901 - one rule per joint part
         out = _Joint(j)
         planar = self.d.platform.planar
-        allowed = ("planar_R", "planar_P", "distance") if planar else ("P", "R", "C", "U", "S", "distance")
+        kind = JOINT_TYPES[j.type]
+        allowed = joint_types(planar)
         if j.type not in allowed:
-            other = {"R": "planar_R", "P": "planar_P", "planar_R": "R", "planar_P": "P"}.get(j.type)
+            other = kind.twin
             raise InputError(
                 f"a {'planar' if planar else 'spatial'} mechanism takes {', '.join(allowed)} joints, got {j.type}",
                 path=j.path + ("type",),
@@ -326,24 +327,24 @@ class Generator:
             out.to = turn @ self.vector(j.to, j.path + ("to",), env, "length")
         elif j.to is not None:
             raise InputError("only a distance joint has 'to'", path=j.path + ("to",))
-        if j.type in ("P", "R", "C", "planar_P"):
+        if kind.axis == "given":
             if j.axis is None:
                 raise InputError(f"a {j.type} joint needs its 'axis'", path=j.path)
             a = turn @ self.vector(j.axis, j.path + ("axis",), env, None)
             out.axis = a / ca.norm_2(a)
-        elif j.type == "planar_R":
-            out.axis = ca.SX(ca.DM([0.0, 0.0, 1.0]))
+        elif kind.axis == "z":
+            out.axis = ca.SX(_BASE_AXES["z"])
         for k, a in enumerate(j.axes):
             v = turn @ self.vector(a, j.path + ("axes", k), env, None)
             out.axes.append(v / ca.norm_2(v))
-        need = {"U": 2, "S": 3}.get(j.type)
-        if j.axes and (need is None or len(j.axes) != need):
+        need = kind.n_axes
+        if j.axes and len(j.axes) != need:
             raise InputError(f"a {j.type} joint takes {need or 'no'} axes, got {len(j.axes)}", path=j.path + ("axes",))
-        if j.type == "U" and not j.axes:
-            raise InputError("a U joint needs its two 'axes'", path=j.path)
-        if j.type == "S" and j.axes:
+        if need and not kind.default_axes and not j.axes:
+            raise InputError(f"a {j.type} joint needs its {need} 'axes'", path=j.path)
+        if need == 3 and j.axes:
             self._independent_axes(out.axes, j.path + ("axes",))
-        dof = {"P": 1, "R": 1, "planar_R": 1, "planar_P": 1, "C": 2, "U": 2, "S": 3, "distance": 0}[j.type]
+        dof = kind.dof
         if j.coordinates and len(j.coordinates) != dof:
             raise InputError(
                 f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}", path=j.path + ("coordinates",)
@@ -351,8 +352,11 @@ class Generator:
         if j.actuated is not None:
             out.value = self.actuator(j, env)
         elif j.home:
-            dim = JOINT_DIMS.get(j.type)
-            out.home = [self.scalar(h, j.path + ("home", k), env, dim) for k, h in enumerate(j.home)]
+            dims = kind.dims
+            out.home = [
+                self.scalar(h, j.path + ("home", k), env, dims[k] if k < len(dims) else None)
+                for k, h in enumerate(j.home)
+            ]
         return out
 
     #: |det| of an S joint's three unit axes below which they count as linearly dependent
@@ -472,8 +476,7 @@ class Generator:
         """A generated branch indicator, named after its leg and joint (``a1.U1``: leg a1, its
         first joint, a U); value None: filled in by :meth:`elimination_indicators`."""
         n = j.spec.path[-1] + 1 if j.spec.path and isinstance(j.spec.path[-1], int) else 0
-        letter = "R" if j.type == "planar_R" else "P" if j.type == "planar_P" else j.type
-        name = f"{leg.name}.{letter}{n}"
+        name = f"{leg.name}.{JOINT_TYPES[j.type].letter}{n}"
         self.branch.append((value, name, f"leg {leg.name}, joint {n} ({j.type}): {what}"))
 
     def eliminated(self, leg: Leg, elim: _Joint, before: list[_Joint], c: ca.SX, vp: ca.SX, nrows: int) -> None:
@@ -483,10 +486,10 @@ class Generator:
         (None: no joint before it, or one with several motions).  The indicator itself is chosen
         once Φ_x is known (:meth:`elimination_indicators`)."""
         working, what = None, ""
-        if before and before[-1].type in ("R", "planar_R", "P", "planar_P"):
+        if before and JOINT_TYPES[before[-1].type].dof == 1:
             b = before[-1]
             Rk, tk = self.chain(before[:-1])  # the joint before, moved by the joints before it
-            if b.type in ("R", "planar_R"):
+            if JOINT_TYPES[b.type].motion[0][0] == "R":
                 rate = ca.cross(Rk @ b.axis, c - (Rk @ b.at + tk))
                 what = _WORKING_PLANAR if self.d.platform.planar else _WORKING_R
             else:
@@ -590,7 +593,7 @@ class Generator:
         """The motion y -> Rm y + tm of the proximal chain's last body (product of exponentials)."""
         Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
         for j in joints:
-            motions = j.motions or [("P" if j.type in ("P", "planar_P") else "R", j.axis, j.value)]
+            motions = j.motions or [(JOINT_TYPES[j.type].motion[0][0], j.axis, j.value)]
             for kind, axis, value in motions:
                 if kind == "P":
                     Rk, tk = ca.SX.eye(3), value * axis
@@ -607,8 +610,9 @@ class Generator:
         elementary = elementary_motions(j)
         names = j.spec.coordinates or tuple(f"{leg.name}_j{k + 1}_{n + 1}" for n in range(len(elementary)))
         j.names = tuple(names)
+        dims = JOINT_TYPES[j.type].dims
         for n, ((kind, axis), name) in enumerate(zip(elementary, names)):
-            dim = "length" if kind == "P" else "angle"
+            dim = dims[n]
             sym = ca.SX.sym(name)
             home = j.home[n] if n < len(j.home) else ca.SX(0)
             fam = j.spec.limit or family(name)
@@ -622,7 +626,7 @@ class Generator:
             return
         for k, (name, val) in enumerate(zip(names, values)):
             home = j.home[k] if k < len(j.home) else 0
-            dim = "length" if (j.type == "C" and k == 1) or j.type in ("P", "planar_P") else "angle"
+            dim = JOINT_TYPES[j.type].dims[k]
             fam = j.spec.limit or family(name)
             desc = f"{j.type} joint of leg {leg}" + (f", axis {k + 1}" if len(names) > 1 else "")
             self.reported.append(

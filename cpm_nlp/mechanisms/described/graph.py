@@ -38,6 +38,7 @@ import numpy as np
 
 from ...core.aspect import ASPECT_MAX_NX, twist_determinant
 from ...core.errors import InputError, suggest
+from ...core.joints import JOINT_TYPES, joint_types
 from ...core.mechanism import Drawing
 from ...core.model import Coordinate
 from ...core.options import REQUIRED
@@ -48,11 +49,9 @@ from .spec import GROUND_NAMES, Description, Joint
 
 log = logging.getLogger(__name__)
 
-#: constraints a joint puts on the relative motion of two bodies (Grübler-Kutzbach), spatial and planar
-_DOF = {"P": 1, "R": 1, "C": 2, "U": 2, "S": 3, "planar_R": 1, "planar_P": 1}
-#: a planar file reads R and P as the planar joints
-_PLANAR = {"R": "planar_R", "P": "planar_P"}
-_LETTER = {"P": "P", "planar_P": "P", "R": "R", "planar_R": "R", "C": "C", "U": "U", "S": "S"}
+#: the freedom a distance joint (a rod with a spherical joint at each end) leaves between the
+#: two bodies it joins, spatial and planar (Grübler-Kutzbach); other joints: their dof (the table)
+_ROD_FREEDOM = {False: 5, True: 2}
 #: a row is independent of the rows kept before it when its part outside their span is at least
 #: this share of its norm (the rank test at the reference configuration, in file order)
 RANK_TOL = 1e-8
@@ -160,9 +159,10 @@ class GraphGenerator(Generator):
 
     def read_joints(self) -> None:  # noqa: C901 - one rule per joint part
         planar = self.d.platform.planar
-        allowed = ("planar_R", "planar_P", "distance") if planar else ("P", "R", "C", "U", "S", "distance")
+        allowed = joint_types(planar)
         for j in self.d.joints:
-            kind = _PLANAR.get(j.type, j.type) if planar else j.type
+            jt = JOINT_TYPES[j.type]
+            kind = jt.twin if planar and jt.twin and not jt.planar else j.type  # a planar file reads R, P as planar
             if kind not in allowed:
                 raise InputError(
                     f"a {'planar' if planar else 'spatial'} mechanism takes {', '.join(allowed)} joints, got {j.type}",
@@ -199,7 +199,7 @@ class GraphGenerator(Generator):
                 raise InputError("a U joint needs its two 'axes' (the first on the proximal body)", path=j.path)
             if kind == "S" and j.axes:
                 self._independent_axes(g.axes, j.path + ("axes",))
-            dof = _DOF.get(kind, 0)
+            dof = JOINT_TYPES[kind].dof
             if j.coordinates and len(j.coordinates) != dof:
                 raise InputError(
                     f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}",
@@ -218,8 +218,9 @@ class GraphGenerator(Generator):
 
     # -- the tree and its loops ----------------------------------------------------------------
     def spanning_tree(self) -> None:
-        """Grow the tree from the ground: actuated joints first, then in file order (a distance
-        joint never); the joints left out close one loop each."""
+        """Grow the tree from the ground: actuated joints first, then the joints whose values are
+        task coordinates, then in file order (a distance joint never); the joints left out close
+        one loop each."""
         bodies = [b.name for b in self.d.bodies]
         root = {b: b for b in bodies}
 
@@ -229,7 +230,13 @@ class GraphGenerator(Generator):
                 b = root[b]
             return b
 
-        order = sorted(range(len(self.gjoints)), key=lambda k: (self.gjoints[k].spec.actuated is None, k))
+        task = set(self.d.platform.task)  # a joint whose value is a task coordinate joins the tree early
+
+        def rank(k: int) -> tuple:
+            j = self.gjoints[k].spec
+            return (j.actuated is None, not task & set(j.coordinates), k)
+
+        order = sorted(range(len(self.gjoints)), key=rank)
         for k in order:
             g = self.gjoints[k]
             if g.type == "distance":
@@ -243,6 +250,15 @@ class GraphGenerator(Generator):
                     f"the actuated joint {g.name} closes a loop of actuated joints only (they form a cycle)",
                     path=g.spec.path + ("actuated",),
                 )
+        self._orient(bodies)
+        loop = 0
+        for g in self.gjoints:
+            if not g.tree:
+                loop += 1
+                g.loop = loop
+
+    def _orient(self, bodies: list[str]) -> None:
+        """Each body's parent in the tree (breadth first from the ground), and each tree joint's direction."""
         ground = self.ground
         self.parent = {ground: None}
         frontier = [ground]
@@ -267,11 +283,6 @@ class GraphGenerator(Generator):
                 path=("bodies", loose[0]),
                 hint="join every body to another by a P, R, C, U or S joint",
             )
-        loop = 0
-        for g in self.gjoints:
-            if not g.tree:
-                loop += 1
-                g.loop = loop
 
     def path_to_ground(self, body: str) -> list[str]:
         out = [body]
@@ -373,7 +384,10 @@ class GraphGenerator(Generator):
                 rows.append((ca.cross(Ra @ g.axis, d)[2], "offset across the axis"))
             else:
                 n1, n2 = self.normals(g)
-                rows += [(ca.dot(Ra @ n1, d), "offset across the axis, 1"), (ca.dot(Ra @ n2, d), "offset across the axis, 2")]
+                rows += [
+                    (ca.dot(Ra @ n1, d), "offset across the axis, 1"),
+                    (ca.dot(Ra @ n2, d), "offset across the axis, 2"),
+                ]
         if g.type in ("R", "C"):
             n1, n2 = self.normals(g)
             wa_axis = Ra @ g.axis
@@ -445,7 +459,8 @@ class GraphGenerator(Generator):
             )
         if pf.point is not None and pf.point not in self.body_points[body]:
             raise InputError(
-                f"{pf.point!r} is not a point of {body!r}; it carries {', '.join(self.body_points[body]) or 'no points'}",
+                f"{pf.point!r} is not a point of {body!r}; it carries "
+                f"{', '.join(self.body_points[body]) or 'no points'}",
                 path=("platform", "point"),
                 suggestions=suggest(pf.point, self.body_points[body]),
             )
@@ -539,6 +554,8 @@ class GraphGenerator(Generator):
         self._unique_names()
         self.assembler = Assembler(self, q, span)
         keep = self.assembler.select_rows()
+        if self.assembler.info.mobility != len(self.q_coords):
+            raise InputError(self.assembler.mobility_message(), path=("joints",))
         self.normal_form = len(keep) < len(self.loop_rows)
         act = self.actuation()
         if self.normal_form:  # overconstrained: the normal equations of every loop row (see normal_rows)
@@ -549,7 +566,8 @@ class GraphGenerator(Generator):
         if len(self.platform_rows) != npf:
             raise InputError(
                 f"the platform's position and rotation locate {len(self.platform_rows)} coordinate(s) of the body "
-                f"{self.platform_body!r}, and {npf} platform coordinate(s) are declared ({', '.join(self.x_names[:npf])})",
+                f"{self.platform_body!r}, and {npf} platform coordinate(s) are declared "
+                f"({', '.join(self.x_names[:npf])})",
                 path=("platform", "coordinates"),
                 hint="each coordinate of position and rotation is one platform coordinate; fix the others",
             )
@@ -629,7 +647,9 @@ class GraphGenerator(Generator):
         somewhere along the motion, where the rows it left out would not)."""
         r = ca.vertcat(*[row[0] for row in self.loop_rows])
         tree = [
-            k for k, n in enumerate(self.x_names) if n not in self.d.platform.coordinates and n not in self.actuated_coords
+            k
+            for k, n in enumerate(self.x_names)
+            if n not in self.d.platform.coordinates and n not in self.actuated_coords
         ]
         xt = ca.vertcat(*[self.x[k] for k in tree])
         g = ca.jacobian(r, xt).T @ r / scale
@@ -752,9 +772,21 @@ class Assembler:
         x, q, status = self.solve(self.defaults)
         self.status = status
         if not status["assembled"]:
+            x0, _q0, _span = (np.asarray(v, dtype=float).ravel() for v in self.draw(self.defaults))
+            Jx = np.asarray(self.F(x0, _q0, self.defaults)[1], dtype=float)
+            cols = [k for k, n in enumerate(gen.x_names) if n not in gen.d.platform.coordinates]
+            free = len(cols) - int(np.linalg.matrix_rank(Jx[: self.nloop][:, cols]))
+            if free < len(gen.q_coords):  # the actuators lock the loops against each other
+                raise InputError(
+                    f"wrong mobility: at the drawing the loops leave {free} degree(s) of freedom, and "
+                    f"{len(gen.q_coords)} joint(s) are actuated ({', '.join(c.name for c in gen.q_coords)}); "
+                    "actuate fewer joints (the reference configuration cannot assemble with all of them held)",
+                    path=("joints",),
+                )
             raise InputError(
                 f"the reference configuration does not assemble from the drawing with the parameters' defaults: "
-                f"after {status['steps']} step(s) the residual is {status['residual']:.3e} (SI) in {status['worst_row']}",
+                f"after {status['steps']} step(s) the residual is {status['residual']:.3e} (SI) in "
+                f"{status['worst_row']}",
                 path=("joints",),
                 hint="draw the mechanism closer to an assembled configuration, or check the link lengths",
             )
@@ -776,7 +808,11 @@ class Assembler:
         rank = len(keep)
         mobility = ntree - rank
         lam = 3 if gen.d.platform.planar else 6
-        gk = lam * (len(gen.d.bodies) - 1) - sum(lam - _DOF[g.type] if g.type != "distance" else 1 for g in gen.gjoints)
+        freedom = [
+            _ROD_FREEDOM[gen.d.platform.planar] if g.type == "distance" else JOINT_TYPES[g.type].dof
+            for g in gen.gjoints
+        ]
+        gk = lam * (len(gen.d.bodies) - 1) - sum(lam - f for f in freedom)
         dropped = [(int(self.names[k].split()[1]), self.names[k]) for k in range(self.nloop) if k not in keep]
         loops = [(g.loop, g.name, gen.loop_bodies(g)) for g in gen.gjoints if not g.tree]
         self.info = GraphInfo(
@@ -839,12 +875,12 @@ def graph_geometry(fn: ca.Function, layout: list, gen: GraphGenerator) -> Callab
     d = gen.d
     ground, platform = gen.ground, gen.platform_body
     actuated = {g.b if not g.reversed else g.a for g in gen.gjoints if g.tree and g.spec.actuated is not None}
-    letters = {}
-    for g in gen.gjoints:
-        if g.type == "distance":
-            continue
-        key = g.spec.at if isinstance(g.spec.at, str) and g.spec.at.isidentifier() else g.name
-        letters[key] = _LETTER[g.type]
+    named = [(g, g.spec.at if isinstance(g.spec.at, str) and g.spec.at.isidentifier() else g.name) for g in gen.gjoints]
+    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type != "distance"}
+    ends = [(g.spec.at, g.spec.to) for g in gen.gjoints if g.type == "distance"]
+
+    def rods(pts: dict) -> list[tuple[str, str, str]]:
+        return [(a, b, "leg") for a, b in ends if isinstance(a, str) and isinstance(b, str) and a in pts and b in pts]
 
     def geometry(model: Any, x: Any, q: Any) -> Drawing:
         V = np.asarray(
@@ -875,12 +911,7 @@ def graph_geometry(fn: ca.Function, layout: list, gen: GraphGenerator) -> Callab
                 faces.append((part, tuple(ring)))
             elif len(ring) == 2:
                 segments.append((ring[0], ring[1], part))
-        for g in gen.gjoints:
-            if g.type == "distance":
-                a = g.spec.at if isinstance(g.spec.at, str) else None
-                b = g.spec.to if isinstance(g.spec.to, str) else None
-                if a in pts and b in pts:
-                    segments.append((a, b, "leg"))
+        segments += rods(pts)
         note = "bodies as straight links (two points) or polygons (three or more) through their points"
         if d.platform.planar:
             note += "; a planar mechanism, drawn in its plane z = 0"

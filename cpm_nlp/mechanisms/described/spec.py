@@ -39,21 +39,11 @@ from typing import Any
 from ...analysis.compliance import HINGE_KEYS
 from ...core.errors import InputError, suggest, unknown_key_error
 from ...core.finite import check_numbers
+from ...core.joints import JOINT_TYPES, joint_type
 from ...core.mechanism import JointStiffness
 from ...core.options import REQUIRED
 from ...core.units import parse_quantity
 
-#: joint types -> (degrees of freedom, description)
-JOINT_TYPES = {
-    "P": (1, "prismatic (spatial)"),
-    "R": (1, "revolute (spatial)"),
-    "C": (2, "cylindrical: a revolute and a prismatic on one axis"),
-    "U": (2, "universal: two revolutes, axes[0] on the proximal body, axes[1] on the distal one"),
-    "S": (3, "spherical"),
-    "planar_R": (1, "revolute of a planar mechanism (axis z)"),
-    "planar_P": (1, "prismatic of a planar mechanism (axis in the plane)"),
-    "distance": (0, "rigid distance between two points (an S-S strut or a parallelogram's link)"),
-}
 DIMENSIONS = ("length", "angle", "dimensionless")
 AXES = ("x", "y", "z")
 
@@ -444,13 +434,7 @@ GRAPH_JOINT_KEYS = {
 
 def _joint(raw: Any, path: tuple, template: dict, graph: bool = False) -> Joint:  # noqa: C901 - one check per key
     raw = _mapping(raw, path, "a joint {type, at, axis, ...}", GRAPH_JOINT_KEYS if graph else JOINT_KEYS)
-    kind = raw.get("type")
-    if kind not in JOINT_TYPES:
-        raise InputError(
-            f"unknown joint type {kind!r}; expected one of: {', '.join(JOINT_TYPES)}",
-            path=path + ("type",),
-            suggestions=suggest(str(kind), JOINT_TYPES),
-        )
+    kind = joint_type(raw.get("type"), path + ("type",)).name
     actuated = raw.get("actuated")
     if actuated is not None:
         actuated = _name(_fill(actuated, template, path + ("actuated",)), path + ("actuated",), "an actuator name")
@@ -724,7 +708,8 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
             for k, n in enumerate(raw):
                 if n not in points:
                     raise InputError(
-                        f"unknown point {n!r}; the drawing's points: {', '.join(points) or 'none (declare them under points)'}",
+                        f"unknown point {n!r}; the drawing's points: "
+                        f"{', '.join(points) or 'none (declare them under points)'}",
                         path=path + (k,),
                         suggestions=suggest(str(n), points),
                     )
@@ -770,7 +755,7 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
         for key in ("at", "to"):
             v = getattr(j, key)
             if isinstance(v, str) and v.isidentifier():
-                for n, b in enumerate(j.between):
+                for b in j.between:
                     body = bodies[names.index(b)]
                     if v not in body.points and v not in points:
                         raise InputError(

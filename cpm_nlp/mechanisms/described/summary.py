@@ -14,13 +14,11 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from ...core.joints import JOINT_TYPES
 from ...core.model import Model
 from ...core.units import format_quantity
 from .generate import Generator, closure_parts, family
-from .spec import JOINT_TYPES, Description, Joint
-
-#: a joint's degrees of freedom (the table of spec.JOINT_TYPES)
-_DOF = {name: dof for name, (dof, _text) in JOINT_TYPES.items()}
+from .spec import Description, Joint
 
 
 def _hinges_of(d: Description) -> dict[str, str]:
@@ -55,15 +53,15 @@ def _joint_line(k: int, spec: Joint, resolved: Any, gen: Generator, model: Model
     parts.append(f"at {_vector(resolved.at, model, gen, 'length')}")
     if resolved.to is not None:
         parts.append(f"to {_vector(resolved.to, model, gen, 'length')}")
-    if resolved.axis is not None and spec.type not in ("planar_R",):
+    if resolved.axis is not None and JOINT_TYPES[spec.type].axis == "given":
         parts.append(f"axis {_vector(resolved.axis, model, gen, 'axis')}")
     names = list(spec.coordinates) or list(resolved.names)
     if spec.actuated:
         parts.append(f"actuated: {spec.actuated}")
     elif names:
         parts.append("coordinates: " + ", ".join(names))
-    elif _DOF.get(spec.type):
-        parts.append(f"{_DOF[spec.type]} passive dof (eliminated)")
+    elif JOINT_TYPES[spec.type].dof:
+        parts.append(f"{JOINT_TYPES[spec.type].dof} passive dof (eliminated)")
     keys = [key for name in [*names, spec.actuated or ""] for key in (name, family(name))]
     found = sorted({hinges[key] for key in keys if key in hinges})
     if spec.flexure is not None:
@@ -93,6 +91,9 @@ def summary_text(d: Description, model: Model | None, source: str) -> str:  # no
             lines.append(f"  {name:<8} = {shown or text}  ({dim}{'' if not shown else ': ' + text})")
             if q.description:
                 lines.append(f"  {'':<8}   {q.description}")
+    if d.is_graph:
+        lines += graph_lines(gen, model)
+        return "\n".join(lines) + "\n"
     hinges = _hinges_of(d)
     lines.append("legs (bodies and joints, base -> platform, at the reference configuration):")
     if not gen.leg_joints:
@@ -140,9 +141,91 @@ def summary_text(d: Description, model: Model | None, source: str) -> str:  # no
     return "\n".join(lines) + "\n"
 
 
+def graph_lines(gen: Any, model: Model | None) -> list[str]:  # noqa: C901 - one section after another
+    """``describe`` of a bodies-and-joints file: bodies, joints (in the spanning tree or closing a
+    loop), the loops, mobility by rank beside Grübler-Kutzbach, and the assembly of the reference
+    configuration."""
+    info = gen.info
+    lines = [f"bodies ({len(info.bodies)}; the ground: {info.ground}):"]
+    for body in gen.d.bodies:
+        what = f"  -- {body.description}" if body.description else ""
+        lines.append(f"  {body.name:<10} points: {', '.join(body.points) or '-'}{what}")
+    ntree = sum(1 for j in info.joints if j[5])
+    lines.append(
+        f"joints ({len(info.joints)}; {ntree} in the spanning tree, {len(info.joints) - ntree} closing a loop):"
+    )
+    for g, (name, kind, a, b, actuated, tree, loop) in zip(gen.gjoints, info.joints):
+        at = g.spec.at if isinstance(g.spec.at, str) else "(a point)"
+        role = "tree" if tree else f"closes loop {loop}"
+        coords = (
+            f"actuated: {g.spec.actuated}" if actuated else ("coordinates: " + ", ".join(g.names) if g.names else "")
+        )
+        if not tree and g.spec.coordinates:
+            coords = "coordinates: " + ", ".join(g.spec.coordinates)
+        lines.append(f"  {name:<6} {kind:<9} {a} -> {b} at {at}  {role}" + (f"  {coords}" if coords else ""))
+    lines.append("loops (a cycle basis: one per joint outside the spanning tree):")
+    counts: dict[int, int] = {}
+    for _r, _name, loop in gen.loop_rows:
+        counts[loop] = counts.get(loop, 0) + 1
+    for number, joint, bodies in info.loops:
+        lines.append(f"  loop {number}, closed by {joint}: {' - '.join(bodies)}  ({counts.get(number, 0)} equation(s))")
+    nq = len(gen.q_coords)
+    lines.append("mobility:")
+    lines.append(
+        f"  rank of the loops' Jacobian at the reference configuration: {info.mobility} degree(s) of freedom; "
+        f"Grübler-Kutzbach: {info.gruebler}; actuated: {nq} ({', '.join(c.name for c in gen.q_coords)})"
+    )
+    if info.dropped:
+        by_loop: dict[int, int] = {}
+        for loop, _name in info.dropped:
+            by_loop[loop] = by_loop.get(loop, 0) + 1
+        which = ", ".join(f"loop {k} ({n} of {counts[k]})" for k, n in sorted(by_loop.items()))
+        lines.append(
+            f"  the two disagree: equations repeat one another at the reference configuration in {which}: "
+            "overconstrained (Φ holds the normal equations of every loop equation; a pose is checked against each)"
+            if info.mobility != info.gruebler
+            else f"  equations that repeat others at the reference configuration: {which}"
+        )
+    elif info.mobility != info.gruebler:
+        lines.append("  the two disagree: a loop's joints are arranged so that they move more than counted")
+    task = list(gen.d.platform.task)
+    dependent = [n for n in gen.x_names if n not in task]
+    lines.append(f"  pose coordinates ({len(gen.x_names)}): task {', '.join(task)}; dependent {', '.join(dependent)}")
+    p = np.asarray(model.p, dtype=float) if model is not None else gen.p_default
+    _x, _q, status = gen.assembler.solve(p)
+    move_name, move = status["largest_move"]
+    lines.append(
+        "reference configuration: "
+        + (
+            f"assembled from the drawing in {status['steps']} Gauss-Newton step(s): residual "
+            f"{status['residual_at_drawing']:.3g} at the drawing, {status['residual']:.3g} assembled (SI); "
+            f"largest move {move_name} by {move:.4g}"
+            if status["assembled"]
+            else f"does not assemble from the drawing: residual {status['residual']:.3g} in {status['worst_row']}"
+        )
+    )
+    if gen.branch:
+        lines.append("branch indicators: " + ", ".join(b[1] for b in gen.branch))
+    return lines
+
+
 def body_graph(d: Description) -> tuple[list[str], list[tuple[str, str, str, bool]]]:
     """The bodies (base, each leg's links, platform) and the joints between them as edges
-    (from body, to body, label, actuated), base side first: the graph ``describe --plot`` draws."""
+    (from body, to body, label, actuated), base side first: the graph ``describe --plot`` draws.
+    A bodies-and-joints file: its bodies (the ground first) and every joint, named."""
+    if d.is_graph:
+        ground = next(b.name for b in d.bodies if b.name in ("ground", "base"))
+        nodes = [ground] + [b.name for b in d.bodies if b.name != ground]
+        edges = [
+            (
+                j.between[0],
+                j.between[1],
+                f"{j.name} {j.type}" + (f" {j.actuated}" if j.actuated else ""),
+                j.actuated is not None,
+            )
+            for j in d.joints
+        ]
+        return nodes, edges
     nodes = ["base"]
     edges: list[tuple[str, str, str, bool]] = []
     for leg in d.legs:
