@@ -329,7 +329,9 @@ def test_sidecar_errors(tmp_path):
 def test_option_errors():
     with pytest.raises(InputError, match=r"--actuated: the joint 'effector_frame' is fixed"):
         import_urdf(FIVE, FIVE_SIDE, actuated=["effector_frame"])
-    with pytest.raises(InputError, match=r"--task\[1\]: unknown task coordinate 'w'"):
+    with pytest.raises(
+        InputError, match=r"--task\[1\]: unknown task coordinate 'w'; expected one of: x, y, phi, free1"
+    ):
         import_urdf(FIVE, FIVE_SIDE, task=["x", "w"])
     with pytest.raises(InputError, match=r"--task: expected 2 different task coordinates"):
         import_urdf(FIVE, FIVE_SIDE, task=["x"])
@@ -628,3 +630,13 @@ def test_cli_spatial_and_task(cli, tmp_path):
     assert out.read_text() == import_urdf(FOUR, FOUR_SIDE, platform="tracer", planar=False, task=["phi"]).text
     run = cli("import", FOUR, "--sidecar", FOUR_SIDE, "--platform", "tracer", "--spatial", "-o", str(out))
     assert run.code == 2 and "--task: which task coordinates for 1 actuated joint(s)?" in run.err
+
+
+def test_a_passive_joint_as_the_task(tmp_path):
+    """--task rocker_pivot: the four-bar's output angle (Freudenstein's), its change from the
+    drawing th4(q) - th4(0) by hand, to 1e-9 rad."""
+    model = _model(tmp_path, import_urdf(FOUR, FOUR_SIDE, platform="tracer", task=["rocker_pivot"]).text)
+    fk = cn.forward_kinematics(model, [0.5], NEWTON)
+    assert fk.status == Status.SOLVED, fk.message
+    x = dict(zip(model.closure.x_names, fk.x))
+    assert x["rocker_pivot"] == pytest.approx(four_bar_drawing(0.5)["th4"] - four_bar_drawing()["th4"], abs=1e-9)

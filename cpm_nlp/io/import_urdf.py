@@ -814,9 +814,10 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
     ``actuated``: the actuated joints (URDF names), instead of the sidecar's ``name_mot``.
     ``platform``: the frame (a link or joint name) whose body is the platform and whose origin
     is its point (default: a link named platform, effector or end_effector).  ``task``: the
-    task coordinates (default: by the number of actuators -- planar 1: phi, 2: x, y, 3: x, y, phi;
-    spatial 3: x, y, z, 6: all six).  ``planar``: None -- a planar file when every R axis is one
-    direction; False -- always spatial; True -- planar or an error.
+    task coordinates, the platform's or passive joints' (default: by the number of actuators --
+    planar 1: phi, 2: x, y, 3: x, y, phi; spatial 3: x, y, z, 6: all six).  ``planar``: None --
+    a planar file when every R axis is one direction; False -- always spatial; True -- planar or
+    an error.
     """
     file = display_name(path)
     text = read_input_text(path, limit=MAX_INPUT_BYTES)
@@ -919,12 +920,14 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
                 hint="give --task, e.g. --task " + ",".join(list(coord_dims)[:n_act]),
             )
         task = default_task
+    passive = [c for j in out_joints if "actuated" not in j for c in j.get("coordinates", [])]
     for k, t in enumerate(task):
-        if t not in coord_dims:
+        if t not in coord_dims and t not in passive:
             raise InputError(
-                f"unknown task coordinate {t!r}; expected one of: {', '.join(coord_dims)}",
+                f"unknown task coordinate {t!r}; expected one of: {', '.join(list(coord_dims) + passive)} "
+                "(the platform's coordinates, or a passive joint's)",
                 path=("--task", k),
-                suggestions=suggest(t, coord_dims),
+                suggestions=suggest(t, list(coord_dims) + passive),
             )
     if len(set(task)) != len(task) or len(task) != n_act:
         raise InputError(
