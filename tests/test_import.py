@@ -640,3 +640,35 @@ def test_a_passive_joint_as_the_task(tmp_path):
     assert fk.status == Status.SOLVED, fk.message
     x = dict(zip(model.closure.x_names, fk.x))
     assert x["rocker_pivot"] == pytest.approx(four_bar_drawing(0.5)["th4"] - four_bar_drawing()["th4"], abs=1e-9)
+
+
+def test_an_open_drawing_is_closed_at_import(tmp_path):
+    """The rocker drawn 0.3 rad off (the loop open at the URDF's zero): the importer closes the
+    loops with the crank held at 0 (Gauss-Newton on the other joints, AD Jacobian), so the
+    drawing is the assembled four-bar of four_bar_drawing (by hand), and the header says by how
+    much each passive joint moved (the rocker back by 0.3 rad)."""
+    text = Path(FOUR).read_text().replace('rpy="0 0 1.3129882281354577"', 'rpy="0 0 1.6129882281354577"')
+    path = tmp_path / "open.urdf"
+    path.write_text(text)
+    imported = import_urdf(str(path), FOUR_SIDE, platform="tracer")
+    data, hand = load(imported.text), four_bar_drawing()
+    for body, name, value in (
+        ("rocker", "P_coupler_end", "C"),
+        ("coupler", "P_coupler_end", "C"),
+        ("coupler", "P_tracer", "T"),
+    ):
+        np.testing.assert_allclose(point(data, body, name), hand[value], rtol=0, atol=1e-12)
+    assert "configuration with the loops closed" in imported.text.splitlines()[1]
+    moved = next(n for n in imported.notes if n.startswith("the drawing closes the loops"))
+    assert "rocker_pivot -0.3 " in moved and "crank" not in moved
+
+
+def test_loops_that_cannot_close_keep_the_zero_configuration(tmp_path):
+    """A 6d closure whose frames are 0.01 m apart along the axes of a planar linkage cannot
+    close: the drawing stays the zero configuration, and the header says so."""
+    text = Path(FIVE).read_text().replace('xyz="0.1 0.11180339887498947 -0.01"', 'xyz="0.1 0.11180339887498947 0"')
+    path = tmp_path / "layers.urdf"
+    path.write_text(text)
+    imported = import_urdf(str(path), FIVE_SIDE)
+    assert any(n.startswith("the loops do not close from the URDF's zero configuration") for n in imported.notes)
+    np.testing.assert_allclose(point(load(imported.text), "distal2", "P_free2"), five_bar_drawing()["C2"], atol=1e-12)

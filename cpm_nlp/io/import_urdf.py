@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError, suggest
@@ -460,6 +461,100 @@ class _Names:
         return name
 
 
+#: Gauss-Newton steps of the assembly, and the residual it reaches (times the drawing's size)
+ASSEMBLY_STEPS, ASSEMBLY_TOL = 100, 1e-12
+_DOF = {"R": 1, "P": 1, "S": 3, "U": 2, "fixed": 0}
+
+
+def _rot(axis: Any, angle: Any) -> ca.SX:
+    """Rodrigues: the rotation by ``angle`` about the unit ``axis``."""
+    k = ca.SX(3, 3)
+    k[0, 1], k[0, 2], k[1, 0], k[1, 2], k[2, 0], k[2, 1] = -axis[2], axis[1], axis[2], -axis[0], -axis[1], axis[0]
+    return ca.SX.eye(3) + ca.sin(angle) * k + (1 - ca.cos(angle)) * (k @ k)
+
+
+def _motion(j: _Joint, v: ca.SX) -> ca.SX:
+    """The child's frame in the joint frame for the joint values ``v`` (4x4)."""
+    m = ca.SX.eye(4)
+    e = np.eye(3)
+    if j.kind == "R":
+        m[:3, :3] = _rot(j.axis, v[0])
+    elif j.kind == "P":
+        m[:3, 3] = ca.DM(j.axis) * v[0]
+    elif j.kind == "S":
+        m[:3, :3] = _rot(e[0], v[0]) @ _rot(e[1], v[1]) @ _rot(e[2], v[2])
+    elif j.kind == "U":
+        m[:3, :3] = _rot(e[j.u_axes[0]], v[0]) @ _rot(e[j.u_axes[1]], v[1])
+    return m
+
+
+def _kinematics(order: list[str], parent_joint: dict[str, _Joint]) -> tuple[ca.Function, dict[str, tuple[int, int]]]:
+    """Every link's frame in the world (4x4, column-major, one after another in ``order``) as a
+    function of the joint values, and each joint's slice of those values."""
+    slots, n = {}, 0
+    for lk in order[1:]:
+        j = parent_joint[lk]
+        slots[j.name] = (n, n + _DOF[j.kind])
+        n += _DOF[j.kind]
+    q = ca.SX.sym("q", n)
+    frame = {order[0]: ca.SX.eye(4)}
+    for lk in order[1:]:
+        j = parent_joint[lk]
+        frame[lk] = frame[j.parent] @ ca.DM(j.origin) @ _motion(j, q[slots[j.name][0] : slots[j.name][1]])
+    out = ca.vertcat(*[ca.reshape(frame[lk], 16, 1) for lk in order])
+    return ca.Function("urdf_frames", [q], [out], ["q"], ["frames"]), slots
+
+
+def _world(frames: ca.Function, values: np.ndarray, order: list[str]) -> dict[str, np.ndarray]:
+    flat = np.asarray(frames(values)).ravel()
+    return {lk: flat[16 * k : 16 * k + 16].reshape(4, 4, order="F") for k, lk in enumerate(order)}
+
+
+def _assemble(
+    frames: ca.Function, order: list[str], pairs: list[tuple[str, str, str]], held: list[int], scale: float
+) -> tuple[np.ndarray, str]:
+    """The joint values (the ``held`` ones 0) that close the loops, by Gauss-Newton steps from
+    the URDF's zero configuration (minimum-norm steps: redundant rows are fine); a 3d closure
+    brings the two frames' origins together, a 6d closure the frames.  If the loops do not
+    close, the zero configuration, and a note that says by how much they stay open."""
+    q = ca.SX.sym("q", frames.size1_in(0))
+    flat = frames(q)
+    index = {lk: k for k, lk in enumerate(order)}
+
+    def frame(lk: str) -> ca.SX:
+        return ca.reshape(flat[16 * index[lk] : 16 * index[lk] + 16], 4, 4)
+
+    rows = []
+    for la, lb, kind in pairs:
+        ta, tb = frame(la), frame(lb)
+        rows.append(ta[:3, 3] - tb[:3, 3])
+        if kind == "6d":  # the whole rotation matrices: zero at the same frame only (not at a half turn)
+            rows.append(ca.reshape(ta[:3, :3] - tb[:3, :3], 9, 1) * scale)
+    r = ca.vertcat(*rows)
+    fn = ca.Function("urdf_loops", [q], [r, ca.jacobian(r, q)], ["q"], ["residual", "jacobian"])
+    free = [k for k in range(q.size1()) if k not in set(held)]
+    values = np.zeros(q.size1())
+    tol = ASSEMBLY_TOL * scale
+    res, jac = (np.asarray(v) for v in fn(values))
+    start = float(np.max(np.abs(res))) if res.size else 0.0
+    if start <= tol or not free:
+        return values, ""
+    for _step in range(ASSEMBLY_STEPS):
+        step = np.linalg.lstsq(jac[:, free], -res.ravel(), rcond=None)[0]
+        longest = float(np.max(np.abs(step)))
+        if longest > 0.5:  # at most half a radian (or half a metre) a step
+            step *= 0.5 / longest
+        values[free] += step
+        res, jac = (np.asarray(v) for v in fn(values))
+        if float(np.max(np.abs(res))) <= tol:
+            return values, ""
+    left = float(np.max(np.abs(res)))
+    return np.zeros(q.size1()), (
+        f"the loops do not close from the URDF's zero configuration (largest closure residual {start:.3g}, "
+        f"{left:.3g} after {ASSEMBLY_STEPS} steps): the drawing is the zero configuration"
+    )
+
+
 def _frame(name: str, links: list[str], by_name: dict[str, _Joint], file: str, path: tuple) -> str:
     """The link whose frame a sidecar frame name is: a joint's child link, or the link itself."""
     if name in by_name:
@@ -484,8 +579,9 @@ def _build(  # noqa: C901 - one pass per step of the conversion
     platform: str | None,
     urdf: str,
     side: str,
-) -> tuple[_Graph, str, str, np.ndarray]:
-    """The bodies, joints and drawing of the mechanism; the platform body and its point."""
+) -> tuple[_Graph, str, str, np.ndarray, bool]:
+    """The bodies, joints and drawing of the mechanism; the platform body and its point; whether
+    the drawing is the URDF's zero configuration moved to close the loops."""
     by_name = {j.name: j for j in joints}
     notes: list[str] = []
     # the sidecar's joint types
@@ -502,24 +598,6 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         else:
             j.kind = "U"
             j.u_axes = ("XYZ".index(jtype[-2]), "XYZ".index(jtype[-1]))
-    # the zero configuration: each link's frame in the world (the root link's frame)
-    world: dict[str, np.ndarray] = {root: np.eye(4)}
-    parent_joint = {j.child: j for j in joints}
-    for lk in order[1:]:
-        j = parent_joint[lk]
-        world[lk] = world[j.parent] @ j.origin
-    scale = max([1e-3] + [float(np.linalg.norm(t[:3, 3])) for t in world.values()])
-    # bodies: the links joined by fixed joints are one body (its key: its top link)
-    body_of: dict[str, str] = {}
-    for lk in order:
-        j = parent_joint.get(lk)
-        body_of[lk] = body_of[j.parent] if j is not None and j.kind == "fixed" else lk
-    points: dict[str, dict[str, np.ndarray]] = {body_of[lk]: {} for lk in order}
-    names, bnames, pnames = _Names(), _Names(), _Names()  # joints and coordinates, bodies, points
-    bnames.used.add("ground")
-    body_names: dict[str, str] = {}
-    for key in points:
-        body_names[key] = "ground" if key == root else bnames.take(key, avoid=_GROUND_NAMES)
     # actuated joints: the option, else the sidecar
     if actuated is not None:
         wanted = [(a, ("--actuated",)) for a in actuated]
@@ -541,6 +619,48 @@ def _build(  # noqa: C901 - one pass per step of the conversion
                 path=path,
             )
         act.add(a)
+    # the drawing: each link's frame in the world (the root link's frame), the loops closed from
+    # the URDF's zero configuration with the actuated joints held at 0 where they can be
+    parent_joint = {j.child: j for j in joints}
+    frames, slots = _kinematics(order, parent_joint)
+    values = np.zeros(frames.size1_in(0))
+    world = _world(frames, values, order)
+    assembled = False
+    scale = max([1e-3] + [float(np.linalg.norm(t[:3, 3])) for t in world.values()])
+    if sidecar.closures:
+        pairs = [
+            (_frame(fa, links, by_name, side, path + (0,)), _frame(fb, links, by_name, side, path + (1,)), kind)
+            for fa, fb, kind, path in sidecar.closures
+        ]
+        held = [k for j in joints if j.name in act for k in range(*slots[j.name])]
+        values, note = _assemble(frames, order, pairs, held, scale)
+        if note:
+            notes.append(note)
+        world = _world(frames, values, order)
+        moved = [
+            f"{j.name} {values[slots[j.name][0]]:.4g}"
+            for j in joints
+            if slots[j.name][1] - slots[j.name][0] == 1 and abs(values[slots[j.name][0]]) > 1e-12
+        ]
+        if moved:
+            assembled = True
+            notes.append(
+                "the drawing closes the loops: passive joints moved from their URDF zero by "
+                + ", ".join(moved[:12])
+                + (", ..." if len(moved) > 12 else "")
+                + " (rad or m); their coordinates here are measured from there"
+            )
+    # bodies: the links joined by fixed joints are one body (its key: its top link)
+    body_of: dict[str, str] = {}
+    for lk in order:
+        j = parent_joint.get(lk)
+        body_of[lk] = body_of[j.parent] if j is not None and j.kind == "fixed" else lk
+    points: dict[str, dict[str, np.ndarray]] = {body_of[lk]: {} for lk in order}
+    names, bnames, pnames = _Names(), _Names(), _Names()  # joints and coordinates, bodies, points
+    bnames.used.add("ground")
+    body_names: dict[str, str] = {}
+    for key in points:
+        body_names[key] = "ground" if key == root else bnames.take(key, avoid=_GROUND_NAMES)
     # the tree's joints
     gjoints: list[_GJoint] = []
     for j in joints:
@@ -559,8 +679,9 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         if j.kind in ("R", "P"):
             g.axis = frame[:3, :3] @ j.axis
             g.limits = j.limits
-        elif j.kind == "U":
-            g.axes = (frame[:3, j.u_axes[0]].copy(), frame[:3, j.u_axes[1]].copy())
+        elif j.kind == "U":  # the first axis turns with the parent, the second with the child
+            first = (world[j.parent] @ j.origin)[:3, j.u_axes[0]].copy()
+            g.axes = (first, frame[:3, j.u_axes[1]].copy())
         gjoints.append(g)
     # the closures
     merged: dict[str, str] = {}  # a welded body -> the body it was welded to
@@ -624,7 +745,7 @@ def _build(  # noqa: C901 - one pass per step of the conversion
                 "which body is the platform? No link is named platform, effector or end_effector",
                 file=urdf,
                 path=("robot",),
-                hint="give --platform FRAME (a link or joint name of the URDF)",
+                hint="give --platform FRAME, a link or joint name of the URDF",
             )
         plink, ppath, pfile = platform, ("link", platform), urdf
     else:
@@ -637,7 +758,7 @@ def _build(  # noqa: C901 - one pass per step of the conversion
     points[pbody][ppoint] = pframe[:3, 3].copy()
     graph = _Graph(body_names, points, gjoints, notes, scale, {**bnames.renamed, **names.renamed})
     _simplify(graph, root, keep={root, pbody})
-    return graph, pbody, ppoint, pframe
+    return graph, pbody, ppoint, pframe, assembled
 
 
 def _simplify(graph: _Graph, ground: str, keep: set[str]) -> None:
@@ -825,7 +946,9 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
     root, order, _parents = _tree(links, joints, file)
     side = _read_sidecar(sidecar) if sidecar is not None else _Sidecar()
     side_name = display_name(sidecar) if sidecar is not None else None
-    graph, pbody, ppoint, pframe = _build(links, joints, root, order, side, actuated, platform, file, side_name or file)
+    graph, pbody, ppoint, pframe, assembled = _build(
+        links, joints, root, order, side, actuated, platform, file, side_name or file
+    )
     n_act = sum(g.actuated for g in graph.joints)
     if n_act == 0:
         raise InputError(
@@ -945,7 +1068,9 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
         f"# {mech_name}: imported by cpm-nlp import from {Path(file).name} (URDF)"
         + (f" and {Path(side_name).name} (Extended URDF sidecar)" if side_name else "")
         + ".",
-        "# The drawing is the URDF's zero configuration in the root link's frame, lengths in metres (SI);",
+        "# The drawing is the URDF's "
+        + ("configuration with the loops closed" if assembled else "zero configuration")
+        + " in the root link's frame, lengths in metres (SI);",
         "# the reference pose is assembled from it with the actuators at 0 (their URDF zero).",
     ]
     if basis is not None:
