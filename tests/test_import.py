@@ -644,9 +644,9 @@ def test_a_passive_joint_as_the_task(tmp_path):
 
 def test_an_open_drawing_is_closed_at_import(tmp_path):
     """The rocker drawn 0.3 rad off (the loop open at the URDF's zero): the importer closes the
-    loops with the crank held at 0 (Gauss-Newton on the other joints, AD Jacobian), so the
-    drawing is the assembled four-bar of four_bar_drawing (by hand), and the header says by how
-    much each passive joint moved (the rocker back by 0.3 rad)."""
+    loops with the crank held at 0 (Levenberg-Marquardt on the other joints, AD Jacobian), so
+    the drawing is the assembled four-bar of four_bar_drawing (by hand), and each joint's
+    coordinate stays the URDF's: the rocker's home is -0.3 rad, and its FK value is too."""
     text = Path(FOUR).read_text().replace('rpy="0 0 1.3129882281354577"', 'rpy="0 0 1.6129882281354577"')
     path = tmp_path / "open.urdf"
     path.write_text(text)
@@ -659,8 +659,15 @@ def test_an_open_drawing_is_closed_at_import(tmp_path):
     ):
         np.testing.assert_allclose(point(data, body, name), hand[value], rtol=0, atol=1e-12)
     assert "configuration with the loops closed" in imported.text.splitlines()[1]
-    moved = next(n for n in imported.notes if n.startswith("the drawing closes the loops"))
-    assert "rocker_pivot -0.3 " in moved and "crank" not in moved
+    joints = {j["name"]: j for j in data["joints"]}
+    assert joints["rocker_pivot"]["home"] == pytest.approx(-0.3, abs=1e-12)
+    assert "home" not in joints["crank"] and "home" not in joints["coupler_pin"]
+    model = _model(tmp_path, imported.text)
+    fk = cn.forward_kinematics(model, [0.5], NEWTON)
+    assert fk.status == Status.SOLVED, fk.message
+    x = dict(zip(model.closure.x_names, fk.x))
+    turn = four_bar_drawing(0.5)["th4"] - hand["th4"]
+    assert x["rocker_pivot"] == pytest.approx(turn - 0.3, abs=1e-9)
 
 
 def test_loops_that_cannot_close_keep_the_zero_configuration(tmp_path):

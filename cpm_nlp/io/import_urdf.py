@@ -424,6 +424,7 @@ class _GJoint:
     limits: tuple[float, float] | None = None
     coordinate: str = ""  # an actuated joint's own coordinate (its actuator is named after the joint)
     to: str = ""  # a distance joint: its point on b
+    home: float = 0.0  # an R or P joint's URDF value at the drawing
     rod: np.ndarray | None = None  # ... and the rod (b's end less a's end, in the rod's drawing)
 
 
@@ -462,7 +463,7 @@ class _Names:
 
 
 #: Gauss-Newton steps of the assembly, and the residual it reaches (times the drawing's size)
-ASSEMBLY_STEPS, ASSEMBLY_TOL = 100, 1e-12
+ASSEMBLY_STEPS, ASSEMBLY_TOL = 500, 1e-12
 _DOF = {"R": 1, "P": 1, "S": 3, "U": 2, "fixed": 0}
 
 
@@ -513,10 +514,11 @@ def _world(frames: ca.Function, values: np.ndarray, order: list[str]) -> dict[st
 def _assemble(
     frames: ca.Function, order: list[str], pairs: list[tuple[str, str, str]], held: list[int], scale: float
 ) -> tuple[np.ndarray, str]:
-    """The joint values (the ``held`` ones 0) that close the loops, by Gauss-Newton steps from
-    the URDF's zero configuration (minimum-norm steps: redundant rows are fine); a 3d closure
-    brings the two frames' origins together, a 6d closure the frames.  If the loops do not
-    close, the zero configuration, and a note that says by how much they stay open."""
+    """Joint values that close the loops, from the URDF's zero configuration: a 3d closure brings
+    the two frames' origins together, a 6d closure the frames.  Levenberg-Marquardt steps with
+    CasADi's AD Jacobian (redundant rows are fine), first with the ``held`` (actuated) joints at
+    0, then, if that fails, with them free too.  If the loops do not close, the zero
+    configuration, and a note that says by how much they stay open."""
     q = ca.SX.sym("q", frames.size1_in(0))
     flat = frames(q)
     index = {lk: k for k, lk in enumerate(order)}
@@ -530,29 +532,52 @@ def _assemble(
         rows.append(ta[:3, 3] - tb[:3, 3])
         if kind == "6d":  # the whole rotation matrices: zero at the same frame only (not at a half turn)
             rows.append(ca.reshape(ta[:3, :3] - tb[:3, :3], 9, 1) * scale)
-    r = ca.vertcat(*rows)
-    fn = ca.Function("urdf_loops", [q], [r, ca.jacobian(r, q)], ["q"], ["residual", "jacobian"])
-    free = [k for k in range(q.size1()) if k not in set(held)]
-    values = np.zeros(q.size1())
+    fn = ca.Function("urdf_loops", [q], [ca.vertcat(*rows), ca.jacobian(ca.vertcat(*rows), q)], ["q"], ["r", "J"])
     tol = ASSEMBLY_TOL * scale
-    res, jac = (np.asarray(v) for v in fn(values))
-    start = float(np.max(np.abs(res))) if res.size else 0.0
-    if start <= tol or not free:
-        return values, ""
+    start = float(np.max(np.abs(np.asarray(fn(np.zeros(q.size1()))[0]))))
+    if start <= tol:
+        return np.zeros(q.size1()), ""
+    left = start
+    for fixed in (set(held), set()):
+        free = [k for k in range(q.size1()) if k not in fixed]
+        if not free:
+            continue
+        values, reached = _levenberg_marquardt(fn, q.size1(), free, tol)
+        if reached <= tol:
+            return values, ""
+        left = min(left, reached)
+    return np.zeros(q.size1()), (
+        f"the loops do not close from the URDF's zero configuration (largest closure residual {start:.3g}, "
+        f"at best {left:.3g}): the drawing is the zero configuration"
+    )
+
+
+def _levenberg_marquardt(fn: ca.Function, n: int, free: list[int], tol: float) -> tuple[np.ndarray, float]:
+    """Minimise |r(q)|^2 over the ``free`` values from q = 0; the values and the largest |r|."""
+    values = np.zeros(n)
+    r, jac = (np.asarray(v) for v in fn(values))
+    r = r.ravel()
+    cost, lam = float(r @ r), 1e-3
     for _step in range(ASSEMBLY_STEPS):
-        step = np.linalg.lstsq(jac[:, free], -res.ravel(), rcond=None)[0]
+        if float(np.max(np.abs(r))) <= tol:
+            break
+        j = jac[:, free]
+        g = j.T @ j
+        step = np.linalg.solve(g + lam * (np.diag(np.diag(g)) + 1e-12 * np.eye(len(free))), -j.T @ r)
         longest = float(np.max(np.abs(step)))
         if longest > 0.5:  # at most half a radian (or half a metre) a step
             step *= 0.5 / longest
-        values[free] += step
-        res, jac = (np.asarray(v) for v in fn(values))
-        if float(np.max(np.abs(res))) <= tol:
-            return values, ""
-    left = float(np.max(np.abs(res)))
-    return np.zeros(q.size1()), (
-        f"the loops do not close from the URDF's zero configuration (largest closure residual {start:.3g}, "
-        f"{left:.3g} after {ASSEMBLY_STEPS} steps): the drawing is the zero configuration"
-    )
+        trial = values.copy()
+        trial[free] += step
+        r2, jac2 = (np.asarray(v) for v in fn(trial))
+        r2 = r2.ravel()
+        if float(r2 @ r2) < cost:
+            values, r, jac, cost, lam = trial, r2, jac2, float(r2 @ r2), max(lam / 3, 1e-12)
+        else:
+            lam *= 4
+            if lam > 1e12:
+                break
+    return values, float(np.max(np.abs(r)))
 
 
 def _frame(name: str, links: list[str], by_name: dict[str, _Joint], file: str, path: tuple) -> str:
@@ -637,18 +662,12 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         if note:
             notes.append(note)
         world = _world(frames, values, order)
-        moved = [
-            f"{j.name} {values[slots[j.name][0]]:.4g}"
-            for j in joints
-            if slots[j.name][1] - slots[j.name][0] == 1 and abs(values[slots[j.name][0]]) > 1e-12
-        ]
+        assembled = bool(np.any(values != 0))
+        moved = [j.name for j in joints if j.name in act and np.any(values[slots[j.name][0] : slots[j.name][1]])]
         if moved:
-            assembled = True
             notes.append(
-                "the drawing closes the loops: passive joints moved from their URDF zero by "
-                + ", ".join(moved[:12])
-                + (", ..." if len(moved) > 12 else "")
-                + " (rad or m); their coordinates here are measured from there"
+                f"the loops do not close with the actuated joints at 0: the drawing has {', '.join(moved)} "
+                "at other values (their home)"
             )
     # bodies: the links joined by fixed joints are one body (its key: its top link)
     body_of: dict[str, str] = {}
@@ -679,6 +698,7 @@ def _build(  # noqa: C901 - one pass per step of the conversion
         if j.kind in ("R", "P"):
             g.axis = frame[:3, :3] @ j.axis
             g.limits = j.limits
+            g.home = float(values[slots[j.name][0]])  # the URDF's joint value at the drawing
         elif j.kind == "U":  # the first axis turns with the parent, the second with the child
             first = (world[j.parent] @ j.origin)[:3, j.u_axes[0]].copy()
             g.axes = (first, frame[:3, j.u_axes[1]].copy())
@@ -1019,6 +1039,9 @@ def import_urdf(  # noqa: C901 - reads, builds and writes in one place
         elif g.kind in ("R", "P") and g.source.startswith("joint ") and " and " not in g.source:
             entry["coordinates"] = [g.name]
             fields.append(f"coordinates: [{_word(g.name)}]")
+        if abs(g.home) > ZERO and g.kind in ("R", "P"):
+            entry["home"] = flip * g.home
+            fields.append(f"home: {_num(flip * g.home, 1.0)}")
         if g.limits is not None and g.kind in ("R", "P"):
             lo, hi = sorted((flip * g.limits[0], flip * g.limits[1]))
             entry["range"] = [lo, hi]
