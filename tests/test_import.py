@@ -679,3 +679,51 @@ def test_loops_that_cannot_close_keep_the_zero_configuration(tmp_path):
     imported = import_urdf(str(path), FIVE_SIDE)
     assert any(n.startswith("the loops do not close from the URDF's zero configuration") for n in imported.notes)
     np.testing.assert_allclose(point(load(imported.text), "distal2", "P_free2"), five_bar_drawing()["C2"], atol=1e-12)
+
+
+def _four_bar_with_pin_chain(tmp_path, more_axes: list[str]) -> str:
+    """four_bar.urdf with revolutes about ``more_axes`` after the coupler pin's (z), dummy links
+    between them, all crossing at the pin (as the Gepetto examples write U and S joints)."""
+    old = '<parent link="crank_link"/>\n    <child link="coupler"/>'
+    text = Path(FOUR).read_text()
+    assert old in text
+    text = text.replace(old, '<parent link="crank_link"/>\n    <child link="pin0"/>')
+    links = [f"pin{k}" for k in range(len(more_axes))] + ["coupler"]
+    extra = "".join(f'  <link name="{lk}"/>\n' for lk in links[:-1])
+    for k, axis in enumerate(more_axes):
+        extra += (
+            f'  <joint name="pin_r{k + 1}" type="continuous"><parent link="{links[k]}"/>'
+            f'<child link="{links[k + 1]}"/><axis xyz="{axis}"/></joint>\n'
+        )
+    path = tmp_path / f"chain{len(more_axes)}.urdf"
+    path.write_text(text.replace("</robot>", extra + "</robot>"))
+    return str(path)
+
+
+def test_revolutes_crossing_at_a_point_are_a_u_or_an_s(tmp_path):
+    """Two revolutes crossing at the coupler pin (z, then the coupler's x) are one U joint with
+    those axes in world directions; three (z, x, y) are one S joint; the dummy links between
+    them are gone (the coupler's frame is turned by theta3 about z: x -> (cos, sin, 0))."""
+    th3 = four_bar_drawing()["th3"]
+    data = load(
+        import_urdf(_four_bar_with_pin_chain(tmp_path, ["1 0 0"]), FOUR_SIDE, platform="tracer", task=["phi"]).text
+    )
+    assert set(data["bodies"]) == {"ground", "crank_link", "coupler", "rocker"}
+    pin = next(j for j in data["joints"] if j["name"] == "coupler_pin")
+    assert pin["type"] == "U" and pin["between"] == ["crank_link", "coupler"] and pin["at"] == "P_coupler_pin"
+    np.testing.assert_allclose(pin["axes"], [[0, 0, 1], [math.cos(th3), math.sin(th3), 0]], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(point(data, "coupler", "P_coupler_pin"), [*four_bar_drawing()["B"], 0], atol=1e-12)
+    path = _four_bar_with_pin_chain(tmp_path, ["1 0 0", "0 1 0"])
+    data = load(import_urdf(path, FOUR_SIDE, platform="tracer", task=["phi"]).text)
+    pin = next(j for j in data["joints"] if j["name"] == "coupler_pin")
+    assert (
+        pin["type"] == "S"
+        and pin["between"] == ["crank_link", "coupler"]
+        and set(data["bodies"])
+        == {
+            "ground",
+            "crank_link",
+            "coupler",
+            "rocker",
+        }
+    )
