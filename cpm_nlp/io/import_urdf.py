@@ -25,7 +25,8 @@ coordinates (the root link's frame), lengths in metres.  Every non-fixed URDF jo
 between the bodies of its parent and child links, at the origin of its frame, its axis a world
 direction; each 3d closure is an S joint, each 6d closure merges the two bodies.  A body that
 only links two joints turning about one axis or point (the dummy links at which example files
-close their loops) is removed and its two joints become one; a passive joint to a body that
+close their loops, or between revolutes crossing at one point: a U, an S) is removed and its
+two joints become one; a passive joint to a body that
 carries nothing else (a free spin) is dropped; a rod between two S joints is a distance joint
 (or, where the mechanism hangs on it, keeps its body with a U instead of one S).  An actuated
 joint's actuator is named after it, its own coordinate ``<name>_joint``.  All R axes parallel
@@ -784,8 +785,9 @@ def _build(  # noqa: C901 - one pass per step of the conversion
 def _simplify(graph: _Graph, ground: str, keep: set[str]) -> None:
     """Remove the bodies (not the ground nor the platform's) that only carry passive joints
     adding a free spin, until none is left: a body on one joint and nothing else; a body joined
-    by two joints that turn about one axis (R, R coaxial) or one point (S, S concentric, or S
-    with an R through it), whose two joints become one between its neighbours; a rod between
+    by two joints that turn about one axis (R, R coaxial: an R) or one point (two R crossing: a
+    U; an S, or three independent axes through it: an S), whose two joints become one between
+    its neighbours (a chain of three revolutes crossing at a point is two steps); a rod between
     two S joints, which becomes a distance joint of its length -- unless a body would then hang
     on distance joints only (a mechanism file joins every body to the ground by joints): then
     its S joint on the side of the ground is a U normal to it (the rod's spin is gone)."""
