@@ -30,8 +30,8 @@ from . import expr as ex
 from .chains import chains_function
 from .chains import supported as chains_supported
 from .drawing import geometry_of
-from .generate import closure_parts, parameter_options
-from .graph import graph_geometry
+from .generate import parameter_options
+from .graph import closure_parts, graph_geometry
 from .spec import Description, description_from_dict
 
 log = logging.getLogger(__name__)

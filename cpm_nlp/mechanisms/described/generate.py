@@ -990,17 +990,6 @@ def _dim_name(dim: ex.Dim) -> str:
     return "length"
 
 
-def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
-    """The generator of a description (legs, or bodies and joints) and its built functions."""
-    if d.is_graph:
-        from .graph import GraphGenerator  # the graph form builds on this module
-
-        g: Generator = GraphGenerator(d)
-    else:
-        g = Generator(d)
-    return g, g.build()
-
-
 def parameter_options(d: Description) -> tuple[Option, ...]:
     """The declared parameters as options (validated like a built-in mechanism's)."""
     return tuple(
@@ -1009,4 +998,4 @@ def parameter_options(d: Description) -> tuple[Option, ...]:
     )
 
 
-__all__ = ["Generator", "closure_parts", "parameter_options"]
+__all__ = ["Generator", "parameter_options"]

@@ -855,6 +855,13 @@ class Assembler:
         return 1.0 if v > 0 else -1.0
 
 
+def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
+    """The generator of a description -- its legs (:class:`Generator`) or its bodies and joints
+    (:class:`GraphGenerator`) -- and the functions it built."""
+    g = GraphGenerator(d) if d.is_graph else Generator(d)
+    return g, g.build()
+
+
 def _defaults(d: Description) -> np.ndarray:
     """The parameters' defaults: the loops' rank is taken with them at the reference configuration."""
     vals = []
@@ -926,4 +933,4 @@ def graph_geometry(fn: ca.Function, layout: list, gen: GraphGenerator) -> Callab
     return geometry
 
 
-__all__ = ["Assembler", "GraphGenerator", "GraphInfo", "graph_geometry"]
+__all__ = ["Assembler", "GraphGenerator", "GraphInfo", "closure_parts", "graph_geometry"]

@@ -17,7 +17,8 @@ import numpy as np
 from ...core.joints import JOINT_TYPES
 from ...core.model import Model
 from ...core.units import format_quantity
-from .generate import Generator, closure_parts, family
+from .generate import Generator, family
+from .graph import closure_parts
 from .spec import Description, Joint
 
 
