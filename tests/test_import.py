@@ -415,7 +415,27 @@ def test_imported_five_bar_forward_kinematics_is_the_closed_form(tmp_path, q):
     np.testing.assert_allclose(ik.q, q, rtol=0, atol=1e-9)
 
 
-@pytest.mark.parametrize("q", [0.0, 0.5, -0.7, 1.0])
+@pytest.mark.parametrize(
+    "q",
+    [
+        0.0,
+        0.5,
+        -0.7,
+        1.0,
+        2.0,
+        3.0,
+        -2.0,
+        pytest.param(
+            -3.0,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="the loader of main a6ad246: FK from home at crank -3 rad returns rocker_pivot = -5.3923 "
+                "(0.8909 - 2 pi, the same pose) and calls it outside_joint_limits [-1, 1]; by hand the rocker "
+                "turned 0.8909 rad",
+            ),
+        ),
+    ],
+)
 def test_imported_four_bar_forward_kinematics_is_the_closed_form(tmp_path, q):
     """FK of the imported four-bar (1 degree of freedom, task phi: the coupler's turn from the
     drawing; x, y: the tracer) against the circle intersection of four_bar_drawing to 1e-9."""
