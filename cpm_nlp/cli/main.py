@@ -640,6 +640,42 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
     return EXIT_OK
 
 
+def cmd_import(args: argparse.Namespace, out: TextIO) -> int:
+    from ..io.import_urdf import import_urdf
+
+    inputs = [args.file] + ([args.sidecar] if args.sidecar else [])
+    for f in inputs:
+        check_input_file(f)
+    check_output_path(args.output, inputs)
+    imported = import_urdf(
+        args.file,
+        args.sidecar,
+        actuated=_comma_list(args.actuated, "--actuated"),
+        name=args.name,
+        platform=args.platform,
+        task=_comma_list(args.task, "--task"),
+        planar=False if args.spatial else None,
+    )
+    if args.output is None:
+        out.write(imported.text)
+        return EXIT_OK
+    write_atomic(args.output, imported.text, inputs=inputs)
+    kind = "planar" if imported.planar else "spatial"
+    out.write(
+        f"{args.output}: {len(imported.bodies)} bodies, {len(imported.joints)} joints ({kind}) from {args.file}\n"
+    )
+    return EXIT_OK
+
+
+def _comma_list(text: str | None, option: str) -> list[str] | None:
+    if text is None:
+        return None
+    items = [t.strip() for t in text.split(",")]
+    if not all(items):
+        raise InputError(f"expected names separated by commas, got {text!r}", path=(option,))
+    return items
+
+
 def _check_graph_plot(args: argparse.Namespace) -> None:
     """``describe FILE --plot FIGURE``: a mechanism file, and a .png, .svg or .pdf to write."""
     from ..plot.draw import check_figure_path, require_backend
@@ -796,6 +832,25 @@ def build_parser() -> argparse.ArgumentParser:
         "--plot", metavar="FIGURE", help="with a mechanism file: also draw its body graph (.png, .svg, .pdf)"
     )
     p.set_defaults(func=cmd_describe)
+
+    p = sub.add_parser(
+        "import",
+        help="write a mechanism file (bodies and joints) from a URDF and its Extended URDF sidecar",
+        description="Read a URDF (its links, joints and zero configuration) and the loop closures and actuated "
+        "joints of its Extended URDF sidecar (robot.yaml: closed_loop, type, name_mot, joint_name, joint_type); "
+        "write a mechanism file of bodies and joints. Nothing the URDF names (meshes, includes) is opened.",
+    )
+    p.add_argument("file", help="the URDF (.urdf)")
+    p.add_argument("--sidecar", metavar="FILE", help="the Extended URDF sidecar (robot.yaml): closures, actuators")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the mechanism file to FILE (default: print it)")
+    p.add_argument("--actuated", metavar="J1,J2", help="the actuated joints (URDF names), instead of name_mot")
+    p.add_argument("--name", metavar="NAME", help="the mechanism's name (default: the robot's name)")
+    p.add_argument(
+        "--platform", metavar="FRAME", help="the platform: a link or joint name (default: platform, effector)"
+    )
+    p.add_argument("--task", metavar="X,Y", help="the task coordinates (default: by the number of actuators)")
+    p.add_argument("--spatial", action="store_true", help="write a spatial file even if the mechanism is planar")
+    p.set_defaults(func=cmd_import)
     return parser
 
 
