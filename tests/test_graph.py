@@ -257,3 +257,98 @@ def test_set_override_reaches_a_graph_parameter():
     """`--set mechanism.parameters.dr1=...` on the Jansen problem file: the crank length changes."""
     problem = cn.load_problem(CORPUS / "problems" / "jansen_pyslvs_fk.yaml", ["mechanism.parameters.dr1=1 mm"])
     assert problem.model.parameters["dr1"] == pytest.approx(0.001)
+
+
+# -- a spatial platform: the 6-UPS as bodies and joints against its legs file ------------------
+
+
+def _ups6_graph() -> dict:
+    """problems/mechanisms/ups6.yaml (legs) written as 14 bodies and 18 joints, with the file's
+    default dimensions in numbers: U at the base (axes normal to the leg), the actuated P along
+    the leg, S at the platform."""
+    rb, rp, bb, pb, h0 = 0.150, 0.100, 20 * DEG, 20 * DEG, 0.200
+    z = np.array([0.0, 0.0, 1.0])
+
+    def rz(v, t):
+        c, s = math.cos(t), math.sin(t)
+        return [c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]]
+
+    points, bodies, joints = {"O": [0, 0, 0]}, {"ground": ["O"], "platform": []}, []
+    for i in range(3):
+        turn = 2 * math.pi * i / 3
+        for side, sign in (("a", -1.0), ("b", 1.0)):
+            n = f"{side}{i + 1}"
+            base = np.array(rz([rb * math.cos(bb / 2), sign * rb * math.sin(bb / 2), 0.0], turn))
+            top = np.array(
+                rz([rp * math.cos(math.pi / 3 - pb / 2), sign * rp * math.sin(math.pi / 3 - pb / 2), h0], turn)
+            )
+            d = top - base
+            u1 = np.cross(z, d) / np.linalg.norm(np.cross(z, d))
+            u2 = np.cross(d, u1) / np.linalg.norm(np.cross(d, u1))
+            points[f"A{n}"], points[f"B{n}"] = base.tolist(), top.tolist()
+            bodies["ground"].append(f"A{n}")
+            bodies["platform"].append(f"B{n}")
+            bodies[f"cyl_{n}"] = [f"A{n}"]
+            bodies[f"rod_{n}"] = [f"A{n}", f"B{n}"]
+            joints += [
+                {"type": "U", "between": ["ground", f"cyl_{n}"], "at": f"A{n}", "axes": [u1.tolist(), u2.tolist()]},
+                {
+                    "type": "P",
+                    "between": [f"cyl_{n}", f"rod_{n}"],
+                    "at": f"A{n}",
+                    "axis": d.tolist(),
+                    "actuated": f"l{n}",
+                    "home": float(np.linalg.norm(d)),
+                },
+                {"type": "S", "between": [f"rod_{n}", "platform"], "at": f"B{n}"},
+            ]
+    points["P0"] = [0.0, 0.0, h0]
+    bodies["platform"].append("P0")
+    return {
+        "name": "ups6_graph",
+        "points": points,
+        "bodies": bodies,
+        "joints": joints,
+        "platform": {
+            "body": "platform",
+            "point": "P0",
+            "coordinates": {
+                "px": "length",
+                "py": "length",
+                "pz": "length",
+                "psi": "angle",
+                "theta": "angle",
+                "phi": "angle",
+            },
+            "position": ["px", "py", "pz"],
+            "rotation": [["z", "phi"], ["y", "theta"], ["x", "psi"]],
+            "task": ["px", "py", "pz", "psi", "theta", "phi"],
+            "home": {"pz": h0},
+        },
+    }
+
+
+def test_ups6_as_bodies_and_joints_equals_its_legs_file():
+    """The Stewart platform written as bodies and joints (five S joints close five loops; the
+    platform's six coordinates locate its body through position and rotation rows) against
+    the legs file, whose closure the leg generator writes by elimination: FK of 10 seeded
+    random leg lengths (+-10 mm) agree to 1e-10, and so does the task Jacobian dx/dq."""
+    mech = from_dict(_ups6_graph())
+    graph = mech.model(mech.closure(), {}, {}, ())
+    legs = cn.build_model("ups6", {})
+    c = graph.closure
+    assert sorted(c.q_names) == sorted(legs.closure.q_names)
+    order = [list(c.q_names).index(n) for n in legs.closure.q_names]  # graph's q in the legs' order
+    rows = [c.x_names.index(n) for n in ("px", "py", "pz", "psi", "theta", "phi")]
+    rng = np.random.default_rng(7)
+    for _ in range(10):
+        dq = rng.uniform(-0.01, 0.01, 6)  # in the legs file's order
+        qa = np.empty(6)
+        qa[order] = legs.q_home + dq
+        a = cn.forward_kinematics(graph, qa, NEWTON)
+        b = cn.forward_kinematics(legs, legs.q_home + dq, NEWTON)
+        assert a.status == b.status == Status.SOLVED, (a.message, b.message)
+        np.testing.assert_allclose(np.asarray(a.x)[rows], np.asarray(b.x)[:6], rtol=0, atol=1e-10)
+        ja = cn.jacobians(graph, a.x, a.q).J_task[:, order]
+        jb = cn.jacobians(legs, b.x, b.q).J_task
+        np.testing.assert_allclose(ja, jb, rtol=0, atol=1e-9 * np.max(np.abs(jb)))

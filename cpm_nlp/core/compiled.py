@@ -240,6 +240,11 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
 
 
 BACKENDS = ("map", "compiled", "auto")
+#: backend "auto" compiles a kernel whose C source is at most this long: the compiler takes
+#: about 25 s per MB on the 2-core machine (the 6-UPS written as 14 bodies, 27 pose coordinates:
+#: 1.5 MB, 36 s, most of it the symbolic inverse in the conditioning check), the shipped
+#: mechanisms' kernels are 0.06-0.22 MB; "compiled" still compiles any size
+AUTO_COMPILE_MAX_BYTES = 750_000
 
 
 def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[ca.Function, str]:
@@ -259,6 +264,10 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
         def decide() -> str:
             if not compiler_available():
                 log.info("no C compiler: backend 'auto' uses 'map'")
+                return "map"
+            size = len(generate_source(kern.function, kern.name))
+            if size > AUTO_COMPILE_MAX_BYTES:  # a compile of minutes would cost more than it saves
+                log.info("%s: %d bytes of C: backend 'auto' uses 'map' (see AUTO_COMPILE_MAX_BYTES)", kern.name, size)
                 return "map"
             try:
                 compiled_function(closure, kern)
