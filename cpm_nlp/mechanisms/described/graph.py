@@ -603,6 +603,9 @@ class GraphGenerator(Generator):
             sign = self.assembler.reference_sign(d)
             scale = ca.fmax(ca.fabs(ca.substitute(d, xq, draw)), 1e-300)
             name = "loop" + "_".join(str(n) for n in loops)
+            taken, base, m = {b[1] for b in self.branch}, name, 2
+            while name in taken:  # another block of the same loops (the 3-PRC's platform closes two)
+                name, m = f"{base}_block{m}", m + 1
             what = (
                 f"assembly mode of loop{'s' if len(loops) > 1 else ''} {', '.join(map(str, loops))}: det of "
                 f"{'their' if len(loops) > 1 else 'its'} block of Φ_x, signed as at the reference configuration"
