@@ -96,6 +96,19 @@ def test_pantograph_joints_equals_the_builtin_module(pantographs):
         _close(ib.q, q)  # FK -> IK round trip gives the actuators back
 
 
+def test_pantograph_joints_other_parameters_assemble_and_agree():
+    """The drawing is written in a and b: other values assemble exactly and agree (section 6's
+    synthesis varies them)."""
+    fm = _file_model("pantograph_joints", {"a": 0.025, "b": 0.040})
+    hm = cn.build_model("pantograph", {"a": "25 mm", "b": "40 mm"})
+    for dq in ([1e-3, -2e-3, 1.5e-3], [-2e-3, 1e-3, -1e-3]):
+        q = hm.q_home + np.array(dq)
+        a, b = cn.forward_kinematics(hm, q, NEWTON), cn.forward_kinematics(fm, q, NEWTON)
+        assert a.status == b.status == Status.SOLVED, (a.message, b.message)
+        _close(np.asarray(b.x)[:3], a.x[:3])
+        _close(np.asarray(fm.closure.jacobian(b.x, q, fm.p))[:3], np.asarray(hm.closure.jacobian(a.x, q, hm.p))[:3])
+
+
 def test_pantograph_joints_task_jacobian_is_the_papers(pantographs):
     """Eq 9-13: J = diag(Mx, -My, -Mz), Mx = 1 + b/a, My = Mz = b/a, at every pose (derived by
     the paper from eq 3-8); omega = b^2 (a + b)/a^3 (eq 16)."""
