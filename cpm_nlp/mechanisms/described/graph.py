@@ -629,9 +629,9 @@ class GraphGenerator(Generator):
             sign = self.assembler.reference_sign(d)
             scale = ca.fmax(ca.fabs(ca.substitute(d, xq, draw)), 1e-300)
             name = "loop" + "_".join(str(n) for n in loops)
-            taken = [b[1] for b in self.branch]
-            if name in taken:  # one loop's rows in two blocks: a sub-chain each (a, b, ...)
-                name += "abcdefghijklmnopqrstuvwxyz"[sum(t.startswith(name) for t in taken) % 26]
+            taken, base, m = {b[1] for b in self.branch}, name, 2
+            while name in taken:  # another block of the same loops (the 3-PRC's platform closes two)
+                name, m = f"{base}_block{m}", m + 1
             what = (
                 f"assembly mode of loop{'s' if len(loops) > 1 else ''} {', '.join(map(str, loops))}: det of "
                 f"{'their' if len(loops) > 1 else 'its'} block of Φ_x, signed as at the reference configuration"
