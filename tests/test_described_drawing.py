@@ -31,7 +31,8 @@ def _model(name):
 def test_drawing_at_home_and_at_another_pose(name):
     model = _model(name)
     mech = model.mechanism
-    if not described.read_description(FILES[name]).legs:
+    d = described.read_description(FILES[name])
+    if not d.legs and not d.is_graph:
         assert mech.geometry is None  # closures written as expressions: no legs to draw
         return
     home = mech.geometry(model, model.x_home, model.q_home)
@@ -55,6 +56,15 @@ def test_drawing_at_home_and_at_another_pose(name):
     for drawing in (home, pose):
         for a, b, _part in drawing.segments:
             assert np.all(np.isfinite(drawing.points[a])) and np.all(np.isfinite(drawing.points[b]))
+    if d.is_graph:  # each body is drawn as a segment or a face through its points: rigid
+        edges = [(a, b) for a, b, _part in home.segments]
+        edges += [(r[k], r[(k + 1) % len(r)]) for _part, r in home.faces for k in range(len(r))]
+        assert edges
+        for a, b in edges:
+            dh = np.linalg.norm(np.asarray(home.points[a]) - np.asarray(home.points[b]))
+            dp = np.linalg.norm(np.asarray(pose.points[a]) - np.asarray(pose.points[b]))
+            assert dp == pytest.approx(dh, abs=1e-9 * span), (a, b)
+        return
     layout = _layout(model)
     # the platform is one rigid body: its joint points and its centre P keep their distances
     platform = [f"{leg}_{len(joints)}" for leg, joints in layout] + ["P"]

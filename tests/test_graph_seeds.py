@@ -1,6 +1,6 @@
 """Seed mechanisms written with bodies and joints only (issue 21, item 5), against the built-in modules.
 
-* tests/corpus/pantograph_joints.yaml -- the 3D pantograph of Elgammal et al. (links, the
+* problems/mechanisms/pantograph.yaml (``pantograph_file``) -- the 3D pantograph of Elgammal et al. (links, the
   parallelogram CDFB, the two loops sharing links, U joints at A and B for the plane's turn phi):
   FK, IK, the task Jacobian dx/dq and the hinge angle psi equal the built-in ``pantograph``
   (cpm_nlp/mechanisms/pantograph/kinematics.py, eq 1-8 written by hand) to 1e-12; its task
@@ -25,19 +25,22 @@ import cpm_nlp as cn
 from cpm_nlp.core.result import Status
 from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import load_file
-from cpm_nlp.mechanisms.described.generate import closure_parts
+from cpm_nlp.mechanisms.described.graph import closure_parts
 
 CORPUS = Path(__file__).resolve().parent / "corpus"
+SHIPPED = Path(__file__).resolve().parent.parent / "problems" / "mechanisms"
+#: the seed files: the pantograph is the shipped one, the others are in the corpus
+FILES = {"pantograph_joints": SHIPPED / "pantograph.yaml"}
 NEWTON = cn.SolverConfig("newton")
 
 
 def _file_model(name: str, parameters: dict | None = None) -> cn.Model:
-    mech = load_file(CORPUS / f"{name}.yaml")
+    mech = load_file(FILES.get(name, CORPUS / f"{name}.yaml"))
     return mech.model(mech.closure(), parameters or {}, {}, ())
 
 
 def _info(name: str):
-    gen, _fns = closure_parts(described.read_description(CORPUS / f"{name}.yaml"))
+    gen, _fns = closure_parts(described.read_description(FILES.get(name, CORPUS / f"{name}.yaml")))
     return gen.info
 
 

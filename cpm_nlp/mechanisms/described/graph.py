@@ -669,11 +669,28 @@ class GraphGenerator(Generator):
     # -- drawing ---------------------------------------------------------------------------
     def drawing_function(self, q: ca.SX) -> tuple[ca.Function, list]:
         """Every body's points at the pose (x, q, p), and what to draw: the layout."""
+        # a point name on several bodies is one drawn point where a joint keeps them together
+        # (R, U, S, planar R at that point); across a P or C joint, or unjoined, a point of its own
+        root: dict[tuple, tuple] = {}
+
+        def find(k: tuple) -> tuple:
+            while root.get(k, k) != k:
+                k = root[k]
+            return k
+
+        for g in self.gjoints:
+            at = g.spec.at
+            if isinstance(at, str) and g.type in ("R", "U", "S", "planar_R"):
+                root[find((g.b, at))] = find((g.a, at))
+        drawn: dict[tuple, str] = {}
         cols, layout = [], []
         for body in self.d.bodies:
             for name, p in self.body_points[body.name].items():
+                key = find((body.name, name))
+                if key not in drawn:
+                    drawn[key] = name + "'" * sum(1 for k in drawn if k[1] == name)
                 cols.append(self.world(body.name, p))
-                layout.append((body.name, name))
+                layout.append((body.name, drawn[key]))
         for g in self.gjoints:
             if isinstance(g.spec.at, str) and g.spec.at.isidentifier():
                 continue
