@@ -363,11 +363,13 @@ def test_describe_shipped_prs3_lists_hinges_and_its_example_values(cli):
     assert "task pz, psi, theta; dependent px, py, phi" in run.out
 
 
-def test_describe_pantograph_file_has_closures_not_legs(cli):
+def test_describe_pantograph_file_lists_bodies_joints_and_loops(cli):
+    """The shipped pantograph is bodies and joints (issue 21): describe lists its loops and says
+    that Grübler-Kutzbach (-1, as the paper's section 2 says: "negative") and the rank (3) disagree."""
     run = cli("describe", str(MECH / "pantograph.yaml"))
     assert run.code == 0, run.err
-    assert "(none: the loops are written as closures)" in run.out
-    assert "closures (expressions): 6 equation(s)" in run.out
+    assert "loop 1, closed by J8: L1 - Az - Ay - ground - Bx - L3" in run.out
+    assert "3 degree(s) of freedom; Grübler-Kutzbach: -1" in run.out and "the two disagree" in run.out
 
 
 def test_describe_kind_takes_a_mechanism_file(tmp_path, cli):
