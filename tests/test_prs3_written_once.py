@@ -67,6 +67,19 @@ def test_the_registered_prs3_is_the_file():
     assert "prs3_file" not in registry.mechanism_names()
 
 
+def test_the_name_resolves_to_the_file_without_reading_the_others(monkeypatch):
+    """Issue 23 (start-up): a built-in file's name is its file; the plugins and the other
+    shipped files are not discovered (nor their YAML parsed) to resolve it."""
+    read = []
+    monkeypatch.setattr(registry, "_file_mechanism_name", lambda path: read.append(path))
+    fresh = registry._Registry()
+    mech = fresh.lookup("prs3")
+    assert mech is not None and mech.name == "prs3" and mech.origin.endswith("prs3.yaml")
+    assert fresh._specs is None and read == []
+    assert fresh.lookup("prs3_file") is mech  # the old name: the discovery runs, and maps it
+    assert fresh.lookup("prs3_nonesuch") is None
+
+
 @pytest.mark.parametrize("params", PARAMETER_SETS, ids=["paper", "small", "steep"])
 def test_fk_ik_passive_and_jacobians_equal_the_reference(params):
     fm, rm = _models(params)
