@@ -1,7 +1,8 @@
 """Aliases for the module paths of cpm_nlp 0.1, before the package had layers.
 
-``import cpm_nlp.prs3`` (or ``from cpm_nlp import workspace``) still works and
+``import cpm_nlp.workspace`` (or ``from cpm_nlp import workspace``) still works and
 gives the module at its new place, with a DeprecationWarning that names it.
+``cpm_nlp.prs3`` is gone (:data:`REMOVED`): the 3-PRS is a mechanism file now.
 Three old modules became packages of the same name and are not aliased:
 ``cpm_nlp.problems`` (its ``ProblemKind`` is in :mod:`cpm_nlp.core.kind`, its
 ``problem_kind`` in :mod:`cpm_nlp.problems.registry`), ``cpm_nlp.mechanisms``
@@ -44,7 +45,6 @@ MOVED = {
     "workspace_problems": "kinds.workspace",
     "analysis_problems": "kinds.analysis",
     "synthesis": "kinds.synthesis",
-    "prs3": "mechanisms.prs3",
     "prc3": "mechanisms.prc3.kinematics",
     "rpr": "mechanisms.rpr.kinematics",
     "rpr_design": "mechanisms.rpr.design",
@@ -59,6 +59,13 @@ MOVED = {
 }
 
 
+#: old module name (under cpm_nlp) -> why it is gone and what replaces it
+REMOVED = {
+    "prs3": "the 3-PRS is the mechanism file problems/mechanisms/prs3.yaml since issue 21: "
+    "cpm_nlp.build_model('prs3', {...}) builds it, cpm_nlp.mechanism_type('prs3') declares it",
+}
+
+
 class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     """Finds ``cpm_nlp.<old>`` and loads it as the module at its new place."""
 
@@ -67,6 +74,8 @@ class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def find_spec(self, fullname, path=None, target=None):  # noqa: ARG002 - the finder protocol
         package, _, leaf = fullname.rpartition(".")
+        if package == "cpm_nlp" and leaf in REMOVED:
+            raise ModuleNotFoundError(f"{fullname} was removed: {REMOVED[leaf]}", name=fullname)
         if package != "cpm_nlp" or leaf not in MOVED:
             return None
         return importlib.util.spec_from_loader(fullname, self)

@@ -179,7 +179,18 @@ def test_public_names_listed_once():
 def test_legacy_module_names_still_import_with_a_warning():
     import importlib
 
-    with pytest.warns(DeprecationWarning, match="cpm_nlp.prs3 moved to cpm_nlp.mechanisms.prs3"):
-        old = importlib.import_module("cpm_nlp.prs3")
-    assert old is importlib.import_module("cpm_nlp.mechanisms.prs3")
-    assert old.__spec__.name == "cpm_nlp.mechanisms.prs3"
+    with pytest.warns(DeprecationWarning, match="cpm_nlp.workspace moved to cpm_nlp.analysis.workspace"):
+        old = importlib.import_module("cpm_nlp.workspace")
+    assert old is importlib.import_module("cpm_nlp.analysis.workspace")
+    assert old.__spec__.name == "cpm_nlp.analysis.workspace"
+
+
+def test_the_removed_prs3_module_says_where_the_mechanism_is():
+    """cpm_nlp.prs3 (0.1) and cpm_nlp.mechanisms.prs3 left the package (issue 21): the
+    3-PRS is problems/mechanisms/prs3.yaml."""
+    import importlib
+
+    with pytest.raises(ModuleNotFoundError, match="problems/mechanisms/prs3.yaml"):
+        importlib.import_module("cpm_nlp.prs3")
+    with pytest.raises(ModuleNotFoundError):
+        importlib.import_module("cpm_nlp.mechanisms.prs3")

@@ -51,7 +51,8 @@ def test_formulation_is_checked(prs3):
     with pytest.raises(InputError, match="unknown cuboid formulation 'pose'.*did you mean 'poses'"):
         W.inscribed_cuboid(prs3, formulation="pose")
     from cpm_nlp.core.model import LoopClosure, Model
-    from cpm_nlp.mechanisms import prs3 as P3
+
+    from .reference import prs3_closures as P3
 
     no_ik = LoopClosure(
         "prs3_no_ik",

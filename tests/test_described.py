@@ -3,8 +3,8 @@
 The papers' mechanisms re-described as files must be the hand-derived modules:
 FK, IK, the Jacobians and the passive joint angles to 1e-12 on random poses of
 the working range.  The reference is the hand-written module of each paper
-(cpm_nlp/mechanisms/prs3.py, prc3/kinematics.py, rpr/kinematics.py,
-pantograph/kinematics.py), whose
+(tests/reference/prs3_closures.py -- the 3-PRS is the file itself now, issue 21 --,
+prc3/kinematics.py, rpr/kinematics.py, pantograph/kinematics.py), whose
 formulas are pinned to the papers in their own tests; the file's closure is
 generated from the legs and shares no code with them.
 """
@@ -29,7 +29,7 @@ MECH = ROOT / "problems" / "mechanisms"
 
 CASES = {
     # file mechanism, hand-written type, parameters, actuator half-range around home
-    "prs3": ("prs3_file", "prs3", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}, 2e-3),
+    "prs3": ("prs3", "prs3_reference", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}, 2e-3),
     "prc3": ("prc3_file", "prc3", {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}, 15e-6),
     "rpr": ("rpr_file", "rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 50e-6),
     "pantograph": ("pantograph_file", "pantograph", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
@@ -39,6 +39,10 @@ NEWTON = cn.SolverConfig("newton")
 
 def _models(case):
     file_name, hand_name, params, _ = CASES[case]
+    if hand_name == "prs3_reference":  # the hand-written 3-PRS left the package: tests/reference
+        from .reference import prs3_closures
+
+        return cn.build_model(file_name, params), prs3_closures.reference_model(params)
     return cn.build_model(file_name, params), cn.build_model(hand_name, params)
 
 
@@ -102,11 +106,12 @@ def test_ipopt_fk_agrees(case):
 
 
 def test_prs3_joint_requirements_equal_the_hand_module():
-    """The joint requirements of the paper's Fig. 6-7 (problems/prs3_joint_requirements.yaml)."""
-    hand = cn.load_problem(ROOT / "problems" / "prs3_joint_requirements.yaml")
-    res_h = cn.solve(hand)
-    fm, _ = _models("prs3")
-    res_f = hand.kind.run(fm, hand.kind.parse_inputs(hand.data["inputs"], fm, ("inputs",)), hand.solver)
+    """The joint requirements of the paper's Fig. 6-7 (problems/prs3_joint_requirements.yaml),
+    on the file (the problem as shipped) and on the hand-written reference closures."""
+    problem = cn.load_problem(ROOT / "problems" / "prs3_joint_requirements.yaml")
+    res_f = cn.solve(problem)
+    _, hm = _models("prs3")
+    res_h = problem.kind.run(hm, problem.kind.parse_inputs(problem.data["inputs"], hm, ("inputs",)), problem.solver)
     assert res_h.status == res_f.status == Status.SOLVED
     common = [k for k in res_h.values if k in res_f.values and isinstance(res_h.values[k], float)]
     assert {"s_min", "s_max", "beta_m_min", "beta_m_max", "beta_n_max", "beta_l_max"} <= set(common)
@@ -317,7 +322,7 @@ def test_flexure_hinge_sets_the_joint_limits(tmp_path):
     """A circular-notch hinge on the S joints: the limits of beta_m, beta_n, beta_l are the
     stress-limited rotation of cpm_nlp.analysis.flexure (the built-in formula, eq 38 of the
     pantograph paper), +- about the reference configuration."""
-    text = (MECH / "prs3.yaml").read_text().replace("name: prs3_file", "name: prs3_flex")
+    text = (MECH / "prs3.yaml").read_text().replace("\nname: prs3\n", "\nname: prs3_flex\n")
     text = text.replace(
         '        coordinates: ["beta_m{i}", "beta_n{i}", "beta_l{i}"]',
         '        coordinates: ["beta_m{i}", "beta_n{i}", "beta_l{i}"]\n'

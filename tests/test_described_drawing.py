@@ -15,7 +15,7 @@ from cpm_nlp.mechanisms.described.drawing import fixed_links
 NEWTON = cn.SolverConfig("newton")
 #: parameters of the files that declare no defaults
 PARAMS = {
-    "prs3_file": {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"},
+    "prs3": {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"},
     "prc3_file": {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"},
     "rpr_file": {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"},
     "pantograph_file": {"a": "20 mm", "b": "50 mm"},
@@ -88,9 +88,12 @@ def _layout(model):
     return fns["drawing_legs"]
 
 
-def test_prs3_file_platform_points_equal_the_built_in_drawing():
-    params = PARAMS["prs3_file"]
-    fm, hm = cn.build_model("prs3_file", params), cn.build_model("prs3", params)
+def test_prs3_file_platform_points_equal_the_reference_drawing():
+    """The drawing of prs3 (the file) against the hand-written reference's A_i, C_i, B_i, P."""
+    from .reference import prs3_closures
+
+    params = PARAMS["prs3"]
+    fm, hm = cn.build_model("prs3", params), prs3_closures.reference_model(params)
     rng = np.random.default_rng(3)
     for q in (hm.q_home, hm.q_home + rng.uniform(-2e-3, 2e-3, 3)):
         x = cn.forward_kinematics(hm, q, NEWTON).x

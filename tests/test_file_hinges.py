@@ -24,7 +24,7 @@ PROBLEMS = ROOT / "problems"
 MECH_TEXT = (
     (PROBLEMS / "mechanisms" / "prs3.yaml")
     .read_text()
-    .replace("name: prs3_file", "name: prs3_hinged")
+    .replace("\nname: prs3\n", "\nname: prs3_hinged\n")
     .split("examples:")[0]
 )
 PROBLEM = """problem: actuator_forces
@@ -35,25 +35,32 @@ inputs: {s1: 0.935 mm, s2: 0.935 mm, s3: 0.935 mm, stress_limit: true}
 """
 
 
-def test_file_twin_declares_the_builtin_hinges():
-    builtin = cn.mechanism_type("prs3").stiffness
+def test_file_declares_the_hinges_of_the_reference():
+    """The hinges, material and source of prs3-ruiz.md sections 4-5 in the mechanism file
+    (the built-in prs3) equal the hand-written module's STIFFNESS, kept in
+    tests/reference/prs3_closures.py."""
+    from .reference import prs3_closures
+
+    reference = prs3_closures.STIFFNESS
     mech = described.load_file(PROBLEMS / "mechanisms" / "prs3.yaml")
-    assert mech.stiffness is not None and set(mech.stiffness.hinges) == set(builtin.hinges)
-    for name, spec in builtin.hinges.items():
+    assert cn.mechanism_type("prs3") is mech
+    assert mech.stiffness is not None and set(mech.stiffness.hinges) == set(reference.hinges)
+    for name, spec in reference.hinges.items():
         assert mech.stiffness.hinges[name] == spec, name
-    assert mech.stiffness.material == builtin.material
+    assert mech.stiffness.material == reference.material
+    assert mech.stiffness.source == reference.source
     assert "prs3_file_table2_forces.yaml" in " ".join(mech.problem_files)
     # the same hinge set (stiffness over the joint vector) on both models
     params = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
-    hf = cm.hinge_set(cn.build_model("prs3_file", params), None)
-    hb = cm.hinge_set(cn.build_model("prs3", params), None)
+    hf = cm.hinge_set(cn.build_model("prs3", params), None)
+    hb = cm.hinge_set(prs3_closures.reference_model(params), None)
     assert hf.names == hb.names
     assert list(hf.k) == list(hb.k)
 
 
 def test_file_twin_table2_forces_equal_the_builtin():
-    """prs3_file_table2_forces.yaml (hinges from the mechanism file) gives the results of
-    prs3_table2_forces.yaml (the built-in's STIFFNESS): the same mechanism."""
+    """prs3_file_table2_forces.yaml (the mechanism named by its file) gives the results of
+    prs3_table2_forces.yaml (named by its type, prs3): the same mechanism, by two routes."""
     ref = solve(load_problem(PROBLEMS / "prs3_table2_forces.yaml"))
     res = solve(load_problem(PROBLEMS / "prs3_file_table2_forces.yaml"))
     assert ref.ok and res.ok

@@ -83,7 +83,8 @@ def _file_mechanism(tmp_path, *, derived=None, material=None, problem="prs3_file
     another material) and of a problem on it; returns the problem file."""
     mech_dir = tmp_path / "mechanisms"
     mech_dir.mkdir()
-    text = (PROBLEMS / "mechanisms" / "prs3.yaml").read_text()
+    # a changed copy of the built-in prs3's file takes a name of its own
+    text = (PROBLEMS / "mechanisms" / "prs3.yaml").read_text().replace("\nname: prs3\n", "\nname: prs3_copy\n")
     if derived is not None:  # as written, quoted: YAML itself reads a bare 1e999 as inf
         assert "\nderived:\n" in text
         text = text.replace("\nderived:\n", f"\nderived:\n  evil: {json.dumps(derived)}\n")

@@ -48,6 +48,7 @@ def _refused(work: Path, problem: Path, key: str) -> str:
 def _mechanism_problem(work: Path, mech: str, edit: tuple[str, str], problem: str) -> Path:
     text = (work / "mechanisms" / mech).read_text()
     assert edit[0] in text
+    text = text.replace("\nname: prs3\n", "\nname: bad_prs3\n")  # a changed copy of a built-in's file: its own name
     (work / "mechanisms" / f"bad_{mech}").write_text(text.replace(edit[0], edit[1]))
     data = (PROBLEMS / problem).read_text().replace(f"mechanisms/{mech}", f"mechanisms/bad_{mech}")
     target = work / "p.yaml"

@@ -95,16 +95,19 @@ def _dist(d, a, b):
 
 
 def test_prs3_drawing_has_legs_of_length_L_and_sliders_on_their_rails():
-    """prs3-ruiz.md eq 2-6, 17-18: |C_iB_i| = L, C_i = A_i + s_i s_i0 (towards the axis)."""
+    """prs3-ruiz.md eq 2-6, 17-18: |C_iB_i| = L, C_i = A_i + s_i s_i0 (towards the axis).
+    The drawing of the mechanism file names its points by leg and joint: leg{i}_1 is the
+    slider's zero position A_i (P joint), leg{i}_2 the slider C_i (R joint), leg{i}_3 B_i (S)."""
     model, x, q = pose_of("prs3")
     d = model.mechanism.geometry(model, x, q)
     L = model.parameters["L"]
     for i in (1, 2, 3):
-        assert _dist(d, f"C{i}", f"B{i}") == pytest.approx(L, rel=1e-9)
-        A, C = np.asarray(d.points[f"A{i}"]), np.asarray(d.points[f"C{i}"])
+        assert (d.joints[f"leg{i}_1"], d.joints[f"leg{i}_2"], d.joints[f"leg{i}_3"]) == ("P", "R", "S")
+        assert _dist(d, f"leg{i}_2", f"leg{i}_3") == pytest.approx(L, rel=1e-9)
+        A, C = np.asarray(d.points[f"leg{i}_1"]), np.asarray(d.points[f"leg{i}_2"])
         assert np.linalg.norm(A - C) == pytest.approx(abs(q[i - 1]), abs=1e-12)
         assert np.linalg.norm(C) == pytest.approx(np.linalg.norm(A) - q[i - 1], rel=1e-12)  # towards the axis
-    centre = np.mean([d.points[f"B{i}"] for i in (1, 2, 3)], axis=0)
+    centre = np.mean([d.points[f"leg{i}_3"] for i in (1, 2, 3)], axis=0)
     assert centre[:2] == pytest.approx(x[:2], abs=1e-12) and centre[2] == pytest.approx(x[2], rel=1e-12)
 
 

@@ -323,7 +323,10 @@ def test_in_process_name_mismatch_and_build_failure(site):
 
 def test_in_process_plugin_cannot_take_a_builtin_name(site, caplog):
     _install(site, "plugclash", BIGLIDE, {"cpm_nlp.mechanisms": {"prs3": "plugclash:MECHANISM"}})
-    assert cn.mechanism_type("prs3").origin == "built-in"
+    # the built-in prs3 is its shipped mechanism file (issue 21), not the plugin; a built-in's
+    # name resolves without discovering the plugins, so the clash is told at the discovery
+    assert cn.mechanism_type("prs3").origin.startswith("file ") and cn.mechanism_type("prs3").name == "prs3"
+    assert "prs3" in cn.mechanism_names()
     assert "mechanism plugin plugin 'prs3'" in caplog.text and "ignored" in caplog.text
 
 

@@ -11,9 +11,9 @@ import pytest
 
 import cpm_nlp as cn
 from cpm_nlp.core.result import Status
-from cpm_nlp.mechanisms import prs3 as P
 
 from .conftest import central_difference
+from .reference import prs3_closures as P
 
 NEWTON = cn.SolverConfig(method="newton")
 IPOPT = cn.SolverConfig(method="ipopt")
@@ -28,7 +28,7 @@ def random_task(rng, n, dz=2e-3, tilt=TILT):
 
 
 def test_home_pose_geometry(prs3):
-    # a follows from alpha0 (see prs3.py): a = b + L cos(alpha0), pz0 = L sin(alpha0)
+    # a follows from alpha0 (see problems/mechanisms/prs3.yaml): a = b + L cos(alpha0), pz0 = L sin(alpha0)
     b, L = 47.91e-3, 109.215e-3
     assert prs3.derived["a"] == pytest.approx(b + L * math.cos(math.pi / 4), rel=1e-15)
     assert prs3.derived["a"] == pytest.approx(0.1251366671, rel=1e-9)

@@ -69,7 +69,8 @@ def test_membership_without_closed_form_ik(prs3):
     """A mechanism without a closed-form IK: membership solves the IK point by point
     and agrees with the closed form."""
     from cpm_nlp.core.model import LoopClosure, Model
-    from cpm_nlp.mechanisms import prs3 as P3
+
+    from .reference import prs3_closures as P3
 
     solved = LoopClosure(
         "prs3_solved_ik",

@@ -43,10 +43,28 @@ ENTRY_POINT_GROUP = "cpm_nlp.mechanisms"
 #: built-in mechanism type -> "module:attribute" of its declaration
 BUILTIN = {
     "prc3": "cpm_nlp.mechanisms.prc3:MECHANISM",
-    "prs3": "cpm_nlp.mechanisms.prs3:MECHANISM",
     "rpr": "cpm_nlp.mechanisms.rpr:MECHANISM",
     "pantograph": "cpm_nlp.mechanisms.pantograph:MECHANISM",
 }
+
+#: built-in mechanism type -> its shipped mechanism file (in problems/mechanisms/): the
+#: mechanism is written once, in that file; its name resolves to the file without reading
+#: any other (issue 21, item 5)
+BUILTIN_FILES = {
+    "prs3": "prs3.yaml",
+}
+
+#: old name -> the built-in mechanism it names now (the file twin became the built-in)
+ALIASES = {
+    "prs3_file": "prs3",
+}
+
+
+def _builtin_specs() -> dict[str, tuple[str, str]]:
+    """name -> (target, origin) of the built-in mechanisms (nothing read)."""
+    specs = {name: (target, "built-in") for name, target in BUILTIN.items()}
+    specs.update({name: (f"file:{described.SHIPPED_DIR / f}", "built-in") for name, f in BUILTIN_FILES.items()})
+    return specs
 
 
 #: what a mechanism file named by a problem file is called (the problem file reads only YAML files)
@@ -70,7 +88,8 @@ class _Registry:
 
     def _discover(self) -> dict[str, tuple[str, str]]:
         if self._specs is None:
-            specs = {name: (target, "built-in") for name, target in BUILTIN.items()}
+            specs = _builtin_specs()
+            builtin_files = {target for target, _origin in specs.values()}
             for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
                 origin = f"plugin {ep.name!r} ({ep.value}" + (f", package {ep.dist.name})" if ep.dist else ")")
                 if ep.name in specs:
@@ -80,6 +99,8 @@ class _Registry:
                     continue
                 specs[ep.name] = (ep.value, origin)
             for path in described.shipped_files():
+                if f"file:{path}" in builtin_files:  # a built-in's file (its name is the built-in's)
+                    continue
                 name = _file_mechanism_name(path)
                 if name is None or name in specs:
                     log.warning("mechanism file %s ignored: no valid name, or the name is taken", path)
@@ -132,14 +153,34 @@ class _Registry:
             self._closures.pop(name, None)
             self.version += 1
 
+    def _spec(self, name: str) -> tuple[str, str] | None:
+        """The (target, origin) of ``name``: a built-in's without discovering the plugins and
+        reading the shipped files (nothing registered yet, so no spec can differ from it)."""
+        if self._specs is None and name in BUILTIN.keys() | BUILTIN_FILES.keys():
+            return _builtin_specs()[name]
+        return self._discover().get(name)
+
     def get(self, name: str) -> Mechanism:
         with self._lock:
             mech = self._loaded.get(name)
             if mech is None:
-                target, origin = self._discover()[name]
-                mech = _load(name, target, origin)
+                spec = self._spec(name)
+                if spec is None:
+                    raise KeyError(name)
+                mech = _load(name, *spec)
                 self._loaded[name] = mech
             return mech
+
+    def lookup(self, name: str) -> Mechanism | None:
+        """The declaration registered as ``name`` (or as the name an old alias stands for),
+        None if there is none."""
+        with self._lock:
+            if self._spec(name) is not None:
+                return self.get(name)
+            if name in ALIASES and self._spec(ALIASES[name]) is not None:
+                log.debug("mechanism %r is now called %r", name, ALIASES[name])
+                return self.get(ALIASES[name])
+            return None
 
     def closure(self, mech: Mechanism) -> LoopClosure:
         with self._lock:
@@ -229,15 +270,17 @@ def unregister(name: str) -> None:
 
 
 def mechanism_type(name: Any, path: tuple = ("mechanism", "type")) -> Mechanism:
-    """The declaration of a mechanism type (with a "did you mean" if unknown)."""
+    """The declaration of a mechanism type (with a "did you mean" if unknown); an old name
+    (:data:`ALIASES`) gives the mechanism it stands for."""
+    mech = REGISTRY.lookup(name) if isinstance(name, str) else None
+    if mech is not None:
+        return mech
     names = REGISTRY.names()
-    if not isinstance(name, str) or name not in names:
-        raise InputError(
-            f"unknown mechanism type {name!r}; expected one of: {', '.join(names)}",
-            path=path,
-            suggestions=suggest(str(name), names),
-        )
-    return REGISTRY.get(name)
+    raise InputError(
+        f"unknown mechanism type {name!r}; expected one of: {', '.join(names)}",
+        path=path,
+        suggestions=suggest(str(name), names),
+    )
 
 
 def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
@@ -245,6 +288,17 @@ def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
     an earlier description of that name; a built-in or plugin of that name is an error."""
     with REGISTRY._lock:
         current = REGISTRY._discover().get(mech.name)
+        if current is not None and current[0].startswith("file:") and current[1] == "built-in":
+            builtin = REGISTRY.get(mech.name)
+            if builtin is mech or described.same_text(builtin, mech):
+                return builtin  # the built-in's own file, or an unchanged copy of it (cpm-nlp init)
+            raise InputError(
+                f"the described mechanism's name {mech.name!r} is the built-in mechanism of "
+                f"{current[0][len('file:') :]}, and this description differs from it; rename it",
+                path=path + ("name",),
+                hint="a changed copy of a shipped mechanism file needs a name of its own "
+                f"(e.g. {mech.name}_edited), so that 'type: {mech.name}' keeps meaning the shipped one",
+            )
         if current is not None and not current[1].startswith(("file ", "described")):
             raise InputError(
                 f"the described mechanism's name {mech.name!r} is taken by a {current[1]} mechanism; rename it",

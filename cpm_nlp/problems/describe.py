@@ -63,7 +63,8 @@ def _mechanism_section(mech: Mechanism) -> tuple[dict[str, Any], str]:
             section = read_yaml(path).get("mechanism")
             # the mechanism's own example: by type, or by its file (a mechanism described in a file)
             if isinstance(section, dict) and (section.get("type") == mech.name or "file" in section):
-                return section, f"problems/{path.name}" if not Path(name).is_absolute() else str(path)
+                shipped = not Path(name).is_absolute() or path.parent == shipped_problems_dir()
+                return section, f"problems/{path.name}" if shipped else str(path)
     return {"type": mech.name}, "the declared defaults"
 
 

@@ -30,7 +30,7 @@ from . import expr as ex
 from .chains import chains_function
 from .chains import supported as chains_supported
 from .drawing import geometry_of
-from .generate import parameter_options
+from .generate import described_limits, parameter_options
 from .graph import closure_parts, graph_geometry
 from .spec import Description, description_from_dict
 
@@ -58,23 +58,13 @@ SHIPPED_DIR = (
 _LOCK = threading.Lock()
 #: content hash -> Mechanism (code, not problem data: one per distinct description)
 _CACHE: dict[str, Mechanism] = {}
+#: id of a Mechanism read from a file (kept alive by _CACHE) -> SHA-256 of the file's text alone
+_TEXT_HASH: dict[int, str] = {}
 
 
 def shipped_files() -> list[Path]:
     """The mechanism files shipped in ``problems/mechanisms/``."""
     return sorted(SHIPPED_DIR.glob("*.yaml")) if SHIPPED_DIR.is_dir() else []
-
-
-def twin_chains(file_name: str, model: Model) -> Any:
-    """The ``chains`` of a built-in mechanism from its shipped file twin (same parameter
-    and coordinate names, checked), at the model's parameters."""
-    twin = load_file(SHIPPED_DIR / file_name)
-    closure = twin.closure()
-    c = model.closure
-    if (closure.x_names, closure.q_names) != (c.x_names, c.q_names) or set(closure.parameters) != set(c.parameters):
-        raise ValueError(f"{file_name} is not a twin of {c.name}: its coordinates or parameters differ")
-    twin_model = twin.model(closure, {n: model.parameters[n] for n in closure.parameters}, {}, ())
-    return twin.chains(twin_model)
 
 
 def load_file(path: str | Path, *, allow_pipe: bool = False) -> Mechanism:
@@ -94,7 +84,17 @@ def load_file_description(path: str | Path, *, allow_pipe: bool = False) -> tupl
     text_key = hashlib.sha256(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode()).hexdigest()
     data = parse_yaml(text, file)
     mech = _cached(text_key, lambda: from_dict(data, file=file, base_dir=base_dir))
+    with _LOCK:
+        _TEXT_HASH[id(mech)] = hashlib.sha256(text.encode()).hexdigest()
     return mech, description_from_dict(data, file=file)  # read without error: from_dict read it
+
+
+def same_text(a: Mechanism, b: Mechanism) -> bool:
+    """Whether two mechanisms were read from files of the same text (a shipped file and an
+    unchanged copy of it elsewhere: ``cpm-nlp init``'s problems/mechanisms)."""
+    with _LOCK:
+        ha, hb = _TEXT_HASH.get(id(a)), _TEXT_HASH.get(id(b))
+    return ha is not None and ha == hb
 
 
 def _cached(key: str, make: Any) -> Mechanism:
@@ -148,7 +148,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
         check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))
     params = parameter_options(d)
-    limits = gen.limit_options()
+    limits = described_limits(gen.limit_options(), d)
     examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)
     #: (name, dimension, size): a derived vector is reported as a vector under its name
     derived_names = [(n, dim, int(sx.numel())) for n, sx, dim in gen.derived]

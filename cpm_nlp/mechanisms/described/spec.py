@@ -60,6 +60,8 @@ class Parameter:
     lower: float | None = None
     upper: float | None = None
     description: str = ""
+    #: the bounds exclude their ends (``strict: true``, as a built-in option's ``strict=True``)
+    strict: bool = False
 
 
 @dataclass
@@ -198,6 +200,8 @@ class Description:
     characteristic_length: Expr = None
     paper: str = ""
     examples: tuple[str, ...] = ()
+    #: joint-limit family -> its description (what ``describe`` and the error messages call it)
+    limits: dict[str, str] = field(default_factory=dict)
     #: the compliant joints (hinges, material, source): the compliance kinds' defaults
     stiffness: JointStiffness | None = None
     file: str | None = None
@@ -220,7 +224,7 @@ TOP = {
     "name": "the mechanism type name (an identifier)",
     "title": "a one-line title",
     "paper": "where the mechanism comes from",
-    "parameters": "name -> {dimension, default, bounds, description}",
+    "parameters": "name -> {dimension, default, bounds, strict, description}",
     "derived": "name -> expression (or {value, dimension, description})",
     "platform": "{coordinates, position, rotation, task, fixed, home, bounds}",
     "legs": "list of {name, repeat, joints}",
@@ -231,6 +235,7 @@ TOP = {
     "ik": "{let, pose, actuators, reach}: a closed-form inverse kinematics",
     "characteristic_length": "length expression for conditioning measures",
     "examples": "problem files that use the mechanism (relative to this file)",
+    "limits": "joint-limit family -> its description (text)",
     "stiffness": "{hinges, material, source}: the compliant joints, defaults of the compliance kinds",
     "points": "name -> vector: named points of the drawing (bodies-and-joints files)",
     "bodies": "name -> [point names] or {points, description}: the rigid bodies (the ground is 'ground')",
@@ -299,13 +304,13 @@ def _dimension(value: Any, path: tuple) -> str:
     return value
 
 
-PARAMETER_KEYS = {"dimension": "", "default": "", "bounds": "", "description": ""}
+PARAMETER_KEYS = {"dimension": "", "default": "", "bounds": "", "strict": "", "description": ""}
 
 
 def _parameter(name: str, raw: Any, path: tuple) -> Parameter:
     if isinstance(raw, str) and raw in DIMENSIONS:
         raw = {"dimension": raw}
-    raw = _mapping(raw, path, "{dimension, default, bounds, description}", PARAMETER_KEYS)
+    raw = _mapping(raw, path, "{dimension, default, bounds, strict, description}", PARAMETER_KEYS)
     dim = _dimension(raw.get("dimension", "length"), path + ("dimension",))
     lower = upper = None
     if raw.get("bounds") is not None:
@@ -316,7 +321,16 @@ def _parameter(name: str, raw: Any, path: tuple) -> Parameter:
         if lower is not None and upper is not None and not lower < upper:
             raise InputError(f"expected [low, high] with low < high, got {b!r}", path=path + ("bounds",))
     default = REQUIRED if raw.get("default") is None else parse_quantity(raw["default"], dim, path + ("default",))
-    return Parameter(name, dim, default, lower, upper, _text(raw.get("description"), path + ("description",)))
+    strict = raw.get("strict", False)
+    if not isinstance(strict, bool):
+        raise InputError(
+            f"expected true (the bounds exclude their ends) or false, got {strict!r:.60}", path=path + ("strict",)
+        )
+    if strict and lower is None and upper is None:
+        raise InputError("'strict' makes the bounds exclusive, and there are no bounds", path=path + ("strict",))
+    return Parameter(
+        name, dim, default, lower, upper, _text(raw.get("description"), path + ("description",)), strict=strict
+    )
 
 
 QUANTITY_KEYS = {"value": "", "dimension": "", "description": "", "family": ""}
@@ -837,6 +851,10 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
             raw.get("reach"),
         )
     examples = _list(data.get("examples") or [], ("examples",), "a list of problem files")
+    limits = {
+        _name(n, ("limits", n), "a joint-limit family"): _text(v, ("limits", n))
+        for n, v in _mapping(data.get("limits") or {}, ("limits",), "joint-limit family -> description").items()
+    }
     legs = _legs(data.get("legs") or [], ("legs",))
     check_bodies(legs)
     graph: tuple = ({}, [], [], {})
@@ -865,6 +883,7 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
         characteristic_length=data.get("characteristic_length"),
         paper=_text(data.get("paper"), ("paper",)),
         examples=tuple(str(e) for e in examples),
+        limits=limits,
         stiffness=None if data.get("stiffness") is None else _stiffness(data["stiffness"], ("stiffness",)),
         file=file,
         points=graph[0],

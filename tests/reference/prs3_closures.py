@@ -1,5 +1,13 @@
 """3-PRS compliant parallel stage (Ruiz, Campa, Roldán-Paraponiaris, Altuzarra,
-Pinto; ``../shared/papers/prs3-ruiz.md``).
+Pinto; ``../shared/papers/prs3-ruiz.md``): the hand-written closures, an independent
+reference for the tests.
+
+The package's ``prs3`` is the mechanism file ``problems/mechanisms/prs3.yaml`` (its
+closures generated from the legs).  These closures, derived by hand from the paper's
+equations, were the built-in module ``cpm_nlp.mechanisms.prs3`` until issue 21 (item 5)
+wrote the mechanism once, in the file; they stay here as the independent derivation the
+file is checked against (``tests/test_prs3_written_once.py``, to 1e-12).  Not part of the
+package: import it from the tests only.
 
 Symbols follow the paper:
 
@@ -33,15 +41,16 @@ Reading of the paper chosen here (documented, not tuned):
 
 from __future__ import annotations
 
+import functools
 import math
 
 import casadi as ca
 import numpy as np
 
-from ..core.aspect import ASPECT, ASPECT_DESCRIPTION, aspect
-from ..core.mechanism import Drawing, JointStiffness, Mechanism
-from ..core.model import Coordinate, LoopClosure, Model
-from ..core.options import Option
+from cpm_nlp.core.aspect import ASPECT, ASPECT_DESCRIPTION, aspect
+from cpm_nlp.core.mechanism import Drawing, JointStiffness, Mechanism
+from cpm_nlp.core.model import Coordinate, LoopClosure, Model
+from cpm_nlp.core.options import Option
 
 SQRT3 = math.sqrt(3.0)
 #: angular positions of the legs, eq 2-3
@@ -306,10 +315,14 @@ def bounds(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (np.array([-L, -L, 0.0, -lim, -lim, -lim]), np.array([L, L, 2 * L, lim, lim, lim]))
 
 
+#: the name the reference registers under (the package's ``prs3`` is the file)
+NAME = "prs3_reference"
+
+
 def closure() -> LoopClosure:
-    """The symbolic 3-PRS (built fresh; the registry caches one per process)."""
+    """The symbolic 3-PRS (built fresh)."""
     return LoopClosure(
-        "prs3",
+        NAME,
         x=X,
         q=Q,
         parameters=("b", "L", "alpha0"),
@@ -373,14 +386,6 @@ def geometry(model: Model, x, q) -> Drawing:
 #: 1 + nu; the filleted neck's formula gives 34.9 and 26.2 N*m/rad against the printed
 #: 32.67 and 24.46: the reproduce rows of prs3_fem_table2.yaml); K_Rsph applies to both
 #: bending axes (beta_m, beta_n), K_Tsph to the torsion beta_l.
-def chains(model: Model):
-    """The legs as serial chains (P at A_i, R at C_i, S at B_i), from the file twin
-    problems/mechanisms/prs3.yaml, whose closure equals this one to 1e-12 (tested)."""
-    from .described import twin_chains  # the twin is read on first use
-
-    return twin_chains("prs3.yaml", model)
-
-
 STIFFNESS = JointStiffness(
     hinges={
         "revolute": {
@@ -414,7 +419,7 @@ STIFFNESS = JointStiffness(
 
 
 MECHANISM = Mechanism(
-    name="prs3",
+    name=NAME,
     title="3-PRS compliant stage (Ruiz et al.)",
     paper=(
         "A. Ruiz, F. J. Campa, C. Roldan-Paraponiaris, O. Altuzarra, C. Pinto, Experimental validation of the "
@@ -426,15 +431,20 @@ MECHANISM = Mechanism(
     build=build,
     geometry=geometry,
     stiffness=STIFFNESS,
-    chains=chains,
-    problem_files=(
-        "prs3_forward_kinematics.yaml",
-        "prs3_inverse_kinematics.yaml",
-        "prs3_jacobian.yaml",
-        "prs3_joint_requirements.yaml",
-        "prs3_fem_table2.yaml",
-        "prs3_table2_forces.yaml",
-        "prs3_cutting_force.yaml",
-        "prs3_natural_frequencies.yaml",
-    ),
 )
+
+
+@functools.lru_cache(maxsize=1)
+def shared_closure() -> LoopClosure:
+    """One closure per process (code, not problem data), so that solvers built for one
+    reference model serve all of them, as the registry's closures do."""
+    c = closure()
+    c.mechanism = MECHANISM
+    return c
+
+
+def reference_model(parameters: dict | None = None, limits: dict | None = None) -> Model:
+    """A model of the reference closures (parameters and limits as in a problem file;
+    the paper's b, L by default), not registered: built from :data:`MECHANISM` directly."""
+    given = {"b": "47.91 mm", "L": "109.215 mm"} if parameters is None else parameters
+    return MECHANISM.model(shared_closure(), given, limits or {}, ("mechanism",))
