@@ -52,7 +52,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from ..core.errors import InputError, suggest
+from ..core.errors import InputError, suggest, unknown_key_error
 from .inputs import MAX_INPUT_BYTES, display_name, read_input_text
 from .yamlfile import read_yaml
 
@@ -349,12 +349,7 @@ def _read_sidecar(path: str) -> _Sidecar:  # noqa: C901 - one check per key
         raise InputError(f"expected a mapping of {', '.join(_SIDECAR_KEYS)}, got {type(data).__name__}", file=file)
     for key in data:
         if key not in _SIDECAR_KEYS:
-            raise InputError(
-                f"unknown key {key!r}; an Extended URDF sidecar has: {', '.join(_SIDECAR_KEYS)}",
-                file=file,
-                path=(str(key),),
-                suggestions=suggest(str(key), _SIDECAR_KEYS),
-            )
+            raise unknown_key_error(str(key), _SIDECAR_KEYS, (str(key),), "Extended URDF sidecar key").at(file=file)
     out = _Sidecar()
     loops = data.get("closed_loop") or []
     if not isinstance(loops, list) or len(loops) > MAX_CLOSURES:

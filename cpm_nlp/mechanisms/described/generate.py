@@ -754,13 +754,18 @@ class Generator:
         self.elimination_indicators(q)
         self.aspect(q)
         self.select_branch(added)
-        if len(d.platform.task) != len(self.q_coords):
+        self.check_task_count()
+        return self.functions(q)
+
+    def check_task_count(self) -> None:
+        """As many task coordinates as actuators."""
+        task = self.d.platform.task
+        if len(task) != len(self.q_coords):
             raise InputError(
-                f"{len(d.platform.task)} task coordinate(s) for {len(self.q_coords)} actuator(s) "
+                f"{len(task)} task coordinate(s) for {len(self.q_coords)} actuator(s) "
                 f"({', '.join(c.name for c in self.q_coords)}); they must be as many",
                 path=("platform", "task"),
             )
-        return self.functions(q)
 
     def branch_expressions(self, env: Mapping[str, ex.Value]) -> list[tuple[ca.SX, str, str]]:
         """The indicators the ``branch`` section writes as expressions (named ``branch[k]`` unless given

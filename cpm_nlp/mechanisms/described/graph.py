@@ -592,12 +592,7 @@ class GraphGenerator(Generator):
         if not self.normal_form:
             self.graph_indicators(q)
         self.select_branch(added)
-        if len(d.platform.task) != len(self.q_coords):
-            raise InputError(
-                f"{len(d.platform.task)} task coordinate(s) for {len(self.q_coords)} actuator(s) "
-                f"({', '.join(c.name for c in self.q_coords)}); they must be as many",
-                path=("platform", "task"),
-            )
+        self.check_task_count()
         fns = self.functions(q)
         fns["assemble"] = self.assembler
         if self.normal_form:  # the normal equations also vanish where |r| is least but not zero: check r
