@@ -440,7 +440,7 @@ def test_prc3_paper_dynamics_is_a_special_case():
     import yaml
 
     from cpm_nlp.analysis import flexure
-    from cpm_nlp.mechanisms.prc3.kinematics import lever_ratios
+    from cpm_nlp.mechanisms.prc3.dynamics import lever_ratios
     from cpm_nlp.problems.file import problem_from_dict
 
     prob = load_problem(ROOT / "problems" / "prc3_dynamics.yaml")

@@ -3,8 +3,8 @@
 The papers' mechanisms re-described as files must be the hand-derived modules:
 FK, IK, the Jacobians and the passive joint angles to 1e-12 on random poses of
 the working range.  The reference is the hand-written module of each paper
-(tests/reference/prs3_closures.py -- the 3-PRS is the file itself now, issue 21 --,
-prc3/kinematics.py, rpr/kinematics.py, pantograph/kinematics.py), whose
+(tests/reference/prs3_closures.py and tests/reference/prc3_closures.py -- the 3-PRS and
+the 3-PRC are the files themselves now, issue 21 --, rpr/kinematics.py, pantograph/kinematics.py), whose
 formulas are pinned to the papers in their own tests; the file's closure is
 generated from the legs and shares no code with them.
 """
@@ -30,7 +30,12 @@ MECH = ROOT / "problems" / "mechanisms"
 CASES = {
     # file mechanism, hand-written type, parameters, actuator half-range around home
     "prs3": ("prs3", "prs3_reference", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}, 2e-3),
-    "prc3": ("prc3_file", "prc3", {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}, 15e-6),
+    "prc3": (
+        "prc3",
+        "prc3_reference",
+        {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"},
+        15e-6,
+    ),
     "rpr": ("rpr_file", "rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 50e-6),
     "pantograph": ("pantograph_file", "pantograph", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
 }
@@ -43,6 +48,10 @@ def _models(case):
         from .reference import prs3_closures
 
         return cn.build_model(file_name, params), prs3_closures.reference_model(params)
+    if hand_name == "prc3_reference":  # the hand-written 3-PRC too (issue 21, item 5)
+        from .reference import prc3_closures
+
+        return cn.build_model(file_name, params), prc3_closures.reference_model(params)
     return cn.build_model(file_name, params), cn.build_model(hand_name, params)
 
 
@@ -122,8 +131,10 @@ def test_prs3_joint_requirements_equal_the_hand_module():
 def test_prc3_cuboid_equals_the_hand_module():
     fm, hm = _models("prc3")
     lims = {"q": ("0 um", "15 um")}
-    fm = cn.build_model("prc3_file", CASES["prc3"][2], lims)
-    hm = cn.build_model("prc3", CASES["prc3"][2], lims)
+    from .reference import prc3_closures
+
+    fm = cn.build_model("prc3", CASES["prc3"][2], lims)
+    hm = prc3_closures.reference_model(CASES["prc3"][2], lims)
     a = cn.inscribed_cuboid(hm, solver=cn.SolverConfig("ipopt"))
     b = cn.inscribed_cuboid(fm, solver=cn.SolverConfig("ipopt"))
     assert a.found and b.found, (a.message, b.message)
@@ -172,12 +183,7 @@ def _error(tmp_path, text: str, *extra: str) -> str:
     return msg
 
 
-BASE = (
-    (MECH / "prc3.yaml")
-    .read_text()
-    .replace("name: prc3_file", "name: prc3_bad")
-    .replace("examples: [../prc3_file_forward_kinematics.yaml]\n", "")
-)
+BASE = (MECH / "prc3.yaml").read_text().replace("name: prc3\n", "name: prc3_bad\n").split("examples:")[0]
 DEFAULTS = BASE
 for _n, _v in (("L1", "9.5 mm"), ("L2", "25 mm"), ("L3", "9 mm"), ("L4", "30 mm"), ("L7", "73.5 mm")):
     DEFAULTS = DEFAULTS.replace(f"  {_n}: {{dimension: length,", f"  {_n}: {{dimension: length, default: {_v},")
@@ -211,7 +217,9 @@ def test_dimension_mismatch(tmp_path):
 def test_reference_configuration_that_does_not_assemble(tmp_path):
     """Legs given at the reference configuration assemble there by construction; an escape-hatch
     closure that does not vanish at home, or a P joint off its leg's line, does not."""
-    text = DEFAULTS.split("  - name: limb3")[0] + "closures: [z + q3 - 1 mm]\nactuators: {q3: length}\n"
+    # (without the limit descriptions: the truncated file has no passive joints d, beta, gamma)
+    no_limits = DEFAULTS.split("limits:")[0] + "derived:" + DEFAULTS.split("derived:", 1)[1]
+    text = no_limits.split("  - name: limb3")[0] + "closures: [z + q3 - 1 mm]\nactuators: {q3: length}\n"
     _error(tmp_path, text, "does not assemble", "residual -1.000e-03", "closures[0]")
     rpr = (
         (MECH / "rpr.yaml")
@@ -299,7 +307,9 @@ def test_builder_api_builds_the_same_mechanism_as_the_file():
     mech = cn.describe_mechanism(desc)
     try:
         code = cn.build_model("prc3_code")
-        ref = cn.build_model("prc3", CASES["prc3"][2])
+        from .reference import prc3_closures  # the hand-written closures (issue 21, item 5)
+
+        ref = prc3_closures.reference_model(CASES["prc3"][2])
         q = np.array([5e-6, 1e-6, 8e-6])
         a, b = cn.forward_kinematics(ref, q, NEWTON), cn.forward_kinematics(code, q, NEWTON)
         assert a.status == b.status == Status.SOLVED
@@ -339,7 +349,7 @@ def test_flexure_hinge_sets_the_joint_limits(tmp_path):
 
 
 def test_a_file_may_not_take_a_built_in_name(tmp_path):
-    (tmp_path / "m.yaml").write_text(DEFAULTS.replace("name: prc3_bad", "name: prc3"))
+    (tmp_path / "m.yaml").write_text(DEFAULTS.replace("name: prc3_bad", "name: rpr"))
     problem = {"problem": "forward_kinematics", "mechanism": {"file": "m.yaml"}, "inputs": {"q1": 0, "q2": 0, "q3": 0}}
     with pytest.raises(cn.InputError, match="taken by a built-in mechanism"):
         cn.problem_from_dict(problem, base_dir=tmp_path)

@@ -16,7 +16,7 @@ NEWTON = cn.SolverConfig("newton")
 #: parameters of the files that declare no defaults
 PARAMS = {
     "prs3": {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"},
-    "prc3_file": {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"},
+    "prc3": {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"},
     "rpr_file": {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"},
     "pantograph_file": {"a": "20 mm", "b": "50 mm"},
 }
@@ -74,7 +74,7 @@ def test_drawing_at_home_and_at_another_pose(name):
             dp = np.linalg.norm(np.asarray(pose.points[a]) - np.asarray(pose.points[b]))
             assert dp == pytest.approx(dh, abs=1e-9 * span), (a, b)
     links = fixed_links(layout)
-    assert links or name in ("prc3_file",)
+    assert links or name in ("prc3",)
     for a, b in links:
         lh = np.linalg.norm(np.asarray(home.points[a]) - np.asarray(home.points[b]))
         lp = np.linalg.norm(np.asarray(pose.points[a]) - np.asarray(pose.points[b]))

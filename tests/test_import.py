@@ -313,7 +313,9 @@ def test_a_large_file_is_refused_before_it_is_read(tmp_path):
 def test_sidecar_errors(tmp_path):
     side = tmp_path / "robot.yaml"
     side.write_text("closed_loops: [[closedloop1_A, closedloop1_B]]\n")
-    with pytest.raises(InputError, match=r"closed_loops: unknown Extended URDF sidecar key .*did you mean 'closed_loop'"):
+    with pytest.raises(
+        InputError, match=r"closed_loops: unknown Extended URDF sidecar key .*did you mean .closed_loop."
+    ):
         import_urdf(FIVE, str(side))
     side.write_text("closed_loop: [[closedloop1_A, closedloop1_B]]\ntype: [6d]\nname_mot: [mot3]\n")
     with pytest.raises(InputError, match=r"name_mot\[0\]: no joint of the URDF is named 'mot3'; did you mean"):

@@ -124,13 +124,19 @@ def test_pantograph_drawing_has_the_paper_link_lengths():
 
 
 def test_prc3_drawing_has_legs_of_length_l():
-    """prc3-li-2018.md eq 5-9: each leg C_iB_i is l = L7 long; the sliders move by d_i = A2 q_i along -e_i."""
+    """prc3-li-2018.md eq 5-9: each leg C_iB_i is l = L7 long; the sliders move by d_i = A2 q_i along -e_i.
+    The drawing is the mechanism file's: limb{i}_1 is the rail's origin A_i, limb{i}_2 the slider
+    C_i, limb{i}_3 the platform joint B_i = P + l e_i."""
     model, x, q = pose_of("prc3")
     d = model.mechanism.geometry(model, x, q)
     l = model.parameters["L7"]
     for i in (1, 2, 3):
-        assert _dist(d, f"C{i}", f"B{i}") == pytest.approx(l, rel=1e-9)
-        assert _dist(d, f"A{i}", f"C{i}") == pytest.approx(model.derived["A2"] * q[i - 1], rel=1e-9)
+        e = np.eye(3)[i - 1]
+        assert _dist(d, f"limb{i}_2", f"limb{i}_3") == pytest.approx(l, rel=1e-9)
+        assert _dist(d, f"limb{i}_1", f"limb{i}_2") == pytest.approx(model.derived["A2"] * q[i - 1], rel=1e-9)
+        slide = np.asarray(d.points[f"limb{i}_2"]) - np.asarray(d.points[f"limb{i}_1"])
+        assert slide == pytest.approx(-model.derived["A2"] * q[i - 1] * e, abs=1e-15)  # along -e_i
+        assert np.asarray(d.points[f"limb{i}_3"]) == pytest.approx(x + l * e, abs=1e-15)
 
 
 def test_rpr_drawing_has_legs_of_the_actuated_lengths():

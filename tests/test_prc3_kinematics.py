@@ -11,9 +11,9 @@ import pytest
 import cpm_nlp as cn
 from cpm_nlp.analysis import workspace as W
 from cpm_nlp.core.result import Status
-from cpm_nlp.mechanisms.prc3 import kinematics as P
 
 from .conftest import PROBLEMS, central_difference
+from .reference import prc3_closures as P
 
 #: Table 1 (kinematic part) and eq 27: l = L7 = 73.5 mm, 0 <= q_i <= 15 um
 TABLE1 = {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 from .errors import suggest
@@ -312,3 +312,58 @@ def declare(**parts: Any) -> Mechanism:
             f"mechanism {parts.get('name', '?')!r}: missing required part(s) {', '.join(missing)}"
         )
     return Mechanism(**parts)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Addon:
+    """What a mechanism file cannot say, given in Python for the mechanism of one shipped file
+    (issue 21, item 5): the file is the mechanism (its closures, IK, passive joints, branch,
+    drawing, paper, problem files); the add-on refers to it by the registry's table
+    :data:`cpm_nlp.mechanisms.registry.ADDONS` and adds only what is not kinematics.
+
+    parameters: optional parameters the closures do not use (e.g. a dynamics model's lengths
+        and hinge sizes); a value given is kept in the model's ``parameters``, never in p.
+    check_parameters: ``(parameters, path) -> None``: rules over several parameters.
+    dynamics: ``(closure) -> DynamicsModel``: the Lagrange model, given the file's closure
+        (so that it may use the file's loop closures, e.g. their Jacobian, never a copy).
+    kinds: problem kinds of the paper's own: kind name -> ProblemKind subclass.
+    """
+
+    parameters: tuple[Option, ...] = ()
+    check_parameters: Callable[[dict, tuple], None] | None = None
+    dynamics: Callable[[Any], DynamicsModel] | None = None
+    kinds: Mapping[str, type] = field(default_factory=dict)
+
+
+def with_addon(mech: Mechanism, addon: Addon) -> Mechanism:
+    """The mechanism of a file with its add-on's parts (validated like any declaration).  A
+    part the add-on gives that the file has too (a parameter, a kind, a check) is an error:
+    each part is written once."""
+    if not isinstance(addon, Addon):
+        raise MechanismDeclarationError(f"mechanism {mech.name!r}: expected an Addon, got {type(addon).__name__}")
+    own = {o.name for o in mech.parameters}
+    clash = sorted(own & {o.name for o in addon.parameters}) + sorted(set(mech.kinds) & set(addon.kinds))
+    if clash or (addon.check_parameters and mech.check_parameters) or (addon.dynamics and mech.dynamics):
+        raise MechanismDeclarationError(
+            f"mechanism {mech.name!r} ({mech.origin}): its add-on repeats what the file declares "
+            f"({', '.join(clash) or 'check_parameters or dynamics'})"
+        )
+    extra = tuple(o.name for o in addon.parameters)
+    dims = {o.name: o.kind for o in addon.parameters}
+    file_build = mech.build
+
+    def build(closure: Any, parameters: dict, limits: dict) -> Any:
+        model = file_build(closure, {k: v for k, v in parameters.items() if k not in extra}, limits)
+        given = {k: parameters[k] for k in extra if parameters.get(k) is not None}
+        model.parameters = {**model.parameters, **given}
+        model.dimensions = {**model.dimensions, **{k: dims[k] for k in given}}
+        return model
+
+    return replace(
+        mech,
+        parameters=mech.parameters + addon.parameters,
+        build=build,
+        check_parameters=addon.check_parameters or mech.check_parameters,
+        dynamics=addon.dynamics(mech.closure()) if addon.dynamics else mech.dynamics,
+        kinds={**mech.kinds, **addon.kinds},
+    )

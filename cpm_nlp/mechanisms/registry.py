@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import CpmError, InputError, suggest
-from ..core.mechanism import PARTS, Mechanism, MechanismDeclarationError, validate
+from ..core.mechanism import PARTS, Addon, Mechanism, MechanismDeclarationError, validate, with_addon
 from ..core.model import LoopClosure, Model
 from . import described
 
@@ -42,7 +42,6 @@ ENTRY_POINT_GROUP = "cpm_nlp.mechanisms"
 
 #: built-in mechanism type -> "module:attribute" of its declaration
 BUILTIN = {
-    "prc3": "cpm_nlp.mechanisms.prc3:MECHANISM",
     "rpr": "cpm_nlp.mechanisms.rpr:MECHANISM",
     "pantograph": "cpm_nlp.mechanisms.pantograph:MECHANISM",
 }
@@ -52,11 +51,20 @@ BUILTIN = {
 #: any other (issue 21, item 5)
 BUILTIN_FILES = {
     "prs3": "prs3.yaml",
+    "prc3": "prc3.yaml",
+}
+
+#: built-in file mechanism -> "module:attribute" of its :class:`~cpm_nlp.core.mechanism.Addon`:
+#: what its file cannot say (the paper's own kinds, a dynamics model, checks over several
+#: parameters), added to the mechanism the file describes
+ADDONS = {
+    "prc3": "cpm_nlp.mechanisms.prc3.addon:ADDON",
 }
 
 #: old name -> the built-in mechanism it names now (the file twin became the built-in)
 ALIASES = {
     "prs3_file": "prs3",
+    "prc3_file": "prc3",
 }
 
 
@@ -221,7 +229,7 @@ def _file_mechanism_name(path: Any) -> str | None:
 def _load(name: str, target: str, origin: str) -> Mechanism:
     """Import and validate one declaration; every failure names its origin."""
     if target.startswith("file:"):
-        return described.load_file(target[len("file:") :])
+        return _load_file(name, target[len("file:") :], origin)
     module, _, attr = target.partition(":")
     try:
         obj: Any = importlib.import_module(module)
@@ -244,6 +252,23 @@ def _load(name: str, target: str, origin: str) -> Mechanism:
         raise PluginError(f"mechanism {name!r} ({origin}) declares the name {obj.name!r}; the two must agree")
     if origin != "built-in" and obj.origin == "built-in":
         obj = _with_origin(obj, origin)
+    return obj
+
+
+def _load_file(name: str, path: str, origin: str) -> Mechanism:
+    """A mechanism file; a built-in one with its add-on (:data:`ADDONS`), if it has one."""
+    mech = described.load_file(path)
+    if origin == "built-in" and name in ADDONS:
+        mech = described.with_same_text(with_addon(mech, _addon(name, ADDONS[name])), mech)
+    return mech
+
+
+def _addon(name: str, target: str) -> Addon:
+    """The add-on of a built-in file mechanism (``module:attribute`` of an :class:`Addon`)."""
+    module, _, attr = target.partition(":")
+    obj = getattr(importlib.import_module(module), attr)
+    if not isinstance(obj, Addon):
+        raise PluginError(f"the add-on of mechanism {name!r} ({target}) must be an Addon, got {type(obj).__name__}")
     return obj
 
 

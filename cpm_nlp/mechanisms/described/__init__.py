@@ -60,6 +60,8 @@ _LOCK = threading.Lock()
 _CACHE: dict[str, Mechanism] = {}
 #: id of a Mechanism read from a file (kept alive by _CACHE) -> SHA-256 of the file's text alone
 _TEXT_HASH: dict[int, str] = {}
+#: mechanisms made from a file's (with_same_text), kept alive so that their ids stay theirs
+_KEEP: list[Mechanism] = []
 
 
 def shipped_files() -> list[Path]:
@@ -95,6 +97,16 @@ def same_text(a: Mechanism, b: Mechanism) -> bool:
     with _LOCK:
         ha, hb = _TEXT_HASH.get(id(a)), _TEXT_HASH.get(id(b))
     return ha is not None and ha == hb
+
+
+def with_same_text(mech: Mechanism, read: Mechanism) -> Mechanism:
+    """``mech`` (a mechanism made from ``read``, e.g. with an add-on) counted as read from the
+    same text as ``read``, for :func:`same_text`."""
+    with _LOCK:
+        if id(read) in _TEXT_HASH:
+            _TEXT_HASH[id(mech)] = _TEXT_HASH[id(read)]
+            _KEEP.append(mech)
+    return mech
 
 
 def _cached(key: str, make: Any) -> Mechanism:

@@ -1,5 +1,14 @@
 """3-PRC compliant parallel micromanipulator with secondary lever amplifiers
-(Li, Li, Ding, Xu, Adv. Mech. Eng. 2018; ``../shared/papers/prc3-li-2018.md``).
+(Li, Li, Ding, Xu, Adv. Mech. Eng. 2018; ``../shared/papers/prc3-li-2018.md``): the
+hand-written closures, an independent reference for the tests.
+
+The package's ``prc3`` is the mechanism file ``problems/mechanisms/prc3.yaml`` (its closures
+generated from the legs) with the add-on ``cpm_nlp.mechanisms.prc3.addon`` (the amplifier kind,
+the dynamics, the hinge check).  These closures, derived by hand from the paper's equations,
+were the built-in module ``cpm_nlp.mechanisms.prc3.kinematics`` until issue 21 (item 5) wrote
+the mechanism once, in the file; they stay here as the independent derivation the file is
+checked against (``tests/test_prc3_written_once.py``, to 1e-12).  Not part of the package:
+import it from the tests only.
 
 Symbols follow the paper:
 
@@ -51,22 +60,20 @@ Readings of the paper chosen here (documented, not tuned):
 * Residuals are scaled to lengths, (|leg|^2 - l^2) / (2 l), so one tolerance
   in metres applies.
 
-The Lagrange model (eq 28-41) is :func:`lagrangian`; its readings are in its
-docstring.
+The Lagrange model (eq 28-41) is the add-on's, :mod:`cpm_nlp.mechanisms.prc3.dynamics`.
 """
 
 from __future__ import annotations
 
 import functools
-import math
 
 import casadi as ca
 import numpy as np
 
-from ...analysis import flexure
-from ...core.mechanism import Drawing
-from ...core.model import Coordinate, LoopClosure, Model
-from ...core.options import Option
+from cpm_nlp.analysis import flexure
+from cpm_nlp.core.mechanism import Drawing, Mechanism
+from cpm_nlp.core.model import Coordinate, LoopClosure, Model
+from cpm_nlp.core.options import Option
 
 
 def _length(name: str, description: str, required: bool = True) -> Option:
@@ -193,10 +200,14 @@ def bounds(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.full(3, -half), np.full(3, half)
 
 
+#: the name the reference's closure carries (the package's ``prc3`` is the file)
+NAME = "prc3_reference"
+
+
 def closure() -> LoopClosure:
-    """The symbolic 3-PRC (built fresh; the registry caches one per process)."""
+    """The symbolic 3-PRC (built fresh)."""
     return LoopClosure(
-        "prc3",
+        NAME,
         x=X,
         q=Q,
         parameters=KINEMATIC,
@@ -259,171 +270,6 @@ def jacobian_printed(x, d, l) -> np.ndarray:
     return J
 
 
-# -- Lagrange dynamics (eq 28-41) -------------------------------------------------------------------
-
-MASSES = (
-    ("m0", "mobile platform (eq 34)"),
-    ("m1", "input block of the amplifier, moving with q (eq 29)"),
-    ("m2", "first lever, length L2, turning about O1 (eq 29: I_G2 = m2 L2^2/3)"),
-    ("m3", "coupler, length L5, moving with A1 q and turning with the first lever (I_G3 = m3 L5^2/12)"),
-    ("m4", "second lever, length L4, turning about O2 (I_G4 = m4 L4^2/3)"),
-    ("m5", "output link, length L6, moving with A2 q and turning with the second lever (I_G5)"),
-    ("m6", "output block E of the amplifier, moving with A2 q (eq 29)"),
-    ("m7", "each of the two bars of an R-C leg (eq 32: I_G6 = m7 L8^2/12, I_G7 = m7 L7^2/12)"),
-)
-#: parameters of the dynamics, in the order of the CasADi vector w: the hinge
-#: material's E, the gravity g, the masses, and mechanism parameters by name
-DYNAMIC_PARAMETERS = ("E", "g", "b", "t", "r", "L5", "L6", "L8") + tuple(m for m, _ in MASSES)
-
-
-def _dynamic_symbols():
-    q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
-    p, w = ca.SX.sym("p", len(KINEMATIC)), ca.SX.sym("w", len(DYNAMIC_PARAMETERS))
-    named = {n: w[k] for k, n in enumerate(DYNAMIC_PARAMETERS)}
-    named.update({n: p[k] for k, n in enumerate(KINEMATIC)})
-    return q, qd, p, w, named
-
-
-def _gravity_coefficient(v: dict, A1, A2):
-    """G_e as printed (eq 35, 38)."""
-    return (
-        v["m0"] * A2 + 6 * (v["m1"] + v["m2"] + v["m3"]) * A1 + 6 * (v["m4"] + v["m5"] + v["m6"] + v["m7"]) * A2
-    ) * v["g"]
-
-
-@functools.lru_cache(maxsize=1)
-def lagrangian() -> ca.Function:
-    """Kinetic energy T(q, qd) and potential energy U(q) of the 3-PRC
-    (eq 28-36), symbolic in the kinematic parameters p and the dynamic ones w
-    (:data:`DYNAMIC_PARAMETERS`).  :mod:`cpm_nlp.analysis.dynamics` derives
-    M = d2T/dqd2, K = d2U/dq2 and G = dU/dq at q = 0 (eq 37-38).
-
-    Each energy is typed in as the first line of its equation (the sum over
-    bodies and hinges); the collected second lines and eq 38 are
-    :func:`printed_coefficients`.  Readings (documented, not tuned):
-
-    * Hinges: k = 2 E b t^2.5 / (9 pi r^0.5) for every hinge (after eq 28).
-      Per limb, 2 x (4 hinges turning theta_1 = A1 q/L2 and 3 turning
-      theta_2 = A2 q/L4) (eq 28), and 4 leg hinges bending by beta and gamma
-      (eq 31).
-    * The leg angles are platform displacement over length (eq 31:
-      beta_2 = z/L8, gamma_2 = x/L7), cyclic for the other limbs (limb i
-      bends by beta_i towards axis i+1 over L8, gamma_i towards axis i+2 over
-      L7).  With x = -A2 q1 (eq 26) this gives the leg term
-      4 k A2^2 (1/L7^2 + 1/L8^2) in K; eq 38 prints it without A2^2 (as does
-      the last line of eq 31, where A stands for A2 but is dropped in eq 38).
-      The model keeps the A2^2 of eq 31's first line.
-    * Platform velocity: pdot = J qdot with J the AD Jacobian of the loop
-      closures at home, which equals -A2 I (eq 26).
-    * m1 is the input block and moves with q: 1/2 m1 qdot^2 (eq 29, first
-      line).  The collected line multiplies m1 by A1^2; the model does not.
-    * I_G5: eq 29 lists I_G5 = m5 L6^2/3, its collected line and eq 38 use
-      m5 L6^2/12.  m5 translates with A2 q *and* turns (like m3, whose I_G3 =
-      m3 L5^2/12): its inertia about its own centre, m5 L6^2/12, is the
-      consistent one and is used.
-    * Gravity: U_G = G_e q2 with G_e as printed (eq 35).  It only shifts the
-      static equilibrium (q = -K^-1 G) and does not enter the frequencies;
-      the mass distribution behind it (Fig. 6) is not in the text.
-    """
-    q, qd, p, w, v = _dynamic_symbols()
-    A1, A2 = lever_ratios(v["L1"], v["L2"], v["L3"], v["L4"])
-    k = flexure.circular_notch_stiffness(v["E"], v["b"], v["t"], v["r"])  # after eq 28
-    m = [v[f"m{j}"] for j in range(8)]
-    L2, L4, L5, L6, L7, L8 = (v[n] for n in ("L2", "L4", "L5", "L6", "L7", "L8"))
-    IG2, IG3, IG4, IG5 = m[2] * L2**2 / 3, m[3] * L5**2 / 12, m[4] * L4**2 / 3, m[5] * L6**2 / 12  # eq 29
-    IG6, IG7 = m[7] * L8**2 / 12, m[7] * L7**2 / 12  # eq 32
-    # platform displacement and velocity from the AD Jacobian at home (= -A2 I, eq 26)
-    xs, qs = ca.SX.sym("xs", 3), ca.SX.sym("qs", 3)
-    phi = loop_closure()(xs, qs, p)
-    J = -ca.solve(ca.jacobian(phi, xs), ca.jacobian(phi, qs))
-    J0 = ca.substitute(J, ca.vertcat(xs, qs), ca.SX.zeros(6))
-    P, Pd = J0 @ q, J0 @ qd
-    T, U = 0, 0
-    for i in range(3):
-        th1, th2 = A1 * q[i] / L2, A2 * q[i] / L4
-        th1d, th2d = A1 * qd[i] / L2, A2 * qd[i] / L4
-        U += 2 * (4 * 0.5 * k * th1**2 + 3 * 0.5 * k * th2**2)  # eq 28
-        T += 2 * (  # eq 29, first line
-            0.5 * m[1] * qd[i] ** 2
-            + 0.5 * IG2 * th1d**2
-            + 0.5 * m[3] * (A1 * qd[i]) ** 2
-            + 0.5 * IG3 * th1d**2
-            + 0.5 * IG4 * th2d**2
-            + 0.5 * (m[5] + m[6]) * (A2 * qd[i]) ** 2
-            + 0.5 * IG5 * th2d**2
-        )
-        nxt, prv = (i + 1) % 3, (i + 2) % 3
-        beta, gamma = P[nxt] / L8, P[prv] / L7
-        betad, gammad = Pd[nxt] / L8, Pd[prv] / L7
-        U += 4 * 0.5 * k * (beta**2 + gamma**2)  # eq 31
-        T += 2 * (  # eq 32, first line; the slider moves with d_i = A2 q_i (eq 2)
-            0.5 * m[7] * ((A2 * qd[i]) ** 2 + (Pd[nxt] / 2) ** 2 + (Pd[prv] / 2) ** 2)
-            + 0.5 * (IG6 * betad**2 + IG7 * gammad**2)
-        )
-    T += 0.5 * m[0] * ca.dot(Pd, Pd)  # eq 34
-    U_G = _gravity_coefficient(v, A1, A2) * q[1]  # eq 35
-    return ca.Function("lagrangian", [q, qd, p, w], [T, U + U_G, k], ["q", "qd", "p", "w"], ["T", "U", "k"])
-
-
-@functools.lru_cache(maxsize=1)
-def printed_coefficients() -> ca.Function:
-    """M_e, K_e, G_e exactly as printed in eq 38 (and eq 41's f from them)."""
-    _q, _qd, p, w, v = _dynamic_symbols()
-    A1, A2 = lever_ratios(v["L1"], v["L2"], v["L3"], v["L4"])
-    m = [v[f"m{j}"] for j in range(8)]
-    L2, L4, L5, L6, L7, L8 = (v[n] for n in ("L2", "L4", "L5", "L6", "L7", "L8"))
-    M_e = (
-        2 * (m[1] + m[2] / 3 + (1 + L5**2 / (12 * L2**2)) * m[3]) * A1**2
-        + (2 * m[4] / 3 + 2 * (1 + L6**2 / (12 * L4**2)) * m[5] + 2 * m[6] + 10 * m[7] / 3 + m[0]) * A2**2
-    )
-    K_e = (
-        8
-        * v["E"]
-        * v["b"]
-        * v["t"] ** 2.5
-        / (9 * math.pi * v["r"] ** 0.5)
-        * (2 * A1**2 / L2**2 + 3 * A2**2 / (2 * L4**2) + (1 / L7**2 + 1 / L8**2))
-    )
-    G_e = _gravity_coefficient(v, A1, A2)
-    f = ca.sqrt(K_e / M_e) / (2 * math.pi)  # eq 41
-    return ca.Function("eq38", [p, w], [M_e, K_e, G_e, f], ["p", "w"], ["M_e", "K_e", "G_e", "f"])
-
-
-def dynamics_values(model: Model, w: np.ndarray, M: np.ndarray, K: np.ndarray, G: np.ndarray) -> dict:
-    """The paper's named quantities: k (after eq 28), M_e, K_e, G_e (eq 38) of
-    the model and as printed, and f (eq 41) both ways."""
-    _T, _U, k = (float(v) for v in lagrangian()(np.zeros(3), np.zeros(3), model.p, w))
-    v = dict(zip(DYNAMIC_PARAMETERS, w))
-    M_p, K_p, G_p, f_p = (float(x) for x in printed_coefficients()(model.p, w))
-    return {
-        "k": k,
-        "k_exact": float(flexure.circular_notch_stiffness_exact(v["E"], v["b"], v["t"], v["r"])),
-        "M_e": float(M[0, 0]),
-        "K_e": float(K[0, 0]),
-        "G_e": float(G[1]),
-        "f": math.sqrt(K[0, 0] / M[0, 0]) / (2 * math.pi),  # eq 41
-        "M_e_printed": M_p,
-        "K_e_printed": K_p,
-        "G_e_printed": G_p,
-        "f_printed": f_p,
-    }
-
-
-#: dimension of each value of :func:`dynamics_values`
-DYNAMICS_DIMENSIONS = {
-    "k": "rotational_stiffness",
-    "k_exact": "rotational_stiffness",
-    "M_e": "mass",
-    "K_e": "stiffness",
-    "G_e": "force",
-    "f": "frequency",
-    "M_e_printed": "mass",
-    "K_e_printed": "stiffness",
-    "G_e_printed": "force",
-    "f_printed": "frequency",
-}
-
-
 #: half size of the platform in the drawing, as a fraction of the leg length l (the paper's
 #: kinematics treats the platform as its centre P: eq 5 has no platform dimension)
 DRAWN_PLATFORM = 0.3
@@ -457,3 +303,38 @@ def geometry(model: Model, x, q) -> Drawing:
         joints={**{f"C{i}": "R" for i in (1, 2, 3)}, **{f"B{i}": "C" for i in (1, 2, 3)}},
         note="platform size drawn at 0.3 l (the paper's model has none); lever amplifiers not drawn",
     )
+
+
+MECHANISM = Mechanism(
+    name=NAME,
+    title="3-PRC micromanipulator with secondary lever amplifiers (Li et al. 2018)",
+    paper=(
+        "X.-C. Li, Y. Li, B.-X. Ding, H.-Y. Xu, An investigation on kinematics and dynamics performance of a novel "
+        "3-PRC-compliant parallel micromanipulator, Adv. Mech. Eng. 10(7), 2018, doi:10.1177/1687814018789800"
+    ),
+    parameters=PARAMETERS,
+    limits=LIMITS,
+    closure=closure,
+    build=build,
+    check_parameters=check_parameters,
+    geometry=geometry,
+)
+
+#: Table 1's five lengths of the closures
+PAPER = {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}
+
+
+@functools.lru_cache(maxsize=1)
+def shared_closure() -> LoopClosure:
+    """One closure per process (code, not problem data), so that solvers built for one
+    reference model serve all of them, as the registry's closures do."""
+    c = closure()
+    c.mechanism = MECHANISM
+    return c
+
+
+def reference_model(parameters: dict | None = None, limits: dict | None = None) -> Model:
+    """A model of the reference closures (parameters and limits as in a problem file;
+    Table 1's by default), not registered: built from :data:`MECHANISM` directly."""
+    given = PAPER if parameters is None else parameters
+    return MECHANISM.model(shared_closure(), given, limits or {}, ("mechanism",))
