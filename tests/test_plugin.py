@@ -186,7 +186,7 @@ def test_register_in_code_and_its_kinds_appear():
         description = "a kind of a mechanism registered in code"
 
     mech = cn.Mechanism(
-        name="prs3_copy",
+        name="prs3_registered_in_code",
         title="copy of the 3-PRS",
         parameters=base.parameters,
         limits=base.limits,
@@ -196,12 +196,12 @@ def test_register_in_code_and_its_kinds_appear():
     )
     cn.register_mechanism(mech)
     try:
-        assert "prs3_copy" in cn.mechanism_names()
+        assert "prs3_registered_in_code" in cn.mechanism_names()
         assert "demo_kind" in cn.kind_names()
         with pytest.raises(MechanismDeclarationError, match="already registered"):
             cn.register_mechanism(mech)
     finally:
-        cn.unregister_mechanism("prs3_copy")
+        cn.unregister_mechanism("prs3_registered_in_code")
     assert "demo_kind" not in cn.kind_names()
 
 
