@@ -28,6 +28,7 @@ from cpm_nlp.mechanisms import registry
 from cpm_nlp.mechanisms.prc3 import addon, dynamics
 
 from .conftest import PROBLEMS
+from .reference import assert_same_kinematics
 from .reference import prc3_closures as ref
 
 NEWTON = cn.SolverConfig(method="newton")
@@ -129,22 +130,7 @@ def test_fk_ik_passive_and_jacobians_equal_the_reference(params):
     _close(fm.q_home, rm.q_home)
     _close(fm.x_lower, rm.x_lower)
     _close(fm.x_upper, rm.x_upper)
-    for t in _poses(rm):
-        ia, ib = cn.inverse_kinematics(rm, t), cn.inverse_kinematics(fm, t)  # eq 8-10
-        assert ia.status is ib.status is Status.SOLVED, (ia.message, ib.message)
-        _close(ib.x, ia.x)
-        _close(ib.q, ia.q)
-        _close(ib.passive, ia.passive)
-        fa, fb = cn.forward_kinematics(rm, ia.q, NEWTON), cn.forward_kinematics(fm, ia.q, NEWTON)
-        assert fa.status is fb.status is Status.SOLVED, (fa.message, fb.message)
-        _close(fb.x, fa.x)
-        _close(fb.x, t, 1e-11)  # FK(IK(t)) = t
-        pa, pb = cn.passive_joints(rm, fa.x, ia.q), cn.passive_joints(fm, fb.x, ia.q)
-        assert list(pa) == list(pb)
-        _close(list(pb.values()), list(pa.values()))
-        ja, jb = cn.jacobians(rm, fa.x, ia.q), cn.jacobians(fm, fb.x, ia.q)
-        for name in ("J", "J_task", "J_inv"):
-            _close(getattr(jb, name), getattr(ja, name))
+    assert_same_kinematics(fm, rm, _poses(rm), task_is_pose=True)
 
 
 def test_jacobian_against_central_differences_and_eq21():
@@ -204,7 +190,7 @@ def test_the_lagrangian_on_the_file_equals_it_on_the_reference():
     only kinematics they use is the closures' Jacobian at home, -A2 I by eq 26)."""
     fm = cn.load_problem(PROBLEMS / "prc3_dynamics.yaml").model
     on_file = fm.mechanism.dynamics.lagrangian()
-    on_ref = dynamics.lagrangian(ref.shared_closure())
+    on_ref = dynamics.lagrangian(ref.reference_model().closure)
     rng = np.random.default_rng(28)
     w = np.concatenate([[71.7e9, 9.81, 6.5e-3, 0.5e-3, 3e-3, 26e-3, 33e-3, 59.5e-3], rng.uniform(1e-3, 0.1, 8)])
     for _ in range(5):

@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.core.result import Status
 from cpm_nlp.mechanisms import registry
 
+from .reference import assert_same_kinematics
 from .reference import prs3_closures as ref
 
 NEWTON = cn.SolverConfig(method="newton")
@@ -91,25 +91,7 @@ def test_fk_ik_passive_and_jacobians_equal_the_reference(params):
     assert fm.characteristic_length == rm.characteristic_length
     _close(fm.x_home, rm.x_home)
     _close(fm.q_home, rm.q_home)
-    for t in _poses(rm):
-        # IK: the file's closed form (eq 13-15, 20) against the hand-written one
-        ia, ib = cn.inverse_kinematics(rm, t), cn.inverse_kinematics(fm, t)
-        assert ia.status is ib.status is Status.SOLVED, (ia.message, ib.message)
-        _close(ib.x, ia.x)
-        _close(ib.q, ia.q)
-        _close(ib.passive, ia.passive)
-        # FK from the IK's actuators (Newton to round-off), and against the IK pose
-        fa, fb = cn.forward_kinematics(rm, ia.q, NEWTON), cn.forward_kinematics(fm, ia.q, NEWTON)
-        assert fa.status is fb.status is Status.SOLVED, (fa.message, fb.message)
-        _close(fb.x, fa.x)
-        _close(fb.x, ia.x, 1e-11)  # FK(IK(t)) = IK(t), each model against itself's solve
-        pa, pb = cn.passive_joints(rm, fa.x, ia.q), cn.passive_joints(fm, fb.x, ia.q)
-        assert list(pa) == list(pb)
-        _close(list(pb.values()), list(pa.values()))
-        # the Jacobians: dx/dq (whole pose), dt/dq (task), dq/dt
-        ja, jb = cn.jacobians(rm, fa.x, ia.q), cn.jacobians(fm, fb.x, ia.q)
-        for name in ("J", "J_task", "J_inv"):
-            _close(getattr(jb, name), getattr(ja, name))
+    assert_same_kinematics(fm, rm, _poses(rm))
 
 
 def _indicators(model, x, q):

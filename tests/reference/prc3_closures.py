@@ -65,8 +65,6 @@ The Lagrange model (eq 28-41) is the add-on's, :mod:`cpm_nlp.mechanisms.prc3.dyn
 
 from __future__ import annotations
 
-import functools
-
 import casadi as ca
 import numpy as np
 
@@ -74,6 +72,8 @@ from cpm_nlp.analysis import flexure
 from cpm_nlp.core.mechanism import Drawing, Mechanism
 from cpm_nlp.core.model import Coordinate, LoopClosure, Model
 from cpm_nlp.core.options import Option
+
+from . import reference_model_of
 
 
 def _length(name: str, description: str, required: bool = True) -> Option:
@@ -324,17 +324,7 @@ MECHANISM = Mechanism(
 PAPER = {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"}
 
 
-@functools.lru_cache(maxsize=1)
-def shared_closure() -> LoopClosure:
-    """One closure per process (code, not problem data), so that solvers built for one
-    reference model serve all of them, as the registry's closures do."""
-    c = closure()
-    c.mechanism = MECHANISM
-    return c
-
-
 def reference_model(parameters: dict | None = None, limits: dict | None = None) -> Model:
     """A model of the reference closures (parameters and limits as in a problem file;
     Table 1's by default), not registered: built from :data:`MECHANISM` directly."""
-    given = PAPER if parameters is None else parameters
-    return MECHANISM.model(shared_closure(), given, limits or {}, ("mechanism",))
+    return reference_model_of(MECHANISM, closure, PAPER if parameters is None else parameters, limits)

@@ -41,7 +41,6 @@ Reading of the paper chosen here (documented, not tuned):
 
 from __future__ import annotations
 
-import functools
 import math
 
 import casadi as ca
@@ -51,6 +50,8 @@ from cpm_nlp.core.aspect import ASPECT, ASPECT_DESCRIPTION, aspect
 from cpm_nlp.core.mechanism import Drawing, JointStiffness, Mechanism
 from cpm_nlp.core.model import Coordinate, LoopClosure, Model
 from cpm_nlp.core.options import Option
+
+from . import reference_model_of
 
 SQRT3 = math.sqrt(3.0)
 #: angular positions of the legs, eq 2-3
@@ -434,17 +435,9 @@ MECHANISM = Mechanism(
 )
 
 
-@functools.lru_cache(maxsize=1)
-def shared_closure() -> LoopClosure:
-    """One closure per process (code, not problem data), so that solvers built for one
-    reference model serve all of them, as the registry's closures do."""
-    c = closure()
-    c.mechanism = MECHANISM
-    return c
-
-
 def reference_model(parameters: dict | None = None, limits: dict | None = None) -> Model:
     """A model of the reference closures (parameters and limits as in a problem file;
     the paper's b, L by default), not registered: built from :data:`MECHANISM` directly."""
-    given = {"b": "47.91 mm", "L": "109.215 mm"} if parameters is None else parameters
-    return MECHANISM.model(shared_closure(), given, limits or {}, ("mechanism",))
+    return reference_model_of(
+        MECHANISM, closure, {"b": "47.91 mm", "L": "109.215 mm"} if parameters is None else parameters, limits
+    )
