@@ -265,7 +265,7 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
             if not compiler_available():
                 log.info("no C compiler: backend 'auto' uses 'map'")
                 return "map"
-            size = len(generate_source(kern.function, kern.name))
+            size = len(_source(closure, kern))
             if size > AUTO_COMPILE_MAX_BYTES:  # a compile of minutes would cost more than it saves
                 log.info("%s: %d bytes of C: backend 'auto' uses 'map' (see AUTO_COMPILE_MAX_BYTES)", kern.name, size)
                 return "map"
@@ -281,10 +281,17 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
     return kern.function, "map"
 
 
+def _source(closure: LoopClosure, kern: Kernel) -> str:
+    """The kernel's C source (its function and the loop over poses), generated once per process."""
+    return closure.solvers.memo(
+        ("source",) + kern.key,
+        lambda: generate_source(kern.function, kern.name) + batch_loop_source(kern.function, kern.name),
+    )
+
+
 def _library(closure: LoopClosure, kern: Kernel) -> Path:
     def build() -> Path:
-        source = generate_source(kern.function, kern.name) + batch_loop_source(kern.function, kern.name)
-        return build_library(source, kern.name)
+        return build_library(_source(closure, kern), kern.name)
 
     return closure.solvers.memo(("library", str(cache_dir())) + kern.key, build)
 
