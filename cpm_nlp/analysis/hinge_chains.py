@@ -54,7 +54,7 @@ from ..core.chains import Chains
 from ..core.errors import InputError
 from ..core.kernels import FastFunction
 from ..core.model import Model
-from ..core.screws import skew
+from ..core.screws import skew, vee
 from .compliance import HINGE_TYPES, SIX_AXES, HingeSet, six_axis_stiffness
 
 log = logging.getLogger(__name__)
@@ -200,7 +200,7 @@ class SixAxisModel:
             tip = ca.DM(ch.legs[li].tip)
             g.append(Rm @ tip + tm - (DR @ (tip - P0) + P))  # the leg's platform point
             M = DR.T @ Rm
-            g.append(0.5 * ca.vertcat(M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]))  # rotation
+            g.append(vee(M))  # rotation
         return ca.vertcat(*g)
 
     def _functions(self, z: Any, g: Any) -> None:

@@ -83,6 +83,12 @@ def skew(a: Any) -> Any:
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
+def vee(M: Any) -> Any:
+    """The axial vector of a 3 x 3 matrix's skew part, (M - Mᵀ)/2 = [v]× (the inverse of
+    :func:`skew`; for a rotation by a small angle about w: the angle times w)."""
+    return 0.5 * ca.vertcat(M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1])
+
+
 # -- elementary screws ----------------------------------------------------------------------------
 
 

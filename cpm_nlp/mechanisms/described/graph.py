@@ -42,6 +42,7 @@ from ...core.joints import JOINT_TYPES, joint_types
 from ...core.mechanism import Drawing
 from ...core.model import Coordinate
 from ...core.options import REQUIRED
+from ...core.screws import vee
 from . import expr as ex
 from .drawing import _polygon
 from .generate import JOINT_DIMS, Generator, _Reported, _rot, _xyz_angles, elementary_motions, family
@@ -82,10 +83,6 @@ class _GJoint:
     def name(self) -> str:
         return str(self.spec.name)
 
-    @property
-    def at(self) -> ca.SX:  # for elementary_motions
-        return self.pa
-
 
 @dataclass
 class GraphInfo:
@@ -98,7 +95,6 @@ class GraphInfo:
     gruebler: int
     mobility: int
     dropped: list[tuple[int, str]]  # (loop, row name) of the rows that repeat others at the reference
-    assembly: dict[str, Any] = field(default_factory=dict)
 
 
 def _compose(A: tuple, B: tuple) -> tuple:
@@ -107,10 +103,6 @@ def _compose(A: tuple, B: tuple) -> tuple:
 
 def _shift(v: ca.SX) -> tuple:
     return ca.SX.eye(3), v
-
-
-def _vee(M: ca.SX) -> ca.SX:
-    return ca.vertcat(M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]) / 2
 
 
 class GraphGenerator(Generator):
@@ -396,7 +388,7 @@ class GraphGenerator(Generator):
         if g.type == "U":
             rows.append((ca.dot(Ra @ g.axes[0], Rb @ g.axes[1]) * scale, "axes normal"))
         if g.type == "P":
-            v = _vee(Ra.T @ Rb) * scale
+            v = vee(Ra.T @ Rb) * scale
             rows += [(v[k], f"no relative rotation, {'xyz'[k]}") for k in range(3)]
         if g.type == "planar_P":
             rows.append(((Ra.T @ Rb)[1, 0] * scale, "no relative rotation"))
@@ -424,7 +416,7 @@ class GraphGenerator(Generator):
         if g.type == "planar_R":
             vals = [ca.atan2(M[1, 0], M[0, 0])]
         elif g.type in ("R", "C"):
-            vals = [ca.atan2(ca.dot(g.axis, _vee(M)), (ca.trace(M) - 1) / 2)]
+            vals = [ca.atan2(ca.dot(g.axis, vee(M)), (ca.trace(M) - 1) / 2)]
             if g.type == "C":
                 vals.append(ca.dot(g.axis, d))
         elif g.type in ("P", "planar_P"):
@@ -492,7 +484,7 @@ class GraphGenerator(Generator):
                 self.platform_rows.append(((self.angle[body] + phi_home - phi) * scale, f"platform: angle of {body}"))
             else:
                 M = self.R.T @ Rb @ self.R_home
-                v = _vee(M) * scale
+                v = vee(M) * scale
                 self.platform_rows += [(v[k], f"platform: rotation of {body}, {'xyz'[k]}") for k in range(3)]
                 # the rows also vanish at a half turn: that solution is not the platform's
                 self.branch.append(
@@ -721,10 +713,8 @@ class Assembler:
             "drawing_pose", [p], [gen.x_home, ca.vertcat(*gen.q_home), span], ["p"], ["x", "q", "span"]
         )
         self.defaults = gen.p_default
-        self.keep: list[int] = []
         self.info: GraphInfo | None = None
         self._cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
-        self.last: dict[str, Any] = {}
 
     # -- assembly ----------------------------------------------------------------------------
     def solve(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
@@ -736,6 +726,8 @@ class Assembler:
         start = float(np.max(np.abs(r))) if r.size else 0.0
         steps = 0
         while r.size and np.all(np.isfinite(r)) and np.max(np.abs(r)) > tol and steps < ASSEMBLY_STEPS:
+            if not np.all(np.isfinite(J)):  # a derivative that is not finite (a root at 0): no step to take
+                break
             step = np.linalg.lstsq(J, -r, rcond=None)[0]
             norm, alpha = float(np.linalg.norm(r)), 1.0
             while alpha > 1e-6:
@@ -772,7 +764,6 @@ class Assembler:
         if hit is not None:
             return hit[0].copy(), hit[1].copy()
         x, q, status = self.solve(p)
-        self.last = status
         if not status["assembled"]:
             raise InputError(
                 f"the reference configuration does not assemble from the drawing: after {status['steps']} "
@@ -793,7 +784,6 @@ class Assembler:
         defaults), in file order; the mobility and Grübler-Kutzbach counts for ``describe``."""
         gen = self.gen
         x, q, status = self.solve(self.defaults)
-        self.status = status
         if not status["assembled"]:
             x0, _q0, _span = (np.asarray(v, dtype=float).ravel() for v in self.draw(self.defaults))
             Jx = np.asarray(self.F(x0, _q0, self.defaults)[1], dtype=float)
@@ -827,7 +817,6 @@ class Assembler:
             if np.linalg.norm(rest) > RANK_TOL * n:
                 keep.append(k)
                 basis = np.vstack([basis, rest / np.linalg.norm(rest)])
-        self.keep = keep
         self.J_ref, self.tree_names = J, [gen.x_names[k] for k in cols]
         rank = len(keep)
         mobility = ntree - rank
@@ -847,7 +836,6 @@ class Assembler:
             gruebler=gk,
             mobility=mobility,
             dropped=dropped,
-            assembly=status,
         )
         self.x_ref, self.q_ref = x, q
         return keep
