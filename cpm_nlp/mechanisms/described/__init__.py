@@ -197,7 +197,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         if d.is_graph
         else geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
         origin=f"file {d.file}" if d.file else "described in code",
-        chains=chains_function(gen) if not d.is_graph and chains_supported(gen) else None,
+        chains=chains_function(gen) if chains_supported(gen) else None,  # legs only: a graph has none
     )
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults
         model = mech.model(closure, {}, {}, ())
