@@ -115,8 +115,25 @@ def test_the_addon_may_not_repeat_the_file():
         with_addon(mech, Addon(kinds=addon.ADDON.kinds))
     with pytest.raises(MechanismDeclarationError, match="repeats what the file declares .*L5"):
         with_addon(mech, Addon(parameters=addon.PARAMETERS))
+    with pytest.raises(MechanismDeclarationError, match="repeats what the file declares .*check_parameters"):
+        with_addon(mech, Addon(check_parameters=addon.check_parameters))
     with pytest.raises(MechanismDeclarationError, match="expected an Addon"):
         with_addon(mech, {"kinds": {}})
+
+
+def test_an_addon_gives_the_parts_the_file_does_not():
+    """Every part an add-on may carry reaches the mechanism (the file has none of these)."""
+    mech = registry.mechanism_type("prs3")
+
+    def check(limits, path):
+        return None
+
+    def member(model, points):
+        return points, {}
+
+    extended = with_addon(mech, Addon(check_limits=check, paper_membership=member))
+    assert extended.check_limits is check and extended.paper_membership is member
+    assert extended.closure is mech.closure and extended.kinds == mech.kinds
 
 
 @pytest.mark.parametrize("params", PARAMETER_SETS, ids=["table1", "short", "long"])

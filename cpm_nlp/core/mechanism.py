@@ -327,12 +327,25 @@ class Addon:
     dynamics: ``(closure) -> DynamicsModel``: the Lagrange model, given the file's closure
         (so that it may use the file's loop closures, e.g. their Jacobian, never a copy).
     kinds: problem kinds of the paper's own: kind name -> ProblemKind subclass.
+    check_limits, synthesis, cuboid, paper_membership, stiffness, chains: as the
+        :class:`Mechanism` fields of the same names (the paper's formulations that refer to
+        the file's mechanism).
     """
 
     parameters: tuple[Option, ...] = ()
     check_parameters: Callable[[dict, tuple], None] | None = None
     dynamics: Callable[[Any], DynamicsModel] | None = None
     kinds: Mapping[str, type] = field(default_factory=dict)
+    check_limits: Callable[[dict, tuple], None] | None = None
+    synthesis: Callable[[], Any] | None = None
+    cuboid: CuboidExtras | None = None
+    paper_membership: Callable[[Any, Any], tuple[Any, dict]] | None = None
+    stiffness: JointStiffness | None = None
+    chains: Callable[[Any], Any] | None = None
+
+
+#: the add-on's parts taken as they are (each must not be given by the file too)
+ADDON_PARTS = ("check_parameters", "check_limits", "synthesis", "cuboid", "paper_membership", "stiffness", "chains")
 
 
 def with_addon(mech: Mechanism, addon: Addon) -> Mechanism:
@@ -343,10 +356,10 @@ def with_addon(mech: Mechanism, addon: Addon) -> Mechanism:
         raise MechanismDeclarationError(f"mechanism {mech.name!r}: expected an Addon, got {type(addon).__name__}")
     own = {o.name for o in mech.parameters}
     clash = sorted(own & {o.name for o in addon.parameters}) + sorted(set(mech.kinds) & set(addon.kinds))
-    if clash or (addon.check_parameters and mech.check_parameters) or (addon.dynamics and mech.dynamics):
+    clash += [part for part in ADDON_PARTS + ("dynamics",) if getattr(addon, part) and getattr(mech, part)]
+    if clash:
         raise MechanismDeclarationError(
-            f"mechanism {mech.name!r} ({mech.origin}): its add-on repeats what the file declares "
-            f"({', '.join(clash) or 'check_parameters or dynamics'})"
+            f"mechanism {mech.name!r} ({mech.origin}): its add-on repeats what the file declares ({', '.join(clash)})"
         )
     extra = tuple(o.name for o in addon.parameters)
     dims = {o.name: o.kind for o in addon.parameters}
@@ -363,7 +376,7 @@ def with_addon(mech: Mechanism, addon: Addon) -> Mechanism:
         mech,
         parameters=mech.parameters + addon.parameters,
         build=build,
-        check_parameters=addon.check_parameters or mech.check_parameters,
         dynamics=addon.dynamics(mech.closure()) if addon.dynamics else mech.dynamics,
+        **{part: getattr(addon, part) or getattr(mech, part) for part in ADDON_PARTS},
         kinds={**mech.kinds, **addon.kinds},
     )
