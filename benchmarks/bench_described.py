@@ -5,6 +5,9 @@
   closures it replaced, kept as the test reference tests/reference/prs3_closures.py;
 * ``--mechanism prc3``: the 3-PRC file prc3.yaml (the built-in ``prc3``, legs, with its add-on)
   against the closures it replaced, tests/reference/prc3_closures.py (q within +-15 um, eq 27);
+* ``--mechanism rpr``: the RPR file rpr.yaml (the built-in ``rpr``, legs and passive expressions,
+  with its add-on) against the closures it replaced, tests/reference/rpr_closures.py (eq 26's
+  design, leg lengths within +-50 um of P0);
 * ``--mechanism pantograph``: the shipped pantograph file (bodies and joints: 12 pose
   coordinates and normal equations) against the built-in ``pantograph`` module (eq 1-8).
 
@@ -36,7 +39,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import cpm_nlp as cn  # noqa: E402
-from tests.reference import prc3_closures, prs3_closures  # noqa: E402 - hand-written closures, test references
+from tests.reference import prc3_closures, prs3_closures, rpr_closures  # noqa: E402 - hand-written closures, test references
 
 PARAMS = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
 #: issue 21: generated FK and batch within 1.1x of the hand-written module
@@ -55,6 +58,11 @@ def _pair(mechanism: str) -> tuple[dict, float]:
             "hand-written reference": prc3_closures.reference_model(prc3_closures.PAPER),
             "file prc3": cn.build_model("prc3", prc3_closures.PAPER),
         }, 15e-6
+    if mechanism == "rpr":
+        return {
+            "hand-written reference": rpr_closures.reference_model(rpr_closures.PAPER),
+            "file rpr": cn.build_model("rpr", rpr_closures.PAPER),
+        }, 50e-6
     # the pantograph: the built-in module (eq 1-8 by hand) against the shipped file of bodies and
     # joints (problems/mechanisms/pantograph.yaml: 12 pose coordinates against 6, normal equations)
     panto = {"a": "20 mm", "b": "50 mm"}
@@ -70,7 +78,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--json", type=Path, default=None)
     ap.add_argument("--backend", default="map", choices=("map", "compiled"))
-    ap.add_argument("--mechanism", default="prs3", choices=("prs3", "prc3", "pantograph"))
+    ap.add_argument("--mechanism", default="prs3", choices=("prs3", "prc3", "rpr", "pantograph"))
     ap.add_argument("--single", type=int, default=200, help="single FK solves timed per model (0: none)")
     args = ap.parse_args()
     newton = cn.SolverConfig("newton")
