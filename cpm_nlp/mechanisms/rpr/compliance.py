@@ -114,10 +114,11 @@ def design_wrenches(model: Model, couple_arm: float) -> dict[str, np.ndarray]:
     joint frame (= the fixed frame: leg 1 runs along z): S_wc,1,1 (couple, scaled
     by ``couple_arm``), S_wc,1,2 and S_wa,1,1, referred to A1 (R) and to B1 (U)."""
     x = model.x_home
-    out = [np.asarray(v) for v in rpr_screws.screw_function()(x, model.p)]
+    p = rpr_screws.paper_parameters(model)
+    out = [np.asarray(v) for v in rpr_screws.screw_function()(x, p)]
     wa, wc = out[3], out[4]  # leg 1: ta1, tc1, wa1, wc1 follow S_t
     o_ = np.array([0.0, 0.0, x[2]])
-    A1 = np.array([model.p[0], 0.0, 0.0])
+    A1 = np.array([p[0], 0.0, 0.0])
     B1 = A1 + np.array([0.0, 0.0, x[2]])
     couple = wc[:, 0] / np.linalg.norm(wc[:, 0][3:]) * couple_arm
     force_y = screws.normalize(wc[:, 1])

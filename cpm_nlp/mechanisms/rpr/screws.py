@@ -97,6 +97,11 @@ def _symbols():
     return ca.SX.sym("x", 3), ca.SX.sym("p", 3)
 
 
+def paper_parameters(model: Model) -> np.ndarray:
+    """(r1, r2, P0) of the model, by name (whatever order the file's closure keeps them in)."""
+    return np.array([float(model.parameters[k]) for k in ("r1", "r2", "P0")])
+
+
 # -- screw theory, eq 7-13 and the appendix -------------------------------------------------------
 
 
@@ -188,7 +193,7 @@ class ScrewJacobian:
 def screw_jacobian(model: Model, x: Sequence[float]) -> ScrewJacobian:
     """J, G and G_p of eq 9-13 from the screw bases of the appendix."""
     xv = np.asarray(x, dtype=float).ravel()
-    out = [np.asarray(v) for v in screw_function()(xv, model.p)]
+    out = [np.asarray(v) for v in screw_function()(xv, paper_parameters(model))]
     S_t = out[0]
     bases = [dict(zip(("ta", "tc", "wa", "wc"), out[1 + 4 * i : 5 + 4 * i])) for i in range(3)]
     D = screws.DELTA
@@ -246,4 +251,4 @@ def twist_basis(model: Model, x: Sequence[float], reference: np.ndarray, convent
             path=("inputs", "convention"),
         )
     k = 1.0 if convention == "velocity" else -1.0
-    return np.asarray(twist_function()(np.asarray(x, dtype=float), model.p, reference, k))
+    return np.asarray(twist_function()(np.asarray(x, dtype=float), paper_parameters(model), reference, k))
