@@ -239,6 +239,30 @@ def test_the_compliance_equals_the_value_before_the_move():
         np.testing.assert_allclose(res.values[name], b, rtol=0, atol=1e-12 * np.abs(b).max(), err_msg=name)
 
 
+def test_the_twists_fk_columns_are_the_exact_roots():
+    """problems/rpr_twists_eq47.yaml's T_fk (S_t times the FK pose change for 10 um on each leg)
+    is the exact one: the Newton root of the file's closures and of the reference's (they agree
+    to 1e-15).  Before the move IPOPT stopped on the reference's |A_iB_i| - l_i after its first
+    step, the linear prediction (T_fk - T = 7.7e-17); the exact columns differ from the linear
+    T by the second-order 2.6e-12."""
+    from cpm_nlp.mechanisms.rpr import screws
+
+    problem = cn.load_problem(PROBLEMS / "rpr_twists_eq47.yaml")
+    res = cn.solve(problem)
+    assert res.status is Status.SOLVED
+    fm = problem.model
+    rm = ref.reference_model(PARAMETER_SETS[1])  # eq 47's design, as the problem file
+    x, q = fm.x_home, fm.q_home
+    S = screws.twist_basis(fm, x, screws.reference_point(fm, x, "o_prime", None), "eq45")
+    newton = cn.SolverConfig("newton")
+    for k in range(3):
+        qk = q + 10e-6 * np.eye(3)[k]
+        a, b = cn.forward_kinematics(fm, qk, newton), cn.forward_kinematics(rm, qk, newton)
+        close(a.x, b.x, 1e-15)
+        close(np.asarray(res.values["T_fk"])[:, k], S @ (a.x - x), 1e-13)  # IPOPT's root: to its tolerance
+    assert 1e-12 < res.values["dT_fk"] < 5e-12
+
+
 def test_what_users_see_is_what_the_module_declared():
     """Parameters (bounds exclusive), limit families with their descriptions, the pose and the
     passive joints with their families and descriptions, the title, the paper, the problem
