@@ -45,6 +45,7 @@ from ...core.options import REQUIRED
 from ...core.screws import vee
 from . import expr as ex
 from .drawing import _polygon
+from .expand import InLeg
 from .generate import JOINT_DIMS, Generator, _Reported, _rot, _xyz_angles, elementary_motions, family
 from .spec import GROUND_NAMES, Description, Joint
 
@@ -122,6 +123,50 @@ class GraphGenerator(Generator):
         self.info: GraphInfo | None = None
         self.assembler: Assembler | None = None
 
+    # -- expressions of an expanded legs file (in a leg's frame: its let, index and rotation) ----
+    def _leg_frame(self, leg: Any) -> tuple[dict, ca.SX]:
+        """A leg's environment (parameters, derived values, its index and ``let``) and its rotation,
+        as the legs generator resolves them (:meth:`Generator.leg`)."""
+        frames = self.__dict__.setdefault("_frames", {})
+        if id(leg) not in frames:
+            env = dict(self.env)
+            if leg.index is not None:
+                self._bind(env, leg.index, ex.Value(ca.SX(float(leg.values[0])), None), leg.path + ("repeat", "index"))
+            for name, text in leg.let.items():
+                self._bind(env, name, super().value(text, leg.path + ("let", name), env), leg.path + ("let", name))
+            turn = ca.SX.eye(3)
+            if leg.rotate is not None:
+                angle = super().scalar(leg.rotate, leg.path + ("repeat", "rotate"), env, "angle")
+                turn = _rot(leg.rotate_axis, angle)
+            frames[id(leg)] = (env, turn)
+        return frames[id(leg)]
+
+    def value(self, text: Any, path: tuple, env: Any, dimension: str | None = None) -> ex.Value:
+        if isinstance(text, InLeg):
+            return super().value(text.text, text.path or path, self._leg_frame(text.leg)[0], dimension)
+        return super().value(text, path, env, dimension)
+
+    def vector(self, text: Any, path: tuple, env: Any, dimension: str | None) -> ca.SX:
+        if not isinstance(text, InLeg):
+            return super().vector(text, path, env, dimension)
+        lenv, turn = self._leg_frame(text.leg)
+        path = text.path or path
+        if text.across is None:
+            v = super().vector(text.text, path, lenv, dimension)
+            return turn @ v if text.turn else v
+        a, b = (super(GraphGenerator, self).vector(t, path, lenv, "length") for t in text.across)
+        u = turn @ (b - a) / ca.norm_2(b - a)
+        if text.normal == 0:  # the point at a length from `from` towards `to`
+            return turn @ a + self.scalar(text.text, path, lenv, "length") * u
+        # two unit vectors across u: n1 = unit(u x e), n2 = u x n1, e the basis vector least aligned
+        # with u (with the parameters' defaults), as for a joint's normals
+        value = np.abs(np.asarray(ca.Function("u", [self.p], [u])(self.p_default), dtype=float).ravel())
+        e = ca.DM.zeros(3)
+        e[int(np.argmin(value))] = 1.0
+        n1 = ca.cross(u, e)
+        n1 = n1 / ca.norm_2(n1)
+        return n1 if text.normal == 1 else ca.cross(u, n1)
+
     # -- the drawing ------------------------------------------------------------------------
     @property
     def ground(self) -> str:
@@ -152,6 +197,10 @@ class GraphGenerator(Generator):
     def read_joints(self) -> None:  # noqa: C901 - one rule per joint part
         planar = self.d.platform.planar
         allowed = joint_types(planar)
+        if self.d.platform.placed:  # the platform coordinates place the platform (an expanded legs file)
+            zero = ca.SX.zeros(3)
+            spec = Joint("pose", name="platform_pose", path=("platform", "coordinates"))
+            self.gjoints.append(_GJoint(spec, "pose", self.ground, "platform", zero, zero, tree=True))
         for j in self.d.joints:
             jt = JOINT_TYPES[j.type]
             kind = jt.twin if planar and jt.twin and not jt.planar else j.type  # a planar file reads R, P as planar
@@ -226,7 +275,7 @@ class GraphGenerator(Generator):
 
         def rank(k: int) -> tuple:
             j = self.gjoints[k].spec
-            return (j.actuated is None, not task & set(j.coordinates), k)
+            return (j.type != "pose", j.actuated is None, not task & set(j.coordinates), k)
 
         order = sorted(range(len(self.gjoints)), key=rank)
         for k in order:
@@ -294,6 +343,9 @@ class GraphGenerator(Generator):
         gets its actuator (q) and a row that ties the two (:attr:`actuation_rows`), so that every
         body's pose is a function of the pose coordinates alone."""
         for g in self.gjoints:
+            if g.type == "pose":  # its values are the platform coordinates
+                g.names = tuple(self.x_names)
+                continue
             if not g.tree:
                 continue
             j = g.spec
@@ -330,6 +382,9 @@ class GraphGenerator(Generator):
     def motion(self, g: _GJoint) -> tuple[ca.SX, ca.SX]:
         """The pose of b relative to a (both frames the world at the drawing): b's point onto a's,
         then the joint's motions about axes through it."""
+        if g.type == "pose":  # the platform where its coordinates put it (the legs generator's platform_point)
+            R = self.R @ self.R_home.T
+            return R, self.P - R @ self.P_home
         T = _shift(g.pa)
         motions = elementary_motions(g) if g.type != "distance" else []  # type: ignore[arg-type]
         for (kind, axis), value in zip(motions, g.values):
@@ -355,6 +410,11 @@ class GraphGenerator(Generator):
                     self.angle[child] = self.angle[body] + (-turn if g.reversed else turn)
                     order.append(child)
             k += 1
+
+    def tree_columns(self) -> list[int]:
+        """The pose coordinates that are tree joints' values (the platform's too when it is placed)."""
+        placed = self.d.platform.placed
+        return [k for k, n in enumerate(self.x_names) if placed or n not in self.d.platform.coordinates]
 
     def world(self, body: str, p: ca.SX) -> ca.SX:
         R, t = self.pose[body]
@@ -444,6 +504,10 @@ class GraphGenerator(Generator):
         """The rows that say the platform coordinates locate the platform body (and its point)."""
         pf = self.d.platform
         names = [b.name for b in self.d.bodies]
+        if pf.placed:  # placed by the coordinates (a joint of the tree): no rows
+            self.platform_body = "platform"
+            self.platform_radius += [ca.norm_2(p - self.P_home) for p in self.body_points["platform"].values()]
+            return
         if not pf.coordinates and pf.body is None:  # the pose is the joints': the platform is the ground
             self.platform_body = self.ground
             self.P, self.R = ca.SX.zeros(3), ca.SX.eye(3)
@@ -563,7 +627,7 @@ class GraphGenerator(Generator):
         else:
             self.rows = [(r, name) for r, name, _loop in self.loop_rows] + act + self.platform_rows
         npf = len([n for n in self.x_names if n in d.platform.coordinates])
-        if len(self.platform_rows) != npf:
+        if len(self.platform_rows) != npf and not d.platform.placed:
             raise InputError(
                 f"the platform's position and rotation locate {len(self.platform_rows)} coordinate(s) of the body "
                 f"{self.platform_body!r}, and {npf} platform coordinate(s) are declared "
@@ -679,7 +743,7 @@ class GraphGenerator(Generator):
                 cols.append(self.world(body.name, p))
                 layout.append((body.name, drawn[key]))
         for g in self.gjoints:
-            if isinstance(g.spec.at, str) and g.spec.at.isidentifier():
+            if (isinstance(g.spec.at, str) and g.spec.at.isidentifier()) or g.type == "pose":
                 continue
             cols.append(self.world(g.a, g.pa))
             layout.append((g.a, g.name))
@@ -787,7 +851,7 @@ class Assembler:
         if not status["assembled"]:
             x0, _q0, _span = (np.asarray(v, dtype=float).ravel() for v in self.draw(self.defaults))
             Jx = np.asarray(self.F(x0, _q0, self.defaults)[1], dtype=float)
-            cols = [k for k, n in enumerate(gen.x_names) if n not in gen.d.platform.coordinates]
+            cols = gen.tree_columns()
             free = len(cols) - int(np.linalg.matrix_rank(Jx[: self.nloop][:, cols]))
             if free < len(gen.q_coords):  # the actuators lock the loops against each other
                 raise InputError(
@@ -804,7 +868,7 @@ class Assembler:
                 hint="draw the mechanism closer to an assembled configuration, or check the link lengths",
             )
         _r, Jx, Jq = (np.asarray(v, dtype=float) for v in self.F(x, q, self.defaults))
-        cols = [k for k, n in enumerate(gen.x_names) if n not in gen.d.platform.coordinates]
+        cols = gen.tree_columns()
         ntree = len(cols)
         J = Jx[: self.nloop][:, cols]
         keep, basis = [], np.zeros((0, J.shape[1]))
@@ -822,7 +886,11 @@ class Assembler:
         mobility = ntree - rank
         lam = 3 if gen.d.platform.planar else 6
         freedom = [
-            _ROD_FREEDOM[gen.d.platform.planar] if g.type == "distance" else JOINT_TYPES[g.type].dof
+            _ROD_FREEDOM[gen.d.platform.planar]
+            if g.type == "distance"
+            else len(g.names)
+            if g.type == "pose"
+            else JOINT_TYPES[g.type].dof
             for g in gen.gjoints
         ]
         gk = lam * (len(gen.d.bodies) - 1) - sum(lam - f for f in freedom)
@@ -902,7 +970,7 @@ def graph_geometry(fn: ca.Function, layout: list, gen: GraphGenerator) -> Callab
     ground, platform = gen.ground, gen.platform_body
     actuated = {g.b if not g.reversed else g.a for g in gen.gjoints if g.tree and g.spec.actuated is not None}
     named = [(g, g.spec.at if isinstance(g.spec.at, str) and g.spec.at.isidentifier() else g.name) for g in gen.gjoints]
-    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type != "distance"}
+    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type not in ("distance", "pose")}
     ends = [(g.spec.at, g.spec.to) for g in gen.gjoints if g.type == "distance"]
 
     def rods(pts: dict) -> list[tuple[str, str, str]]:

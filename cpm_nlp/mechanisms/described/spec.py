@@ -153,6 +153,9 @@ class Platform:
     #: that ``position`` locates (None: the body's frame origin, the world origin in the drawing)
     body: str | None = None
     point: str | None = None
+    #: the platform coordinates place the platform body (a legs file expanded into bodies and
+    #: joints, :mod:`.expand`): its pose is P(x), R(x) R_home^T, the legs close on it
+    placed: bool = False
 
 
 @dataclass

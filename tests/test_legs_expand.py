@@ -1,0 +1,184 @@
+"""Legs as a shorthand that expands into bodies and joints (issue 21, item 1 last bullet).
+
+For every legs file shipped (problems/mechanisms) and in tests/corpus: the expanded graph
+(:func:`cpm_nlp.mechanisms.described.expand.expand_legs`, read by the graph generator) has the
+legs file's mobility -- by the loops' rank at the reference configuration and by Grübler-Kutzbach
+-- and its forward kinematics equals the legs generator's to 1e-10 at several poses, the passive
+joint values too where a name maps (a legs coordinate that is a tree joint's value or a loop-closing
+joint's reported value in the graph).  The two closures are written independently (elimination
+of each leg's passive joints against a spanning tree with every joint's value an unknown), so
+agreement is a check of both.  Consistency checks, no published figures.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cpm_nlp as cn
+from cpm_nlp.core.errors import InputError
+from cpm_nlp.core.result import Status
+from cpm_nlp.io.yamlfile import read_yaml
+from cpm_nlp.mechanisms import described
+from cpm_nlp.mechanisms.described import load_file, read_description
+from cpm_nlp.mechanisms.described.expand import expand_legs, expansion_gap
+from cpm_nlp.mechanisms.described.graph import closure_parts
+from cpm_nlp.mechanisms.described.spec import description_from_dict
+
+ROOT = Path(__file__).resolve().parent.parent
+LEGS_FILES = sorted(
+    f
+    for f in [*(ROOT / "problems" / "mechanisms").glob("*.yaml"), *(ROOT / "tests" / "corpus").glob("*.yaml")]
+    if read_description(f).legs
+)
+NEWTON = cn.SolverConfig("newton")
+TOL = 1e-10
+
+
+def _parameters(path: Path, d) -> dict:
+    """The parameters of the file's first example (its required parameters have no default)."""
+    if not d.examples:
+        return {}
+    example = read_yaml((path.parent / d.examples[0]).resolve())
+    return dict((example.get("mechanism") or {}).get("parameters") or {})
+
+
+def _models(path: Path):
+    d = read_description(path)
+    gap = expansion_gap(d)
+    if gap is not None:
+        pytest.skip(f"{path.name}: no bodies-and-joints equivalent yet: {gap}")
+    mech = load_file(path)
+    legs = mech.model(mech.closure(), _parameters(path, d), {}, ())
+    values = dict(zip(legs.closure.parameters, np.asarray(legs.p, dtype=float)))
+    e = expand_legs(d, values)
+    gmech = described.mechanism(e)
+    graph = gmech.model(gmech.closure(), values, {}, ())
+    return d, e, legs, graph
+
+
+def _close(a, b, tol=TOL):
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    np.testing.assert_allclose(a, b, rtol=0, atol=tol * max(1.0, float(np.max(np.abs(b))) if b.size else 1.0))
+
+
+def _inputs(model: cn.Model, n: int = 4) -> np.ndarray:
+    """Actuator values around the reference: lengths within 0.2% of the characteristic length,
+    angles within 0.005 rad (seeded)."""
+    rng = np.random.default_rng(21)
+    scale = np.array([2e-3 * model.characteristic_length if c.kind == "length" else 5e-3 for c in model.closure.q])
+    return model.q_home + rng.uniform(-1, 1, (n, len(scale))) * scale
+
+
+@pytest.mark.parametrize("path", LEGS_FILES, ids=lambda p: p.name)
+def test_expanded_graph_has_the_legs_mobility_and_forward_kinematics(path):
+    d, e, legs, graph = _models(path)
+    gen, _fns = closure_parts(e)
+    nq = len(legs.closure.q_names)
+    # mobility: the legs' (nx + nq - rank [Φ_x Φ_q] at the reference) and the graph's by rank
+    c = legs.closure
+    J = np.hstack(
+        [np.asarray(c.phi_x(legs.x_home, legs.q_home, legs.p)), np.asarray(c.phi_q(legs.x_home, legs.q_home, legs.p))]
+    )
+    assert c.nx + c.nq - np.linalg.matrix_rank(J) == nq
+    assert gen.info.mobility == nq
+    assert gen.info.gruebler == nq  # no leg file is overconstrained: the two counts agree
+    assert list(graph.closure.q_names) == list(c.q_names)
+    names = list(graph.closure.x_names)
+    idx = [names.index(n) for n in c.x_names if n in names]
+    assert [names[k] for k in idx[: len(d.platform.coordinates)]] == [
+        n for n in d.platform.coordinates if n not in d.platform.fixed
+    ]
+    _close(np.asarray(graph.x_home)[idx], np.asarray(legs.x_home)[: len(idx)], 1e-15)
+    _close(graph.q_home, legs.q_home, 1e-15)
+    for q in _inputs(legs):
+        a, b = cn.forward_kinematics(legs, q, NEWTON), cn.forward_kinematics(graph, q, NEWTON)
+        assert a.status == b.status == Status.SOLVED, (a.message, b.message)
+        xa, xb = np.asarray(a.x), np.asarray(b.x)
+        _close(xb[idx], xa[: len(idx)])
+        # passive joint values where a name maps: the graph's unknowns and its reported values
+        pa = cn.passive_joints(legs, xa, q)
+        pb = dict(zip(names, xb)) | cn.passive_joints(graph, xb, q)
+        shared = [n for n in pa if n in pb]
+        _close([pb[n] for n in shared], [pa[n] for n in shared])
+
+
+def test_every_legs_file_maps_its_platform_and_some_passive_values():
+    """The comparison above is not empty: the platform coordinates always map, and the shipped
+    files' named joint values do (prs3: alpha_i, beta_*i; rpr: none named, its passive are expressions)."""
+    path = ROOT / "problems" / "mechanisms" / "prs3.yaml"
+    _d, _e, legs, graph = _models(path)
+    q = _inputs(legs, 1)[0]
+    a, b = cn.forward_kinematics(legs, q, NEWTON), cn.forward_kinematics(graph, q, NEWTON)
+    pa = cn.passive_joints(legs, np.asarray(a.x), q)
+    pb = dict(zip(graph.closure.x_names, np.asarray(b.x))) | cn.passive_joints(graph, np.asarray(b.x), q)
+    wanted = {f"{f}{i}" for f in ("alpha", "beta_m", "beta_n", "beta_l") for i in (1, 2, 3)}
+    assert wanted <= set(pa) & set(pb)
+    assert max(abs(pa[n]) for n in wanted if n.startswith("beta")) > 1e-4  # the poses move the joints
+
+
+def test_expanded_bodies_and_joints():
+    """prs3: the ground, three links per leg (slider, leg) and the platform; each leg's P, R, S in
+    order, the P actuated; the platform placed by its six coordinates."""
+    e = expand_legs(read_description(ROOT / "problems" / "mechanisms" / "prs3.yaml"), {"b": 0.04791, "L": 0.109215})
+    assert [b.name for b in e.bodies] == [
+        "ground",
+        "leg1_link1",
+        "leg1_link2",
+        "leg2_link1",
+        "leg2_link2",
+        "leg3_link1",
+        "leg3_link2",
+        "platform",
+    ]
+    assert [(j.name, j.type, j.between, j.actuated) for j in e.joints[:3]] == [
+        ("leg1_j1", "P", ("ground", "leg1_link1"), "s1"),
+        ("leg1_j2", "R", ("leg1_link1", "leg1_link2"), None),
+        ("leg1_j3", "S", ("leg1_link2", "platform"), None),
+    ]
+    assert e.joints[1].coordinates == ("alpha1",) and e.joints[2].coordinates == ("beta_m1", "beta_n1", "beta_l1")
+    gen, _fns = closure_parts(e)
+    assert [(n, t, a, b) for n, t, a, b, *_ in gen.info.joints][0] == ("platform_pose", "pose", "ground", "platform")
+    assert [loop[1] for loop in gen.info.loops] == ["leg1_j3", "leg2_j3", "leg3_j3"]
+
+
+def test_distance_joint_becomes_a_rod_and_ss_link_a_u():
+    """A distance joint is a rod (U at `at` across the rod, S at `to`); the RPR's S-P-S legs get a U
+    at the base: the spin the legs generator never writes stays out of the mobility."""
+    delta = expand_legs(read_description(ROOT / "problems" / "mechanisms" / "delta.yaml"))
+    assert [(j.name, j.type, j.between) for j in delta.joints[:3]] == [
+        ("arm1_j1", "R", ("ground", "arm1_link1")),
+        ("arm1_j2", "U", ("arm1_link1", "arm1_rod")),
+        ("arm1_j2_end", "S", ("arm1_rod", "platform")),
+    ]
+    rpr_file = read_description(ROOT / "problems" / "mechanisms" / "rpr.yaml")
+    rpr = expand_legs(rpr_file, {"r1": 0.04, "r2": 0.08, "P0": 0.04})
+    assert [j.type for j in rpr.joints[:3]] == ["U", "P", "S"]
+
+
+def test_a_legs_feature_without_a_graph_equivalent_is_named():
+    """closures and actuators written as expressions have no bodies-and-joints equivalent yet: one
+    message that says which."""
+    text = {
+        "name": "slider",
+        "parameters": {"l": {"default": "10 mm"}},
+        "platform": {"coordinates": {"x": "length"}, "position": ["x", 0, 0], "rotation": [], "task": ["x"]},
+        "legs": [
+            {
+                "name": "a",
+                "joints": [
+                    {"type": "P", "at": [0, 0, 0], "axis": [1, 0, 0], "actuated": "q1"},
+                    {"type": "S", "at": [0, 0, 0]},
+                ],
+            }
+        ],
+        "actuators": {"d": "length"},
+        "closures": ["x - d"],
+    }
+    d = description_from_dict(text)
+    with pytest.raises(InputError, match="no bodies-and-joints equivalent yet: its closures are written as expr"):
+        expand_legs(d)
+    del text["closures"]
+    assert "declares actuators without joints" in expansion_gap(description_from_dict(text))
