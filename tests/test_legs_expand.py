@@ -182,3 +182,92 @@ def test_a_legs_feature_without_a_graph_equivalent_is_named():
         expand_legs(d)
     del text["closures"]
     assert "declares actuators without joints" in expansion_gap(description_from_dict(text))
+
+
+# -- a rough drawing (issue 21, item 3): a rod's given length, the reference assembled ----------
+
+
+def _delta(z_drawn: str, length: str | None = "lb") -> dict:
+    """problems/mechanisms/delta.yaml with its platform drawn at ``z_drawn`` (not the closed form
+    z0 = -sqrt(lb^2 - (rb + la - rp)^2)) and its forearms of the given length."""
+    data = read_yaml(ROOT / "problems" / "mechanisms" / "delta.yaml")
+    data.pop("examples")
+    data["name"] = "delta_drawn"
+    data["derived"] = {}
+    data["platform"]["home"] = {"z": z_drawn}
+    rod = {"type": "distance", "at": ["rb + la", 0, 0], "to": ["rp", 0, z_drawn]}
+    if length is not None:
+        rod["length"] = length
+    data["legs"][0]["joints"][1] = rod
+    return data
+
+
+def _z0(lb: float, rb: float = 0.1, la: float = 0.12, rp: float = 0.04) -> float:
+    """The Delta's platform height with the arms horizontal (Pythagoras in the leg's plane)."""
+    return -np.sqrt(lb**2 - (rb + la - rp) ** 2)
+
+
+def test_a_rough_drawing_is_assembled_for_any_parameter_value():
+    mech = described.from_dict(_delta("-200 mm"), file="delta_drawn.yaml")
+    for lb in (0.25, 0.30, 0.40):
+        model = mech.model(mech.closure(), {"lb": lb}, {}, ())
+        _close(model.x_home, [0.0, 0.0, _z0(lb)], 1e-12)
+        _close(model.q_home, [0.0, 0.0, 0.0], 0)
+    # the assembled model is the exact file's: FK at other actuator values agrees to 1e-12
+    exact = load_file(ROOT / "problems" / "mechanisms" / "delta.yaml")
+    a = exact.model(exact.closure(), {}, {}, ())
+    b = mech.model(mech.closure(), {}, {}, ())
+    for q in _inputs(a):
+        sa, sb = cn.forward_kinematics(a, q, NEWTON), cn.forward_kinematics(b, q, NEWTON)
+        assert sa.status == sb.status == Status.SOLVED
+        _close(sb.x, sa.x, 1e-12)
+
+
+def test_an_exact_drawing_with_lengths_gives_todays_model():
+    """The rods' lengths given and the drawing exact: the assembly takes no step and the model is
+    the one of the file without lengths (reference to 1e-12, FK to 1e-12)."""
+    z0 = f"{_z0(0.25)} m"
+    plain = described.from_dict(_delta(z0, None), file="plain.yaml")
+    given = described.from_dict(_delta(z0), file="given.yaml")
+    a, b = (m.model(m.closure(), {}, {}, ()) for m in (plain, given))
+    _close(b.x_home, a.x_home, 1e-12)
+    for q in _inputs(a):
+        _close(cn.forward_kinematics(b, q, NEWTON).x, cn.forward_kinematics(a, q, NEWTON).x, 1e-12)
+
+
+def test_links_that_cannot_close_are_refused_with_the_loops_residual():
+    mech = described.from_dict(_delta("-200 mm"), file="delta_drawn.yaml")
+    with pytest.raises(InputError, match=r"does not assemble from the drawing: .* residual .* in loop \d") as exc:
+        mech.model(mech.closure(), {"lb": 0.1}, {}, ())  # shorter than rb + la - rp = 0.18 m
+    assert "mechanism" in exc.value.render() or "legs" in exc.value.render()
+
+
+def test_only_a_distance_joint_has_a_length(tmp_path):
+    data = _delta("-200 mm")
+    data["legs"][0]["joints"][0]["length"] = "lb"
+    with pytest.raises(InputError, match="only a distance joint has 'length'") as exc:
+        described.from_dict(data, file="bad.yaml")
+    assert exc.value.path == ("legs", 0, "joints", 0, "length")
+
+
+def test_cli_set_reassembles_and_describe_reports_the_assembly(tmp_path, cli):
+    import yaml
+
+    (tmp_path / "delta_drawn.yaml").write_text(yaml.safe_dump(_delta("-200 mm")))
+    (tmp_path / "fk.yaml").write_text(
+        "problem: forward_kinematics\nmechanism: {file: delta_drawn.yaml}\n"
+        "inputs: {q1: 0 deg, q2: 0 deg, q3: 0 deg}\nsolver: newton\n"
+    )
+    run = cli("solve", str(tmp_path / "fk.yaml"), "--json", "--set", "mechanism.parameters.lb=300mm")
+    assert run.code == 0, run.err
+    import json
+
+    x = json.loads(run.out)["values"]
+    assert x["z"] == pytest.approx(_z0(0.3), abs=1e-12)
+    run = cli("describe", str(tmp_path / "delta_drawn.yaml"))
+    assert run.code == 0, run.err
+    assert "reference configuration: assembled from the drawing in " in run.out
+    assert "in 0 Gauss-Newton" not in run.out  # the drawing is rough: steps were taken
+    run = cli("solve", str(tmp_path / "fk.yaml"), "--set", "mechanism.parameters.lb=100mm")
+    assert run.code == 2 and "Traceback" not in run.err
+    assert "does not assemble from the drawing" in run.err and "delta_drawn.yaml" in run.err

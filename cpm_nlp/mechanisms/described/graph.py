@@ -944,9 +944,83 @@ class Assembler:
 
 def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
     """The generator of a description -- its legs (:class:`Generator`) or its bodies and joints
-    (:class:`GraphGenerator`) -- and the functions it built."""
-    g = GraphGenerator(d) if d.is_graph else Generator(d)
-    return g, g.build()
+    (:class:`GraphGenerator`) -- and the functions it built.  A legs file whose drawing need not
+    close (:func:`assembled_from_drawing`) gets its reference configuration by the assembly of
+    the graph its legs expand into (:class:`LegsAssembler`); its closures stay the legs'."""
+    if d.is_graph:
+        g = GraphGenerator(d)
+        return g, g.build()
+    g = Generator(d)
+    fns = g.build()
+    if assembled_from_drawing(d):
+        fns["assemble"] = LegsAssembler(d, g)
+    return g, fns
+
+
+def assembled_from_drawing(d: Description) -> bool:
+    """Whether a legs file's reference configuration is assembled: a leg's links are drawn by
+    their joints, so its drawing closes by construction, except where a rod (a distance joint)
+    gives its ``length``: then the drawing's ``to`` (and the platform's home) is only roughly
+    there."""
+    return any(j.length is not None for leg in d.legs for j in leg.joints)
+
+
+class LegsAssembler:
+    """The reference configuration of a legs file from a rough drawing: the :class:`Assembler` of
+    the graph its legs expand into (:func:`.expand.expand_legs`; Gauss-Newton on its loops with the
+    actuators at their drawn values), its pose coordinates read by name into the legs' (the
+    platform's, then each proximal chain's passive joints')."""
+
+    def __init__(self, d: Description, legs: Generator) -> None:
+        from .expand import expand_legs, expansion_gap  # expand imports this module's reader
+
+        gap = expansion_gap(d)
+        if gap is not None:
+            raise InputError(
+                f"a rod's given length makes the reference configuration an assembly, and {gap}",
+                path=("legs",),
+                hint="give the rods' lengths by their drawing (no 'length'), or write the loops as legs",
+            )
+        for par in d.parameters:
+            if par.default is REQUIRED:
+                raise InputError(
+                    f"a legs file assembled from its drawing (a rod gives its 'length') needs a default for every "
+                    f"parameter ({par.name!r} has none): the loops' rank is taken with the defaults",
+                    path=("parameters", par.name, "default"),
+                )
+        try:
+            self.graph = GraphGenerator(expand_legs(d))
+            self.graph.build()
+        except InputError as exc:
+            raise _in_legs(exc) from None
+        self.assembler = self.graph.assembler
+        names = self.graph.x_names
+        self.columns = []
+        for name in legs.x_names:
+            # a passive joint of one motion is the graph's joint name (the legs add "_1")
+            short = name[:-2] if name.endswith("_1") else name
+            self.columns.append(names.index(name) if name in names else names.index(short))
+
+    @property
+    def info(self) -> GraphInfo | None:
+        return self.graph.info
+
+    def solve(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
+        x, q, status = self.assembler.solve(p)
+        return x[self.columns], q, status
+
+    def __call__(self, p: Any) -> tuple[np.ndarray, np.ndarray]:
+        try:
+            x, q = self.assembler(p)
+        except InputError as exc:
+            raise _in_legs(exc) from None
+        return x[self.columns], q
+
+
+def _in_legs(exc: InputError) -> InputError:
+    """An error of the expanded graph, located in the legs file (its joints are the legs')."""
+    path = exc.path if exc.path and exc.path[0] != "joints" else ("legs",)
+    return InputError(exc.message, path=path, suggestions=exc.suggestions, hint=exc.hint)
 
 
 def _defaults(d: Description) -> np.ndarray:

@@ -429,6 +429,7 @@ JOINT_KEYS = {
     "type": "one of " + ", ".join(JOINT_TYPES),
     "at": "location (vector expression)",
     "to": "the distal point of a distance joint",
+    "length": "a distance joint's length (default: |to - at| in the drawing; given: the drawing may be rough)",
     "axis": "axis (vector expression)",
     "axes": "the axes of a U (2) or of an S's reported angles (3)",
     "actuated": "the actuator coordinate's name",
@@ -444,8 +445,8 @@ JOINT_KEYS = {
 GRAPH_JOINT_KEYS = {
     "name": "the joint's name (default J1, J2, ... in file order)",
     "between": "[proximal body, distal body]",
-    "length": "the rod's length (a distance joint; default: its length in the drawing)",
     **{k: v for k, v in JOINT_KEYS.items() if k != "body"},
+    "length": "the rod's length (a distance joint; default: its length in the drawing)",
 }
 
 
