@@ -271,3 +271,101 @@ def test_cli_set_reassembles_and_describe_reports_the_assembly(tmp_path, cli):
     run = cli("solve", str(tmp_path / "fk.yaml"), "--set", "mechanism.parameters.lb=100mm")
     assert run.code == 2 and "Traceback" not in run.err
     assert "does not assemble from the drawing" in run.err and "delta_drawn.yaml" in run.err
+
+
+# -- mixing (issue 21, item 1): legs and extra bodies and joints in one file --------------------
+
+MIXED = """
+name: stage_lever
+title: 3-PRC-like stage, limb 1 driven through a lever amplifier (legs and bodies in one file)
+parameters:
+  l: {default: 73.5 mm, description: leg length}
+  a: {default: 5 mm, description: the lever's input arm (pivot O to I)}
+  b: {default: 25 mm, description: the lever's output arm (pivot O to T)}
+  c: {default: 40 mm, description: the pivot's distance from the slider's axis}
+  f: {default: 10 mm, description: the input link J-I}
+  e: {default: 10 mm, description: the output link T-K}
+platform:
+  coordinates: {x: length, y: length, z: length}
+  position: [x, y, z]
+  rotation: []
+  task: [x, y, z]
+legs:
+  - name: limb1          # its slider is not actuated: the lever drives it
+    joints:
+      - {type: P, at: [0, 0, 0], axis: [-1, 0, 0], coordinates: [d1], body: slider1}
+      - {type: distance, at: [0, 0, 0], to: [l, 0, 0]}
+  - name: limb2
+    joints:
+      - {type: P, at: [0, 0, 0], axis: [0, -1, 0], actuated: q2}
+      - {type: distance, at: [0, 0, 0], to: [0, l, 0]}
+  - name: limb3
+    joints:
+      - {type: P, at: [0, 0, 0], axis: [0, 0, -1], actuated: q3}
+      - {type: distance, at: [0, 0, 0], to: [0, 0, l]}
+points:
+  O: [0 m, -c, 0 m]
+  T: [0 m, b - c, 0 m]
+  K: [-e, b - c, 0 m]
+  I: [0 m, -c - a, 0 m]
+  J: [-f, -c - a, 0 m]
+bodies:
+  piezo: [J]
+  lever: [O, T, I]
+  slider1: [K]           # a bracket on limb 1's slider (a body of the legs)
+joints:
+  - {type: P, between: [ground, piezo], at: J, axis: [1, 0, 0], actuated: q1}
+  - {type: R, between: [ground, lever], at: O, axis: [0, 0, 1], coordinates: [theta]}
+  - {type: distance, between: [piezo, lever], at: J, to: I}
+  - {type: distance, between: [lever, slider1], at: T, to: K}
+"""
+#: the stage alone, limb 1's slider actuated: the platform for given slider displacements
+STAGE = MIXED.split("points:")[0].replace("name: stage_lever", "name: stage_alone").replace(
+    "coordinates: [d1], body: slider1}", "actuated: d1}"
+)
+A, B, C, F, E = 5e-3, 25e-3, 40e-3, 10e-3, 10e-3
+
+
+def _lever(q1: float) -> tuple[float, float]:
+    """theta and d1 for the piezo at q1, derived here in numpy (plane z = 0): the input link keeps
+    |J(q1) - I(theta)| = f with J = (-f + q1, -c - a), I = O + Rz(theta) (0, -a); the output link
+    |K(d1) - T(theta)| = e with T = O + Rz(theta) (0, b), K = (-e - d1, b - c)."""
+    theta = 0.0
+    for _ in range(60):  # Newton on g(theta) = |J - I|^2 - f^2
+        ix, iy = A * np.sin(theta), -C - A * np.cos(theta)
+        g = (-F + q1 - ix) ** 2 + (-C - A - iy) ** 2 - F**2
+        dg = -2 * (-F + q1 - ix) * A * np.cos(theta) + 2 * (-C - A - iy) * (-A * np.sin(theta))
+        theta -= g / dg
+    tx, ty = -B * np.sin(theta), -C + B * np.cos(theta)
+    # -e - d1 - tx = -sqrt(e^2 - (b - c - ty)^2): the root with d1 = 0 at theta = 0
+    return theta, -E - tx + np.sqrt(E**2 - (B - C - ty) ** 2)
+
+
+def test_a_file_with_legs_and_bodies_is_one_graph(tmp_path):
+    f = tmp_path / "stage_lever.yaml"
+    f.write_text(MIXED)
+    mech = load_file(f)
+    model = mech.model(mech.closure(), {}, {}, ())
+    gen, _fns = closure_parts(read_description(f))
+    assert gen.info.mobility == gen.info.gruebler == 3
+    bodies = set(gen.info.bodies)
+    assert {"ground", "slider1", "limb1_rod", "piezo", "lever", "platform"} <= bodies
+    qn = list(model.closure.q_names)
+    assert qn == ["q2", "q3", "q1"]  # the legs' actuators, then the file's joints
+    (tmp_path / "stage_alone.yaml").write_text(STAGE)
+    alone = load_file(tmp_path / "stage_alone.yaml")
+    ref = alone.model(alone.closure(), {}, {}, ())
+    names = list(model.closure.x_names)
+    # first order at the reference: d1 = (b/a) q1, and the platform follows the slider (x = -d1)
+    J = np.asarray(model.closure.jacobian(model.x_home, model.q_home, model.p))
+    assert J[names.index("x"), qn.index("q1")] == pytest.approx(-B / A, rel=1e-9)
+    for q1, q2, q3 in ([2e-4, 0.0, 0.0], [-1e-4, 1e-4, -2e-4], [3e-4, -1e-4, 1e-4]):
+        given = {"q1": q1, "q2": q2, "q3": q3}
+        sol = cn.forward_kinematics(model, [given[n] for n in qn], NEWTON)
+        assert sol.status == Status.SOLVED, sol.message
+        x = np.asarray(sol.x)
+        theta, d1 = _lever(q1)
+        _close([x[names.index("theta")], x[names.index("d1")]], [theta, d1], TOL)
+        stage = cn.forward_kinematics(ref, [d1, q2, q3], NEWTON)
+        assert stage.status == Status.SOLVED
+        _close(x[:3], stage.x, TOL)

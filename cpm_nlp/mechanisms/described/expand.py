@@ -26,7 +26,8 @@ the legs file's).
 
 The expansion serves ``describe`` (the body graph, loops and both mobility counts), the
 assembly of a reference configuration from a rough drawing, and files that mix legs with
-bodies and joints.  **A pure legs file keeps the elimination generator for its closures**
+bodies and joints (``legs`` and ``bodies``/``joints`` in one file: a lever between an actuator
+and a leg's slider): their bodies join the legs' by name and the whole is read as one graph.  **A pure legs file keeps the elimination generator for its closures**
 (:class:`~.generate.Generator`): it eliminates each leg's passive joints, so Φ has one to three
 rows per leg in the platform coordinates alone, and its FK and batch run within 1.1x of the
 hand-written modules (benchmarks/bench_described.py); the expanded graph has every passive joint
@@ -106,6 +107,14 @@ def expand_legs(d: Description, defaults: dict[str, float] | None = None) -> Des
             f"the legs have no bodies-and-joints equivalent yet: {gap}",
             path=("legs",) if d.legs else (),
         )
+    pf = d.platform
+    if d.bodies and (not pf.position or pf.body not in (None, PLATFORM) or pf.point is not None):
+        raise InputError(
+            "a file with legs places its platform by its coordinates: give platform.position (and rotation) "
+            "as a legs file does, not the body or point they locate",
+            path=("platform", "position") if not pf.position else ("platform", "body" if pf.body else "point"),
+            hint="the legs end at the body 'platform'; join other bodies to it by joints",
+        )
     points: dict[str, dict[str, Any]] = {GROUND: {}}
     paths: dict[str, tuple] = {GROUND: ("legs",)}
     joints: list[Joint] = []
@@ -156,8 +165,21 @@ def expand_legs(d: Description, defaults: dict[str, float] | None = None) -> Des
                 )
             )
             prev = body
-    order = [GROUND] + [b for b in points if b not in (GROUND, PLATFORM)] + [PLATFORM]
-    bodies = [Body(b, points.get(b, {}), "", paths.get(b, ("legs",))) for b in order]
+    # a mixed file: its own bodies join the legs' (a body of both -- the ground, the platform, a
+    # link it names -- carries the points of both), its joints come after the legs'
+    own = {b.name: b for b in d.bodies}
+    order = [GROUND] + [b for b in points if b not in (GROUND, PLATFORM)]
+    order += [b for b in own if b not in order and b != PLATFORM] + [PLATFORM]
+    bodies = [
+        Body(
+            b,
+            {**(own[b].points if b in own else {}), **points.get(b, {})},
+            own[b].description if b in own else "",
+            own[b].path if b in own else paths.get(b, ("legs",)),
+        )
+        for b in order
+    ]
+    joints += d.joints
     params = d.parameters
     if defaults:
         params = [dataclasses.replace(p, default=defaults[p.name]) if p.name in defaults else p for p in params]
@@ -172,10 +194,8 @@ def expand_legs(d: Description, defaults: dict[str, float] | None = None) -> Des
         legs=[],
         branch=branch,
         ik=None,
-        points={},
         bodies=bodies,
         joints=joints,
-        outputs={},
     )
 
 

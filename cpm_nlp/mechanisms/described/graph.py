@@ -948,6 +948,10 @@ def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
     close (:func:`assembled_from_drawing`) gets its reference configuration by the assembly of
     the graph its legs expand into (:class:`LegsAssembler`); its closures stay the legs'."""
     if d.is_graph:
+        if d.legs:  # a mixed file: its legs expanded, one graph with its bodies and joints
+            from .expand import expand_legs
+
+            d = expand_legs(d)
         g = GraphGenerator(d)
         return g, g.build()
     g = Generator(d)

@@ -668,6 +668,23 @@ def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a
             prev = body
 
 
+def leg_bodies(legs: list[Leg]) -> list[str]:
+    """The bodies the legs run through: the ground, each leg's links (its joints' ``body``, else
+    ``{leg}_link{n}``; a rod ``{leg}_rod`` for a last distance joint) and the platform (see
+    :mod:`.expand`)."""
+    if not legs:
+        return []
+    out = ["ground"]
+    for leg in legs:
+        for n, j in enumerate(leg.joints):
+            last = n == len(leg.joints) - 1
+            if last and j.type == "distance":
+                out.append(f"{leg.name}_rod")
+            elif not last:
+                out.append(j.body or f"{leg.name}_link{n + 1}")
+    return out + ["platform"]
+
+
 STIFFNESS_KEYS = {
     "hinges": "name -> {joints, type, k, t, r, w, d, l, Kt, material}, as a problem file's inputs.hinges",
     "material": "the hinge material: a name or an inline {name, E, nu, density, yield_strength, allowable}",
@@ -700,9 +717,11 @@ BODY_KEYS = {"points": "name -> vector (null: the global point), or a list of gl
 GROUND_NAMES = ("ground", "base")
 
 
-def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa: C901 - one check per key
-    """The ``points``, ``bodies``, ``joints`` and ``outputs`` of a bodies-and-joints file."""
-    for key in ("legs", "closures", "actuators"):
+def _graph(data: Mapping, legs: list[Leg]) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa: C901 - one check per key
+    """The ``points``, ``bodies``, ``joints`` and ``outputs`` of a bodies-and-joints file; with
+    ``legs``, the bodies and joints besides the legs (a mixed file: the legs' bodies -- the ground,
+    each leg's links, the platform -- may be joined to the file's)."""
+    for key in ("closures", "actuators"):
         if data.get(key):
             raise InputError(
                 f"a file describes its mechanism by bodies and joints or by {key}, not both",
@@ -710,6 +729,7 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
                 hint="write every loop as joints between bodies (the loops are found from the graph), and mark "
                 "the actuated joints 'actuated: name'",
             )
+    of_legs = leg_bodies(legs)
     points = {}
     for name, v in _mapping(data.get("points") or {}, ("points",), "name -> vector").items():
         points[_name(name, ("points", name), "a point name")] = v
@@ -745,6 +765,15 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
                     )
         bodies.append(Body(name, own, desc, ("bodies", name)))
     names = [b.name for b in bodies]
+    if of_legs:  # a mixed file: the legs' ground is 'ground'; its bodies join the file's
+        if "base" in names:
+            raise InputError(
+                "the legs' fixed body is 'ground': name it so here too", path=("bodies", "base"), suggestions=["ground"]
+            )
+        for b in of_legs:
+            if b not in names:
+                bodies.append(Body(b, {}, "", ("legs",)))
+        names = [b.name for b in bodies]
     if not any(n in GROUND_NAMES for n in names):
         raise InputError(
             f"no ground: name the fixed body 'ground' (or 'base'); the bodies are {', '.join(names)}",
@@ -863,7 +892,7 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
     check_bodies(legs)
     graph: tuple = ({}, [], [], {})
     if data.get("bodies") is not None:
-        graph = _graph(data)
+        graph = _graph(data, legs)
     else:
         for key in ("points", "joints", "outputs"):
             if data.get(key) is not None:

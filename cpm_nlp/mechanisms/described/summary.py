@@ -245,7 +245,7 @@ def body_graph(d: Description) -> tuple[list[str], list[tuple[str, str, str, boo
     A bodies-and-joints file: its bodies (the ground first) and every joint, named; a legs file:
     the bodies and joints its legs expand into (the platform, placed by its coordinates, is not
     joined to the ground by an edge)."""
-    if not d.is_graph and expansion_gap(d) is None:
+    if d.legs and expansion_gap(d) is None:
         d = expand_legs(d)
     if d.is_graph:
         ground = next(b.name for b in d.bodies if b.name in ("ground", "base"))
