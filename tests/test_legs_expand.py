@@ -320,8 +320,10 @@ joints:
   - {type: distance, between: [lever, slider1], at: T, to: K}
 """
 #: the stage alone, limb 1's slider actuated: the platform for given slider displacements
-STAGE = MIXED.split("points:")[0].replace("name: stage_lever", "name: stage_alone").replace(
-    "coordinates: [d1], body: slider1}", "actuated: d1}"
+STAGE = (
+    MIXED.split("points:")[0]
+    .replace("name: stage_lever", "name: stage_alone")
+    .replace("coordinates: [d1], body: slider1}", "actuated: d1}")
 )
 A, B, C, F, E = 5e-3, 25e-3, 40e-3, 10e-3, 10e-3
 

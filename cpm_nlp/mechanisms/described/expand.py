@@ -27,15 +27,19 @@ the legs file's).
 The expansion serves ``describe`` (the body graph, loops and both mobility counts), the
 assembly of a reference configuration from a rough drawing, and files that mix legs with
 bodies and joints (``legs`` and ``bodies``/``joints`` in one file: a lever between an actuator
-and a leg's slider): their bodies join the legs' by name and the whole is read as one graph.  **A pure legs file keeps the elimination generator for its closures**
+and a leg's slider): their bodies join the legs' by name and the whole is read as one graph.
+
+**A pure legs file keeps the elimination generator for its closures**
 (:class:`~.generate.Generator`): it eliminates each leg's passive joints, so Φ has one to three
 rows per leg in the platform coordinates alone, and its FK and batch run within 1.1x of the
 hand-written modules (benchmarks/bench_described.py); the expanded graph has every passive joint
 as an unknown and would be slower.
 
 What has no bodies-and-joints equivalent yet (:func:`expansion_gap`): ``closures`` and
-``actuators`` written as expressions (a graph's loops come from its joints), and a closed-form
-``ik`` (it names only the legs' coordinates; the expanded graph solves its IK).
+``actuators`` written as expressions (a graph's loops come from its joints).  A closed-form
+``ik`` is dropped (it names only the legs' coordinates; the expanded graph solves its IK), and
+so are the legs' generated branch indicators (the graph generates its own; the declared
+``branch.add`` expressions are kept).
 """
 
 from __future__ import annotations
