@@ -98,6 +98,10 @@ def test_expanded_graph_has_the_legs_mobility_and_forward_kinematics(path):
         assert a.status == b.status == Status.SOLVED, (a.message, b.message)
         xa, xb = np.asarray(a.x), np.asarray(b.x)
         _close(xb[idx], xa[: len(idx)])
+        # the task Jacobian dx/dq (AD on each closure) of the coordinates both have
+        Ja = np.asarray(legs.closure.jacobian(xa, q, legs.p))
+        Jb = np.asarray(graph.closure.jacobian(xb, q, graph.p))
+        _close(Jb[idx], Ja[: len(idx)], 1e-8)
         # passive joint values where a name maps: the graph's unknowns and its reported values
         pa = cn.passive_joints(legs, xa, q)
         pb = dict(zip(names, xb)) | cn.passive_joints(graph, xb, q)
@@ -117,6 +121,14 @@ def test_every_legs_file_maps_its_platform_and_some_passive_values():
     wanted = {f"{f}{i}" for f in ("alpha", "beta_m", "beta_n", "beta_l") for i in (1, 2, 3)}
     assert wanted <= set(pa) & set(pb)
     assert max(abs(pa[n]) for n in wanted if n.startswith("beta")) > 1e-4  # the poses move the joints
+    # the graph's AD Jacobian dx/dq against central differences of its FK
+    h = 1e-7
+    J = np.asarray(graph.closure.jacobian(b.x, q, graph.p))
+    for k in range(len(q)):
+        step = np.zeros(len(q))
+        step[k] = h
+        up, down = (cn.forward_kinematics(graph, q + s, NEWTON, guess=b.x) for s in (step, -step))
+        _close((np.asarray(up.x) - np.asarray(down.x)) / (2 * h), J[:, k], 1e-6)
 
 
 def test_expanded_bodies_and_joints():

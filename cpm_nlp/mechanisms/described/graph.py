@@ -122,12 +122,14 @@ class GraphGenerator(Generator):
         self.actuated_coords: set[str] = set()
         self.info: GraphInfo | None = None
         self.assembler: Assembler | None = None
+        #: an expanded legs file: each leg's environment and rotation (id of the leg -> (env, turn))
+        self._frames: dict[int, tuple[dict, ca.SX]] = {}
 
     # -- expressions of an expanded legs file (in a leg's frame: its let, index and rotation) ----
     def _leg_frame(self, leg: Any) -> tuple[dict, ca.SX]:
         """A leg's environment (parameters, derived values, its index and ``let``) and its rotation,
         as the legs generator resolves them (:meth:`Generator.leg`)."""
-        frames = self.__dict__.setdefault("_frames", {})
+        frames = self._frames
         if id(leg) not in frames:
             env = dict(self.env)
             if leg.index is not None:
@@ -998,16 +1000,15 @@ class LegsAssembler:
         except InputError as exc:
             raise _in_legs(exc) from None
         self.assembler = self.graph.assembler
-        names = self.graph.x_names
+        where = {n: k for k, n in enumerate(self.graph.x_names)}
         self.columns = []
         for name in legs.x_names:
             # a passive joint of one motion is the graph's joint name (the legs add "_1")
             short = name[:-2] if name.endswith("_1") else name
-            self.columns.append(names.index(name) if name in names else names.index(short))
-
-    @property
-    def info(self) -> GraphInfo | None:
-        return self.graph.info
+            k = where.get(name, where.get(short))
+            if k is None:  # every legs coordinate is a tree coordinate of the expansion
+                raise RuntimeError(f"the expanded graph of {d.name} has no coordinate {name!r}")
+            self.columns.append(k)
 
     def solve(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
         x, q, status = self.assembler.solve(p)
