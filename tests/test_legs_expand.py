@@ -383,3 +383,30 @@ def test_a_file_with_legs_and_bodies_is_one_graph(tmp_path):
         stage = cn.forward_kinematics(ref, [d1, q2, q3], NEWTON)
         assert stage.status == Status.SOLVED
         _close(x[:3], stage.x, TOL)
+
+
+@pytest.mark.parametrize(
+    ("change", "path", "words"),
+    [
+        (
+            lambda t: t.replace("between: [lever, slider1]", "between: [lever, slidr1]"),
+            "joints[3].between[1]",
+            "slider1",
+        ),
+        (lambda t: t.replace("position: [x, y, z]", "position: []"), "platform.position", "places its platform"),
+        (lambda t: t.replace("coordinates: [d1], body: slider1", "coordinates: [d1], body: ground"), "body", "base"),
+        (
+            lambda t: t.replace("type: P, between: [ground, piezo]", "type: P, length: 1 mm, between: [ground, piezo]"),
+            "joints[0].length",
+            "only a distance joint",
+        ),
+    ],
+)
+def test_bad_mixed_files_name_the_key(tmp_path, change, path, words):
+    f = tmp_path / "stage_lever.yaml"
+    f.write_text(change(MIXED))
+    with pytest.raises(InputError) as exc:
+        mech = load_file(f)
+        mech.model(mech.closure(), {}, {}, ())
+    text = exc.value.render()
+    assert path in text and words in text and "stage_lever.yaml" in text, text

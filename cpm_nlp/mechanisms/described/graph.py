@@ -248,6 +248,11 @@ class GraphGenerator(Generator):
                     f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}",
                     path=j.path + ("coordinates",),
                 )
+            if kind != "distance" and j.length is not None:
+                raise InputError(
+                    f"only a distance joint has 'length' (a {j.type} joint's bodies carry its points)",
+                    path=j.path + ("length",),
+                )
             if kind == "distance":
                 if j.actuated is not None:
                     raise InputError(

@@ -638,8 +638,8 @@ def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a
             last = n == len(leg.joints) - 1
             body = j.body or ("platform" if last else f"{leg.name}.link{n + 1}")
             where = j.path + ("body",)
-            if body == "base":
-                raise InputError(f"a joint cannot carry the base (it joins {prev!r} to the base)", path=where)
+            if body in GROUND_NAMES:
+                raise InputError(f"a joint cannot carry the base (it joins {prev!r} to {body!r})", path=where)
             if body == prev or body in seen:
                 raise InputError(
                     f"two joints on the body {body!r} with no loop between them: this joint joins {prev!r} "
