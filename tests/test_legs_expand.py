@@ -410,3 +410,12 @@ def test_bad_mixed_files_name_the_key(tmp_path, change, path, words):
         mech.model(mech.closure(), {}, {}, ())
     text = exc.value.render()
     assert path in text and words in text and "stage_lever.yaml" in text, text
+
+
+def test_describe_says_why_a_legs_file_has_no_graph_view():
+    from cpm_nlp.mechanisms.described.summary import summary_text
+
+    d = read_description(ROOT / "problems" / "mechanisms" / "prs3.yaml")  # b and L have no default
+    text = summary_text(d, None, "the declared defaults")
+    assert "(no bodies-and-joints view: the loops' rank needs a value of b, L" in text
+    assert "leg leg1: ground -> leg1_link1 -> leg1_link2 -> platform" in text  # the legs are still listed
