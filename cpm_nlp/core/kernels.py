@@ -290,7 +290,7 @@ def cond1_block_bound(phi_x: ca.SX) -> ca.SX:
     rows = [list(range(rowblock[k], rowblock[k + 1])) for k in range(nb)]
     cols = [list(range(colblock[k], colblock[k + 1])) for k in range(nb)]
     u = phi_x[rowperm, colperm]
-    if not _block_upper(u, rows, cols):  # the lower form: reversing both orders makes it upper
+    if not _block_upper(u, rows, cols):  # the lower form (CasADi 3.6 gives it): reversing both orders makes it upper
         rowperm, colperm = rowperm[::-1], colperm[::-1]
         rows = [[n - 1 - r for r in rows[k][::-1]] for k in reversed(range(nb))]
         cols = [[n - 1 - r for r in cols[k][::-1]] for k in reversed(range(nb))]
