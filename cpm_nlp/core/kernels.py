@@ -352,14 +352,18 @@ def n_joints(closure: LoopClosure) -> int:
 def checks_function(closure: LoopClosure) -> ca.Function:
     """``pose_checks: (x, q, p, lower, upper, tol) -> (passive, residual,
     branch_margin, round_trip_error, cond1, limit_margin, phi_x, status)``;
-    status with the conservative (1-norm) singularity screen."""
+    status with the conservative (1-norm) singularity screen.  For a closure
+    solved through normal equations (``loops``), cond1 is the upper bound of
+    :func:`cond1_block_bound`."""
 
     def build() -> ca.Function:
         c = closure
         x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
         nl = n_joints(c)
         lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
-        chk = check_expressions(c, x, q, p, lower, upper)
+        # normal equations: the block bound (a symbolic inverse of the whole Φ_x costs twice the rest of
+        # the checks); any upper bound of κ₁ keeps the screen conservative, and the 2-norm decides
+        chk = check_expressions(c, x, q, p, lower, upper, block_bound=c.loops is not None)
         singular = is_singular(chk["cond1"], CASADI, factor=c.nx)
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         names = ["passive", *CHECKS, "phi_x"]
