@@ -17,8 +17,9 @@
 Both models (the reference built from its declaration directly, not registered) have the
 same parameters (problems/prs3_forward_kinematics.yaml); the same N
 random actuator vectors (s within +-2 mm) are solved by ``cn.batch_forward_kinematics``
-(Newton; ``--backend map`` or ``compiled``, single solves on the same backend) for each, interleaved, warm (solvers built before the clock
-starts); the median of the repeats is taken.  The machine's load (os.getloadavg()) is
+(Newton; ``--backend map`` or ``compiled``, single solves on the same backend) for each,
+interleaved, warm (solvers built before the clock starts); the median of the repeats is taken,
+in wall time and in this process's CPU time.  The machine's load (os.getloadavg()) is
 recorded beside the figures.
 """
 
