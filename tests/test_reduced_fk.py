@@ -414,3 +414,30 @@ def test_block_bound_on_block_triangular_matrices(lower):
     g = ca.Function("g", [one], [cond1_block_bound(one)])
     m = rng.normal(size=(3, 3))
     assert float(g(m)) == pytest.approx(np.linalg.cond(m, 1), rel=1e-12)
+
+
+def test_pantograph_file_near_full_reach_is_singular_from_the_full_path():
+    """Along qx -> 2a (the arms stretched, theta1 -> theta2; q = (2a(1 - eps), 0, 0)): at
+    eps = 1e-3 the reduced path settles the pose (its bound ~4e6 is far below 1e10/24); at
+    eps = 1e-9 Φ_x of the normal equations has κ₂ ~ 5e11 (numpy, at the module's pose):
+    the reduced path does not settle it and the full path reports it singular, as it did
+    before the reduced path existed.  (The module's own Φ_x has κ₂ ~ 2e6 there: the normal
+    equations square the conditioning, so the file is singular nearer home than the module.)"""
+    file, module = _pantographs()
+    c = file.closure
+    a = 0.020
+    q = np.array([[2 * a * (1 - 1e-3), 0, 0], [2 * a * (1 - 1e-9), 0, 0]])
+    res, ref = cn.batch_forward_kinematics(file, q), full_only(file, q)
+    np.testing.assert_array_equal(res.status, ref.status)
+    assert res.statuses[0] is Status.SOLVED and res.path(0) == "reduced"
+    assert res.statuses[1] is Status.SINGULAR and res.path(1) == "full"
+    assert res.checks["cond_phi_x"][1] >= 1e10
+    # the module (eq 1-8) solves the pose, the arms nearly stretched, with a moderate κ₂(Φ_x)
+    mod = cn.batch_forward_kinematics(module, q[1:])
+    m = module.closure
+    assert mod.ok[0] and abs(mod.x[0][m.x_names.index("theta1")] - mod.x[0][m.x_names.index("theta2")]) < 1e-3
+    assert np.linalg.cond(np.asarray(m.phi_x(mod.x[0], q[1], module.p))) < 1e7
+    kernel = reduced_fk_kernel(c, NEWTON)
+    out = dict(zip(kernel.outputs, evaluate(kernel.function, [q, file.x_home, *shared_values(kernel, file, 1e-10)])))
+    assert out["status"][1, 0] != 0 and out["cond1"][1, 0] >= 1e10 / (2 * c.nx)
+    assert np.linalg.cond(np.asarray(c.phi_x(out["x"][1], q[1], file.p))) >= 1e10
