@@ -28,6 +28,11 @@ factor n: κ₂ ≤ n κ₁.  The kernel flags a pose singular when κ₁ ≥ 10
 conservative, it never misses a pose the single check would flag -- and the
 batch path recomputes κ₂ with numpy for the (rare) flagged poses, so batch
 and single statuses agree exactly.  Exported code keeps the conservative flag.
+A closure solved through normal equations (``LoopClosure.loops``: an
+overconstrained linkage) squares the condition number and makes the symbolic
+inverse of Φ_x costly; its kernels use :func:`cond1_block_bound`, an upper
+bound of κ₁ from the inverses of Φ_x's diagonal blocks at the pose, so the
+screen stays conservative and the 2-norm still decides.
 """
 
 from __future__ import annotations
@@ -239,8 +244,10 @@ def _induced_norm_1(m: ca.SX) -> ca.SX:
 
 
 def _robust_norm_1(m: ca.SX) -> ca.SX:
-    """‖M‖₁, inf if any entry is not finite (C's fmax would skip NaN)."""
-    return ca.if_else(_all_finite(ca.vec(m)), _induced_norm_1(m), ca.inf)
+    """‖M‖₁, inf if any entry is not finite (C's fmax would skip NaN): the column sums of |M|
+    carry a NaN or inf into their total (a total that overflows also gives inf: conservative)."""
+    sums = ca.sum1(ca.fabs(m))
+    return ca.if_else(ca.sum2(sums) < ca.inf, ca.mmax(sums), ca.inf)
 
 
 def cond1_bound(phi_x: ca.SX, b: ca.SX) -> ca.SX:
@@ -320,8 +327,7 @@ def cond1_block_bound(phi_x: ca.SX) -> ca.SX:
             beta[i, j] = b
             column.append(b)
         sums.append(ca.sum1(ca.vertcat(*column)))
-    bound = _induced_norm_1(phi_x) * _robust_max_abs(ca.vertcat(*sums))  # inf where a sum is NaN
-    return ca.if_else(_all_finite(ca.vec(phi_x)), bound, ca.inf)
+    return _robust_norm_1(phi_x) * _robust_max_abs(ca.vertcat(*sums))  # inf where a sum is NaN
 
 
 def limited_coordinates(closure: LoopClosure) -> tuple[Coordinate, ...]:
@@ -525,8 +531,11 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
     ``status`` is ``solved`` only where max |g| <= abstol after the steps
     (Newton converged) and every check of the full path passes on (x, q):
     residual of the full Φ, branch, reach and IK round trip, limits, with
-    ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x)
-    and a margin of 2 on the singularity threshold.  Any other status means
+    ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x;
+    for a closure solved through normal equations, the bound of
+    :func:`cond1_block_bound` at the pose: Φ_x⁻¹ at home certifies only near
+    home when the condition number is squared) and a margin of 2 on the
+    singularity threshold.  Any other status means
     "not settled here": the full path decides (see :func:`fk_kernel`).
     """
     opts = newton_options(config)
