@@ -443,21 +443,28 @@ def reduce_angle(v: float, ranges: Sequence[tuple[float, float] | None]) -> floa
     return r
 
 
-def _angle_ranges(model: Model) -> list[tuple[bool, int, tuple]]:
+def _angle_ranges(model: Model) -> list[tuple[bool, int, tuple, float, float]]:
     """The angle coordinates :func:`reduce_angles` reduces, with their ranges, in its order (the
-    actuators first): (in x, index, ranges); built once per model (a single FK calls it each time)."""
+    actuators first): (in x, index, ranges, low, high), [low, high] the first finite range (a value
+    there is kept: :func:`reduce_angle`; (inf, -inf) when none is); built once per model (a single
+    FK calls it each time)."""
     cached = model.__dict__.get("_angle_ranges")
     if cached is None:
         c = model.closure
         # an actuator without a declared range keeps its value (the solvers start from its home value)
-        cached = [
+        items = [
             (False, k, (model.limit_of(co),)) for k, co in enumerate(c.q) if co.kind == "angle" and model.limit_of(co)
         ]
-        cached += [
+        items += [
             (True, k, (model.limit_of(co), (model.x_lower[k], model.x_upper[k])))
             for k, co in enumerate(c.x)
             if co.kind == "angle"
         ]
+        cached = []
+        for in_x, k, ranges in items:
+            finite = [lim for lim in ranges if lim is not None and math.isfinite(lim[0]) and math.isfinite(lim[1])]
+            low, high = (float(finite[0][0]), float(finite[0][1])) if finite else (math.inf, -math.inf)
+            cached.append((in_x, k, ranges, low, high))
         model.__dict__["_angle_ranges"] = cached
     return cached
 
@@ -471,15 +478,18 @@ def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) 
     values.  Returns (x, q)."""
     out_x, out_q = np.array(x, dtype=float), np.array(q, dtype=float)
     limit = max(tolerance, 1e-12)
-    for in_x, k, ranges in _angle_ranges(model):
-        vec = out_x if in_x else out_q
-        r = reduce_angle(float(vec[k]), ranges)
-        if r == vec[k]:
+    values = (out_q.tolist(), out_x.tolist())  # each coordinate is read once, before it may change
+    for in_x, k, ranges, low, high in _angle_ranges(model):
+        v = values[in_x][k]
+        if low <= v <= high:  # in its first finite range: kept (reduce_angle would return v)
             continue
-        old = vec[k]
+        vec = out_x if in_x else out_q
+        r = reduce_angle(v, ranges)
+        if r == v:
+            continue
         vec[k] = r
         if not np.max(np.abs(residual(model, out_x, out_q)), initial=0.0) <= limit:
-            vec[k] = old
+            vec[k] = v
     return out_x, out_q
 
 
