@@ -12,6 +12,7 @@ first-order guess against central differences, and batch = single solves
 
 import math
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -21,7 +22,10 @@ from cpm_nlp.core.compiled import compiler_available
 from cpm_nlp.core.kernels import (
     CERTIFY_DELTA,
     PATHS,
+    SCALAR,
+    cond1_block_bound,
     full_fk_kernel,
+    is_singular,
     linearization,
     reduced_fk_kernel,
     shared_values,
@@ -44,6 +48,8 @@ def build(name, limited=True):
         return cn.build_model("prc3", TABLE1, {"q": ["0 um", "15 um"]} if limited else {})
     if name == "rpr":
         return cn.build_model("rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"})
+    if name == "pantograph_file":  # bodies and joints, solved through normal equations (no limits declared)
+        return cn.build_model("pantograph_file", {"a": "20 mm", "b": "50 mm"})
     limits = {"psi_min": "1.49 rad", "psi_max": "1.65 rad", "phi_max": "0.0795 rad"}
     return cn.build_model("pantograph", {"a": "20 mm", "b": "50 mm"}, limits if limited else {})
 
@@ -54,6 +60,7 @@ SPREAD = {
     "prc3": [4e-6, 4e-6, 4e-6],
     "rpr": [0.2, 0.2, 8e-3],
     "pantograph": [6e-3, 6e-3, 6e-3],
+    "pantograph_file": [6e-3, 6e-3, 6e-3],
 }
 
 
@@ -66,7 +73,7 @@ def full_only(model, q, x0=None):
     return _finish("forward_kinematics", model, out, q, NEWTON.tolerance, "map", 1, 0.0, "fast_newton")
 
 
-@pytest.mark.parametrize("name", ["prs3", "prc3", "rpr", "pantograph"])
+@pytest.mark.parametrize("name", ["prs3", "prc3", "rpr", "pantograph", "pantograph_file"])
 def test_reduced_agrees_with_full_on_random_poses(name):
     """Random poses (from the closed-form IK of random task coordinates, and
     random actuator vectors about home): the reduced path answers the poses it
@@ -274,3 +281,163 @@ def test_auto_backend_falls_back_to_the_virtual_machine_when_compiling_fails(tmp
     assert "backend 'auto' uses 'map'" in caplog.text
     ref = cn.forward_kinematics(model, [1e-3, 0.5e-3, -0.3e-3], NEWTON, backend="map")
     np.testing.assert_array_equal(sol.x, ref.x)
+
+
+# -- a linkage solved through normal equations (the pantograph file): certified at the pose --------
+
+
+def _pantographs():
+    panto = {"a": "20 mm", "b": "50 mm"}
+    return cn.build_model("pantograph_file", panto), cn.build_model("pantograph", panto)
+
+
+def test_pantograph_file_answers_on_the_reduced_path_as_the_module():
+    """The shipped pantograph file (bodies and joints: 12 pose coordinates, normal equations of
+    10 loop rows) on 500 random actuator vectors within +-2 mm of home: every pose solved on the
+    reduced path (before cond1_block_bound, 498 of 500 fell back to the full Newton: Φ_x⁻¹ at home
+    no longer certified), and each equals the hand-written module (eq 1-8) to 1e-12; a single
+    solve answers on the same path with the same pose."""
+    file, module = _pantographs()
+    c = file.closure
+    assert c.loops is not None  # the normal-equation form
+    q = module.q_home + np.random.default_rng(160).uniform(-2e-3, 2e-3, (500, 3))
+    res, ref = cn.batch_forward_kinematics(file, q), cn.batch_forward_kinematics(module, q)
+    assert res.ok.all() and ref.ok.all()
+    assert all(res.path(i) == "reduced" for i in range(len(res)))
+    idx = [c.x_names.index(n) for n in module.closure.x_names]  # px, py, pz, theta1, theta2, phi
+    np.testing.assert_allclose(res.x[:, idx], ref.x, rtol=0, atol=1e-12)
+    for k in range(0, 500, 50):
+        single = cn.forward_kinematics(file, q[k], NEWTON)
+        assert single.ok and single.path == "reduced"
+        np.testing.assert_allclose(single.x, res.x[k], rtol=0, atol=1e-13)
+        assert np.max(np.abs(np.asarray(c.loops(single.x, q[k], file.p)))) < 1e-12  # every loop row holds
+
+
+def test_pantograph_file_edge_cases_have_the_statuses_of_the_full_path():
+    """Out of reach and large strokes (+-50 mm on 20 mm links), from home: a pose that is not
+    solved has the full path's status and message and was answered by it; a pose the full path
+    solves is solved with its pose (angles up to whole turns: Newton from home may wind them); a
+    pose solved where Newton on the normal equations from home is not (it wanders at large
+    strokes) is on the reduced path and checked here independently: every loop row holds, and
+    the hand-written module's IK (eq 9-10, 18) of its task coordinates gives back its q."""
+    file, module = _pantographs()
+    c = file.closure
+    rng = np.random.default_rng(161)
+    q = np.vstack(
+        [
+            file.q_home + rng.uniform(-2e-3, 2e-3, (40, 3)),
+            [[0.3, -0.3, 0.0], [0.0, 0.0, 0.2], [-0.1, 0.05, 0.08]],
+            file.q_home + rng.uniform(-0.05, 0.05, (60, 3)),
+        ]
+    )
+    res = cn.batch_forward_kinematics(file, q)
+    ref = full_only(file, q)
+    assert {Status.SOLVED, Status.NOT_CONVERGED} <= set(res.statuses), res.counts()
+    for i in np.flatnonzero(~res.ok):
+        assert res.status[i] == ref.status[i] and res.path(i) == "full" and res.message(i) == ref.message(i)
+    assert res.ok[ref.ok].all()
+    both = ref.ok
+    np.testing.assert_allclose(_wrap_angles(c, res.x[both] - ref.x[both]), 0, atol=1e-12)
+    extra = np.flatnonzero(res.ok & ~ref.ok)
+    assert extra.size >= 1
+    for i in extra:
+        assert res.path(i) == "reduced"
+        assert np.max(np.abs(np.asarray(c.loops(res.x[i], q[i], file.p)))) < 1e-12
+        ik = cn.inverse_kinematics(module, res.x[i][c.task_index])
+        np.testing.assert_allclose(ik.q, q[i], rtol=0, atol=1e-12)
+
+
+def _wrap_angles(c, d):
+    """Differences of poses with the angle coordinates' whole turns taken off."""
+    d = np.array(d, dtype=float)
+    for k, coord in enumerate(c.x):
+        if coord.kind == "angle":
+            d[:, k] = (d[:, k] + math.pi) % (2 * math.pi) - math.pi
+    return d
+
+
+def test_block_bound_of_the_pantograph_file_bounds_its_condition_number():
+    """cond1 of the reduced path on the pantograph file is an upper bound of κ₁(Φ_x) (numpy, the
+    normal equations' Φ_x with its second-derivative terms) and within 10x of it (not vacuous),
+    from poses near home to poses where Φ_x⁻¹ at home certifies nothing (δ > CERTIFY_DELTA)."""
+    file, _ = _pantographs()
+    c = file.closure
+    rng = np.random.default_rng(162)
+    q = file.q_home + np.vstack([rng.uniform(-2e-3, 2e-3, (60, 3)), rng.uniform(-6e-3, 6e-3, (60, 3))])
+    kern = reduced_fk_kernel(c, NEWTON)
+    out = dict(zip(kern.outputs, evaluate(kern.function, [q, file.x_home, *shared_values(kern, file, 1e-10)])))
+    b = linearization(file)["Phi_x_home_inv"].reshape(c.nx, c.nx, order="F")
+    uncertified = 0
+    for i in np.flatnonzero(out["status"].ravel() == 0):
+        a = np.asarray(c.phi_x(out["x"][i], q[i], file.p))
+        exact = np.linalg.cond(a, 1)
+        assert exact * (1 - 1e-12) <= out["cond1"][i, 0] <= 10 * exact
+        uncertified += np.abs(np.eye(c.nx) - a @ b).sum(axis=0).max() > CERTIFY_DELTA
+    assert uncertified >= 60  # the home inverse would have sent these to the full path
+
+
+@pytest.mark.parametrize("lower", [False, True])
+def test_block_bound_on_block_triangular_matrices(lower):
+    """cond1_block_bound on a block triangular pattern (1 x 1 blocks around a 4 x 4 block, either
+    pattern or its transpose, permuted), numbers from numpy: never below κ₁ (100 random
+    matrices), exact for a single block, +inf for a singular block or a NaN entry."""
+    rng = np.random.default_rng(163 + lower)
+    n = 7
+    pattern = np.triu(rng.uniform(size=(n, n)) < 0.5, 1) | np.eye(n, dtype=bool)
+    pattern[2:6, 2:6] = True  # one 4 x 4 block
+    pattern = pattern.T if lower else pattern
+    perm_r, perm_c = rng.permutation(n), rng.permutation(n)
+    pattern = pattern[np.ix_(perm_r, perm_c)]  # row i of the pattern is row perm_r[i] before
+    sp = ca.sparsify(ca.DM(pattern.astype(float))).sparsity()
+    assert sp.nnz() == pattern.sum() and sp.btf()[0] == 4  # 1 x 1, 1 x 1, 4 x 4, 1 x 1
+    sym = ca.SX.sym("a", sp)
+    fn = ca.Function("bound", [sym], [cond1_block_bound(sym)])
+
+    def bound(values):
+        return float(fn(ca.DM(sp, values)))
+
+    for _ in range(100):
+        v = rng.normal(size=sp.nnz())
+        exact = np.linalg.cond(np.array(ca.DM(sp, v)), 1)
+        assert exact * (1 - 1e-12) <= bound(v) < np.inf
+    dense = np.array(ca.DM(sp, rng.normal(size=sp.nnz())))
+    # two equal rows in the 4 x 4 block (rows and columns 2-5 before the permutations): singular
+    block_rows = [int(np.flatnonzero(perm_r == k)[0]) for k in range(2, 6)]
+    block_cols = [int(np.flatnonzero(perm_c == k)[0]) for k in range(2, 6)]
+    dense[block_rows[1], block_cols] = dense[block_rows[0], block_cols]
+    assert np.linalg.matrix_rank(dense) < n
+    assert is_singular(float(fn(ca.project(ca.DM(dense), sp))), SCALAR, factor=2 * n)
+    nan = rng.normal(size=sp.nnz())
+    nan[3] = np.nan
+    assert bound(nan) == np.inf
+    one = ca.SX.sym("a", 3, 3)
+    g = ca.Function("g", [one], [cond1_block_bound(one)])
+    m = rng.normal(size=(3, 3))
+    assert float(g(m)) == pytest.approx(np.linalg.cond(m, 1), rel=1e-12)
+
+
+def test_pantograph_file_near_full_reach_is_singular_from_the_full_path():
+    """Along qx -> 2a (the arms stretched, theta1 -> theta2; q = (2a(1 - eps), 0, 0)): at
+    eps = 1e-3 the reduced path settles the pose (its bound ~4e6 is far below 1e10/24); at
+    eps = 1e-9 Φ_x of the normal equations has κ₂ ~ 5e11 (numpy, at the module's pose):
+    the reduced path does not settle it and the full path reports it singular, as it did
+    before the reduced path existed.  (The module's own Φ_x has κ₂ ~ 2e6 there: the normal
+    equations square the conditioning, so the file is singular nearer home than the module.)"""
+    file, module = _pantographs()
+    c = file.closure
+    a = 0.020
+    q = np.array([[2 * a * (1 - 1e-3), 0, 0], [2 * a * (1 - 1e-9), 0, 0]])
+    res, ref = cn.batch_forward_kinematics(file, q), full_only(file, q)
+    np.testing.assert_array_equal(res.status, ref.status)
+    assert res.statuses[0] is Status.SOLVED and res.path(0) == "reduced"
+    assert res.statuses[1] is Status.SINGULAR and res.path(1) == "full"
+    assert res.checks["cond_phi_x"][1] >= 1e10
+    # the module (eq 1-8) solves the pose, the arms nearly stretched, with a moderate κ₂(Φ_x)
+    mod = cn.batch_forward_kinematics(module, q[1:])
+    m = module.closure
+    assert mod.ok[0] and abs(mod.x[0][m.x_names.index("theta1")] - mod.x[0][m.x_names.index("theta2")]) < 1e-3
+    assert np.linalg.cond(np.asarray(m.phi_x(mod.x[0], q[1], module.p))) < 1e7
+    kernel = reduced_fk_kernel(c, NEWTON)
+    out = dict(zip(kernel.outputs, evaluate(kernel.function, [q, file.x_home, *shared_values(kernel, file, 1e-10)])))
+    assert out["status"][1, 0] != 0 and out["cond1"][1, 0] >= 1e10 / (2 * c.nx)
+    assert np.linalg.cond(np.asarray(c.phi_x(out["x"][1], q[1], file.p))) >= 1e10

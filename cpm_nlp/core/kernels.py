@@ -28,6 +28,11 @@ factor n: κ₂ ≤ n κ₁.  The kernel flags a pose singular when κ₁ ≥ 10
 conservative, it never misses a pose the single check would flag -- and the
 batch path recomputes κ₂ with numpy for the (rare) flagged poses, so batch
 and single statuses agree exactly.  Exported code keeps the conservative flag.
+A closure solved through normal equations (``LoopClosure.loops``: an
+overconstrained linkage) squares the condition number and makes the symbolic
+inverse of Φ_x costly; its kernels use :func:`cond1_block_bound`, an upper
+bound of κ₁ from the inverses of Φ_x's diagonal blocks at the pose, so the
+screen stays conservative and the 2-norm still decides.
 """
 
 from __future__ import annotations
@@ -135,6 +140,7 @@ def check_expressions(
     lower: ca.SX,
     upper: ca.SX,
     phi_x_home_inv: ca.SX | None = None,
+    block_bound: bool = False,
 ) -> dict[str, ca.SX]:
     """Symbolic checks of the pose (x, q): see :data:`CHECKS`.
 
@@ -143,6 +149,8 @@ def check_expressions(
     phi_x_home_inv: if given (a numeric nx x nx input, Φ_x⁻¹ at the home pose),
     ``cond1`` is the certified upper bound of :func:`cond1_bound` instead of
     the exact 1-norm condition number (which needs a symbolic inverse of Φ_x).
+    block_bound: ``cond1`` is the upper bound of :func:`cond1_block_bound` (inverses of
+    Φ_x's diagonal blocks at the pose; takes precedence over phi_x_home_inv).
     """
     c = closure
     out: dict[str, ca.SX] = {"finite": _all_finite(ca.vertcat(x, q))}
@@ -168,7 +176,9 @@ def check_expressions(
         out["round_trip_error"] = ca.SX(0)
     phi_x = c.phi_x(x, q, p)
     out["phi_x"] = phi_x
-    if phi_x_home_inv is not None:
+    if block_bound:
+        out["cond1"] = cond1_block_bound(phi_x)
+    elif phi_x_home_inv is not None:
         out["cond1"] = cond1_bound(ca.densify(phi_x), phi_x_home_inv)
     elif ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
         out["cond1"] = ca.SX(ca.inf)
@@ -233,6 +243,13 @@ def _induced_norm_1(m: ca.SX) -> ca.SX:
     return ca.mmax(ca.sum1(ca.fabs(m)))
 
 
+def _robust_norm_1(m: ca.SX) -> ca.SX:
+    """‖M‖₁, inf if any entry is not finite (C's fmax would skip NaN): the column sums of |M|
+    carry a NaN or inf into their total (a total that overflows also gives inf: conservative)."""
+    sums = ca.sum1(ca.fabs(m))
+    return ca.if_else(ca.sum2(sums) < ca.inf, ca.mmax(sums), ca.inf)
+
+
 def cond1_bound(phi_x: ca.SX, b: ca.SX) -> ca.SX:
     """A certified upper bound of the 1-norm condition number of Φ_x, from an
     approximate inverse B (Φ_x⁻¹ at the home pose, numbers) and no inverse
@@ -249,6 +266,68 @@ def cond1_bound(phi_x: ca.SX, b: ca.SX) -> ca.SX:
     delta = _induced_norm_1(ca.DM.eye(n) - ca.mtimes(phi_x, b))
     bound = _induced_norm_1(phi_x) * _induced_norm_1(b) / (1 - delta)
     return ca.if_else(ca.logic_and(_all_finite(ca.vec(phi_x)), delta <= CERTIFY_DELTA), bound, ca.inf)
+
+
+def _block_upper(u: ca.SX, rows: list[list[int]], cols: list[list[int]]) -> bool:
+    """Whether u has no structural nonzero below its diagonal blocks."""
+    return all(u[rows[i], cols[j]].nnz() == 0 for i in range(len(rows)) for j in range(i))
+
+
+def cond1_block_bound(phi_x: ca.SX) -> ca.SX:
+    """An upper bound of the 1-norm condition number of Φ_x at the pose itself, from its block
+    triangular form: no approximate inverse from elsewhere, so it holds as far from home as
+    Φ_x stays regular.
+
+    The sparsity's Dulmage-Mendelsohn form (fixed when the kernel is built) permutes Φ_x to a
+    block upper triangular U with square diagonal blocks D_i.  The inverse X = U⁻¹ is block
+    upper triangular too: X_jj = D_j⁻¹ and X_ij = -D_i⁻¹ Σ_{i<k≤j} U_ik X_kj, so with
+    α_i = ‖D_i⁻¹‖₁ (each block inverted at the pose; a 1 x 1 block is 1/d) the norms obey
+    ‖X_ij‖₁ ≤ β_ij = α_i Σ_k ‖U_ik‖₁ β_kj, and ‖Φ_x⁻¹‖₁ = ‖X‖₁ ≤ max_j Σ_i β_ij (a column of
+    block column j sums at most the blocks' 1-norms).  Permutations keep the 1-norm, so
+    κ₁(Φ_x) ≤ ‖Φ_x‖₁ max_j Σ_i β_ij (induced 1-norms).  A structurally singular Φ_x, a
+    singular block (its inverse not finite) or a Φ_x that is not finite gives +inf (NaN is
+    read as singular too: :func:`is_singular`).  Costs the inverses of the diagonal blocks only
+    (for a linkage's normal equations: the block of the loops' passive coordinates).
+    """
+    n = phi_x.size1()
+    sp = phi_x.sparsity()
+    if ca.sprank(sp) < n:
+        return ca.SX(ca.inf)
+    nb, rowperm, colperm, rowblock, colblock, *_ = sp.btf()
+    rows = [list(range(rowblock[k], rowblock[k + 1])) for k in range(nb)]
+    cols = [list(range(colblock[k], colblock[k + 1])) for k in range(nb)]
+    u = phi_x[rowperm, colperm]
+    if not _block_upper(u, rows, cols):  # the lower form (CasADi 3.6 gives it): reversing both orders makes it upper
+        rowperm, colperm = rowperm[::-1], colperm[::-1]
+        rows = [[n - 1 - r for r in rows[k][::-1]] for k in reversed(range(nb))]
+        cols = [[n - 1 - r for r in cols[k][::-1]] for k in reversed(range(nb))]
+        u = phi_x[rowperm, colperm]
+        if not _block_upper(u, rows, cols):  # pragma: no cover - the Dulmage-Mendelsohn form is triangular
+            return ca.SX(ca.inf)
+    alpha = []
+    for i in range(nb):
+        d = u[rows[i], cols[i]]
+        alpha.append(1 / ca.fabs(d) if d.numel() == 1 else _robust_norm_1(ca.inv(ca.densify(d))))
+    beta: dict[tuple[int, int], ca.SX] = {}
+    sums = []
+    for j in range(nb):
+        column = []
+        for i in range(j, -1, -1):
+            if i == j:
+                b = alpha[j]
+            else:
+                terms = [
+                    _induced_norm_1(u[rows[i], cols[k]]) * beta[k, j]
+                    for k in range(i + 1, j + 1)
+                    if u[rows[i], cols[k]].nnz() and (k, j) in beta
+                ]
+                if not terms:
+                    continue
+                b = alpha[i] * ca.sum1(ca.vertcat(*terms))
+            beta[i, j] = b
+            column.append(b)
+        sums.append(ca.sum1(ca.vertcat(*column)))
+    return _robust_norm_1(phi_x) * _robust_max_abs(ca.vertcat(*sums))  # inf where a sum is NaN
 
 
 def limited_coordinates(closure: LoopClosure) -> tuple[Coordinate, ...]:
@@ -279,14 +358,18 @@ def n_joints(closure: LoopClosure) -> int:
 def checks_function(closure: LoopClosure) -> ca.Function:
     """``pose_checks: (x, q, p, lower, upper, tol) -> (passive, residual,
     branch_margin, round_trip_error, cond1, limit_margin, phi_x, status)``;
-    status with the conservative (1-norm) singularity screen."""
+    status with the conservative (1-norm) singularity screen.  For a closure
+    solved through normal equations (``loops``), cond1 is the upper bound of
+    :func:`cond1_block_bound`."""
 
     def build() -> ca.Function:
         c = closure
         x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
         nl = n_joints(c)
         lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
-        chk = check_expressions(c, x, q, p, lower, upper)
+        # normal equations: the block bound (a symbolic inverse of the whole Φ_x costs twice the rest of
+        # the checks); any upper bound of κ₁ keeps the screen conservative, and the 2-norm decides
+        chk = check_expressions(c, x, q, p, lower, upper, block_bound=c.loops is not None)
         singular = is_singular(chk["cond1"], CASADI, factor=c.nx)
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         names = ["passive", *CHECKS, "phi_x"]
@@ -448,8 +531,11 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
     ``status`` is ``solved`` only where max |g| <= abstol after the steps
     (Newton converged) and every check of the full path passes on (x, q):
     residual of the full Φ, branch, reach and IK round trip, limits, with
-    ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x)
-    and a margin of 2 on the singularity threshold.  Any other status means
+    ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x;
+    for a closure solved through normal equations, the bound of
+    :func:`cond1_block_bound` at the pose: Φ_x⁻¹ at home certifies only near
+    home when the condition number is squared) and a margin of 2 on the
+    singularity threshold.  Any other status means
     "not settled here": the full path decides (see :func:`fk_kernel`).
     """
     opts = newton_options(config)
@@ -480,7 +566,9 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
             t = step(t, q, p)
         x, q_ik, _reach = c.ik(t, p)
         converged = _robust_max_abs(q_ik - q) <= abstol
-        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
+        # normal equations (an overconstrained graph) square Φ_x's condition number: Φ_x⁻¹ at home
+        # stops certifying a short way from home, so certify at the pose, block by block
+        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b, block_bound=c.loops is not None)
         singular = is_singular(chk["cond1"], CASADI, factor=2 * c.nx)  # margin 2 over the certified bound
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)

@@ -443,6 +443,32 @@ def reduce_angle(v: float, ranges: Sequence[tuple[float, float] | None]) -> floa
     return r
 
 
+def _angle_ranges(model: Model) -> list[tuple[bool, int, tuple, float, float]]:
+    """The angle coordinates :func:`reduce_angles` reduces, with their ranges, in its order (the
+    actuators first): (in x, index, ranges, low, high), [low, high] the first finite range (a value
+    there is kept: :func:`reduce_angle`; (inf, -inf) when none is); built once per model (a single
+    FK calls it each time)."""
+    cached = model.__dict__.get("_angle_ranges")
+    if cached is None:
+        c = model.closure
+        # an actuator without a declared range keeps its value (the solvers start from its home value)
+        items = [
+            (False, k, (model.limit_of(co),)) for k, co in enumerate(c.q) if co.kind == "angle" and model.limit_of(co)
+        ]
+        items += [
+            (True, k, (model.limit_of(co), (model.x_lower[k], model.x_upper[k])))
+            for k, co in enumerate(c.x)
+            if co.kind == "angle"
+        ]
+        cached = []
+        for in_x, k, ranges in items:
+            finite = [lim for lim in ranges if lim is not None and math.isfinite(lim[0]) and math.isfinite(lim[1])]
+            low, high = (float(finite[0][0]), float(finite[0][1])) if finite else (math.inf, -math.inf)
+            cached.append((in_x, k, ranges, low, high))
+        model.__dict__["_angle_ranges"] = cached
+    return cached
+
+
 def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
     """The pose and the actuators with each angle coordinate reduced by whole turns
     (:func:`reduce_angle`) to its declared range (its joint limits, else, for a pose
@@ -450,24 +476,20 @@ def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) 
     (-pi, pi]; an actuator without a declared range, and a coordinate the closures are not
     periodic in (the residual grows, e.g. an actuator geared to its joint), keep their
     values.  Returns (x, q)."""
-    c = model.closure
     out_x, out_q = np.array(x, dtype=float), np.array(q, dtype=float)
     limit = max(tolerance, 1e-12)
-    # an actuator without a declared range keeps its value (the solvers start from its home value)
-    items = [(out_q, k, coord, (model.limit_of(coord),)) for k, coord in enumerate(c.q) if model.limit_of(coord)]
-    items += [
-        (out_x, k, coord, (model.limit_of(coord), (model.x_lower[k], model.x_upper[k]))) for k, coord in enumerate(c.x)
-    ]
-    for vec, k, coord, ranges in items:
-        if coord.kind != "angle":
+    values = (out_q.tolist(), out_x.tolist())  # each coordinate is read once, before it may change
+    for in_x, k, ranges, low, high in _angle_ranges(model):
+        v = values[in_x][k]
+        if low <= v <= high:  # in its first finite range: kept (reduce_angle would return v)
             continue
-        r = reduce_angle(float(vec[k]), ranges)
-        if r == vec[k]:
+        vec = out_x if in_x else out_q
+        r = reduce_angle(v, ranges)
+        if r == v:
             continue
-        old = vec[k]
         vec[k] = r
         if not np.max(np.abs(residual(model, out_x, out_q)), initial=0.0) <= limit:
-            vec[k] = old
+            vec[k] = v
     return out_x, out_q
 
 
