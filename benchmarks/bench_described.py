@@ -5,8 +5,9 @@
   closures it replaced, kept as the test reference tests/reference/prs3_closures.py;
 * ``--mechanism prc3``: the 3-PRC file prc3.yaml (the built-in ``prc3``, legs, with its add-on)
   against the closures it replaced, tests/reference/prc3_closures.py (q within +-15 um, eq 27);
-* ``--mechanism pantograph``: the shipped pantograph file (bodies and joints: 12 pose
-  coordinates and normal equations) against the built-in ``pantograph`` module (eq 1-8).
+* ``--mechanism pantograph``: the pantograph file pantograph.yaml (the built-in ``pantograph``,
+  bodies and joints: 12 pose coordinates and normal equations, with its add-on) against the
+  closures it replaced (eq 1-8), tests/reference/pantograph_closures.py.
 
     python benchmarks/bench_described.py [--mechanism prs3] [--n 20000] [--repeat 5] [--single 200]
         [--json benchmarks/bench_described.json]
@@ -36,7 +37,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import cpm_nlp as cn  # noqa: E402
-from tests.reference import prc3_closures, prs3_closures  # noqa: E402 - hand-written closures, test references
+from tests.reference import pantograph_closures, prc3_closures, prs3_closures  # noqa: E402 - hand-written closures, test references
 
 PARAMS = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
 #: issue 21: generated FK and batch within 1.1x of the hand-written module
@@ -55,12 +56,11 @@ def _pair(mechanism: str) -> tuple[dict, float]:
             "hand-written reference": prc3_closures.reference_model(prc3_closures.PAPER),
             "file prc3": cn.build_model("prc3", prc3_closures.PAPER),
         }, 15e-6
-    # the pantograph: the built-in module (eq 1-8 by hand) against the shipped file of bodies and
-    # joints (problems/mechanisms/pantograph.yaml: 12 pose coordinates against 6, normal equations)
-    panto = {"a": "20 mm", "b": "50 mm"}
+    # the pantograph: the closures it replaced (eq 1-8 by hand) against the shipped file of bodies
+    # and joints (problems/mechanisms/pantograph.yaml: 12 pose coordinates against 6, normal equations)
     return {
-        "hand-written reference": cn.build_model("pantograph", panto),
-        "file pantograph_file": cn.build_model("pantograph_file", panto),
+        "hand-written reference": pantograph_closures.reference_model(pantograph_closures.PAPER),
+        "file pantograph": cn.build_model("pantograph", pantograph_closures.PAPER),
     }, 2e-3
 
 

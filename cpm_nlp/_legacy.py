@@ -49,7 +49,6 @@ MOVED = {
     "rpr_design": "mechanisms.rpr.design",
     "rpr_compliance": "mechanisms.rpr.compliance",
     "rpr_problems": "mechanisms.rpr.kinds",
-    "pantograph": "mechanisms.pantograph.kinematics",
     "pantograph_synthesis": "mechanisms.pantograph.synthesis",
     "problem_file": "problems.file",
     "reproduce": "problems.reproduce",
@@ -62,6 +61,9 @@ MOVED = {
 REMOVED = {
     "prc3": "the 3-PRC is the mechanism file problems/mechanisms/prc3.yaml since issue 21, with the add-on "
     "cpm_nlp.mechanisms.prc3 (its amplifier kind, its dynamics): cpm_nlp.build_model('prc3', {...}) builds it",
+    "pantograph": "the pantograph is the mechanism file problems/mechanisms/pantograph.yaml since issue 21, with "
+    "the add-on cpm_nlp.mechanisms.pantograph (the paper's limits, workspace and cuboid in "
+    "cpm_nlp.mechanisms.pantograph.analysis, its synthesis): cpm_nlp.build_model('pantograph', {...}) builds it",
     "prs3": "the 3-PRS is the mechanism file problems/mechanisms/prs3.yaml since issue 21: "
     "cpm_nlp.build_model('prs3', {...}) builds it, cpm_nlp.mechanism_type('prs3') declares it",
 }

@@ -43,7 +43,6 @@ ENTRY_POINT_GROUP = "cpm_nlp.mechanisms"
 #: built-in mechanism type -> "module:attribute" of its declaration
 BUILTIN = {
     "rpr": "cpm_nlp.mechanisms.rpr:MECHANISM",
-    "pantograph": "cpm_nlp.mechanisms.pantograph:MECHANISM",
 }
 
 #: built-in mechanism type -> its shipped mechanism file (in problems/mechanisms/): the
@@ -52,6 +51,7 @@ BUILTIN = {
 BUILTIN_FILES = {
     "prs3": "prs3.yaml",
     "prc3": "prc3.yaml",
+    "pantograph": "pantograph.yaml",
 }
 
 #: built-in file mechanism -> "module:attribute" of its :class:`~cpm_nlp.core.mechanism.Addon`:
@@ -59,12 +59,14 @@ BUILTIN_FILES = {
 #: parameters), added to the mechanism the file describes
 ADDONS = {
     "prc3": "cpm_nlp.mechanisms.prc3.addon:ADDON",
+    "pantograph": "cpm_nlp.mechanisms.pantograph.addon:ADDON",
 }
 
 #: old name -> the built-in mechanism it names now (the file twin became the built-in)
 ALIASES = {
     "prs3_file": "prs3",
     "prc3_file": "prc3",
+    "pantograph_file": "pantograph",
 }
 
 
