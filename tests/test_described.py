@@ -3,8 +3,9 @@
 The papers' mechanisms re-described as files must be the hand-derived modules:
 FK, IK, the Jacobians and the passive joint angles to 1e-12 on random poses of
 the working range.  The reference is the hand-written module of each paper
-(tests/reference/prs3_closures.py and tests/reference/prc3_closures.py -- the 3-PRS and
-the 3-PRC are the files themselves now, issue 21 --, rpr/kinematics.py, pantograph/kinematics.py), whose
+(tests/reference/prs3_closures.py, tests/reference/prc3_closures.py and
+tests/reference/pantograph_closures.py -- the 3-PRS, the 3-PRC and the pantograph are the files
+themselves now, issue 21 --, rpr/kinematics.py), whose
 formulas are pinned to the papers in their own tests; the file's closure is
 generated from the legs and shares no code with them.
 """
@@ -37,7 +38,7 @@ CASES = {
         15e-6,
     ),
     "rpr": ("rpr_file", "rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 50e-6),
-    "pantograph": ("pantograph_file", "pantograph", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
+    "pantograph": ("pantograph", "pantograph_reference", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
 }
 NEWTON = cn.SolverConfig("newton")
 
@@ -52,6 +53,10 @@ def _models(case):
         from .reference import prc3_closures
 
         return cn.build_model(file_name, params), prc3_closures.reference_model(params)
+    if hand_name == "pantograph_reference":  # and the hand-written pantograph (issue 21, item 5)
+        from .reference import pantograph_closures
+
+        return cn.build_model(file_name, params), pantograph_closures.reference_model(params)
     return cn.build_model(file_name, params), cn.build_model(hand_name, params)
 
 

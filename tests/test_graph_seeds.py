@@ -1,9 +1,9 @@
 """Seed mechanisms written with bodies and joints only (issue 21, item 5), against the built-in modules.
 
-* problems/mechanisms/pantograph.yaml (``pantograph_file``) -- the 3D pantograph of Elgammal et al. (links, the
-  parallelogram CDFB, the two loops sharing links, U joints at A and B for the plane's turn phi):
-  FK, IK, the task Jacobian dx/dq and the hinge angle psi equal the built-in ``pantograph``
-  (cpm_nlp/mechanisms/pantograph/kinematics.py, eq 1-8 written by hand) to 1e-12; its task
+* problems/mechanisms/pantograph.yaml (the built-in ``pantograph``, read here without its add-on) -- the 3D
+  pantograph of Elgammal et al. (links, the parallelogram CDFB, the two loops sharing links, U joints at A and B
+  for the plane's turn phi): FK, IK, the task Jacobian dx/dq and the hinge angle psi equal the hand-written
+  closures it replaced (tests/reference/pantograph_closures.py, eq 1-8 by hand) to 1e-12; its task
   Jacobian is the paper's constant J = diag(Mx, -My, -Mz) (eq 9-13); Gruebler-Kutzbach is
   negative (section 2) while the loops' rank gives 3 degrees of freedom.
 * tests/corpus/prc3_levers.yaml -- the 3-PRC of Li et al. with each limb's secondary lever
@@ -26,6 +26,8 @@ from cpm_nlp.core.result import Status
 from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import load_file
 from cpm_nlp.mechanisms.described.graph import closure_parts
+
+from .reference import pantograph_closures
 
 CORPUS = Path(__file__).resolve().parent / "corpus"
 SHIPPED = Path(__file__).resolve().parent.parent / "problems" / "mechanisms"
@@ -57,7 +59,7 @@ PANTO = {"a": "20 mm", "b": "50 mm"}  # the paper's Fig. 9-10 and the file's def
 
 @pytest.fixture(scope="module")
 def pantographs():
-    return _file_model("pantograph_joints"), cn.build_model("pantograph", PANTO)
+    return _file_model("pantograph_joints"), pantograph_closures.reference_model(PANTO)
 
 
 def _pantograph_inputs(hm: cn.Model) -> np.ndarray:
@@ -103,7 +105,7 @@ def test_pantograph_joints_other_parameters_assemble_and_agree():
     """The drawing is written in a and b: other values assemble exactly and agree (section 6's
     synthesis varies them)."""
     fm = _file_model("pantograph_joints", {"a": 0.025, "b": 0.040})
-    hm = cn.build_model("pantograph", {"a": "25 mm", "b": "40 mm"})
+    hm = pantograph_closures.reference_model({"a": "25 mm", "b": "40 mm"})
     for dq in ([1e-3, -2e-3, 1.5e-3], [-2e-3, 1e-3, -1e-3]):
         q = hm.q_home + np.array(dq)
         a, b = cn.forward_kinematics(hm, q, NEWTON), cn.forward_kinematics(fm, q, NEWTON)
