@@ -1,9 +1,11 @@
 """Seed mechanisms written with bodies and joints only (issue 21, item 5), against the built-in modules.
 
-* problems/mechanisms/pantograph.yaml (the built-in ``pantograph``, read here without its add-on) -- the 3D
-  pantograph of Elgammal et al. (links, the parallelogram CDFB, the two loops sharing links, U joints at A and B
-  for the plane's turn phi): FK, IK, the task Jacobian dx/dq and the hinge angle psi equal the hand-written
-  closures it replaced (tests/reference/pantograph_closures.py, eq 1-8 by hand) to 1e-12; its task
+* tests/corpus/pantograph_joints.yaml -- the 3D pantograph of Elgammal et al. with the paper's own joints (links,
+  the parallelogram CDFB, the two loops sharing links, U joints at A and B for the plane's turn phi, R hinges at
+  C and F: overconstrained, normal equations): FK, IK, the task Jacobian dx/dq and the hinge angle psi equal the
+  hand-written closures the built-in replaced (tests/reference/pantograph_closures.py, eq 1-8 by hand) to
+  1e-12 (the built-in, problems/mechanisms/pantograph.yaml, closes its loops with S joints at C and F:
+  tests/test_pantograph_written_once.py); its task
   Jacobian is the paper's constant J = diag(Mx, -My, -Mz) (eq 9-13); Gruebler-Kutzbach is
   negative (section 2) while the loops' rank gives 3 degrees of freedom.
 * tests/corpus/prc3_levers.yaml -- the 3-PRC of Li et al. with each limb's secondary lever
@@ -31,8 +33,8 @@ from .reference import pantograph_closures
 
 CORPUS = Path(__file__).resolve().parent / "corpus"
 SHIPPED = Path(__file__).resolve().parent.parent / "problems" / "mechanisms"
-#: the seed files: the pantograph is the shipped one, the others are in the corpus
-FILES = {"pantograph_joints": SHIPPED / "pantograph.yaml"}
+#: the seed files (in the corpus unless named here)
+FILES: dict[str, Path] = {}
 NEWTON = cn.SolverConfig("newton")
 
 
@@ -134,6 +136,9 @@ def test_pantograph_joints_mobility_by_rank_against_gruebler():
     assert info.gruebler == -1
     assert info.mobility == 3
     assert len(info.loops) == 2  # through C (A-C-B) and the parallelogram (closed at F)
+    # the shipped file closes both loops with S joints at C and F: no repeated equations
+    gen, _fns = closure_parts(described.read_description(SHIPPED / "pantograph.yaml"))
+    assert gen.info.gruebler == gen.info.mobility == 3 and len(gen.info.loops) == 2
 
 
 # -- the 3-PRC with its lever amplifiers ---------------------------------------------------------
