@@ -424,5 +424,11 @@ def test_pantograph_outputs_against_dx_like_fig_20(tmp_path):
     # dy, dz and the second U's turn), said in the title, not drawn as flat panels
     title = fig._suptitle.get_text().replace("\n", " ")
     assert "constant over the batch: py = 0 mm, pz = 0 mm, yA = 0 mm, zA = 0 mm, phi = 0 deg, phiB = 0 deg" in title
-    assert [ax.get_ylabel() for ax in fig.axes] == ["$px$ (mm)", r"$\theta_{1}$ (deg)", r"$\theta_{2}$ (deg)"]
+    # the paper's px, theta1, theta2, and the file's own joints that move: the slider xB (= dx), the
+    # parallelogram's angles psiD, psiB (= psi, eq 17)
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert labels == ["$px$ (mm)", "$xB$ (mm)", r"$\theta_{1}$ (deg)", r"$\theta_{2}$ (deg)"] + [
+        "psiD (deg)",
+        "psiB (deg)",
+    ]
     assert_figure_readable(fig)
