@@ -482,7 +482,7 @@ def test_rpr_eq40_is_the_generic_input_stiffness():
     from cpm_nlp.mechanisms.rpr import compliance as rc
 
     m = build_model("rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"})
-    k_J = rc.stiffness_order(12.0, 3.0)
+    k_J = rc.stiffness_order(m, 12.0, 3.0)
     G, G_p = rc.passive_rates(m, m.x_home)
     np.testing.assert_allclose(rc.mechanism_stiffness(m, m.x_home, k_J), G_p.T @ np.diag(k_J) @ G_p, rtol=1e-9)
     x = m.x_home + np.array([0.02, -0.01, 1e-3])

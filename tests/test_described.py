@@ -3,9 +3,9 @@
 The papers' mechanisms re-described as files must be the hand-derived modules:
 FK, IK, the Jacobians and the passive joint angles to 1e-12 on random poses of
 the working range.  The reference is the hand-written module of each paper
-(tests/reference/prs3_closures.py, tests/reference/prc3_closures.py and
-tests/reference/pantograph_closures.py -- the 3-PRS, the 3-PRC and the pantograph are the files
-themselves now, issue 21 --, rpr/kinematics.py), whose
+(tests/reference/prs3_closures.py, prc3_closures.py, rpr_closures.py and
+pantograph_closures.py -- the 3-PRS, the 3-PRC, the RPR and the pantograph are the files
+themselves now, issue 21), whose
 formulas are pinned to the papers in their own tests; the file's closure is
 generated from the legs and shares no code with them.
 """
@@ -37,7 +37,7 @@ CASES = {
         {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"},
         15e-6,
     ),
-    "rpr": ("rpr_file", "rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 50e-6),
+    "rpr": ("rpr", "rpr_reference", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 50e-6),
     "pantograph": ("pantograph", "pantograph_reference", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
 }
 NEWTON = cn.SolverConfig("newton")
@@ -53,6 +53,10 @@ def _models(case):
         from .reference import prc3_closures
 
         return cn.build_model(file_name, params), prc3_closures.reference_model(params)
+    if hand_name == "rpr_reference":  # and the hand-written RPR (issue 21, item 5)
+        from .reference import rpr_closures
+
+        return cn.build_model(file_name, params), rpr_closures.reference_model(params)
     if hand_name == "pantograph_reference":  # and the hand-written pantograph (issue 21, item 5)
         from .reference import pantograph_closures
 
@@ -229,7 +233,7 @@ def test_reference_configuration_that_does_not_assemble(tmp_path):
     rpr = (
         (MECH / "rpr.yaml")
         .read_text()
-        .replace("name: rpr_file", "name: rpr_bad")
+        .replace("name: rpr\n", "name: rpr_bad\n")
         .replace("P0: {dimension: length,", "P0: {dimension: length, default: 40 mm,")
     )
     rpr = rpr.replace("r1: {dimension: length,", "r1: {dimension: length, default: 40 mm,").replace(
@@ -354,9 +358,10 @@ def test_flexure_hinge_sets_the_joint_limits(tmp_path):
 
 
 def test_a_file_may_not_take_a_built_in_name(tmp_path):
+    """A file named like a built-in (rpr, itself a shipped file) that differs from it."""
     (tmp_path / "m.yaml").write_text(DEFAULTS.replace("name: prc3_bad", "name: rpr"))
     problem = {"problem": "forward_kinematics", "mechanism": {"file": "m.yaml"}, "inputs": {"q1": 0, "q2": 0, "q3": 0}}
-    with pytest.raises(cn.InputError, match="taken by a built-in mechanism"):
+    with pytest.raises(cn.InputError, match="name 'rpr' is the built-in mechanism of .*rpr.yaml.* rename it"):
         cn.problem_from_dict(problem, base_dir=tmp_path)
 
 

@@ -346,7 +346,12 @@ def test_describe_file_prints_derived_legs_loops_and_mobility(tmp_path, cli):
     assert run.code == 0, run.err
     out = run.out
     assert "P1       = [73.5 mm, 11.52 mm, 0 mm]" in out
-    assert "leg limb1: base -> limb1.link1 -> platform" in out
+    assert "leg limb1: ground -> limb1_link1 -> limb1_rod -> platform" in out
+    # the expanded graph (issue 21): bodies, joints, loops, both mobility counts, the assembly
+    assert "limb1_rod  points: limb1_j2, limb1_j2_end" in out
+    assert "loop 1, closed by limb1_j2_end: limb1_rod - limb1_link1 - ground - platform  (3 equation(s))" in out
+    assert "3 degree(s) of freedom; Grübler-Kutzbach: 3; actuated: 3 (q1, q2, q3)" in out
+    assert "reference configuration: assembled from the drawing in 0 Gauss-Newton step(s)" in out
     assert "1. P         at [0 mm, 0 mm, 0 mm]  axis [-1, 0, 0]  actuated: q1" in out
     assert "2. distance  at [0 mm, 0 mm, 0 mm]  to [73.5 mm, 0 mm, 0 mm]" in out
     assert "leg limb1: 1 equation(s): distance" in out
@@ -397,10 +402,10 @@ def test_describe_kind_with_a_bad_mechanism_file_is_exit_2(tmp_path, cli):
 def test_describe_plot_draws_the_body_graph(tmp_path, cli):
     from cpm_nlp.mechanisms.described.summary import body_graph
 
-    nodes, edges = body_graph(described.read_description(MECH / "prs3.yaml"))
-    assert nodes == ["base", *[f"leg{k}.link{n}" for k in (1, 2, 3) for n in (1, 2)], "platform"]
-    assert [e for e in edges if e[3]] == [("base", f"leg{k}.link1", f"P s{k}", True) for k in (1, 2, 3)]
-    assert [e[2] for e in edges if e[1] == "platform"] == ["S", "S", "S"]
+    nodes, edges = body_graph(described.read_description(MECH / "prs3.yaml"))  # the expanded graph's
+    assert nodes == ["ground", *[f"leg{k}_link{n}" for k in (1, 2, 3) for n in (1, 2)], "platform"]
+    assert [e for e in edges if e[3]] == [("ground", f"leg{k}_link1", f"leg{k}_j1 P s{k}", True) for k in (1, 2, 3)]
+    assert [e[2] for e in edges if e[1] == "platform"] == [f"leg{k}_j3 S" for k in (1, 2, 3)]
     out = tmp_path / "graph.png"
     run = cli("describe", str(MECH / "prs3.yaml"), "--plot", str(out))
     assert run.code == 0, run.err

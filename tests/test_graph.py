@@ -221,7 +221,9 @@ def _bad(change) -> cn.InputError:
         (lambda d: d["joints"][1].update(at="Q"), "joints[1].at", "not a point of 'crank'"),
         (lambda d: d["bodies"].update(base=d["bodies"].pop("ground")), None, None),  # 'base' is a ground too
         (lambda d: d["bodies"].update(frame=d["bodies"].pop("ground")), "bodies", "no ground"),
-        (lambda d: d.update(legs=[{"joints": [{"type": "S", "at": [0, 0]}]}]), "legs", "not both"),
+        # legs and bodies in one file (issue 21): the legs place the platform by its coordinates
+        (lambda d: d.update(legs=[{"joints": [{"type": "planar_R", "at": [0, 0]}]}]), "platform", "places its"),
+        (lambda d: d.update(actuators={"u": "length"}), "actuators", "not both"),
         (lambda d: d["joints"][0].pop("actuated"), "joints", "no actuators"),
         (lambda d: d["joints"][3].update(actuated="psi2"), "joints", "actuate fewer"),
         (lambda d: d["platform"].update(task=["chi"]), "platform.task[0]", "unknown task coordinate"),

@@ -29,7 +29,7 @@ from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import load_file
 from cpm_nlp.mechanisms.described.graph import closure_parts
 
-from .reference import pantograph_closures
+from .reference import pantograph_closures, prs3_closures, rpr_closures
 
 CORPUS = Path(__file__).resolve().parent / "corpus"
 SHIPPED = Path(__file__).resolve().parent.parent / "problems" / "mechanisms"
@@ -253,9 +253,10 @@ def test_prc3_levers_mobility():
 # -- the 3-PRS and the RPR -----------------------------------------------------------------------
 
 TWINS = {
-    # joints-only file, built-in module, its parameters (the papers'), actuator half-range about home
-    "prs3_joints": ("prs3", {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}, 2e-3),
-    "rpr_joints": ("rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 2e-3),
+    # joints-only file, the hand-written closures the built-in replaced (tests/reference, issue 21),
+    # its parameters (the papers'), actuator half-range about home
+    "prs3_joints": (prs3_closures, {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}, 2e-3),
+    "rpr_joints": (rpr_closures, {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 2e-3),
 }
 
 
@@ -272,7 +273,7 @@ def test_joints_only_twin_equals_the_builtin_module(name):
     FK -> IK round trip.  The joint angles are the file's joint coordinates (a tree joint's) or
     its cut joints' reported values: alpha_i, beta_*i (prs3, eq 22-33), theta_a** (rpr, eq 13)."""
     hand, params, half = TWINS[name]
-    fm, hm = _file_model(name), cn.build_model(hand, params)
+    fm, hm = _file_model(name), hand.reference_model(params)
     assert list(fm.closure.q_names) == list(hm.closure.q_names)
     assert fm.closure.task == hm.closure.task
     idx = [fm.closure.x_names.index(n) for n in hm.closure.x_names]

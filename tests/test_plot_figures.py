@@ -144,12 +144,16 @@ def test_prc3_drawing_has_legs_of_length_l():
 
 
 def test_rpr_drawing_has_legs_of_the_actuated_lengths():
-    """rpr-2rpu-upr-zhang-2022.md eq 2-6: |A_iB_i| = l_i; |oo'| = P."""
+    """rpr-2rpu-upr-zhang-2022.md eq 2-6: |A_iB_i| = l_i; |oo'| = P.  The drawing is its file's
+    (problems/mechanisms/rpr.yaml): A_i is leg{i}_1, B_i leg{i}_3, o' the platform centre P."""
     model, x, q = pose_of("rpr")
     d = model.mechanism.geometry(model, x, q)
     for i in (1, 2, 3):
-        assert _dist(d, f"A{i}", f"B{i}") == pytest.approx(q[i - 1], rel=1e-9)
-    assert _dist(d, "o", "o'") == pytest.approx(x[2], rel=1e-12)
+        assert _dist(d, f"leg{i}_1", f"leg{i}_3") == pytest.approx(q[i - 1], rel=1e-9)
+    assert np.linalg.norm(np.asarray(d.points["P"])) == pytest.approx(x[2], rel=1e-12)
+    r1, r2 = model.parameters["r1"], model.parameters["r2"]
+    for i, A in ((1, [r1, 0, 0]), (2, [0, r2, 0]), (3, [-r1, 0, 0])):  # eq 5
+        assert np.asarray(d.points[f"leg{i}_1"]) == pytest.approx(A, abs=1e-15)
 
 
 def test_a_mechanism_without_geometry_says_so():

@@ -10,7 +10,7 @@ import cpm_nlp as cn
 from cpm_nlp.analysis import flexure
 from cpm_nlp.analysis import flexure_compliance as fc
 from cpm_nlp.mechanisms.rpr import compliance as rc
-from cpm_nlp.mechanisms.rpr import kinematics as rpr
+from cpm_nlp.mechanisms.rpr import screws as rpr
 
 AL = flexure.MATERIALS["Al 7075-T6"]
 SPEC = rc.JointSpec(AL, SF=2.0, theta_des=math.radians(2), box=12e-3, t_min=0.3e-3, couple_arm=1.0)
@@ -81,7 +81,7 @@ def test_eq_36_amplifier_matrices_and_the_exchanged_arms():
 def test_compliance_model_structure(model):
     kR, kU = 3.0, 6.0
     out = rc.compliance_model(
-        model, model.x_home, l1=16e-3, l2=1.6e-3, c_r=0.2, c_t=3e-9, k_J=rc.stiffness_order(kR, kU)
+        model, model.x_home, l1=16e-3, l2=1.6e-3, c_r=0.2, c_t=3e-9, k_J=rc.stiffness_order(model, kR, kU)
     )
     G, G_p, K = out["G"], out["G_p"], out["K_prime"]
     assert np.allclose(G, rpr.screw_jacobian(model, model.x_home).G)
@@ -105,7 +105,7 @@ def test_compliance_of_the_shipped_assumptions_against_eq_55_and_58(model):
     kU = 1 / fc.circular_notch_compliances(AL.E, AL.G, 12e-3, 0.4e-3, 1e-3)["rz"]
     c_r, c_t = rc.leaf_compliances(AL, 1e-3, 0.4e-3, 12e-3)
     out = rc.compliance_model(
-        model, model.x_home, l1=16e-3, l2=1.6e-3, c_r=c_r, c_t=c_t, k_J=rc.stiffness_order(kR, kU)
+        model, model.x_home, l1=16e-3, l2=1.6e-3, c_r=c_r, c_t=c_t, k_J=rc.stiffness_order(model, kR, kU)
     )
     C, C_in = out["C"], out["C_in"]
     # eq 55 (the paper's theory) and eq 58, within the 15 % of problems/rpr_compliance.yaml

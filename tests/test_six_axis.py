@@ -213,8 +213,9 @@ def test_cutting_force_file_with_the_actuators_held():
 
 
 def test_six_axis_needs_chains(tmp_path):
-    """hinge_axes: all on a mechanism without leg chains (the built-in rpr) is bad
-    input: exit 2, one message naming the key."""
+    """hinge_axes: all on a mechanism whose hinges are not in its legs' chains (the built-in
+    rpr: its R and U angles are passive expressions of its file, its legs S-P-S) is bad input:
+    exit 2, one message naming the hinge's key and what to do."""
     f = tmp_path / "p.yaml"
     f.write_text(
         "problem: platform_compliance\n"
@@ -223,7 +224,8 @@ def test_six_axis_needs_chains(tmp_path):
     )
     out = subprocess.run([sys.executable, "-m", "cpm_nlp", "solve", str(f)], capture_output=True, text=True)
     assert out.returncode == 2, out.stderr
-    assert "inputs.hinge_axes" in out.stderr and "chains" in out.stderr and "Traceback" not in out.stderr
+    assert "inputs.hinges.R" in out.stderr and "chains" in out.stderr and "Traceback" not in out.stderr
+    assert "hinge_axes: kinematic" in out.stderr
 
 
 def test_filleted_neck_against_adaptive_quadrature():
@@ -291,15 +293,16 @@ inputs:
   material: Al 7075-T6
   k_actuator: 1e5 N/m
   hinges:
-    a: {{joints: theta_R, type: circular_notch, t: 0.4 mm, r: 4 mm, w: 12 mm}}
+    R: {{joints: theta_R, type: circular_notch, t: 0.4 mm, r: 4 mm, w: 12 mm}}
   load: {{P: 1 N}}
 """
 
 
 def test_hinges_the_chains_cannot_place_fall_back_to_the_kinematic_model(tmp_path):
-    """The RPR file twin writes its R and U joints as expressions (its legs are S-P-S), so
-    its hinges are not in the chains: the default says so and uses the kinematic model;
-    asking for hinge_axes: all is bad input (exit 2, the key path, what to do)."""
+    """The RPR file writes its R and U joints as expressions (its legs are S-P-S), so its
+    hinges (its Table 1 R and U, the R given again here) are not in the chains: the default
+    says so and uses the kinematic model; asking for hinge_axes: all is bad input (exit 2, the
+    key path, what to do)."""
     out = _solve_file(tmp_path, RPR)
     assert out.returncode == 0, out.stderr
     res = json.loads(out.stdout)
@@ -307,7 +310,7 @@ def test_hinges_the_chains_cannot_place_fall_back_to_the_kinematic_model(tmp_pat
     assert "cannot place" in res["message"]
     bad = _solve_file(tmp_path, RPR, "inputs.hinge_axes=all")
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
-    assert "inputs.hinges.a" in bad.stderr and "hinge_axes: kinematic" in bad.stderr
+    assert "inputs.hinges.R" in bad.stderr and "hinge_axes: kinematic" in bad.stderr
 
 
 @pytest.mark.parametrize(

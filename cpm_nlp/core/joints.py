@@ -22,7 +22,7 @@ them, and by a hinge's geometry where none does.
   leaf spring (offered for the pantograph's joints by flexure.HINGES; it bends
   about one axis).
 * As a U: a circular notch on each axis (rpr-2rpu-upr-zhang-2022.md Table 1 as
-  cpm_nlp.mechanisms.rpr reads it); a round neck (circular or filleted rod), which bends
+  problems/mechanisms/rpr.yaml reads it); a round neck (circular or filleted rod), which bends
   about two axes (geometry: no shipped mechanism has one there).
 * As an S: a filleted rod (prs3-ruiz.md section 5), a circular rod (the same
   neck without fillets: geometry).

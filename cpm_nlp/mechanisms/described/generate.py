@@ -39,6 +39,13 @@ configuration (:meth:`Generator.elimination_indicators`):
   is the ``aspect``;
 * a P leg: its length over its reference length (its working mode) and the
   cosine of the leg to its reference direction.
+
+A pure legs file keeps this generator for its closures: with each leg's passive joints
+eliminated, Φ has one to three rows per leg in the platform coordinates alone, and its FK and
+batch run within 1.1x of the hand-written modules (benchmarks/bench_described.py).  The same
+file expanded into bodies and joints (:mod:`.expand`, every passive joint an unknown of a
+spanning tree) serves ``describe``, the assembly of a rough drawing and files that mix legs
+with bodies; it would be the slower closure.
 """
 
 from __future__ import annotations
@@ -121,6 +128,8 @@ class _Joint:
     motions: list = field(default_factory=list)
     #: the coordinate names of its degrees of freedom (given, or made up for a passive unknown)
     names: tuple = ()
+    #: a distance joint's given length (None: |to - at| in the drawing)
+    length: ca.SX | None = None
 
     @property
     def type(self) -> str:
@@ -326,8 +335,18 @@ class Generator:
             if j.to is None:
                 raise InputError("a distance joint needs 'to' (the point on the distal body)", path=j.path)
             out.to = turn @ self.vector(j.to, j.path + ("to",), env, "length")
+            if j.length is not None:  # the rod's length, the drawing's `to` only roughly there (assembled)
+                out.length = self.scalar(j.length, j.path + ("length",), env, "length")
+                self.requirements.append(
+                    (ca.if_else(out.length > 0, 0, 1), "expected a positive length", j.path + ("length",))
+                )
         elif j.to is not None:
             raise InputError("only a distance joint has 'to'", path=j.path + ("to",))
+        if j.length is not None and j.type != "distance":
+            raise InputError(
+                f"only a distance joint has 'length' (a {j.type} joint's links are drawn by their joints)",
+                path=j.path + ("length",),
+            )
         if kind.axis == "given":
             if j.axis is None:
                 raise InputError(f"a {j.type} joint needs its 'axis'", path=j.path)
@@ -383,8 +402,10 @@ class Generator:
 
     def close(self, leg: Leg, joints: list[_Joint]) -> None:  # noqa: C901 - one branch per leg ending
         last = joints[-1]
+        rod = None  # a distance joint's given length
         if last.type == "distance":
             tip, elim = last.to, _Joint(Joint("S", path=last.spec.path), at=last.at)
+            rod = last.length
             before = joints[:-1]
         elif last.type in POINT_JOINTS and (last.type == "S") != self.d.platform.planar:
             tip = last.at
@@ -468,7 +489,10 @@ class Generator:
             self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0, elim.axis)], leg.name)
             Rb = _rot(w, theta) @ Rm
         else:
-            self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: distance"))
+            if rod is None:
+                self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: distance"))
+            else:  # its given length: the drawing need not close (the reference is assembled)
+                self.rows.append(((ca.dot(v, v) - rod**2) / (2 * rod), f"leg {leg.name}: distance"))
             self.eliminated(leg, elim, before, c, v, 1)
             Rb = self.report_sphere(elim, Rm, u0, v, leg)
         self.report_tip(last, Rb, R_rel, leg.name)

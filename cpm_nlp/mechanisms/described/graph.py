@@ -45,6 +45,7 @@ from ...core.options import REQUIRED
 from ...core.screws import vee
 from . import expr as ex
 from .drawing import _polygon
+from .expand import InLeg
 from .generate import JOINT_DIMS, Generator, _Reported, _rot, _xyz_angles, elementary_motions, family
 from .spec import GROUND_NAMES, Description, Joint
 
@@ -121,6 +122,52 @@ class GraphGenerator(Generator):
         self.actuated_coords: set[str] = set()
         self.info: GraphInfo | None = None
         self.assembler: Assembler | None = None
+        #: an expanded legs file: each leg's environment and rotation (id of the leg -> (env, turn))
+        self._frames: dict[int, tuple[dict, ca.SX]] = {}
+
+    # -- expressions of an expanded legs file (in a leg's frame: its let, index and rotation) ----
+    def _leg_frame(self, leg: Any) -> tuple[dict, ca.SX]:
+        """A leg's environment (parameters, derived values, its index and ``let``) and its rotation,
+        as the legs generator resolves them (:meth:`Generator.leg`)."""
+        frames = self._frames
+        if id(leg) not in frames:
+            env = dict(self.env)
+            if leg.index is not None:
+                self._bind(env, leg.index, ex.Value(ca.SX(float(leg.values[0])), None), leg.path + ("repeat", "index"))
+            for name, text in leg.let.items():
+                self._bind(env, name, super().value(text, leg.path + ("let", name), env), leg.path + ("let", name))
+            turn = ca.SX.eye(3)
+            if leg.rotate is not None:
+                angle = super().scalar(leg.rotate, leg.path + ("repeat", "rotate"), env, "angle")
+                turn = _rot(leg.rotate_axis, angle)
+            frames[id(leg)] = (env, turn)
+        return frames[id(leg)]
+
+    def value(self, text: Any, path: tuple, env: Any, dimension: str | None = None) -> ex.Value:
+        if isinstance(text, InLeg):
+            return super().value(text.text, text.path or path, self._leg_frame(text.leg)[0], dimension)
+        return super().value(text, path, env, dimension)
+
+    def vector(self, text: Any, path: tuple, env: Any, dimension: str | None) -> ca.SX:
+        if not isinstance(text, InLeg):
+            return super().vector(text, path, env, dimension)
+        lenv, turn = self._leg_frame(text.leg)
+        path = text.path or path
+        if text.across is None:
+            v = super().vector(text.text, path, lenv, dimension)
+            return turn @ v if text.turn else v
+        a, b = (super(GraphGenerator, self).vector(t, path, lenv, "length") for t in text.across)
+        u = turn @ (b - a) / ca.norm_2(b - a)
+        if text.normal == 0:  # the point at a length from `from` towards `to`
+            return turn @ a + self.scalar(text.text, path, lenv, "length") * u
+        # two unit vectors across u: n1 = unit(u x e), n2 = u x n1, e the basis vector least aligned
+        # with u (with the parameters' defaults), as for a joint's normals
+        value = np.abs(np.asarray(ca.Function("u", [self.p], [u])(self.p_default), dtype=float).ravel())
+        e = ca.DM.zeros(3)
+        e[int(np.argmin(value))] = 1.0
+        n1 = ca.cross(u, e)
+        n1 = n1 / ca.norm_2(n1)
+        return n1 if text.normal == 1 else ca.cross(u, n1)
 
     # -- the drawing ------------------------------------------------------------------------
     @property
@@ -152,6 +199,10 @@ class GraphGenerator(Generator):
     def read_joints(self) -> None:  # noqa: C901 - one rule per joint part
         planar = self.d.platform.planar
         allowed = joint_types(planar)
+        if self.d.platform.placed:  # the platform coordinates place the platform (an expanded legs file)
+            zero = ca.SX.zeros(3)
+            spec = Joint("pose", name="platform_pose", path=("platform", "coordinates"))
+            self.gjoints.append(_GJoint(spec, "pose", self.ground, "platform", zero, zero, tree=True))
         for j in self.d.joints:
             jt = JOINT_TYPES[j.type]
             kind = jt.twin if planar and jt.twin and not jt.planar else j.type  # a planar file reads R, P as planar
@@ -197,6 +248,11 @@ class GraphGenerator(Generator):
                     f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}",
                     path=j.path + ("coordinates",),
                 )
+            if kind != "distance" and j.length is not None:
+                raise InputError(
+                    f"only a distance joint has 'length' (a {j.type} joint's bodies carry its points)",
+                    path=j.path + ("length",),
+                )
             if kind == "distance":
                 if j.actuated is not None:
                     raise InputError(
@@ -226,7 +282,7 @@ class GraphGenerator(Generator):
 
         def rank(k: int) -> tuple:
             j = self.gjoints[k].spec
-            return (j.actuated is None, not task & set(j.coordinates), k)
+            return (j.type != "pose", j.actuated is None, not task & set(j.coordinates), k)
 
         order = sorted(range(len(self.gjoints)), key=rank)
         for k in order:
@@ -294,6 +350,9 @@ class GraphGenerator(Generator):
         gets its actuator (q) and a row that ties the two (:attr:`actuation_rows`), so that every
         body's pose is a function of the pose coordinates alone."""
         for g in self.gjoints:
+            if g.type == "pose":  # its values are the platform coordinates
+                g.names = tuple(self.x_names)
+                continue
             if not g.tree:
                 continue
             j = g.spec
@@ -330,6 +389,9 @@ class GraphGenerator(Generator):
     def motion(self, g: _GJoint) -> tuple[ca.SX, ca.SX]:
         """The pose of b relative to a (both frames the world at the drawing): b's point onto a's,
         then the joint's motions about axes through it."""
+        if g.type == "pose":  # the platform where its coordinates put it (the legs generator's platform_point)
+            R = self.R @ self.R_home.T
+            return R, self.P - R @ self.P_home
         T = _shift(g.pa)
         motions = elementary_motions(g) if g.type != "distance" else []  # type: ignore[arg-type]
         for (kind, axis), value in zip(motions, g.values):
@@ -355,6 +417,11 @@ class GraphGenerator(Generator):
                     self.angle[child] = self.angle[body] + (-turn if g.reversed else turn)
                     order.append(child)
             k += 1
+
+    def tree_columns(self) -> list[int]:
+        """The pose coordinates that are tree joints' values (the platform's too when it is placed)."""
+        placed = self.d.platform.placed
+        return [k for k, n in enumerate(self.x_names) if placed or n not in self.d.platform.coordinates]
 
     def world(self, body: str, p: ca.SX) -> ca.SX:
         R, t = self.pose[body]
@@ -444,6 +511,10 @@ class GraphGenerator(Generator):
         """The rows that say the platform coordinates locate the platform body (and its point)."""
         pf = self.d.platform
         names = [b.name for b in self.d.bodies]
+        if pf.placed:  # placed by the coordinates (a joint of the tree): no rows
+            self.platform_body = "platform"
+            self.platform_radius += [ca.norm_2(p - self.P_home) for p in self.body_points["platform"].values()]
+            return
         if not pf.coordinates and pf.body is None:  # the pose is the joints': the platform is the ground
             self.platform_body = self.ground
             self.P, self.R = ca.SX.zeros(3), ca.SX.eye(3)
@@ -563,7 +634,7 @@ class GraphGenerator(Generator):
         else:
             self.rows = [(r, name) for r, name, _loop in self.loop_rows] + act + self.platform_rows
         npf = len([n for n in self.x_names if n in d.platform.coordinates])
-        if len(self.platform_rows) != npf:
+        if len(self.platform_rows) != npf and not d.platform.placed:
             raise InputError(
                 f"the platform's position and rotation locate {len(self.platform_rows)} coordinate(s) of the body "
                 f"{self.platform_body!r}, and {npf} platform coordinate(s) are declared "
@@ -679,7 +750,7 @@ class GraphGenerator(Generator):
                 cols.append(self.world(body.name, p))
                 layout.append((body.name, drawn[key]))
         for g in self.gjoints:
-            if isinstance(g.spec.at, str) and g.spec.at.isidentifier():
+            if (isinstance(g.spec.at, str) and g.spec.at.isidentifier()) or g.type == "pose":
                 continue
             cols.append(self.world(g.a, g.pa))
             layout.append((g.a, g.name))
@@ -787,7 +858,7 @@ class Assembler:
         if not status["assembled"]:
             x0, _q0, _span = (np.asarray(v, dtype=float).ravel() for v in self.draw(self.defaults))
             Jx = np.asarray(self.F(x0, _q0, self.defaults)[1], dtype=float)
-            cols = [k for k, n in enumerate(gen.x_names) if n not in gen.d.platform.coordinates]
+            cols = gen.tree_columns()
             free = len(cols) - int(np.linalg.matrix_rank(Jx[: self.nloop][:, cols]))
             if free < len(gen.q_coords):  # the actuators lock the loops against each other
                 raise InputError(
@@ -804,7 +875,7 @@ class Assembler:
                 hint="draw the mechanism closer to an assembled configuration, or check the link lengths",
             )
         _r, Jx, Jq = (np.asarray(v, dtype=float) for v in self.F(x, q, self.defaults))
-        cols = [k for k, n in enumerate(gen.x_names) if n not in gen.d.platform.coordinates]
+        cols = gen.tree_columns()
         ntree = len(cols)
         J = Jx[: self.nloop][:, cols]
         keep, basis = [], np.zeros((0, J.shape[1]))
@@ -822,7 +893,11 @@ class Assembler:
         mobility = ntree - rank
         lam = 3 if gen.d.platform.planar else 6
         freedom = [
-            _ROD_FREEDOM[gen.d.platform.planar] if g.type == "distance" else JOINT_TYPES[g.type].dof
+            _ROD_FREEDOM[gen.d.platform.planar]
+            if g.type == "distance"
+            else len(g.names)
+            if g.type == "pose"
+            else JOINT_TYPES[g.type].dof
             for g in gen.gjoints
         ]
         gk = lam * (len(gen.d.bodies) - 1) - sum(lam - f for f in freedom)
@@ -876,9 +951,86 @@ class Assembler:
 
 def closure_parts(d: Description) -> tuple[Generator, dict[str, Any]]:
     """The generator of a description -- its legs (:class:`Generator`) or its bodies and joints
-    (:class:`GraphGenerator`) -- and the functions it built."""
-    g = GraphGenerator(d) if d.is_graph else Generator(d)
-    return g, g.build()
+    (:class:`GraphGenerator`) -- and the functions it built.  A legs file whose drawing need not
+    close (:func:`assembled_from_drawing`) gets its reference configuration by the assembly of
+    the graph its legs expand into (:class:`LegsAssembler`); its closures stay the legs'."""
+    if d.is_graph:
+        if d.legs:  # a mixed file: its legs expanded, one graph with its bodies and joints
+            from .expand import expand_legs
+
+            d = expand_legs(d)
+        g = GraphGenerator(d)
+        return g, g.build()
+    g = Generator(d)
+    fns = g.build()
+    if assembled_from_drawing(d):
+        fns["assemble"] = LegsAssembler(d, g)
+    return g, fns
+
+
+def assembled_from_drawing(d: Description) -> bool:
+    """Whether a legs file's reference configuration is assembled: a leg's links are drawn by
+    their joints, so its drawing closes by construction, except where a rod (a distance joint)
+    gives its ``length``: then the drawing's ``to`` (and the platform's home) is only roughly
+    there."""
+    return any(j.length is not None for leg in d.legs for j in leg.joints)
+
+
+class LegsAssembler:
+    """The reference configuration of a legs file from a rough drawing: the :class:`Assembler` of
+    the graph its legs expand into (:func:`.expand.expand_legs`; Gauss-Newton on its loops with the
+    actuators at their drawn values), its pose coordinates read by name into the legs' (the
+    platform's, then each proximal chain's passive joints')."""
+
+    def __init__(self, d: Description, legs: Generator) -> None:
+        from .expand import expand_legs, expansion_gap  # expand imports this module's reader
+
+        gap = expansion_gap(d)
+        if gap is not None:
+            raise InputError(
+                f"a rod's given length makes the reference configuration an assembly, and {gap}",
+                path=("legs",),
+                hint="give the rods' lengths by their drawing (no 'length'), or write the loops as legs",
+            )
+        for par in d.parameters:
+            if par.default is REQUIRED:
+                raise InputError(
+                    f"a legs file assembled from its drawing (a rod gives its 'length') needs a default for every "
+                    f"parameter ({par.name!r} has none): the loops' rank is taken with the defaults",
+                    path=("parameters", par.name, "default"),
+                )
+        try:
+            self.graph = GraphGenerator(expand_legs(d))
+            self.graph.build()
+        except InputError as exc:
+            raise _in_legs(exc) from None
+        self.assembler = self.graph.assembler
+        where = {n: k for k, n in enumerate(self.graph.x_names)}
+        self.columns = []
+        for name in legs.x_names:
+            # a passive joint of one motion is the graph's joint name (the legs add "_1")
+            short = name[:-2] if name.endswith("_1") else name
+            k = where.get(name, where.get(short))
+            if k is None:  # every legs coordinate is a tree coordinate of the expansion
+                raise RuntimeError(f"the expanded graph of {d.name} has no coordinate {name!r}")
+            self.columns.append(k)
+
+    def solve(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
+        x, q, status = self.assembler.solve(p)
+        return x[self.columns], q, status
+
+    def __call__(self, p: Any) -> tuple[np.ndarray, np.ndarray]:
+        try:
+            x, q = self.assembler(p)
+        except InputError as exc:
+            raise _in_legs(exc) from None
+        return x[self.columns], q
+
+
+def _in_legs(exc: InputError) -> InputError:
+    """An error of the expanded graph, located in the legs file (its joints are the legs')."""
+    path = exc.path if exc.path and exc.path[0] != "joints" else ("legs",)
+    return InputError(exc.message, path=path, suggestions=exc.suggestions, hint=exc.hint)
 
 
 def _defaults(d: Description) -> np.ndarray:
@@ -902,7 +1054,7 @@ def graph_geometry(fn: ca.Function, layout: list, gen: GraphGenerator) -> Callab
     ground, platform = gen.ground, gen.platform_body
     actuated = {g.b if not g.reversed else g.a for g in gen.gjoints if g.tree and g.spec.actuated is not None}
     named = [(g, g.spec.at if isinstance(g.spec.at, str) and g.spec.at.isidentifier() else g.name) for g in gen.gjoints]
-    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type != "distance"}
+    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type not in ("distance", "pose")}
     ends = [(g.spec.at, g.spec.to) for g in gen.gjoints if g.type == "distance"]
 
     def rods(pts: dict) -> list[tuple[str, str, str]]:

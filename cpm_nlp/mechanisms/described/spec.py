@@ -153,6 +153,9 @@ class Platform:
     #: that ``position`` locates (None: the body's frame origin, the world origin in the drawing)
     body: str | None = None
     point: str | None = None
+    #: the platform coordinates place the platform body (a legs file expanded into bodies and
+    #: joints, :mod:`.expand`): its pose is P(x), R(x) R_home^T, the legs close on it
+    placed: bool = False
 
 
 @dataclass
@@ -426,6 +429,7 @@ JOINT_KEYS = {
     "type": "one of " + ", ".join(JOINT_TYPES),
     "at": "location (vector expression)",
     "to": "the distal point of a distance joint",
+    "length": "a distance joint's length (default: |to - at| in the drawing; given: the drawing may be rough)",
     "axis": "axis (vector expression)",
     "axes": "the axes of a U (2) or of an S's reported angles (3)",
     "actuated": "the actuator coordinate's name",
@@ -441,8 +445,8 @@ JOINT_KEYS = {
 GRAPH_JOINT_KEYS = {
     "name": "the joint's name (default J1, J2, ... in file order)",
     "between": "[proximal body, distal body]",
-    "length": "the rod's length (a distance joint; default: its length in the drawing)",
     **{k: v for k, v in JOINT_KEYS.items() if k != "body"},
+    "length": "the rod's length (a distance joint; default: its length in the drawing)",
 }
 
 
@@ -634,8 +638,8 @@ def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a
             last = n == len(leg.joints) - 1
             body = j.body or ("platform" if last else f"{leg.name}.link{n + 1}")
             where = j.path + ("body",)
-            if body == "base":
-                raise InputError(f"a joint cannot carry the base (it joins {prev!r} to the base)", path=where)
+            if body in GROUND_NAMES:
+                raise InputError(f"a joint cannot carry the base (it joins {prev!r} to {body!r})", path=where)
             if body == prev or body in seen:
                 raise InputError(
                     f"two joints on the body {body!r} with no loop between them: this joint joins {prev!r} "
@@ -662,6 +666,23 @@ def check_bodies(legs: list[Leg]) -> None:  # noqa: C901 - one message per way a
             owner[body] = leg.name
             seen.add(body)
             prev = body
+
+
+def leg_bodies(legs: list[Leg]) -> list[str]:
+    """The bodies the legs run through: the ground, each leg's links (its joints' ``body``, else
+    ``{leg}_link{n}``; a rod ``{leg}_rod`` for a last distance joint) and the platform (see
+    :mod:`.expand`)."""
+    if not legs:
+        return []
+    out = ["ground"]
+    for leg in legs:
+        for n, j in enumerate(leg.joints):
+            last = n == len(leg.joints) - 1
+            if last and j.type == "distance":
+                out.append(f"{leg.name}_rod")
+            elif not last:
+                out.append(j.body or f"{leg.name}_link{n + 1}")
+    return out + ["platform"]
 
 
 STIFFNESS_KEYS = {
@@ -696,9 +717,11 @@ BODY_KEYS = {"points": "name -> vector (null: the global point), or a list of gl
 GROUND_NAMES = ("ground", "base")
 
 
-def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa: C901 - one check per key
-    """The ``points``, ``bodies``, ``joints`` and ``outputs`` of a bodies-and-joints file."""
-    for key in ("legs", "closures", "actuators"):
+def _graph(data: Mapping, legs: list[Leg]) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa: C901 - one check per key
+    """The ``points``, ``bodies``, ``joints`` and ``outputs`` of a bodies-and-joints file; with
+    ``legs``, the bodies and joints besides the legs (a mixed file: the legs' bodies -- the ground,
+    each leg's links, the platform -- may be joined to the file's)."""
+    for key in ("closures", "actuators"):
         if data.get(key):
             raise InputError(
                 f"a file describes its mechanism by bodies and joints or by {key}, not both",
@@ -706,6 +729,7 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
                 hint="write every loop as joints between bodies (the loops are found from the graph), and mark "
                 "the actuated joints 'actuated: name'",
             )
+    of_legs = leg_bodies(legs)
     points = {}
     for name, v in _mapping(data.get("points") or {}, ("points",), "name -> vector").items():
         points[_name(name, ("points", name), "a point name")] = v
@@ -741,6 +765,15 @@ def _graph(data: Mapping) -> tuple[dict, list[Body], list[Joint], dict]:  # noqa
                     )
         bodies.append(Body(name, own, desc, ("bodies", name)))
     names = [b.name for b in bodies]
+    if of_legs:  # a mixed file: the legs' ground is 'ground'; its bodies join the file's
+        if "base" in names:
+            raise InputError(
+                "the legs' fixed body is 'ground': name it so here too", path=("bodies", "base"), suggestions=["ground"]
+            )
+        for b in of_legs:
+            if b not in names:
+                bodies.append(Body(b, {}, "", ("legs",)))
+        names = [b.name for b in bodies]
     if not any(n in GROUND_NAMES for n in names):
         raise InputError(
             f"no ground: name the fixed body 'ground' (or 'base'); the bodies are {', '.join(names)}",
@@ -859,7 +892,7 @@ def description_from_dict(data: Any, file: str | None = None) -> Description:  #
     check_bodies(legs)
     graph: tuple = ({}, [], [], {})
     if data.get("bodies") is not None:
-        graph = _graph(data)
+        graph = _graph(data, legs)
     else:
         for key in ("points", "joints", "outputs"):
             if data.get(key) is not None:

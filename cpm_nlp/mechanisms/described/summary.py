@@ -1,5 +1,6 @@
-"""A mechanism file as text, for ``cpm-nlp describe FILE``: its derived values, legs (bodies
-and joints: type, coordinates, actuated, hinge), loops and mobility.
+"""A mechanism file as text, for ``cpm-nlp describe FILE``: its derived values, its bodies and
+joints (a legs file: the graph its legs expand into, :mod:`.expand`), loops and mobility, and a
+legs file's legs (type, location, coordinates, actuated, hinge) and generated closures.
 
 The text is built from the description and its generated closure (the same the solvers use),
 and, when a model can be built (the parameters of the file's first example, else its
@@ -14,9 +15,12 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from ...core.errors import InputError
 from ...core.joints import JOINT_TYPES
 from ...core.model import Model
+from ...core.options import REQUIRED
 from ...core.units import format_quantity
+from .expand import GROUND, PLATFORM, expand_legs, expansion_gap
 from .generate import Generator, family
 from .graph import closure_parts
 from .spec import Description, Joint
@@ -95,19 +99,27 @@ def summary_text(d: Description, model: Model | None, source: str) -> str:  # no
     if d.is_graph:
         lines += graph_lines(gen, model)
         return "\n".join(lines) + "\n"
+    expanded, why = _expanded_graph(d, model)
+    if expanded is not None:
+        lines.append("the legs as bodies and joints (expanded; the platform is placed by its coordinates):")
+        lines += graph_lines(expanded, model, branch=False)
+    else:
+        lines.append(f"(no bodies-and-joints view: {why})")
     hinges = _hinges_of(d)
-    lines.append("legs (bodies and joints, base -> platform, at the reference configuration):")
+    lines.append("legs (the shorthand; joints base -> platform, at the reference configuration):")
     if not gen.leg_joints:
         lines.append("  (none: the loops are written as closures)")
     for leg, joints in gen.leg_joints:
-        bodies = ["base"]
+        bodies = [GROUND]
         for n, j in enumerate(leg.joints):
             last = n == len(leg.joints) - 1
-            bodies.append(j.body or ("platform" if last else f"{leg.name}.link{n + 1}"))
+            bodies.append(j.body or (PLATFORM if last else f"{leg.name}_link{n + 1}"))
+            if last and j.type == "distance":
+                bodies.insert(-1, f"{leg.name}_rod")
         lines.append(f"  leg {leg.name}: " + " -> ".join(bodies))
         for k, (spec, resolved) in enumerate(zip(leg.joints, joints)):
             lines.append("    " + _joint_line(k, spec, resolved, gen, model, hinges))
-    lines.append("loops (closure equations; one loop per leg: base -> leg -> platform -> base):")
+    lines.append("closures (generated from the legs by elimination, one group per leg: what the solvers use):")
     groups: dict[str, list[str]] = {}
     for name in fns["row_names"]:
         head, _, what = name.partition(": ")
@@ -142,10 +154,10 @@ def summary_text(d: Description, model: Model | None, source: str) -> str:  # no
     return "\n".join(lines) + "\n"
 
 
-def graph_lines(gen: Any, model: Model | None) -> list[str]:  # noqa: C901 - one section after another
+def graph_lines(gen: Any, model: Model | None, branch: bool = True) -> list[str]:  # noqa: C901 - one section after another
     """``describe`` of a bodies-and-joints file: bodies, joints (in the spanning tree or closing a
     loop), the loops, mobility by rank beside Grübler-Kutzbach, and the assembly of the reference
-    configuration."""
+    configuration (``branch``: and the branch indicators)."""
     info = gen.info
     lines = [f"bodies ({len(info.bodies)}; the ground: {info.ground}):"]
     for body in gen.d.bodies:
@@ -156,7 +168,7 @@ def graph_lines(gen: Any, model: Model | None) -> list[str]:  # noqa: C901 - one
         f"joints ({len(info.joints)}; {ntree} in the spanning tree, {len(info.joints) - ntree} closing a loop):"
     )
     for g, (name, kind, a, b, actuated, tree, loop) in zip(gen.gjoints, info.joints):
-        at = g.spec.at if isinstance(g.spec.at, str) else "(a point)"
+        at = g.spec.at if isinstance(g.spec.at, str) else "its coordinates" if kind == "pose" else "(a point)"
         role = "tree" if tree else f"closes loop {loop}"
         coords = (
             f"actuated: {g.spec.actuated}" if actuated else ("coordinates: " + ", ".join(g.names) if g.names else "")
@@ -205,15 +217,36 @@ def graph_lines(gen: Any, model: Model | None) -> list[str]:  # noqa: C901 - one
             else f"does not assemble from the drawing: residual {status['residual']:.3g} in {status['worst_row']}"
         )
     )
-    if gen.branch:
+    if gen.branch and branch:
         lines.append("branch indicators: " + ", ".join(b[1] for b in gen.branch))
     return lines
+
+
+def _expanded_graph(d: Description, model: Model | None) -> tuple[Any, str]:
+    """The graph generator of a legs file's expansion, with the model's parameters (or the
+    defaults); None and why when there is none."""
+    gap = expansion_gap(d)
+    if gap is not None:
+        return None, f"it has no bodies-and-joints equivalent yet: {gap}"
+    values = dict(zip([p.name for p in d.parameters], np.asarray(model.p, dtype=float))) if model is not None else {}
+    missing = [p.name for p in d.parameters if p.default is REQUIRED and p.name not in values]
+    if missing:
+        return None, f"the loops' rank needs a value of {', '.join(missing)} (give them in an example problem)"
+    try:
+        gen, _fns = closure_parts(expand_legs(d, values))
+    except InputError as exc:
+        return None, exc.render()
+    return gen, ""
 
 
 def body_graph(d: Description) -> tuple[list[str], list[tuple[str, str, str, bool]]]:
     """The bodies (base, each leg's links, platform) and the joints between them as edges
     (from body, to body, label, actuated), base side first: the graph ``describe --plot`` draws.
-    A bodies-and-joints file: its bodies (the ground first) and every joint, named."""
+    A bodies-and-joints file: its bodies (the ground first) and every joint, named; a legs file:
+    the bodies and joints its legs expand into (the platform, placed by its coordinates, is not
+    joined to the ground by an edge)."""
+    if d.legs and expansion_gap(d) is None:
+        d = expand_legs(d)
     if d.is_graph:
         ground = next(b.name for b in d.bodies if b.name in ("ground", "base"))
         nodes = [ground] + [b.name for b in d.bodies if b.name != ground]

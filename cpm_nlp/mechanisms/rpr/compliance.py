@@ -44,7 +44,8 @@ Readings and inputs the paper leaves out (documented, not tuned):
   12 L/(E w t³), c_t = L/(E w t), the PRB rotation and the stretch along the
   leaf).
 * K_J holds the stiffness of each passive joint's working rotation (eq 39), in
-  the order of :data:`cpm_nlp.mechanisms.rpr.kinematics.PASSIVE` (R, U, U, U, U, R, R, U, U).
+  the order of the file's passive joints (problems/mechanisms/rpr.yaml, eq 13: R, U, U, U, U, R,
+  R, U, U), each by its family (theta_R or theta_U).
 """
 
 from __future__ import annotations
@@ -65,10 +66,10 @@ from ...analysis import flexure_compliance as fc
 from ...analysis.flexure import Material
 from ...core import screws
 from ...core.kinematics import jacobians
-from ...core.model import Model
+from ...core.model import LoopClosure, Model
 from ...core.result import Status
 from ...core.solver import SolverConfig, translate_casadi_error
-from . import kinematics as rpr
+from . import screws as rpr_screws
 from .design import optimisation_options
 
 log = logging.getLogger(__name__)
@@ -113,10 +114,11 @@ def design_wrenches(model: Model, couple_arm: float) -> dict[str, np.ndarray]:
     joint frame (= the fixed frame: leg 1 runs along z): S_wc,1,1 (couple, scaled
     by ``couple_arm``), S_wc,1,2 and S_wa,1,1, referred to A1 (R) and to B1 (U)."""
     x = model.x_home
-    out = [np.asarray(v) for v in rpr.screw_function()(x, model.p)]
+    p = rpr_screws.paper_parameters(model)
+    out = [np.asarray(v) for v in rpr_screws.screw_function()(x, p)]
     wa, wc = out[3], out[4]  # leg 1: ta1, tc1, wa1, wc1 follow S_t
     o_ = np.array([0.0, 0.0, x[2]])
-    A1 = np.array([model.p[0], 0.0, 0.0])
+    A1 = np.array([p[0], 0.0, 0.0])
     B1 = A1 + np.array([0.0, 0.0, x[2]])
     couple = wc[:, 0] / np.linalg.norm(wc[:, 0][3:]) * couple_arm
     force_y = screws.normalize(wc[:, 1])
@@ -332,9 +334,27 @@ def amplifier_matrices(l1: float, l2: float, c_r: float, c_t: float) -> dict[str
     }
 
 
-def stiffness_order(k_R: float, k_U: float) -> np.ndarray:
-    """K_J diagonal in the order of :data:`cpm_nlp.mechanisms.rpr.kinematics.PASSIVE`."""
-    return np.array([k_R if c.family == "theta_R" else k_U for c in rpr.PASSIVE])
+def stiffness_order(model: Model, k_R: float, k_U: float) -> np.ndarray:
+    """K_J diagonal in the order of the model's passive joints, by their family (eq 39)."""
+    return np.array([k_R if c.family == "theta_R" else k_U for c in model.closure.passive_coords])
+
+
+def passive_jacobian(closure: LoopClosure) -> ca.Function:
+    """``("passive_jacobian", [x, q, p], [dj_dx, dj_dq])``: the partial derivatives of the
+    closure's passive joint angles (the file's, eq 13) by AD, built once per closure (code)."""
+
+    def build() -> ca.Function:
+        x, q, p = ca.SX.sym("x", closure.nx), ca.SX.sym("q", closure.nq), ca.SX.sym("p", closure.np)
+        j = closure.passive(x, q, p)
+        return ca.Function(
+            "passive_jacobian",
+            [x, q, p],
+            [ca.jacobian(j, x), ca.jacobian(j, q)],
+            ["x", "q", "p"],
+            ["dj_dx", "dj_dq"],
+        )
+
+    return closure.solvers.memo(("rpr_passive_jacobian",), build)
 
 
 def passive_rates(model: Model, x: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
@@ -342,8 +362,8 @@ def passive_rates(model: Model, x: Sequence[float]) -> tuple[np.ndarray, np.ndar
     xv = np.asarray(x, dtype=float)
     q = np.asarray(model.closure.ik(xv, model.p)[1]).ravel()
     G = jacobians(model, xv, q).J
-    dj = np.asarray(rpr.passive_jacobian()(xv, model.p))
-    return G, dj @ G
+    dj_dx, dj_dq = (np.asarray(v) for v in passive_jacobian(model.closure)(xv, q, model.p))
+    return G, dj_dx @ G + dj_dq  # the passive angles' total rate per actuator rate (eq 13)
 
 
 def mechanism_stiffness(model: Model, x: Sequence[float], k_J: Sequence[float]) -> np.ndarray:

@@ -3,11 +3,12 @@
 * ``rpr_screw_jacobian`` -- eq 7-13 by screw theory beside the AD Jacobians;
 * ``rpr_twists`` -- displacement twists of the platform per actuator (eq 45);
 * ``rpr_transmission_map`` -- η over the (s, t) triangle (Fig. 4), plot-ready;
-* ``synthesis`` (the shared kind, via ``rpr.SYNTHESIS``) -- maximise η under eq 22 (eq 19-26);
+* ``synthesis`` (the shared kind, via the add-on's ``synthesis``) -- maximise η under eq 22 (eq 19-26);
 * ``rpr_joint_design`` -- the R and U flexure joints (eq 27-32, Table 1);
 * ``rpr_compliance`` -- the pseudo-rigid-body compliance model (eq 33-44).
 
-Every kind applies to the ``rpr`` mechanism only (:meth:`supports`).
+Every kind applies to the ``rpr`` mechanism only (:meth:`supports`), the mechanism of the file
+problems/mechanisms/rpr.yaml, and runs on its closures (pose, passive joints, Jacobians).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from ...core.solver import SolverConfig
 from ...kinds.kinematic import Jacobian, _model_info, _si
 from . import compliance as rpr_compliance
 from . import design as rpr_design
-from . import kinematics as rpr
+from . import screws as rpr_screws
 
 MM = 1e-3
 
@@ -41,12 +42,17 @@ class RprKind(ProblemKind):
         return None if model.name == "rpr" else "it is specific to the RPR mechanism (type rpr)"
 
 
-def _pose_options() -> list[Option]:
-    return [Option(c.name, c.kind, c.description + " (default: the initial pose)", default=None) for c in rpr.X]
+def _pose_options(model: Model) -> list[Option]:
+    """The pose (theta, alpha, P) of the file's closure, each defaulting to the initial pose."""
+    return [
+        Option(c.name, c.kind, c.description + " (default: the initial pose)", default=None) for c in model.closure.x
+    ]
 
 
 def _pose(model: Model, inputs: Mapping[str, Any]) -> np.ndarray:
-    return np.array([model.x_home[i] if inputs.get(c.name) is None else inputs[c.name] for i, c in enumerate(rpr.X)])
+    return np.array(
+        [model.x_home[i] if inputs.get(c.name) is None else inputs[c.name] for i, c in enumerate(model.closure.x)]
+    )
 
 
 def _matrix(a: np.ndarray) -> list:
@@ -108,7 +114,7 @@ class ScrewJacobian(RprKind, Jacobian):
         if not res.ok:
             return res
         x = np.array([res.values[n] for n in model.closure.x_names])
-        st = rpr.screw_jacobian(model, x)
+        st = rpr_screws.screw_jacobian(model, x)
         G_p_ad = rpr_compliance.passive_rates(model, x)[1]
         J_ad = np.array(res.values["J_inv"])
         extra = {
@@ -130,7 +136,7 @@ class ScrewJacobian(RprKind, Jacobian):
                 "J_b": "eq 9",
                 "J_st": "rows l1 l2 l3 per columns theta, alpha [rad], P [m] (eq 10; = J_inv by AD)",
                 "G_st": "rows theta, alpha [rad], P [m] per columns l1 l2 l3 [m] (eq 11; = J by AD)",
-                "G_p": "rows " + ", ".join(rpr.passive_names()) + " [rad] per l1 l2 l3 [m] (eq 13)",
+                "G_p": "rows " + ", ".join(model.closure.passive_names) + " [rad] per l1 l2 l3 [m] (eq 13)",
                 "G_p_ad": "as G_p, by AD of the passive joint angles",
                 "dJ": "max |J_st - J_inv|",
                 "dG_p": "max |G_p - G_p_ad|",
@@ -152,7 +158,7 @@ class Twists(RprKind):
     description = "displacement twists of the RPR platform for a small displacement of each actuator (eq 45)"
 
     def input_options(self, model: Model) -> list[Option]:
-        return _pose_options() + [
+        return _pose_options(model) + [
             Option(
                 "d",
                 "length",
@@ -167,7 +173,7 @@ class Twists(RprKind):
                 "choice",
                 "point the translational rows refer to: o' (the platform centre), o (the fixed origin) or 'point'",
                 default="o_prime",
-                choices=rpr.REFERENCES,
+                choices=rpr_screws.REFERENCES,
             ),
             Option(
                 "point",
@@ -184,7 +190,7 @@ class Twists(RprKind):
                 "rotation's moment with the position vector from the axis to the reference (how eq 45 and 47 "
                 "are printed)",
                 default="velocity",
-                choices=rpr.CONVENTIONS,
+                choices=rpr_screws.CONVENTIONS,
             ),
         ]
 
@@ -203,9 +209,9 @@ class Twists(RprKind):
         sol = inverse_kinematics(model, x0, solver)
         if not sol.ok:
             return _finish(self.name, model, sol.status, {}, {}, message=sol.message)
-        c = rpr.reference_point(model, sol.x, inputs["reference"], inputs.get("point"))
-        S = rpr.twist_basis(model, sol.x, c, inputs["convention"])
-        G = rpr.screw_jacobian(model, sol.x).G
+        c = rpr_screws.reference_point(model, sol.x, inputs["reference"], inputs.get("point"))
+        S = rpr_screws.twist_basis(model, sol.x, c, inputs["convention"])
+        G = rpr_screws.screw_jacobian(model, sol.x).G
         d = inputs["d"]
         T = S @ G * d  # one column per actuator
         fk_cols, iters, status, msg = [], 0, Status.SOLVED, ""
@@ -720,7 +726,7 @@ class Compliance(RprKind):
     description = "pseudo-rigid-body compliance C and input compliance C_in of the RPR (eq 33-44)"
 
     def input_options(self, model: Model) -> list[Option]:
-        return _pose_options() + [
+        return _pose_options(model) + [
             Option(
                 "k_R",
                 "rotational_stiffness",
@@ -806,7 +812,7 @@ class Compliance(RprKind):
             l2=amp["l2"],
             c_r=c_r,
             c_t=c_t,
-            k_J=rpr_compliance.stiffness_order(k["R"], k["U"]),
+            k_J=rpr_compliance.stiffness_order(model, k["R"], k["U"]),
         )
         values = {
             "c_r": c_r,
@@ -849,9 +855,9 @@ class Compliance(RprKind):
             "A12": "m/N",
             "A21": "m/N",
             "A22": "m/N",
-            "K_J": "N m/rad, order " + ", ".join(rpr.passive_names()),
+            "K_J": "N m/rad, order " + ", ".join(model.closure.passive_names),
             "G": "rows theta, alpha [rad], P [m] per l1 l2 l3 [m]",
-            "G_p": "rows " + ", ".join(rpr.passive_names()) + " [rad] per l1 l2 l3 [m]",
+            "G_p": "rows " + ", ".join(model.closure.passive_names) + " [rad] per l1 l2 l3 [m]",
             "K_prime": "N/m (eq 40)",
             "C": "rows theta [rad/N], alpha [rad/N], P [m/N]; columns input forces 1, 2, 3 (eq 43)",
             "C_in": "m/N (eq 44)",
