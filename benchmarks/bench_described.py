@@ -8,11 +8,10 @@
 * ``--mechanism rpr``: the RPR file rpr.yaml (the built-in ``rpr``, legs and passive expressions,
   with its add-on) against the closures it replaced, tests/reference/rpr_closures.py (eq 26's
   design, leg lengths within +-50 um of P0);
-* ``--mechanism pantograph``: the shipped pantograph file (bodies and joints: 12 pose
-  coordinates and normal equations) against the built-in ``pantograph`` module (eq 1-8).
-  ``poses_on_the_reduced_path`` counts the poses the FK through the closed-form IK answered
-  (before the block-by-block conditioning bound, 2 of 500 on the file: the rest went to the
-  full Newton on the normal equations).
+* ``--mechanism pantograph``: the pantograph file pantograph.yaml (the built-in ``pantograph``,
+  bodies and joints: 12 pose coordinates, its loops closed by S joints at C and F, with its
+  add-on) against the closures it replaced (eq 1-8), tests/reference/pantograph_closures.py.
+  ``poses_on_the_reduced_path`` counts the poses the FK through the closed-form IK answered.
 
     python benchmarks/bench_described.py [--mechanism prs3] [--n 20000] [--repeat 5] [--single 200]
         [--json benchmarks/bench_described.json]
@@ -43,7 +42,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import cpm_nlp as cn  # noqa: E402
-from tests.reference import prc3_closures, prs3_closures, rpr_closures  # noqa: E402 - hand-written closures, test references
+from tests.reference import pantograph_closures, prc3_closures, prs3_closures, rpr_closures  # noqa: E402 - hand-written closures, test references
 
 PARAMS = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
 #: issue 21: generated FK and batch within 1.1x of the hand-written module
@@ -67,12 +66,11 @@ def _pair(mechanism: str) -> tuple[dict, float]:
             "hand-written reference": rpr_closures.reference_model(rpr_closures.PAPER),
             "file rpr": cn.build_model("rpr", rpr_closures.PAPER),
         }, 50e-6
-    # the pantograph: the built-in module (eq 1-8 by hand) against the shipped file of bodies and
-    # joints (problems/mechanisms/pantograph.yaml: 12 pose coordinates against 6, normal equations)
-    panto = {"a": "20 mm", "b": "50 mm"}
+    # the pantograph: the closures it replaced (eq 1-8 by hand) against the shipped file of bodies
+    # and joints (problems/mechanisms/pantograph.yaml: 12 pose coordinates against 6)
     return {
-        "hand-written reference": cn.build_model("pantograph", panto),
-        "file pantograph_file": cn.build_model("pantograph_file", panto),
+        "hand-written reference": pantograph_closures.reference_model(pantograph_closures.PAPER),
+        "file pantograph": cn.build_model("pantograph", pantograph_closures.PAPER),
     }, 2e-3
 
 

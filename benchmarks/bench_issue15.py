@@ -41,7 +41,7 @@ import cpm_nlp as cn
 from cpm_nlp.analysis import cuboid_ik
 from cpm_nlp.analysis import workspace as W
 from cpm_nlp.analysis.certify import certify_box
-from cpm_nlp.mechanisms.pantograph.kinematics import paper_cuboid
+from cpm_nlp.mechanisms.pantograph.analysis import paper_cuboid
 
 ROOT = Path(__file__).resolve().parent.parent
 TARGETS = {

@@ -2,7 +2,8 @@
 
 ``import cpm_nlp.workspace`` (or ``from cpm_nlp import workspace``) still works and
 gives the module at its new place, with a DeprecationWarning that names it.
-``cpm_nlp.prs3``, ``cpm_nlp.prc3`` and ``cpm_nlp.rpr`` are gone (:data:`REMOVED`): they are mechanism files now.
+``cpm_nlp.prs3``, ``cpm_nlp.prc3``, ``cpm_nlp.rpr`` and ``cpm_nlp.pantograph`` are gone (:data:`REMOVED`):
+they are mechanism files now.
 Three old modules became packages of the same name and are not aliased:
 ``cpm_nlp.problems`` (its ``ProblemKind`` is in :mod:`cpm_nlp.core.kind`, its
 ``problem_kind`` in :mod:`cpm_nlp.problems.registry`), ``cpm_nlp.mechanisms``
@@ -48,7 +49,6 @@ MOVED = {
     "rpr_design": "mechanisms.rpr.design",
     "rpr_compliance": "mechanisms.rpr.compliance",
     "rpr_problems": "mechanisms.rpr.kinds",
-    "pantograph": "mechanisms.pantograph.kinematics",
     "pantograph_synthesis": "mechanisms.pantograph.synthesis",
     "problem_file": "problems.file",
     "reproduce": "problems.reproduce",
@@ -61,6 +61,9 @@ MOVED = {
 REMOVED = {
     "prc3": "the 3-PRC is the mechanism file problems/mechanisms/prc3.yaml since issue 21, with the add-on "
     "cpm_nlp.mechanisms.prc3 (its amplifier kind, its dynamics): cpm_nlp.build_model('prc3', {...}) builds it",
+    "pantograph": "the pantograph is the mechanism file problems/mechanisms/pantograph.yaml since issue 21, with "
+    "the add-on cpm_nlp.mechanisms.pantograph (the paper's limits, workspace and cuboid in "
+    "cpm_nlp.mechanisms.pantograph.analysis, its synthesis): cpm_nlp.build_model('pantograph', {...}) builds it",
     "rpr": "the RPR is the mechanism file problems/mechanisms/rpr.yaml since issue 21, with the add-on "
     "cpm_nlp.mechanisms.rpr (its screw-theory, twist, transmission, joint-design and compliance kinds, its "
     "synthesis; the screw theory of eq 7-13 in cpm_nlp.mechanisms.rpr.screws): cpm_nlp.build_model('rpr', {...}) "

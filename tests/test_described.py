@@ -3,9 +3,9 @@
 The papers' mechanisms re-described as files must be the hand-derived modules:
 FK, IK, the Jacobians and the passive joint angles to 1e-12 on random poses of
 the working range.  The reference is the hand-written module of each paper
-(tests/reference/prs3_closures.py, tests/reference/prc3_closures.py and
-tests/reference/rpr_closures.py -- the 3-PRS, the 3-PRC and the RPR are the files themselves
-now, issue 21 --, pantograph/kinematics.py), whose
+(tests/reference/prs3_closures.py, prc3_closures.py, rpr_closures.py and
+pantograph_closures.py -- the 3-PRS, the 3-PRC, the RPR and the pantograph are the files
+themselves now, issue 21), whose
 formulas are pinned to the papers in their own tests; the file's closure is
 generated from the legs and shares no code with them.
 """
@@ -38,7 +38,7 @@ CASES = {
         15e-6,
     ),
     "rpr": ("rpr", "rpr_reference", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"}, 50e-6),
-    "pantograph": ("pantograph_file", "pantograph", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
+    "pantograph": ("pantograph", "pantograph_reference", {"a": "20 mm", "b": "50 mm"}, 0.3e-3),
 }
 NEWTON = cn.SolverConfig("newton")
 
@@ -57,6 +57,10 @@ def _models(case):
         from .reference import rpr_closures
 
         return cn.build_model(file_name, params), rpr_closures.reference_model(params)
+    if hand_name == "pantograph_reference":  # and the hand-written pantograph (issue 21, item 5)
+        from .reference import pantograph_closures
+
+        return cn.build_model(file_name, params), pantograph_closures.reference_model(params)
     return cn.build_model(file_name, params), cn.build_model(hand_name, params)
 
 

@@ -18,7 +18,7 @@ PARAMS = {
     "prs3": {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"},
     "prc3": {"L1": "9.5 mm", "L2": "25 mm", "L3": "9 mm", "L4": "30 mm", "L7": "73.5 mm"},
     "rpr": {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"},
-    "pantograph_file": {"a": "20 mm", "b": "50 mm"},
+    "pantograph": {"a": "20 mm", "b": "50 mm"},
 }
 FILES = {described.read_description(f).name: f for f in described.shipped_files()}
 

@@ -369,11 +369,15 @@ def test_describe_shipped_prs3_lists_hinges_and_its_example_values(cli):
 
 
 def test_describe_pantograph_file_lists_bodies_joints_and_loops(cli):
-    """The shipped pantograph is bodies and joints (issue 21): describe lists its loops and says
-    that Grübler-Kutzbach (-1, as the paper's section 2 says: "negative") and the rank (3) disagree."""
+    """The shipped pantograph is bodies and joints (issue 21): describe lists its loops; with the
+    paper's R hinges at C and F (tests/corpus/pantograph_joints.yaml) it says that Grübler-Kutzbach
+    (-1, as the paper's section 2 says: "negative") and the rank (3) disagree."""
     run = cli("describe", str(MECH / "pantograph.yaml"))
     assert run.code == 0, run.err
     assert "loop 1, closed by J8: L1 - Az - Ay - ground - Bx - L3" in run.out
+    assert "3 degree(s) of freedom; Grübler-Kutzbach: 3" in run.out and "the two disagree" not in run.out
+    run = cli("describe", str(ROOT / "tests" / "corpus" / "pantograph_joints.yaml"))
+    assert run.code == 0, run.err
     assert "3 degree(s) of freedom; Grübler-Kutzbach: -1" in run.out and "the two disagree" in run.out
 
 

@@ -1,9 +1,11 @@
 """Seed mechanisms written with bodies and joints only (issue 21, item 5), against the built-in modules.
 
-* problems/mechanisms/pantograph.yaml (``pantograph_file``) -- the 3D pantograph of Elgammal et al. (links, the
-  parallelogram CDFB, the two loops sharing links, U joints at A and B for the plane's turn phi):
-  FK, IK, the task Jacobian dx/dq and the hinge angle psi equal the built-in ``pantograph``
-  (cpm_nlp/mechanisms/pantograph/kinematics.py, eq 1-8 written by hand) to 1e-12; its task
+* tests/corpus/pantograph_joints.yaml -- the 3D pantograph of Elgammal et al. with the paper's own joints (links,
+  the parallelogram CDFB, the two loops sharing links, U joints at A and B for the plane's turn phi, R hinges at
+  C and F: overconstrained, normal equations): FK, IK, the task Jacobian dx/dq and the hinge angle psi equal the
+  hand-written closures the built-in replaced (tests/reference/pantograph_closures.py, eq 1-8 by hand) to
+  1e-12 (the built-in, problems/mechanisms/pantograph.yaml, closes its loops with S joints at C and F:
+  tests/test_pantograph_written_once.py); its task
   Jacobian is the paper's constant J = diag(Mx, -My, -Mz) (eq 9-13); Gruebler-Kutzbach is
   negative (section 2) while the loops' rank gives 3 degrees of freedom.
 * tests/corpus/prc3_levers.yaml -- the 3-PRC of Li et al. with each limb's secondary lever
@@ -27,12 +29,12 @@ from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import load_file
 from cpm_nlp.mechanisms.described.graph import closure_parts
 
-from .reference import prs3_closures, rpr_closures
+from .reference import pantograph_closures, prs3_closures, rpr_closures
 
 CORPUS = Path(__file__).resolve().parent / "corpus"
 SHIPPED = Path(__file__).resolve().parent.parent / "problems" / "mechanisms"
-#: the seed files: the pantograph is the shipped one, the others are in the corpus
-FILES = {"pantograph_joints": SHIPPED / "pantograph.yaml"}
+#: the seed files (in the corpus unless named here)
+FILES: dict[str, Path] = {}
 NEWTON = cn.SolverConfig("newton")
 
 
@@ -59,7 +61,7 @@ PANTO = {"a": "20 mm", "b": "50 mm"}  # the paper's Fig. 9-10 and the file's def
 
 @pytest.fixture(scope="module")
 def pantographs():
-    return _file_model("pantograph_joints"), cn.build_model("pantograph", PANTO)
+    return _file_model("pantograph_joints"), pantograph_closures.reference_model(PANTO)
 
 
 def _pantograph_inputs(hm: cn.Model) -> np.ndarray:
@@ -105,7 +107,7 @@ def test_pantograph_joints_other_parameters_assemble_and_agree():
     """The drawing is written in a and b: other values assemble exactly and agree (section 6's
     synthesis varies them)."""
     fm = _file_model("pantograph_joints", {"a": 0.025, "b": 0.040})
-    hm = cn.build_model("pantograph", {"a": "25 mm", "b": "40 mm"})
+    hm = pantograph_closures.reference_model({"a": "25 mm", "b": "40 mm"})
     for dq in ([1e-3, -2e-3, 1.5e-3], [-2e-3, 1e-3, -1e-3]):
         q = hm.q_home + np.array(dq)
         a, b = cn.forward_kinematics(hm, q, NEWTON), cn.forward_kinematics(fm, q, NEWTON)
@@ -134,6 +136,9 @@ def test_pantograph_joints_mobility_by_rank_against_gruebler():
     assert info.gruebler == -1
     assert info.mobility == 3
     assert len(info.loops) == 2  # through C (A-C-B) and the parallelogram (closed at F)
+    # the shipped file closes both loops with S joints at C and F: no repeated equations
+    gen, _fns = closure_parts(described.read_description(SHIPPED / "pantograph.yaml"))
+    assert gen.info.gruebler == gen.info.mobility == 3 and len(gen.info.loops) == 2
 
 
 # -- the 3-PRC with its lever amplifiers ---------------------------------------------------------

@@ -9,7 +9,7 @@ import pytest
 
 import cpm_nlp as cn
 from cpm_nlp.core.result import Status
-from cpm_nlp.mechanisms.pantograph import kinematics as P
+from cpm_nlp.mechanisms.pantograph import analysis as P
 
 from .test_prs3_kinematics import central_difference
 
@@ -25,6 +25,19 @@ GEOMETRIES = [(0.02, 0.05), (0.015, 0.03), (0.01, 0.056948), (0.02, 0.02), (0.03
 @pytest.fixture(scope="module")
 def panto():
     return cn.build_model("pantograph", PAPER, PAPER_LIMITS)
+
+
+def at(model, x, *names):
+    """The values of the named pose coordinates of x (the file's twelve, by name)."""
+    return np.array([x[model.closure.x_names.index(n)] for n in names])
+
+
+def pose(model, **values):
+    """A pose of the file's coordinates: home, with the named ones set."""
+    x = model.x_home.copy()
+    for n, v in values.items():
+        x[model.closure.x_names.index(n)] = v
+    return x
 
 
 def rigid(a, b):
@@ -44,8 +57,12 @@ def test_home_configuration(panto):
     # section 8: the flexures are undeflected at the middle of the strokes; eq 31: psi = pi/2 there
     a, b = 0.02, 0.05
     np.testing.assert_allclose(panto.q_home, [math.sqrt(2) * a, 0, 0], rtol=1e-15)
-    np.testing.assert_allclose(panto.x_home, [math.sqrt(2) * (a + b), 0, 0, math.pi / 4, -math.pi / 4, 0], atol=1e-16)
-    assert np.max(np.abs(cn.residual(panto, panto.x_home, panto.q_home))) < 1e-17
+    np.testing.assert_allclose(
+        at(panto, panto.x_home, "px", "py", "pz", "theta1", "theta2", "phi"),
+        [math.sqrt(2) * (a + b), 0, 0, math.pi / 4, -math.pi / 4, 0],
+        atol=1e-16,
+    )
+    assert np.max(np.abs(cn.residual(panto, panto.x_home, panto.q_home))) < 1e-15  # m (assembled from the drawing)
     assert cn.passive_joints(panto, panto.x_home, panto.q_home)["psi"] == pytest.approx(math.pi / 2, abs=1e-15)
     # section 8: the prototype's dx runs 28.234 ... 28.334 mm around sqrt(2) * 20 mm = 28.284 mm
     assert panto.derived["dx0"] == pytest.approx(0.5 * (28.234e-3 + 28.334e-3), abs=1e-6)
@@ -140,17 +157,18 @@ def test_eq_17_and_18(panto):
         fk = cn.forward_kinematics(model, q, NEWTON)
         psi = fk.passive[0]
         assert float(q @ q) == pytest.approx(2 * 0.02**2 * (1 - math.cos(psi)), rel=1e-12)
-        assert math.tan(fk.x[5]) == pytest.approx(q[2] / q[0], rel=1e-12)
-        assert psi == pytest.approx(math.pi - (fk.x[3] - fk.x[4]), abs=1e-15)
+        theta1, theta2, phi = at(model, fk.x, "theta1", "theta2", "phi")
+        assert math.tan(phi) == pytest.approx(q[2] / q[0], rel=1e-12)
+        assert psi == pytest.approx(math.pi - (theta1 - theta2), abs=1e-15)
 
 
 def test_mirrored_elbow_is_wrong_branch():
     """The loops also close with theta1 and theta2 swapped (the mirrored elbow);
     the model designates theta1 > theta2 and reports the other as wrong_branch."""
     model = rigid(0.02, 0.05)
-    x = model.x_home.copy()
-    x[3], x[4] = x[4], x[3]
-    assert np.max(np.abs(cn.residual(model, x, model.q_home))) < 1e-17
+    # theta1 and theta2 swapped: the parallelogram's angles are psi = pi - (theta1 - theta2) (eq 17)
+    x = pose(model, theta1=-math.pi / 4, theta2=math.pi / 4, psiD=3 * math.pi / 2, psiB=3 * math.pi / 2)
+    assert np.max(np.abs(cn.residual(model, x, model.q_home))) < 1e-15
     status, message, _ = cn.assess(model, x, model.q_home, 1e-10)
     assert status is Status.WRONG_BRANCH
 
@@ -160,12 +178,12 @@ def test_guiding_mechanism_singularity_is_the_branch_limit():
     guiding mechanism: the branch indicator vanishes there."""
     model = rigid(0.02, 0.05)
     a = 0.02
-    # theta1 = pi/2, theta2 = 0: AB = a (u1 + u2) = a (1, 1, 0) -> q = (a, -a, 0)
-    x = np.array([0.0, 0.0, 0.0, math.pi / 2, 0.0, 0.0])
+    # theta1 = pi/2, theta2 = 0: AB = a (u1 + u2) = a (1, 1, 0) -> q = (a, -a, 0); psi = pi/2 (eq 17)
     q = np.array([a, -a, 0.0])
-    x[:3] = [3.5 * a, 2.5 * a, 0.0]
-    assert np.max(np.abs(cn.residual(model, x, q))) < 1e-16
-    assert abs(np.linalg.det(np.asarray(model.closure.phi_x(x, q, model.p)))) > 1e-6
+    x = pose(model, px=3.5 * a, py=2.5 * a, pz=0.0, theta1=math.pi / 2, theta2=0.0, xB=a, yA=-a, zA=0.0)
+    assert np.max(np.abs(cn.residual(model, x, q))) < 1e-15
+    s = np.linalg.svd(np.asarray(model.closure.phi_x(x, q, model.p)), compute_uv=False)
+    assert s.min() > 1e-6 * s.max()  # regular
     g = np.asarray(model.closure.branch(x, q, model.p)).ravel()
     assert g.min() == pytest.approx(0.0, abs=1e-15)
 

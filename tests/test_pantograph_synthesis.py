@@ -14,7 +14,7 @@ import pytest
 import cpm_nlp as cn
 from cpm_nlp.analysis import workspace as W
 from cpm_nlp.core.result import Status
-from cpm_nlp.mechanisms.pantograph import kinematics as P
+from cpm_nlp.mechanisms.pantograph import analysis as P
 
 from .conftest import PROBLEMS
 

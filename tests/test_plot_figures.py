@@ -112,15 +112,19 @@ def test_prs3_drawing_has_legs_of_length_L_and_sliders_on_their_rails():
 
 
 def test_pantograph_drawing_has_the_paper_link_lengths():
-    """pantograph-3d-elgammal-2016.md section 3: AC = BC = DF = a, CD = BF = FE = b; E is the end-effector."""
+    """pantograph-3d-elgammal-2016.md section 3: AC = BC = DF = a, CD = BF = FE = b; E is the end-effector.
+    The file's drawing (problems/mechanisms/pantograph.yaml) names the points of the sliders A' (dy)
+    and A'' (dz, where L1 turns), B' (dx, where L3 turns); A and B are the ground's."""
     model, x, q = pose_of("pantograph")
     d = model.mechanism.geometry(model, x, q)
     a, b = model.parameters["a"], model.parameters["b"]
-    for (p, r), length in {("A", "C"): a, ("B", "C"): a, ("D", "F"): a, ("C", "D"): b, ("B", "F"): b}.items():
+    A, B = "A''", "B'"
+    for (p, r), length in {(A, "C"): a, (B, "C"): a, ("D", "F"): a, ("C", "D"): b, (B, "F"): b}.items():
         assert _dist(d, p, r) == pytest.approx(length, rel=1e-9), (p, r)
     assert _dist(d, "F", "E") == pytest.approx(b, rel=1e-9)
     assert np.asarray(d.points["E"]) == pytest.approx(x[:3], abs=1e-12)
-    assert np.asarray(d.points["A"]) == pytest.approx([0, q[1], q[2]]) and d.points["B"][0] == pytest.approx(q[0])
+    assert np.asarray(d.points[A]) == pytest.approx([0, q[1], q[2]]) and d.points[B][0] == pytest.approx(q[0])
+    assert np.asarray(d.points["A"]) == pytest.approx([0, 0, 0]) and d.points["B"][1:] == pytest.approx([0, 0])
 
 
 def test_prc3_drawing_has_legs_of_length_l():

@@ -420,7 +420,15 @@ def test_pantograph_outputs_against_dx_like_fig_20(tmp_path):
     px = fig.axes[0].lines[0]
     slope = np.polyfit(px.get_xdata(), px.get_ydata(), 1)[0]
     assert slope == pytest.approx(3.5, rel=1e-6)
-    # no parasitic motion: py, pz and phi are exact zeros, said in the title, not drawn as flat panels
-    assert "constant over the batch: py = 0 mm, pz = 0 mm, phi = 0 deg" in fig._suptitle.get_text().replace("\n", " ")
-    assert [ax.get_ylabel() for ax in fig.axes] == ["$px$ (mm)", r"$\theta_{1}$ (deg)", r"$\theta_{2}$ (deg)"]
+    # no parasitic motion: py, pz and phi are exact zeros (and the file's yA, zA, phiB: the sliders of
+    # dy, dz and the second U's turn), said in the title, not drawn as flat panels
+    title = fig._suptitle.get_text().replace("\n", " ")
+    assert "constant over the batch: py = 0 mm, pz = 0 mm, yA = 0 mm, zA = 0 mm, phi = 0 deg, phiB = 0 deg" in title
+    # the paper's px, theta1, theta2, and the file's own joints that move: the slider xB (= dx), the
+    # parallelogram's angles psiD, psiB (= psi, eq 17)
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert labels == ["$px$ (mm)", "$xB$ (mm)", r"$\theta_{1}$ (deg)", r"$\theta_{2}$ (deg)"] + [
+        "psiD (deg)",
+        "psiB (deg)",
+    ]
     assert_figure_readable(fig)

@@ -330,6 +330,12 @@ class Addon:
     check_limits, synthesis, cuboid, paper_membership, stiffness, chains: as the
         :class:`Mechanism` fields of the same names (the paper's formulations that refer to
         the file's mechanism).
+    limits: the paper's own limit options (e.g. a hinge from which a formula sets the joint
+        limits, or ranges counted from home), beside the file's limit families; one named
+        like a family of the file replaces it (the paper's meaning of that name wins).
+    complete: ``(model, limits) -> None``: completes the file's model with what ``limits``
+        gives (joint limits on the file's coordinates) and the paper's derived quantities
+        (``model.derived``), from the file's closure and model, never a copy of them.
     """
 
     parameters: tuple[Option, ...] = ()
@@ -342,6 +348,8 @@ class Addon:
     paper_membership: Callable[[Any, Any], tuple[Any, dict]] | None = None
     stiffness: JointStiffness | None = None
     chains: Callable[[Any], Any] | None = None
+    limits: tuple[Option, ...] = ()
+    complete: Callable[[Any, dict], None] | None = None
 
 
 #: the add-on's parts taken as they are (each must not be given by the file too)
@@ -363,18 +371,23 @@ def with_addon(mech: Mechanism, addon: Addon) -> Mechanism:
         )
     extra = tuple(o.name for o in addon.parameters)
     dims = {o.name: o.kind for o in addon.parameters}
+    own_limits = {o.name for o in addon.limits}
     file_build = mech.build
 
     def build(closure: Any, parameters: dict, limits: dict) -> Any:
-        model = file_build(closure, {k: v for k, v in parameters.items() if k not in extra}, limits)
+        file_limits = {k: v for k, v in limits.items() if k not in own_limits}
+        model = file_build(closure, {k: v for k, v in parameters.items() if k not in extra}, file_limits)
         given = {k: parameters[k] for k in extra if parameters.get(k) is not None}
         model.parameters = {**model.parameters, **given}
         model.dimensions = {**model.dimensions, **{k: dims[k] for k in given}}
+        if addon.complete is not None:
+            addon.complete(model, {k: v for k, v in limits.items() if k in own_limits})
         return model
 
     return replace(
         mech,
         parameters=mech.parameters + addon.parameters,
+        limits=tuple(o for o in mech.limits if o.name not in own_limits) + addon.limits,
         build=build,
         dynamics=addon.dynamics(mech.closure()) if addon.dynamics else mech.dynamics,
         **{part: getattr(addon, part) or getattr(mech, part) for part in ADDON_PARTS},

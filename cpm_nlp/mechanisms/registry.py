@@ -40,10 +40,9 @@ log = logging.getLogger(__name__)
 #: entry-point group of mechanism plugins
 ENTRY_POINT_GROUP = "cpm_nlp.mechanisms"
 
-#: built-in mechanism type -> "module:attribute" of its declaration
-BUILTIN = {
-    "pantograph": "cpm_nlp.mechanisms.pantograph:MECHANISM",
-}
+#: built-in mechanism type -> "module:attribute" of its declaration (every seed mechanism is a
+#: file now: :data:`BUILTIN_FILES`)
+BUILTIN: dict[str, str] = {}
 
 #: built-in mechanism type -> its shipped mechanism file (in problems/mechanisms/): the
 #: mechanism is written once, in that file; its name resolves to the file without reading
@@ -52,6 +51,7 @@ BUILTIN_FILES = {
     "prs3": "prs3.yaml",
     "prc3": "prc3.yaml",
     "rpr": "rpr.yaml",
+    "pantograph": "pantograph.yaml",
 }
 
 #: built-in file mechanism -> "module:attribute" of its :class:`~cpm_nlp.core.mechanism.Addon`:
@@ -60,6 +60,7 @@ BUILTIN_FILES = {
 ADDONS = {
     "prc3": "cpm_nlp.mechanisms.prc3.addon:ADDON",
     "rpr": "cpm_nlp.mechanisms.rpr.addon:ADDON",
+    "pantograph": "cpm_nlp.mechanisms.pantograph.addon:ADDON",
 }
 
 #: old name -> the built-in mechanism it names now (the file twin became the built-in)
@@ -67,6 +68,7 @@ ALIASES = {
     "prs3_file": "prs3",
     "prc3_file": "prc3",
     "rpr_file": "rpr",
+    "pantograph_file": "pantograph",
 }
 
 

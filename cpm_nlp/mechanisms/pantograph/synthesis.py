@@ -53,7 +53,7 @@ from ...core.result import Result, SolverInfo, Status
 from ...core.solver import SolverConfig
 from ...core.units import DIMENSIONS
 from ...kinds.synthesis import SynthesisFormulation
-from . import kinematics as P
+from . import analysis as P
 
 DESIGN = ("a", "b", "l", "t")
 SYNTH_IPOPT = {"ipopt.tol": 1e-10, "ipopt.max_iter": 1000, "ipopt.bound_relax_factor": 0.0}
@@ -65,13 +65,6 @@ REFERENCE_OPTIONS = tuple(
     Option(n, "length", f"{n} of the design to evaluate", lower=0.0, strict=n in DESIGN)
     for n in ("a", "b", "l", "t", "x_hat", "y_hat", "z_hat")
 )
-
-
-def _magnification_symbolic(closure, a, b):
-    """Mx, My, Mz from the AD Jacobian of the loops at home, symbolic in a, b."""
-    x0, q0 = P.home_pose(a, b)
-    J = closure.jacobian(ca.vertcat(*x0), ca.vertcat(*q0), ca.vertcat(a, b))
-    return J[0, 0], -J[1, 1], -J[2, 2]
 
 
 class _SynthesisNLP:
@@ -99,7 +92,7 @@ class _SynthesisNLP:
         s = v[8] if phase == "scale" else 1.0
         delta = flexure.cantilever_notch_rotation(E, l, t, sigma)  # eq 30
         psi_min, psi_max, phi_max = math.pi / 2 - delta, math.pi / 2 + delta, delta  # eq 31
-        Mx, My, Mz = _magnification_symbolic(closure, a, b)
+        Mx, My, Mz = P.magnification_symbolic(closure, a, b)
         x_hat = k + e
         g = [
             k - a * Mx,  # k >= the singularity ellipsoid's semi-axis (eq 29)
@@ -443,7 +436,7 @@ def evaluate_reference(inputs: Mapping[str, Any], E: float, sigma: float, closur
     )  # eq 35
     delta = flexure.cantilever_notch_rotation(E, l, t, sigma)  # eq 30
     psi_min, psi_max = math.pi / 2 - delta, math.pi / 2 + delta  # eq 31
-    Mx, My, Mz = (float(v) for v in _magnification_symbolic(closure, a, b))
+    Mx, My, Mz = (float(v) for v in P.magnification_symbolic(closure, a, b))
     k = P.inner_extent(a, Mx, psi_min)
     g = P.cuboid_constraints(a, Mx, My, Mz, psi_max, delta, k, x_hat, y_hat, z_hat, inputs["paper_reading"])
     names = ["eq 33a", "eq 34a (x_hat >= k)", "eq 34a", "eq 34b", "eq 34c (2nd)", "eq 34c (1st)"]
