@@ -22,9 +22,17 @@ PAPER_PRS3 = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
 
 @pytest.fixture(scope="session", autouse=True)
 def compiled_cache_dir(tmp_path_factory):
-    """Libraries compiled by the tests go to a throwaway cache, never the user's."""
+    """Libraries compiled by the tests go to a throwaway cache, never the user's.  Under
+    pytest-xdist the workers share one (the run's base directory): a kernel is compiled once
+    per run, not once per worker (the cache renames each library into place, so a worker never
+    loads another's half-written file: cpm_nlp.core.compiled)."""
     old = os.environ.get("CPM_NLP_CACHE")
-    os.environ["CPM_NLP_CACHE"] = str(tmp_path_factory.mktemp("cpm_nlp_cache"))
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        shared = tmp_path_factory.getbasetemp().parent / "cpm_nlp_cache"
+        shared.mkdir(exist_ok=True)
+        os.environ["CPM_NLP_CACHE"] = str(shared)
+    else:
+        os.environ["CPM_NLP_CACHE"] = str(tmp_path_factory.mktemp("cpm_nlp_cache"))
     yield Path(os.environ["CPM_NLP_CACHE"])
     if old is None:
         os.environ.pop("CPM_NLP_CACHE", None)
