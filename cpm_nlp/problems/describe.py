@@ -10,6 +10,7 @@ its first shipped problem file (``Mechanism.problem_files``), else from its defa
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,8 @@ from ..core.kind import ProblemKind
 from ..core.mechanism import Mechanism
 from ..core.model import Model
 from ..core.options import Option
-from ..core.units import DIMENSIONS
+from ..core.schema import Either, ListOf, MappingOf, Named, Node, Quantity, Record, children, type_text
+from ..core.units import DIMENSIONS, format_quantity
 from ..mechanisms.registry import PluginError, build_model, mechanism_names, mechanism_type
 from .reader import read_yaml
 from .registry import kind_names, kind_origin, problem_kind
@@ -31,12 +33,23 @@ log = logging.getLogger(__name__)
 @dataclass(frozen=True)
 class InputRow:
     """One input of a kind: name, unit (the display unit of its dimension, or its type),
-    default ("required", "optional" or the value) and meaning (description and what it accepts)."""
+    default ("required", "optional" or the value) and meaning (description and what it accepts);
+    ``children``: the keys nested in it (a record's keys, a mapping's value, the alternatives
+    of an input that takes one of several forms), from the declared schema."""
 
     name: str
     unit: str
     default: str
     meaning: str
+    children: tuple[InputRow, ...] = ()
+
+    def walk(self, depth: int = 0, prefix: str = "") -> list[tuple[int, str, InputRow]]:
+        """This row and every nested one, depth first: (depth, dotted key path, row)."""
+        path = f"{prefix}.{self.name}" if prefix else self.name
+        out = [(depth, path, self)]
+        for child in self.children:
+            out += child.walk(depth + 1, path)
+        return out
 
 
 @dataclass(frozen=True)
@@ -88,20 +101,22 @@ def model_of(mech: Mechanism) -> tuple[Model | None, str]:
         return None, f"the parameters of {source} do not build a model: {exc.message}"
 
 
-def _unit(option: Option) -> str:
-    if option.kind in DIMENSIONS:
-        return DIMENSIONS[option.kind].display or "1"
-    return option.kind
+def _unit(option: Any) -> str:
+    return type_text(option)
 
 
-def _default(option: Option) -> str:
+def _default(option: Any) -> str:
     if option.required:
         return "required"
     value = option.default
-    if value is None:
+    if value is None or (isinstance(value, Mapping) and not value):
         return "optional"
     if isinstance(value, bool):
         return "true" if value else "false"
+    if isinstance(option, Quantity) and isinstance(value, (int, float)):
+        return format_quantity(float(value), option.kinds[0])
+    if isinstance(option, Node):
+        return str(value)
     if isinstance(value, (int, float)) and option.kind in DIMENSIONS:
         return option.format_value(float(value))
     if isinstance(value, (list, tuple)):
@@ -122,11 +137,45 @@ _SHAPES = {
 }
 
 
-def _meaning(option: Option) -> str:
+def _meaning(option: Any) -> str:
+    text = option.description.rstrip(".")
+    if isinstance(option, Named):
+        return f"{text}; a name ({', '.join(option.table)}) or a mapping"
+    if isinstance(option, Quantity):
+        return f"{text}; {option.expectation()}"
+    if isinstance(option, Node):
+        return text
     accepts = "" if option.kind == "str" else option.expectation()
     prefix = _SHAPES.get(option.shape, "")
-    text = option.description.rstrip(".")
     return f"{text}; {prefix}{accepts}" if accepts else text
+
+
+def _form(alt: Any) -> str:
+    """The label of one form of an input that takes one of several (true, a mapping, 'rigid' ...)."""
+    if isinstance(alt, Record):
+        return "{...}"
+    if isinstance(alt, MappingOf):
+        return f"{{<{alt.key_what}>: ...}}"
+    if isinstance(alt, ListOf):
+        return "[...]"
+    if isinstance(alt, Node):
+        return f"<{alt.kind}>"
+    if alt.kind == "choice":
+        return " | ".join(alt.choices)
+    return {"bool": "true | false", "str": "<text>", "int": "<integer>"}.get(alt.kind, "<number>")
+
+
+def _row(option: Any, name: str | None = None, slot: bool = False) -> InputRow:
+    """The row of a declared input, with the rows nested in it; a ``slot`` (a form of an
+    input, a mapping's value, a list's item) is not a key and has no default."""
+    if isinstance(option, Either):  # its forms, by what each takes
+        kids = [_row(alt, _form(alt), slot=True) for alt in option.alternatives]
+    elif isinstance(option, (MappingOf, ListOf)):
+        kids = [_row(c, slot=True) for c in children(option)]
+    else:
+        kids = [_row(c) for c in children(option)]
+    default = "" if slot else _default(option)
+    return InputRow(name or option.name, _unit(option), default, _meaning(option), tuple(kids))
 
 
 def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, source: str = "") -> KindDescription:
@@ -153,7 +202,7 @@ def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, so
         raise
     except Exception as exc:
         raise PluginError(f"problem kind {kind.name!r} ({origin}): describing its inputs failed: {exc}") from exc
-    rows = tuple(InputRow(o.name, _unit(o), _default(o), _meaning(o)) for o in options)
+    rows = tuple(_row(o) for o in options)
     return KindDescription(kind.name, kind.description, origin, mechanism, source, None, rows, values)
 
 
@@ -167,9 +216,12 @@ def kind_text(desc: KindDescription) -> str:
     lines.append("inputs:")
     if not desc.inputs:
         lines.append("  (none)")
-    for row in desc.inputs:
-        lines.append(f"  {row.name:<14} [{row.unit}] {row.default}")
-        lines.append(f"  {'':<14} {row.meaning}")
+    for top in desc.inputs:
+        for depth, _path, row in top.walk():
+            pad = "  " * (depth + 1)
+            width = max(14 - 2 * depth, 1)
+            lines.append(f"{pad}{row.name:<{width}} [{row.unit}] {row.default}".rstrip())
+            lines.append(f"{pad}{'':<{width}} {row.meaning}")
     lines.append("values:")
     lines.append("  " + (", ".join(desc.values) if desc.values else "(none)"))
     return "\n".join(lines) + "\n"
@@ -189,7 +241,11 @@ def kind_markdown(desc: KindDescription, level: int = 3) -> str:
     out.append("")
     if desc.inputs:
         out += ["| input | unit | default | meaning |", "| --- | --- | --- | --- |"]
-        out += [f"| `{r.name}` | {_cell(r.unit)} | {_cell(r.default)} | {_cell(r.meaning)} |" for r in desc.inputs]
+        out += [
+            f"| `{path}` | {_cell(r.unit)} | {_cell(r.default)} | {_cell(r.meaning)} |"
+            for top in desc.inputs
+            for _depth, path, r in top.walk()
+        ]
     else:
         out.append("No inputs.")
     out += ["", "Values: " + (", ".join(f"`{v}`" for v in desc.values) if desc.values else "none") + ".", ""]
