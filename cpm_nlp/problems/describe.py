@@ -9,7 +9,9 @@ its first shipped problem file (``Mechanism.problem_files``), else from its defa
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -231,8 +233,46 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
 
 
-def kind_markdown(desc: KindDescription, level: int = 3) -> str:
-    """One kind on one mechanism as a Markdown section (a table of inputs, the values)."""
+def _table(rows: list[tuple[str, InputRow]]) -> list[str]:
+    out = ["| input | unit | default | meaning |", "| --- | --- | --- | --- |"]
+    out += [f"| `{_cell(p)}` | {_cell(r.unit)} | {_cell(r.default)} | {_cell(r.meaning)} |" for p, r in rows]
+    return out
+
+
+def _schema_key(top: InputRow) -> tuple:
+    """What identifies the schema nested in an input: its name and every nested row."""
+    return (top.name, tuple((p, r.unit, r.default, r.meaning) for _d, p, r in top.walk()[1:]))
+
+
+class _Nested:
+    """The nested keys of the inputs on the reference page: a schema that several tables
+    share (the hinges of six kinds on every mechanism) is one table the kinds link to; one
+    that a single table has (a mechanism's load coordinates) stays in it."""
+
+    def __init__(self, counts: Mapping[tuple, int]) -> None:
+        self.counts = counts
+        self.anchors: dict[tuple, str] = {}
+        self.sections: list[str] = []
+
+    def link(self, top: InputRow) -> str | None:
+        """The anchor of the schema nested in ``top`` (its table added on first sight), or
+        None when no other table has it."""
+        key = _schema_key(top)
+        if self.counts.get(key, 0) < 2:
+            return None
+        if key not in self.anchors:
+            n = sum(1 for k in self.anchors if k[0] == top.name)
+            anchor = (f"nested-{top.name}" + (f"-{n + 1}" if n else "")).replace("_", "-").lower()
+            self.anchors[key] = anchor
+            title = f"`{top.name}`" + (f" ({n + 1})" if n else "")
+            rows = [(p, r) for _d, p, r in top.walk()[1:]]
+            self.sections += [f"### {title} {{ #{anchor} }}", "", *_table(rows), ""]
+        return self.anchors[key]
+
+
+def kind_markdown(desc: KindDescription, level: int = 3, nested: _Nested | None = None) -> str:
+    """One kind on one mechanism as a Markdown section (a table of inputs, the values); the
+    keys nested in an input follow it, or, with ``nested``, are linked to its one table."""
     head = "#" * level
     out = [f"{head} `{desc.kind}` on `{desc.mechanism}`", ""]
     if desc.unsupported:
@@ -240,12 +280,15 @@ def kind_markdown(desc: KindDescription, level: int = 3) -> str:
     out.append(f"Defaults and bounds for the model of `{desc.model_from}`.")
     out.append("")
     if desc.inputs:
-        out += ["| input | unit | default | meaning |", "| --- | --- | --- | --- |"]
-        out += [
-            f"| `{path}` | {_cell(r.unit)} | {_cell(r.default)} | {_cell(r.meaning)} |"
-            for top in desc.inputs
-            for _depth, path, r in top.walk()
-        ]
+        rows: list[tuple[str, InputRow]] = []
+        for top in desc.inputs:
+            anchor = nested.link(top) if nested is not None and top.children else None
+            if anchor is None:
+                rows += [(p, r) for _d, p, r in top.walk()]
+                continue
+            link = f"{top.meaning}; its keys: [{top.name}](#{anchor})"
+            rows.append((top.name, dataclasses.replace(top, meaning=link)))
+        out += _table(rows)
     else:
         out.append("No inputs.")
     out += ["", "Values: " + (", ".join(f"`{v}`" for v in desc.values) if desc.values else "none") + ".", ""]
@@ -263,22 +306,26 @@ def reference_markdown() -> str:
     out = [
         "# Problem kinds",
         "",
-        "Generated from the declared options when the site is built "
-        "(`cpm_nlp/problems/describe.py`); `cpm-nlp describe KIND --mechanism NAME` prints the same. "
-        "Units are the display units; a bare number is read in SI. A list makes a batch where the "
-        "kind allows it.",
+        "Generated from the declared inputs (options and the nested schema of `cpm_nlp/core/schema.py`) "
+        "when the site is built (`cpm_nlp/problems/describe.py`); `cpm-nlp describe KIND --mechanism NAME` "
+        "prints the same. Units are the display units; a bare number is read in SI. A list makes a batch "
+        "where the kind allows it. The keys nested in an input (hinges, materials, stress limits ...) are "
+        "in [Nested inputs](#nested-inputs), each schema once.",
         "",
     ]
-    for kind_name in kind_names():
+    descs = {k: [describe_kind(k, m, model, source) for m, (model, source) in models.items()] for k in kind_names()}
+    counts = Counter(_schema_key(top) for ds in descs.values() for d in ds for top in d.inputs if top.children)
+    nested = _Nested(counts)
+    for kind_name, kind_descs in descs.items():
         kind = problem_kind(kind_name)
         out += [f"## `{kind_name}`", "", f"{_cell(kind.description)} ({kind_origin(kind_name)}).", ""]
         skipped = []
-        for mech, (model, source) in models.items():
-            desc = describe_kind(kind_name, mech, model, source)
+        for desc in kind_descs:
             if desc.unsupported:
-                skipped.append(f"`{mech}` ({_cell(desc.unsupported)})")
+                skipped.append(f"`{desc.mechanism}` ({_cell(desc.unsupported)})")
                 continue
-            out.append(kind_markdown(desc))
+            out.append(kind_markdown(desc, nested=nested))
         if skipped:
             out += ["Does not apply to: " + "; ".join(skipped) + ".", ""]
-    return "\n".join(out)
+    out += ["## Nested inputs", "", "The keys of the inputs that nest, by the kinds' tables that link here.", ""]
+    return "\n".join(out + nested.sections)
