@@ -82,11 +82,6 @@ def _load_option(model: Model) -> Record:
     )
 
 
-def parse_load(raw: Any, model: Model, path: tuple) -> np.ndarray:
-    """A load mapping (pose coordinate -> force on a length, moment on an angle) as an nx vector."""
-    return _load_option(model).parse(raw, path) if raw is not None else np.zeros(model.closure.nx)
-
-
 def _pose_inputs(model: Model) -> list[Option]:
     return task_options(model, "grid") + actuator_options(model, "grid")
 
