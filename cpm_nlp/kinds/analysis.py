@@ -24,7 +24,7 @@ from ..core.options import REQUIRED, Option
 from ..core.result import Result, ResultWarning, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS, size_dimension
-from .compliance import mass_node, stress_limit_option
+from .hinge_inputs import mass_node, stress_limit_option
 from .kinematic import _model_info, _si
 
 

@@ -22,8 +22,7 @@ import scipy.optimize
 
 from ..analysis import compliance as cm
 from ..analysis import validity
-from ..analysis.dynamics import BLOCK, INERTIA_BLOCK, parse_inertia, parse_mass
-from ..analysis.flexure import material_node
+from ..analysis.dynamics import parse_inertia, parse_mass
 from ..analysis.hinge_chains import SixAxisModel, six_axis_model
 from ..core.canonical import canonical_eigh, degenerate_note, multiplicities
 from ..core.errors import InputError
@@ -40,46 +39,12 @@ from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinemati
 from ..core.model import Model
 from ..core.options import Option
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
-from ..core.schema import Either, ListOf, Quantity, Record
+from ..core.schema import Record
 from ..core.solver import SolverConfig
+from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
 from .kinematic import _model_info, _pose_names, _pose_values, _si
 
 log = logging.getLogger(__name__)
-
-
-def _hinge_options() -> list[Any]:
-    return [
-        cm.hinges_node(
-            "hinges over the mechanism's defaults, hinge by hinge and key by key: name -> {joints, type, k, "
-            "dimensions, Kt, material}; null removes a default hinge"
-        ),
-        material_node("material", "the hinge material (default: the mechanism's)", None),
-    ]
-
-
-def _load_dimension(kind: str) -> str:
-    return "force" if kind == "length" else "moment"
-
-
-def _load_option(model: Model) -> Record:
-    """``load``: a force on each length and a moment on each angle of the pose, as an nx vector."""
-    c = model.closure
-    names = ", ".join(f"{x.name} ({_load_dimension(x.kind)})" for x in c.x)
-
-    def vector(values: Any, _path: tuple) -> np.ndarray:
-        return np.array([0.0 if not values else values[n] for n in c.x_names], dtype=float)
-
-    return Record(
-        "load",
-        f"external load on the platform, conjugate to the pose coordinates: a mapping over {names}",
-        tuple(
-            Quantity(x.name, f"{_load_dimension(x.kind)} on {x.name}", (_load_dimension(x.kind),), 0.0, si=True)
-            for x in c.x
-        ),
-        default=None,
-        what="pose coordinate",
-        convert=vector,
-    )
 
 
 def _pose_inputs(model: Model) -> list[Option]:
@@ -146,7 +111,7 @@ class _HingeKind(ProblemKind):
         return []
 
     def input_options(self, model: Model) -> list[Option]:
-        return _pose_inputs(model) + _hinge_options() + [_load_option(model)] + self.extra_options(model)
+        return _pose_inputs(model) + hinge_options() + [load_option(model)] + self.extra_options(model)
 
     def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         """The hinges (the mechanism's merged with ``hinges`` and ``material``)."""
@@ -374,48 +339,6 @@ class _OutOfReach(Exception):
         self.lam, self.sol = lam, sol
 
 
-def _k_actuator_option(model: Model) -> Either:
-    """``k_actuator``: 'rigid' (None), or a stiffness >= 0 per actuator (one for all, or a list)."""
-    c = model.closure
-    dims = [_stiffness_dimension(q.kind) for q in c.q]
-    same = len(set(dims)) == 1
-    one = (
-        Option("k_actuator", dims[0], "one stiffness for every actuator", lower=0.0)
-        if same
-        else Quantity("k_actuator", "one stiffness for every actuator", kinds=tuple(dict.fromkeys(dims)))
-    )
-    per = ListOf(
-        "k_actuator",
-        "one stiffness per actuator",
-        Quantity("k", "an actuator's stiffness", kinds=tuple(dict.fromkeys(dims))),
-    )
-
-    def vector(value: Any, path: tuple) -> np.ndarray | None:
-        if value is None or value == "rigid":
-            return None
-        values = value if isinstance(value, list) else [value] * c.nq
-        if len(values) != c.nq:
-            raise InputError(f"expected one actuator stiffness or {c.nq}, got {len(values)}", path=path)
-        out = []
-        for k, (v, dim) in enumerate(zip(values, dims)):
-            opt = Option("k_actuator", dim, "actuator stiffness", lower=0.0)
-            out.append(opt.parse(v, path + ((k,) if isinstance(value, list) else ())))
-        return np.array(out, dtype=float)
-
-    return Either(
-        "k_actuator",
-        "actuator stiffness: 'rigid' (positions held), 0 N/m (the actuator forces held, the load case of a "
-        "FEM with forces at the actuators), or a stiffness (one, or one per actuator)",
-        (Option("k_actuator", "choice", "positions held", choices=("rigid",)), one, per),
-        default="rigid",
-        convert=vector,
-    )
-
-
-def _stiffness_dimension(kind: str) -> str:
-    return "stiffness" if kind == "length" else "rotational_stiffness"
-
-
 class PlatformCompliance(_HingeKind):
     name = "platform_compliance"
     description = (
@@ -426,7 +349,7 @@ class PlatformCompliance(_HingeKind):
 
     def extra_options(self, model: Model) -> list[Option]:
         return [
-            _k_actuator_option(model),
+            k_actuator_option(model),
             Option(
                 "hinge_axes",
                 "choice",
@@ -633,28 +556,6 @@ def _six_axis_warnings(sm: SixAxisModel, zs: list[np.ndarray]) -> list:
     return validity.hinge_warnings(sm.hs.hinges, pts)
 
 
-def mass_node(name: str, description: str, angle: bool = False, default: Any = None) -> Either:
-    """A mass (on a length coordinate) or an inertia (``angle``: on an angle coordinate): a
-    quantity, or a block of the hinge material.  The value is checked here and read by
-    :func:`~cpm_nlp.analysis.dynamics.parse_mass` / ``parse_inertia`` once the material is known."""
-    block = (*BLOCK, INERTIA_BLOCK[-1]) if angle else BLOCK
-    return Either(
-        name,
-        description,
-        (
-            Quantity(name, "an inertia" if angle else "a mass", kinds=("inertia" if angle else "mass",)),
-            Record(
-                "block",
-                "a block of the hinge material" + (" turning about its own axis x, y or z" if angle else ""),
-                block,
-                what="block key" if angle else "block dimension",
-                sparse=True,
-            ),
-        ),
-        default=default,
-    )
-
-
 class NaturalFrequencies(_HingeKind):
     name = "natural_frequencies"
     description = (
@@ -664,7 +565,7 @@ class NaturalFrequencies(_HingeKind):
     plots = ("modes",)
 
     def input_options(self, model: Model) -> list[Option]:
-        opts = task_options(model, "scalar") + actuator_options(model, "scalar") + _hinge_options()
+        opts = task_options(model, "scalar") + actuator_options(model, "scalar") + hinge_options()
         c = model.closure
         names = c.x_names + c.q_names
         coords = (*c.x, *c.q)
@@ -773,47 +674,3 @@ class NaturalFrequencies(_HingeKind):
         c = model.closure
         names = _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)]
         return names + ["M", "K", "modes_q", "modes_x", "multiplicity"]
-
-
-# -- stress limits for the workspace kinds ---------------------------------------------------------
-
-_STRESS_DESCRIPTION = (
-    "hinge stress limits in place of angle limits: true (the mechanism's hinges and material) or a mapping "
-    "{sigma_allow, safety_factor, hinges, material}; each hinge's deflection about each axis alone at sigma_allow "
-    "becomes a limit of its joint (generalizing eq 31 of pantograph-3d-elgammal-2016.md); parsed to the model "
-    "with those limits"
-)
-
-
-def stress_limit_option(model: Model) -> Either:
-    """``stress_limit`` of the workspace kinds (workspace, inscribed_cuboid, actuator_workspace):
-    parsed to the model with the joint limits it sets (None when not given)."""
-    spec = Record(
-        "stress_limit",
-        "the allowable stress and the hinges",
-        (
-            Option("sigma_allow", "stress", "allowable stress", default=None, lower=0.0, strict=True),
-            Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
-            *_hinge_options(),
-        ),
-        what="stress_limit key",
-    )
-
-    def limited(value: Any, path: tuple) -> Model | None:
-        if value is None or value is False:
-            return None
-        vals = spec.parse({}, path) if value is True else value
-        hs = cm.hinge_set(model, vals["hinges"], vals["material"], None, path)
-        if not any(h.kind is not None for h in hs.hinges):
-            raise InputError("a stress limit needs hinges with a flexure type and dimensions", path=path + ("hinges",))
-        sigma = cm.allowable(hs, vals["sigma_allow"], vals["safety_factor"], path)
-        return cm.with_limits(model, cm.stress_angle_limits(hs, sigma))
-
-    return Either(
-        "stress_limit",
-        _STRESS_DESCRIPTION,
-        (Option("stress_limit", "bool", "true: the mechanism's hinges and material"), spec),
-        default=None,
-        mismatch="expected stress_limit: true or a mapping {sigma_allow, safety_factor, hinges, material}",
-        convert=limited,
-    )

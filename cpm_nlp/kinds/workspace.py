@@ -38,7 +38,7 @@ from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS, size_dimension
-from .compliance import stress_limit_option
+from .hinge_inputs import stress_limit_option
 from .kinematic import _model_info
 
 
