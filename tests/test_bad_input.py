@@ -212,7 +212,8 @@ def test_unknown_input(cli, tmp_path):
         tmp_path,
         GOOD.replace("s3:", "s4: 1 mm, s3:"),
         "inputs: unknown input 's4'; expected one of: "
-        "assembly_modes, mode_certificate, mode_seed, mode_starts, s1, s2, s3",
+        # guess (a start pose) is accepted and, declared in the schema, now listed too
+        "assembly_modes, guess, mode_certificate, mode_seed, mode_starts, s1, s2, s3",
     )
 
 

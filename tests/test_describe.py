@@ -112,3 +112,37 @@ def test_a_kind_without_declared_inputs_or_with_a_broken_one(monkeypatch):
     assert desc.unsupported and "declares no inputs" in desc.unsupported
     with pytest.raises(PluginError, match="problem kind 'broken' \\(plugin\\): describing its inputs failed"):
         describe.describe_kind("broken", "prs3")
+
+
+def test_no_nested_input_is_described_as_a_string(models):
+    """Issue 22: every nested input (hinges, load, material, stress_limit ...) is declared by
+    its schema, so describe prints its keys, not [str]."""
+    nested = set()
+    for kind_name in kind_names():
+        for mech, (model, source) in models.items():
+            desc = describe_kind(kind_name, mech, model, source)
+            for top in desc.inputs:
+                assert top.unit != "str", (kind_name, mech, top.name)
+                if top.children:
+                    nested.add(top.name)
+    assert {"hinges", "material", "load", "stress_limit", "masses", "k_actuator", "guess", "design"} <= nested
+
+
+def test_describe_prints_the_nested_schema_indented():
+    text = kind_text(describe_kind("platform_compliance", "prc3"))
+    lines = text.splitlines()
+    hinge = lines.index(next(line for line in lines if line.startswith("  hinges ")))
+    assert lines[hinge + 2].startswith("    <hinge>")  # a mapping's value, one level in
+    joints = next(line for line in lines[hinge:] if line.strip().startswith("joints"))
+    assert joints.startswith("      joints") and "[one of] optional" in joints
+    assert any(line.startswith("      t ") and "[mm] optional" in line for line in lines)
+    assert "one of 'circular_notch', 'circular_rod', 'filleted_rod', 'leaf_spring'" in text
+    assert "    x            [N] 0 N" in text  # load on x: a force, default 0
+
+
+def test_reference_page_defines_each_shared_nested_schema_once():
+    page = reference_markdown()
+    assert page.count("### `hinges` { #nested-hinges }") == 1
+    assert "its keys: [hinges](#nested-hinges)" in page
+    assert "| `hinges.<hinge>.t` | mm | optional |" in page
+    assert page.count("| `hinges.<hinge>.t` |") == 1

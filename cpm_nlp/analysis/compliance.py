@@ -55,7 +55,8 @@ from ..core.errors import InputError, suggest
 from ..core.kernels import FastFunction
 from ..core.model import LoopClosure, Model
 from ..core.options import Option, validate_mapping
-from .flexure import Material, circular_notch_stiffness_exact, material
+from ..core.schema import Either, MappingOf, Quantity, Record
+from .flexure import Material, circular_notch_stiffness_exact, material, material_node
 from .flexure_compliance import circular_notch_compliances, rectangle_torsion_constant
 
 #: the axes of a hinge a joint coordinate may turn (or stretch) it about
@@ -288,6 +289,67 @@ DIM_OPTIONS = {
 HINGE_KEYS = ("joints", "type", "k", "material", "Kt", "r_fillet", *DIM_OPTIONS)
 
 
+def _hinge_fields() -> tuple:
+    """The keys of one hinge (``inputs.hinges.<name>``), each optional: a hinge of the
+    problem file is merged key by key over the mechanism's hinge of the same name."""
+    axis_names = ", ".join(AXES)
+    stiffness = Quantity(
+        "k",
+        "stiffness (N*m/rad on a rotation, N/m on a slide; the joint's coordinate decides)",
+        kinds=("rotational_stiffness", "stiffness"),
+        positive=True,
+    )
+    joint = Option("name", "str", "a coordinate or a family of coordinates")
+    return (
+        Either(
+            "joints",
+            "the joint coordinates the hinge carries: a coordinate or family name (its bending axis), or a "
+            "mapping axis -> name",
+            (joint, MappingOf("joints", "axis -> joint", joint, keys=AXES, key_what="hinge axis", non_empty=True)),
+            default=None,
+            mismatch=f"expected joints: a coordinate or family name, or a mapping axis -> name (axes: {axis_names})",
+        ),
+        Option("type", "choice", "the flexure geometry", default=None, choices=tuple(HINGE_TYPES)),
+        Either(
+            "k",
+            "stiffness per axis (one value for a one-axis hinge); default: the hinge formula of type and material",
+            (stiffness, MappingOf("k", "axis -> stiffness", stiffness, keys=AXES, key_what="hinge axis")),
+            default=None,
+        ),
+        material_node("material", "the hinge's own material (default: the problem's or the mechanism's)", None),
+        Option("Kt", "dimensionless", "stress concentration factor (default 1)", default=None, lower=1.0),
+        Option("r_fillet", "length", "accepted for older files; not used (a filleted rod's fillet is r)", default=None),
+        *(dataclasses.replace(o, default=None) for o in DIM_OPTIONS.values()),
+    )
+
+
+def hinges_node(description: str) -> MappingOf:
+    """The declaration of ``inputs.hinges``: hinge name -> hinge (null removes a default hinge)."""
+    return MappingOf(
+        "hinges",
+        description,
+        Record(
+            "<hinge>",
+            "one hinge (its dimensions by its type: " + _type_dims() + ")",
+            _hinge_fields(),
+            what="hinge key",
+            sparse=True,
+        ),
+        key_what="hinge",
+        default=None,
+        nullable=True,
+        mismatch="expected a mapping of hinges (name -> {joints, type, k, ...})",
+    )
+
+
+def _type_dims() -> str:
+    return "; ".join(f"{k}: {', '.join(t.dims)}" for k, t in HINGE_TYPES.items())
+
+
+#: hinge name -> hinge, as a problem file's ``inputs.hinges`` and a mechanism's declared hinges take them
+HINGES = hinges_node("hinges by name: name -> {joints, type, k, dimensions, Kt, material}; null removes one")
+
+
 def check_geometry(kind: str, d: Mapping[str, float], path: tuple) -> None:
     """Reject a hinge that cannot exist (t >= 2r for a circular notch: the two
     notches would not leave a thinnest section narrower than the blank)."""
@@ -381,71 +443,46 @@ def _stiffness_value(raw: Any, kind: str, path: tuple) -> float:
     return float(Option("k", dim, "hinge stiffness", lower=0.0, strict=True).parse(raw, path))
 
 
-def _parse_hinge(  # noqa: C901 - one flat check per key of a hinge entry
-    closure: LoopClosure, gname: str, spec: Any, default_material: Material | None, path: tuple
-) -> list[Hinge]:
-    if not isinstance(spec, Mapping):
-        raise InputError(f"expected a hinge mapping {{joints, type, k, ...}}, got {spec!r}", path=path)
-    for key in spec:
-        if key not in HINGE_KEYS:
-            raise InputError(
-                f"unknown hinge key {key!r}; expected some of: {', '.join(HINGE_KEYS)}",
-                path=path + (str(key),),
-                suggestions=suggest(str(key), HINGE_KEYS),
-            )
-    joints = spec.get("joints")
+def _hinge_axes(closure: LoopClosure, joints: Any, path: tuple) -> dict[str, list[int]]:
+    """axis -> the joint indices of a hinge's members (a name alone: the bending axis)."""
     if isinstance(joints, str):
         joints = {"bend": joints}
-    if not isinstance(joints, Mapping) or not joints:
+    if not joints:
         raise InputError(
             f"expected joints: a coordinate or family name, or a mapping axis -> name (axes: {', '.join(AXES)}), "
             f"got {joints!r}",
             path=path + ("joints",),
         )
-    axes: dict[str, list[int]] = {}
-    for axis, jname in joints.items():
-        if axis not in AXES:
-            raise InputError(
-                f"unknown hinge axis {axis!r}; expected one of: {', '.join(AXES)}",
-                path=path + ("joints", str(axis)),
-                suggestions=suggest(str(axis), AXES),
-            )
-        axes[axis] = _members(closure, str(jname), path + ("joints", axis))
-    counts = {len(v) for v in axes.values()}
-    if len(counts) != 1:
+    axes = {axis: _members(closure, str(jname), path + ("joints", axis)) for axis, jname in joints.items()}
+    if len({len(v) for v in axes.values()}) != 1:
         raise InputError(
             "the joints of one hinge must have as many members each, got "
             + ", ".join(f"{a}: {len(v)}" for a, v in axes.items()),
             path=path + ("joints",),
         )
-    coords = list(closure.x) + list(closure.q) + list(closure.passive_coords)
-    kind = spec.get("type")
-    if kind is not None and kind not in HINGE_TYPES:
+    return axes
+
+
+def _hinge_dims(kind: str | None, spec: Mapping[str, Any], path: tuple) -> dict[str, float]:
+    """The dimensions of a hinge type (and its Kt), from a parsed hinge."""
+    if kind is None:
+        return {}
+    need = HINGE_TYPES[kind].dims
+    extra = [d for d in DIM_OPTIONS if d not in need and spec.get(d) is not None]
+    if extra:
         raise InputError(
-            f"unknown hinge type {kind!r}; expected one of: {', '.join(HINGE_TYPES)}",
-            path=path + ("type",),
-            suggestions=suggest(str(kind), HINGE_TYPES),
+            f"hinge type {kind} has no dimension {', '.join(extra)} (it takes {', '.join(need)})", path=path
         )
-    dims: dict[str, float] = {}
-    if kind is not None:
-        need = HINGE_TYPES[kind].dims
-        extra = [d for d in DIM_OPTIONS if d not in need and spec.get(d) is not None]
-        if extra:
-            raise InputError(
-                f"hinge type {kind} has no dimension {', '.join(extra)} (it takes {', '.join(need)})", path=path
-            )
-        dims = validate_mapping(
-            {d: spec.get(d) for d in need}, [DIM_OPTIONS[d] for d in need], path, what="hinge dimension"
-        )
-        check_geometry(kind, dims, path)
-        kt = spec.get("Kt")
-        dims["Kt"] = 1.0 if kt is None else Option("Kt", "dimensionless", "", lower=1.0).parse(kt, path + ("Kt",))
-    mat = default_material
-    if spec.get("material") is not None:
-        mat = material(spec["material"], path + ("material",))
-    # stiffness: given per axis (or one value for a one-axis hinge), else the hinge formula
-    raw_k = spec.get("k")
-    given: dict[str, Any] = {}
+    dims = validate_mapping(
+        {d: spec.get(d) for d in need}, [DIM_OPTIONS[d] for d in need], path, what="hinge dimension"
+    )
+    check_geometry(kind, dims, path)
+    dims["Kt"] = 1.0 if spec.get("Kt") is None else float(spec["Kt"])
+    return dims
+
+
+def _given_stiffness(raw_k: Any, axes: Mapping[str, Any], path: tuple) -> dict[str, Any]:
+    """axis -> the stiffness given (as written) for it."""
     if isinstance(raw_k, Mapping):
         for a in raw_k:
             if a not in axes:
@@ -453,14 +490,29 @@ def _parse_hinge(  # noqa: C901 - one flat check per key of a hinge entry
                     f"stiffness given for axis {a!r}, which this hinge does not use (its axes: {', '.join(axes)})",
                     path=path + ("k", str(a)),
                 )
-        given = dict(raw_k)
-    elif raw_k is not None:
-        if len(axes) != 1:
-            raise InputError(
-                f"this hinge has {len(axes)} axes ({', '.join(axes)}); give k per axis, e.g. k: {{bend: ...}}",
-                path=path + ("k",),
-            )
-        given = {next(iter(axes)): raw_k}
+        return dict(raw_k)
+    if raw_k is None:
+        return {}
+    if len(axes) != 1:
+        raise InputError(
+            f"this hinge has {len(axes)} axes ({', '.join(axes)}); give k per axis, e.g. k: {{bend: ...}}",
+            path=path + ("k",),
+        )
+    return {next(iter(axes)): raw_k}
+
+
+def _parse_hinge(
+    closure: LoopClosure, gname: str, spec: Mapping[str, Any], default_material: Material | None, path: tuple
+) -> list[Hinge]:
+    """The hinges of one parsed hinge entry (:data:`HINGE`): one per member of its joints."""
+    axes = _hinge_axes(closure, spec.get("joints"), path)
+    coords = list(closure.x) + list(closure.q) + list(closure.passive_coords)
+    kind = spec.get("type")
+    dims = _hinge_dims(kind, spec, path)
+    mat = default_material if spec.get("material") is None else material(spec["material"], path + ("material",))
+    # stiffness: given per axis (or one value for a one-axis hinge), else the hinge formula
+    raw_k = spec.get("k")
+    given = _given_stiffness(raw_k, axes, path)
     formula: dict[str, float] = {}
     if kind is not None and any(a not in given for a in axes) and mat is None:
         raise InputError(
@@ -470,7 +522,7 @@ def _parse_hinge(  # noqa: C901 - one flat check per key of a hinge entry
         G = mat.G if mat.nu is not None else None
         formula = {a: float(v) for a, v in HINGE_TYPES[kind].stiffness(mat.E, G, dims).items()}
     out: list[Hinge] = []
-    n = counts.pop()
+    n = len(next(iter(axes.values())))
     for m in range(n):
         idx = {a: v[m] for a, v in axes.items()}
         k: dict[str, float] = {}
@@ -517,10 +569,11 @@ def check_declared(closure: LoopClosure, hinges: Mapping[str, Any], material_spe
     that name coordinates or families, known hinge types and keys, possible geometry,
     a known material.  Key paths under ``path`` (``stiffness`` of a mechanism file)."""
     mat = None if material_spec is None else material(material_spec, path + ("material",))
-    parse_hinges(closure, hinges, mat, {g: path + ("hinges", g) for g in hinges})
+    parsed = HINGES.parse(hinges, path + ("hinges",))
+    parse_hinges(closure, parsed, mat, {g: path + ("hinges", g) for g in parsed})
 
 
-def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hinge
+def hinge_set(
     model: Model,
     hinges: Mapping[str, Any] | None,
     material_spec: Any = None,
@@ -529,20 +582,19 @@ def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hi
 ) -> HingeSet:
     """The hinges of a model: the mechanism's declared defaults (its ``stiffness``
     capability) merged, hinge by hinge and key by key, with ``hinges`` from the
-    problem file; ``material_spec`` overrides the default material."""
+    problem file (as written or parsed by :data:`HINGES`); ``material_spec`` overrides
+    the default material."""
     c = model.closure
     mech = model.mechanism
     decl = mech.stiffness if mech is not None else None
-    merged: dict[str, dict] = {k: dict(v) for k, v in (decl.hinges.items() if decl else ())}
-    if hinges is not None and not isinstance(hinges, Mapping):
-        raise InputError(f"expected a mapping of hinges (name -> {{joints, type, k, ...}}), got {hinges!r}", path=path)
-    for name, spec in (hinges or {}).items():
-        if isinstance(spec, Mapping):
-            merged[str(name)] = {**merged.get(str(name), {}), **spec}
-        elif spec is None:  # null removes a default hinge
-            merged.pop(str(name), None)
+    declared = HINGES.parse(decl.hinges, ("mechanism", "stiffness")) if decl else {}
+    given = HINGES.parse(hinges, path + ("hinges",)) if hinges is not None else {}
+    merged: dict[str, dict] = {k: dict(v) for k, v in declared.items()}
+    for name, spec in given.items():
+        if spec is None:  # null removes a default hinge
+            merged.pop(name, None)
         else:
-            merged[str(name)] = spec
+            merged[name] = {**merged.get(name, {}), **spec}
     if not merged:
         raise InputError(
             f"mechanism {model.name} declares no joint stiffness; give inputs.hinges "
@@ -554,13 +606,13 @@ def hinge_set(  # noqa: C901 - merge defaults, then one check per source of a hi
         mat = material(material_spec, path + ("material",))
     elif decl is not None and decl.material is not None:
         mat = material(decl.material, ("mechanism", "stiffness", "material"))
-    paths = {g: path + ("hinges", g) if hinges and g in hinges else ("mechanism", "stiffness", g) for g in merged}
+    paths = {g: path + ("hinges", g) if g in given else ("mechanism", "stiffness", g) for g in merged}
     k, out = parse_hinges(c, merged, mat, paths)
     coords = list(c.x) + list(c.q) + list(c.passive_coords)
     names = joint_names(c)
     theta0 = joint_vector(model, model.x_home, model.q_home)
     hs = HingeSet(names, [co.kind for co in coords], k, theta0, out, sigma_allow, [decl.source] if decl else [])
-    hs.material_at = _material_at(mech, out, merged, hinges, material_spec, path)
+    hs.material_at = _material_at(mech, out, merged, given, material_spec, path)
     return hs
 
 

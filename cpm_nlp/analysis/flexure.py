@@ -12,13 +12,13 @@ about its compliant axis.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 import casadi as ca
 
-from ..core.errors import InputError, suggest
-from ..core.options import Option, validate_mapping
+from ..core.errors import InputError
+from ..core.options import REQUIRED, Option
+from ..core.schema import Named, Record
 
 #: properties of a :class:`Material`, in the order the papers list them
 PROPERTIES = {
@@ -114,25 +114,29 @@ MATERIAL_OPTIONS = (
 )
 
 
-def material(spec: str | dict, path: tuple = ("material",)) -> Material:
-    """A material by name (see :data:`MATERIALS`) or inline ``{E: 72 GPa, ...}``."""
-    if isinstance(spec, str):
-        if spec not in MATERIALS:
-            raise InputError(
-                f"unknown material {spec!r}; expected one of: {', '.join(MATERIALS)} or an inline mapping "
-                "{E, nu, density, yield_strength}",
-                path=path,
-                suggestions=suggest(spec, MATERIALS),
-            )
-        return MATERIALS[spec]
-    if not isinstance(spec, Mapping):
-        raise InputError(
-            f"expected a material name ({', '.join(MATERIALS)}) or an inline mapping "
-            f"{{E, nu, density, yield_strength}}, got {type(spec).__name__} {spec!r}",
-            path=path,
-        )
-    values = validate_mapping(spec, MATERIAL_OPTIONS, path, what="material property")
-    return Material(**values, source="inline")
+def material_node(name: str = "material", description: str = "the hinge material", default=REQUIRED) -> Named:
+    """The declaration of a material input: a name of :data:`MATERIALS` or inline
+    ``{E: 72 GPa, nu: 0.33, ...}`` (parsed to a :class:`Material`)."""
+    return Named(
+        name,
+        description,
+        table=MATERIALS,
+        inline=Record("material", "an inline material", MATERIAL_OPTIONS, what="material property"),
+        build=lambda values, _path: Material(**values, source="inline"),
+        what="material",
+        inline_text="{E, nu, density, yield_strength}",
+        default=default,
+        entry=Material,
+    )
+
+
+MATERIAL = material_node()
+
+
+def material(spec: str | dict | Material, path: tuple = ("material",)) -> Material:
+    """A material by name (see :data:`MATERIALS`) or inline ``{E: 72 GPa, ...}``
+    (a :class:`Material` already parsed is returned as it is)."""
+    return MATERIAL.parse(spec, path)
 
 
 # -- right-circular notch hinge ---------------------------------------------------------------

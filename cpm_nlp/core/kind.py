@@ -30,7 +30,11 @@ class ProblemKind:
 
     Subclasses set ``name`` and ``description`` and implement
     :meth:`input_options`, :meth:`run` and :meth:`output_names`; they may
-    override :meth:`check_inputs` for rules that involve several inputs.
+    override :meth:`resolve` for values derived from several inputs (the hinges of
+    ``hinges`` and ``material``) and :meth:`check_inputs` for rules that involve
+    several inputs.  The inputs are parsed once, here, by their declaration
+    (options and the nested nodes of :mod:`cpm_nlp.core.schema`): no kind parses
+    an input by hand.
     """
 
     name = ""
@@ -41,12 +45,19 @@ class ProblemKind:
     map_axes: tuple[str, str, str] | None = None
 
     def input_options(self, model: Model) -> list[Option]:
+        """The declared inputs: :class:`Option` s and nodes of :mod:`cpm_nlp.core.schema`."""
         raise NotImplementedError
 
     def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
+        """The one parse of a kind's inputs: validated by their declaration, then
+        :meth:`resolve` and :meth:`check_inputs`."""
         inputs = validate_mapping(raw, self.input_options(model), path, what="input")
+        self.resolve(inputs, model, path)
         self.check_inputs(inputs, model, path)
         return inputs
+
+    def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        """Add the values derived from several parsed inputs to ``inputs``; raise :class:`InputError`."""
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         """Cross-input validation; raise :class:`InputError`."""

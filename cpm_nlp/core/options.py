@@ -55,10 +55,23 @@ class Option:
     choices: tuple[str, ...] = ()
     shape: str = "scalar"
     max_len: int | None = None
+    #: a validator of the parsed value, ``(value, key path) -> None`` raising InputError
+    check: Any = None
+
+    #: a missing essential input is named before unknown keys (see :func:`validate_mapping`)
+    essential = False
 
     @property
     def required(self) -> bool:
         return self.default is REQUIRED
+
+    def missing_message(self, what: str) -> str:
+        """The message for this option left out where it is required."""
+        return f"missing required {what} '{self.name}' ({self.description}; expected {self.expectation()})"
+
+    def absent(self, _path: tuple) -> Any:
+        """The value of the option when the input does not give it: its default."""
+        return self.default
 
     def expectation(self) -> str:
         """Human text of what the option accepts."""
@@ -96,6 +109,12 @@ class Option:
     # -- validation -------------------------------------------------------
     def parse(self, value: Any, path: tuple) -> Any:
         """Validate ``value`` found at ``path``; return it in SI."""
+        out = self._parse(value, path)
+        if self.check is not None:
+            self.check(out, path)
+        return out
+
+    def _parse(self, value: Any, path: tuple) -> Any:
         if self.shape == "scalar":
             return self._scalar(value, path)
         if self.shape == "list":
@@ -201,6 +220,17 @@ class Option:
         raise InputError(f"expected {self.expectation()}, got {raw!r}", path=path, hint=hint)
 
 
+def _essential_first(data: Mapping, by_name: Mapping[str, Any], path: tuple, what: str) -> None:
+    """A missing essential input (what the problem is about: a synthesis's design) is named
+    before keys unlike any declared one (the inputs of another kind); a key like a declared
+    one is a typo, named first with a "did you mean"."""
+    if any(isinstance(k, str) and k not in by_name and suggest(k, by_name) for k in data):
+        return
+    for opt in by_name.values():
+        if opt.essential and opt.required and data.get(opt.name) is None:
+            raise InputError(opt.missing_message(what), path=path)
+
+
 def validate_mapping(
     data: Any,
     options: Sequence[Option] | Any,
@@ -221,6 +251,7 @@ def validate_mapping(
         raise InputError(f"expected a mapping of {what}s, got {type(data).__name__} {data!r}", path=path)
     by_name = {o.name: o for o in options}
     out: dict[str, Any] = {}
+    _essential_first(data, by_name, path, what)
     for key in data:
         if not isinstance(key, str):
             raise InputError(f"expected {what} names to be strings, got {key!r}", path=path)
@@ -230,10 +261,7 @@ def validate_mapping(
         if opt.name in data and data[opt.name] is not None:
             out[opt.name] = opt.parse(data[opt.name], path + (opt.name,))
         elif opt.required:
-            raise InputError(
-                f"missing required {what} '{opt.name}' ({opt.description}; expected {opt.expectation()})",
-                path=path,
-            )
+            raise InputError(opt.missing_message(what), path=path)
         else:
-            out[opt.name] = opt.default
+            out[opt.name] = opt.absent(path + (opt.name,))
     return out

@@ -14,17 +14,17 @@ from typing import Any
 import numpy as np
 
 from ..analysis import dynamics as dyn
-from ..analysis.flexure import material as parse_material
+from ..analysis.flexure import material_node
 from ..analysis.workspace import joint_box, reachable_workspace
-from ..core.errors import InputError, unknown_key_error
+from ..core.errors import InputError
 from ..core.kind import ProblemKind
 from ..core.mechanism import DynamicsModel
 from ..core.model import Model
-from ..core.options import Option, validate_mapping
+from ..core.options import REQUIRED, Option
 from ..core.result import Result, ResultWarning, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS, size_dimension
-from .compliance import STRESS_LIMIT_OPTION, split_stress_limit
+from .hinge_inputs import mass_node, stress_limit_option
 from .kinematic import _model_info, _si
 
 
@@ -46,22 +46,16 @@ class ActuatorWorkspace(ProblemKind):
     description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
     plots = ("workspace",)  # its points (inputs.points: true): the images of the stroke grid
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        raw, limited = split_stress_limit(raw, model, path)  # hinge stress limits -> joint limits
-        inputs = super().parse_inputs(raw, limited or model, path)
-        inputs["stress_limited_model"] = limited
-        return inputs
-
     def input_options(self, model: Model) -> list[Option]:
         return [
             Option("samples", "int", "grid points per actuator over its stroke (ends included)", 11, 2, 101),
             Option("quadrature", "int", "Gauss-Legendre points per actuator for the volume", 4, 1, 20),
             Option("points", "bool", "also return every sampled point (a large list)", False),
-            STRESS_LIMIT_OPTION,
+            stress_limit_option(model),
         ]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
-        joint_box(model)
+        joint_box(inputs.get("stress_limit") or model)  # the stroke box, under the stress limits when given
         n = model.closure.nq
         if inputs["samples"] ** n > 200_000:
             raise InputError(
@@ -87,7 +81,7 @@ class ActuatorWorkspace(ProblemKind):
         return dims
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
-        model = inputs.get("stress_limited_model") or model
+        model = inputs.get("stress_limit") or model
         c = model.closure
         rep = reachable_workspace(model, inputs["samples"], inputs["quadrature"], solver)
         dims = self._dims(model)
@@ -167,32 +161,20 @@ class Dynamics(ProblemKind):
 
     def input_options(self, model: Model) -> list[Option]:
         masses = [
-            Option(m, "mass", f"{d}; a mass or a block {{length, width, height}}") for m, d in _dynamics(model).masses
+            mass_node(m, f"{d}; a mass or a block {{length, width, height}}", default=REQUIRED)
+            for m, d in _dynamics(model).masses
         ]
         return [
-            Option("material", "str", "the hinge material: a name (Al 7075-T6, ...) or inline {E, nu, density}"),
+            material_node("material", "the hinge material: a name (Al 7075-T6, ...) or inline {E, nu, density}"),
             *masses,
             Option("g", "acceleration", "gravitational acceleration", default=9.81, lower=0.0),
         ]
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        if raw is None:
-            raw = {}
-        if not isinstance(raw, Mapping):
-            raise InputError(f"expected a mapping of inputs, got {type(raw).__name__} {raw!r}", path=path)
-        options = self.input_options(model)
-        known = [o.name for o in options]
-        for key in raw:
-            if key not in known:
-                raise unknown_key_error(str(key), known, path, "input")
-        for o in options:
-            if o.required and raw.get(o.name) is None:
-                raise InputError(f"missing required input '{o.name}' ({o.description})", path=path)
-        mat = parse_material(raw["material"], path + ("material",))
-        inputs: dict[str, Any] = {"material": mat}
+    def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        """The masses of blocks of the material, and its Young's modulus E."""
+        mat = inputs["material"]
         for m, _ in _dynamics(model).masses:
-            inputs[m] = dyn.parse_mass(raw[m], mat.density, mat.name, path + (m,))
-        inputs.update(validate_mapping({"g": raw.get("g")}, [options[-1]], path, what="input"))
+            inputs[m] = dyn.parse_mass(inputs[m], mat.density, mat.name, path + (m,))
         inputs["E"] = mat.require("E", path + ("material",), "the hinge stiffness needs it")
         missing = [n for n in _dynamics(model).parameters if n not in inputs and n not in model.parameters]
         if missing:
@@ -201,7 +183,6 @@ class Dynamics(ProblemKind):
                 f"(see cpm-nlp describe {model.name})",
                 path=("mechanism", "parameters"),
             )
-        return inputs
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         dm = _dynamics(model)

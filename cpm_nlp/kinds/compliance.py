@@ -25,7 +25,7 @@ from ..analysis import validity
 from ..analysis.dynamics import parse_inertia, parse_mass
 from ..analysis.hinge_chains import SixAxisModel, six_axis_model
 from ..core.canonical import canonical_eigh, degenerate_note, multiplicities
-from ..core.errors import InputError, unknown_key_error
+from ..core.errors import InputError
 from ..core.kind import (
     ProblemKind,
     actuator_options,
@@ -37,73 +37,18 @@ from ..core.kind import (
 )
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics
 from ..core.model import Model
-from ..core.options import Option, validate_mapping
+from ..core.options import Option
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
+from ..core.schema import Record
 from ..core.solver import SolverConfig
-from ..core.units import parse_quantity
+from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
 from .kinematic import _model_info, _pose_names, _pose_values, _si
 
 log = logging.getLogger(__name__)
 
-#: inputs parsed by hand (mappings), declared for ``describe``
-_SPECIAL = ("hinges", "material", "load", "masses")
-
-
-def _hinge_options() -> list[Option]:
-    return [
-        Option(
-            "hinges",
-            "str",
-            "hinges over the mechanism's defaults: name -> {joints: <coordinate or family, or axis -> name>, "
-            "k: <N*m/rad or N/m, or axis -> value>, type: circular_notch|circular_rod|leaf_spring, t, r, w, d, l, "
-            "Kt, material}; null removes a default hinge",
-            default=None,
-        ),
-        Option("material", "str", "the hinge material (a name or inline {E, nu, yield_strength, ...})", default=None),
-    ]
-
-
-def _load_option(model: Model) -> Option:
-    names = ", ".join(f"{x.name} ({'force' if x.kind == 'length' else 'moment'})" for x in model.closure.x)
-    return Option(
-        "load",
-        "str",
-        f"external load on the platform, conjugate to the pose coordinates: a mapping over {names}",
-        default=None,
-    )
-
 
 def _pose_inputs(model: Model) -> list[Option]:
     return task_options(model, "grid") + actuator_options(model, "grid")
-
-
-def _split(raw: Any, path: tuple) -> tuple[dict, dict]:
-    if raw is None:
-        raw = {}
-    if not isinstance(raw, Mapping):
-        raise InputError(f"expected a mapping of inputs, got {type(raw).__name__} {raw!r}", path=path)
-    special = {k: raw[k] for k in _SPECIAL if k in raw}
-    rest = {k: v for k, v in raw.items() if k not in _SPECIAL}
-    return rest, special
-
-
-def parse_load(raw: Any, model: Model, path: tuple) -> np.ndarray:
-    """A load mapping (pose coordinate -> force on a length, moment on an angle) as an nx vector."""
-    c = model.closure
-    f = np.zeros(c.nx)
-    if raw is None:
-        return f
-    if not isinstance(raw, Mapping):
-        raise InputError(
-            f"expected a load mapping such as {{{c.x_names[0]}: 1 N}}, got {type(raw).__name__} {raw!r}", path=path
-        )
-    for key, value in raw.items():
-        if key not in c.x_names:
-            raise unknown_key_error(str(key), c.x_names, path, "pose coordinate")
-        i = c.x_names.index(key)
-        dim = "force" if c.x[i].kind == "length" else "moment"
-        f[i] = parse_quantity(value, dim, path + (key,))
-    return f
 
 
 def _solve_poses(model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> tuple[list[PoseSolution], bool]:
@@ -166,18 +111,11 @@ class _HingeKind(ProblemKind):
         return []
 
     def input_options(self, model: Model) -> list[Option]:
-        return _pose_inputs(model) + _hinge_options() + [_load_option(model)] + self.extra_options(model)
+        return _pose_inputs(model) + hinge_options() + [load_option(model)] + self.extra_options(model)
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        rest, special = _split(raw, path)
-        opts = [o for o in self.input_options(model) if o.name not in _SPECIAL]
-        inputs = validate_mapping(rest, opts, path, what="input")
-        sigma = inputs.get("sigma_allow")
-        inputs["hinge_set"] = cm.hinge_set(model, special.get("hinges"), special.get("material"), sigma, path)
-        inputs["load"] = parse_load(special.get("load"), model, path + ("load",))
-        inputs["masses_raw"] = special.get("masses")
-        self.check_inputs(inputs, model, path)
-        return inputs
+    def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        """The hinges (the mechanism's merged with ``hinges`` and ``material``)."""
+        inputs["hinge_set"] = cm.hinge_set(model, inputs["hinges"], inputs["material"], inputs.get("sigma_allow"), path)
 
 
 def _stress_values(hs: cm.HingeSet, points: list[cm.StaticPoint | None], batch: bool) -> tuple[dict, dict]:
@@ -401,22 +339,6 @@ class _OutOfReach(Exception):
         self.lam, self.sol = lam, sol
 
 
-def _k_actuator(raw: Any, model: Model, path: tuple) -> np.ndarray | None:
-    if raw is None or raw == "rigid":
-        return None
-    values = raw if isinstance(raw, list) else [raw] * model.closure.nq
-    if len(values) != model.closure.nq:
-        raise InputError(f"expected one actuator stiffness or {model.closure.nq}, got {len(values)}", path=path)
-    out = []
-    for k, (v, q) in enumerate(zip(values, model.closure.q)):
-        dim = "stiffness" if q.kind == "length" else "rotational_stiffness"
-        val = parse_quantity(v, dim, path + ((k,) if isinstance(raw, list) else ()))
-        if val < 0:
-            raise InputError(f"expected a stiffness >= 0, got {v!r}", path=path)
-        out.append(val)
-    return np.array(out)
-
-
 class PlatformCompliance(_HingeKind):
     name = "platform_compliance"
     description = (
@@ -427,13 +349,7 @@ class PlatformCompliance(_HingeKind):
 
     def extra_options(self, model: Model) -> list[Option]:
         return [
-            Option(
-                "k_actuator",
-                "str",
-                "actuator stiffness: 'rigid' (positions held), 0 N/m (the actuator forces held, the load case of a "
-                "FEM with forces at the actuators), or a stiffness (one, or one per actuator)",
-                default="rigid",
-            ),
+            k_actuator_option(model),
             Option(
                 "hinge_axes",
                 "choice",
@@ -454,11 +370,9 @@ class PlatformCompliance(_HingeKind):
             + super().input_options(model)[len(_pose_inputs(model)) :]
         )
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        raw = dict(raw) if isinstance(raw, Mapping) else raw
-        ka = raw.pop("k_actuator", None) if isinstance(raw, dict) else None
-        inputs = super().parse_inputs(raw, model, path)
-        inputs["k_actuator"] = _k_actuator(ka, model, path + ("k_actuator",))
+    def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        """The hinges, and the six-axis hinge model where ``hinge_axes`` asks for it (or by default can)."""
+        super().resolve(inputs, model, path)
         axes = inputs.get("hinge_axes")
         mech = model.mechanism
         has_chains = mech is not None and mech.chains is not None
@@ -480,7 +394,6 @@ class PlatformCompliance(_HingeKind):
                 inputs["fallback"] = (
                     f"; hinge_axes: kinematic, as the six-axis model cannot place the hinges ({exc.message})"
                 )
-        return inputs
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _check_pose_inputs(model, inputs, path, required=False)
@@ -652,48 +565,57 @@ class NaturalFrequencies(_HingeKind):
     plots = ("modes",)
 
     def input_options(self, model: Model) -> list[Option]:
-        opts = task_options(model, "scalar") + actuator_options(model, "scalar") + _hinge_options()
+        opts = task_options(model, "scalar") + actuator_options(model, "scalar") + hinge_options()
+        c = model.closure
+        names = c.x_names + c.q_names
+        coords = (*c.x, *c.q)
+        text = "expected masses: a mapping of coordinate -> mass or inertia over " + ", ".join(names)
+
+        def non_empty(value: Any, path: tuple) -> None:
+            if not value:
+                raise InputError(text, path=path)
+
         opts.append(
-            Option(
+            Record(
                 "masses",
-                "str",
                 "mass (on a length coordinate: '12 g', or a block {length, width, height} of the material) or "
                 "inertia (on an angle coordinate: kg*m^2, or a block {length, width, height, about: x|y|z} of the "
                 "material turning about its own axis through its centre) per pose or actuator coordinate: "
-                + ", ".join(model.closure.x_names + model.closure.q_names),
+                + ", ".join(names),
+                tuple(mass_node(co.name, co.description, co.kind == "angle") for co in coords),
+                what="coordinate",
+                sparse=True,
+                mismatch=text,
+                check=non_empty,
             )
         )
         return opts
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        if isinstance(raw, Mapping) and "load" in raw:
-            raise unknown_key_error("load", [o.name for o in self.input_options(model)], path, "input")
-        inputs = super().parse_inputs(raw, model, path)
+    def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        """The hinges, and the mass matrices M_x, M_q of the masses (a block's of the hinge material)."""
+        super().resolve(inputs, model, path)
         c = model.closure
-        masses = inputs.pop("masses_raw")
-        if not isinstance(masses, Mapping) or not masses:
-            raise InputError(
-                f"expected masses: a mapping of coordinate -> mass or inertia over {', '.join(c.x_names + c.q_names)}",
-                path=path + ("masses",),
-            )
         hs: cm.HingeSet = inputs["hinge_set"]
         mat = next((h.material for h in hs.hinges if h.material is not None), None)
+        density, name = (mat.density, mat.name) if mat else (None, "?")
         mx, mq = np.zeros(c.nx), np.zeros(c.nq)
-        for key, value in masses.items():
-            names = c.x_names + c.q_names
-            if key not in names:
-                raise unknown_key_error(str(key), names, path + ("masses",), "coordinate")
-            coord = (list(c.x) + list(c.q))[names.index(key)]
-            if coord.kind == "length":
-                m = parse_mass(value, mat.density if mat else None, mat.name if mat else "?", path + ("masses", key))
+        for key, value in inputs["masses"].items():
+            if value is None:
+                continue
+            where = path + ("masses", key)
+            if key in c.x_names:
+                kind = c.x[c.x_names.index(key)].kind
             else:
-                m = parse_inertia(value, mat.density if mat else None, mat.name if mat else "?", path + ("masses", key))
+                kind = c.q[c.q_names.index(key)].kind
+            if kind == "length":
+                m = parse_mass(value, density, name, where)
+            else:
+                m = parse_inertia(value, density, name, where)
             if key in c.x_names:
                 mx[c.x_names.index(key)] = m
             else:
                 mq[c.q_names.index(key)] = m
         inputs["M_x"], inputs["M_q"] = mx, mq
-        return inputs
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _check_pose_inputs(model, inputs, path, required=False)
@@ -752,47 +674,3 @@ class NaturalFrequencies(_HingeKind):
         c = model.closure
         names = _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)]
         return names + ["M", "K", "modes_q", "modes_x", "multiplicity"]
-
-
-# -- stress limits for the workspace kinds ---------------------------------------------------------
-
-#: the input the workspace kinds (workspace, inscribed_cuboid, actuator_workspace) accept
-STRESS_LIMIT_OPTION = Option(
-    "stress_limit",
-    "str",
-    "hinge stress limits in place of angle limits: true (the mechanism's hinges and material) or a mapping "
-    "{sigma_allow, safety_factor, hinges, material}; each hinge's deflection about each axis alone at sigma_allow "
-    "becomes a limit of its joint (generalizing eq 31 of pantograph-3d-elgammal-2016.md)",
-    default=None,
-)
-_STRESS_KEYS = ("sigma_allow", "safety_factor", "hinges", "material")
-
-
-def split_stress_limit(raw: Any, model: Model, path: tuple) -> tuple[Any, Model | None]:
-    """The inputs without ``stress_limit``, and the model with the joint limits it sets
-    (None when not given)."""
-    if not isinstance(raw, Mapping) or raw.get("stress_limit") in (None, False):
-        if isinstance(raw, Mapping) and "stress_limit" in raw:
-            raw = {k: v for k, v in raw.items() if k != "stress_limit"}
-        return raw, None
-    spec = raw["stress_limit"]
-    rest = {k: v for k, v in raw.items() if k != "stress_limit"}
-    sub = path + ("stress_limit",)
-    if spec is True:
-        spec = {}
-    if not isinstance(spec, Mapping):
-        keys = ", ".join(_STRESS_KEYS)
-        raise InputError(f"expected stress_limit: true or a mapping {{{keys}}}, got {spec!r}", path=sub)
-    for key in spec:
-        if key not in _STRESS_KEYS:
-            raise unknown_key_error(str(key), _STRESS_KEYS, sub, "stress_limit key")
-    opts = [
-        Option("sigma_allow", "stress", "allowable stress", default=None, lower=0.0, strict=True),
-        Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
-    ]
-    vals = validate_mapping({k: spec.get(k) for k in ("sigma_allow", "safety_factor")}, opts, sub, what="key")
-    hs = cm.hinge_set(model, spec.get("hinges"), spec.get("material"), None, sub)
-    if not any(h.kind is not None for h in hs.hinges):
-        raise InputError("a stress limit needs hinges with a flexure type and dimensions", path=sub + ("hinges",))
-    sigma = cm.allowable(hs, vals["sigma_allow"], vals["safety_factor"], sub)
-    return rest, cm.with_limits(model, cm.stress_angle_limits(hs, sigma))

@@ -31,9 +31,10 @@ from ..core.kind import (
 )
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
 from ..core.model import Model
-from ..core.options import Option, validate_mapping
+from ..core.options import Option
 from ..core.progress import track
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
+from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
 
@@ -158,18 +159,7 @@ class ForwardKinematics(ProblemKind):
     plots = ("io", "mechanism", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
-        return actuator_options(model, "grid") + list(MODE_OPTIONS)
-
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        raw = dict(raw) if isinstance(raw, Mapping) else raw
-        guess = raw.pop("guess", None) if isinstance(raw, dict) else None
-        inputs = super().parse_inputs(raw, model, path)
-        if guess is not None:
-            c = model.closure
-            opts = [Option(x.name, x.kind, x.description, default=None) for x in c.x]
-            g = validate_mapping(guess, opts, path + ("guess",), what="pose coordinate")
-            inputs["guess"] = np.array([model.x_home[i] if g[n] is None else g[n] for i, n in enumerate(c.x_names)])
-        return inputs
+        return actuator_options(model, "grid") + list(MODE_OPTIONS) + [_guess_option(model)]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         names = model.closure.q_names
@@ -206,6 +196,25 @@ class ForwardKinematics(ProblemKind):
         # the values of ``assembly_modes: all`` (:func:`mode_value_names`) are not listed: they
         # would become columns (and change the fingerprint) of every forward_kinematics sweep
         return _pose_names(model)[0]
+
+
+def _guess_option(model: Model) -> Record:
+    """``guess``: a start pose of the FK Newton (coordinates not given: the home pose), as an nx vector."""
+    c = model.closure
+
+    def vector(g: Any, _path: tuple) -> np.ndarray | None:
+        if g is None:
+            return None
+        return np.array([model.x_home[i] if g[n] is None else g[n] for i, n in enumerate(c.x_names)])
+
+    return Record(
+        "guess",
+        "start pose of the Newton solve (a coordinate not given: its home value), to pick an assembly mode",
+        tuple(Option(x.name, x.kind, x.description, default=None) for x in c.x),
+        default=None,
+        what="pose coordinate",
+        convert=vector,
+    )
 
 
 #: inputs of the forward_kinematics kind that ask for every assembly mode

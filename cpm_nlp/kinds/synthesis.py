@@ -23,8 +23,9 @@ from ..core.errors import InputError, suggest
 from ..core.kind import ProblemKind, require_ipopt
 from ..core.model import Model
 from ..core.multistart import start_options
-from ..core.options import Option, validate_mapping
+from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
+from ..core.schema import Either, ListOf, Record
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS
 from .workspace import _volume_dimension
@@ -48,6 +49,89 @@ def _dim(model: Model, name: str) -> str:
     return opt.kind if opt is not None else model.dimensions.get(name, "dimensionless")
 
 
+def _known_parameter(model: Model) -> Any:
+    """A validator: the name of a parameter of the model (else "unknown parameter", with a "did you mean")."""
+    names = model.closure.parameters
+
+    def check(name: Any, path: tuple) -> None:
+        if name not in names:
+            raise InputError(
+                f"unknown parameter {name!r}; expected one of: {', '.join(names)}",
+                path=path,
+                suggestions=suggest(str(name), names),
+            )
+
+    return check
+
+
+def _design_option(model: Model) -> Either:
+    """``design``: the parameters to vary, by name (within their declared bounds) or name -> [low, high]."""
+    declared = _declared(model)
+    names = model.closure.parameters
+
+    def declared_bounds(chosen: list, path: tuple) -> dict[str, tuple[float, float]]:
+        out = {}
+        for k, name in enumerate(chosen):
+            opt = declared.get(name)
+            lo, hi = (opt.lower, opt.upper) if opt is not None else (None, None)
+            if lo is None or hi is None:
+                raise InputError(
+                    f"parameter {name} declares no finite bounds; give them: design: {{{name}: [low, high]}}",
+                    path=path + (k,),
+                )
+            out[name] = (float(lo), float(hi))
+        return out
+
+    def ranges() -> tuple:
+        out = []
+        for name in names:
+            opt = declared.get(name)
+            kind = opt.kind if opt is not None else _dim(model, name)
+            bounds = {"lower": opt.lower, "upper": opt.upper} if opt is not None else {}
+            out.append(Option(name, kind, f"bounds of {name}", default=None, shape="range", **bounds))
+        return tuple(out)
+
+    def non_empty(value: Any, path: tuple) -> None:
+        if not value or any(v is None for v in value.values()):
+            raise InputError(f"{mismatch}, got {value!r}", path=path)
+
+    mismatch = "expected a non-empty list of parameter names or a mapping name -> [low, high]"
+    return Either(
+        "design",
+        "the parameters to vary: a list of names, which vary within their declared bounds, or a mapping "
+        "name -> [low, high]; e.g. design: {L: [90 mm, 130 mm]}",
+        (
+            ListOf(
+                "design",
+                "parameter names",
+                Option("parameter", "str", "a parameter of the mechanism", check=_known_parameter(model)),
+                convert=declared_bounds,
+            ),
+            Record("design", "name -> [low, high]", ranges(), what="parameter", sparse=True, check=non_empty),
+        ),
+        mismatch=mismatch,
+        essential=True,
+        missing=f"; parameters of {model.name}: {', '.join(names)}",
+    )
+
+
+def _footprint_option(model: Model) -> Record:
+    """``footprint``: parameter -> exponent; the footprint is the product of the parameters' powers."""
+    return Record(
+        "footprint",
+        "footprint = product of parameter powers, parameter -> exponent, e.g. {b: 2} (default: none)",
+        tuple(
+            Option(n, "dimensionless", f"exponent of {n}", default=None, lower=-10.0, upper=10.0)
+            for n in model.closure.parameters
+        ),
+        default={},
+        what="parameter",
+        sparse=True,
+        convert=lambda value, _path: {k: e for k, e in value.items() if e is not None},
+        mismatch="expected a mapping parameter -> exponent (footprint = product of parameter powers, e.g. {b: 2})",
+    )
+
+
 class CuboidSynthesis(SynthesisFormulation):
     """The generic synthesis of a mechanism without a paper formulation: the
     parameters named in ``design`` vary within their bounds to maximise the
@@ -60,7 +144,10 @@ class CuboidSynthesis(SynthesisFormulation):
     )
 
     def input_options(self, model: Model) -> list[Option]:
-        return start_options(default=4) + [
+        return [
+            _design_option(model),
+            _footprint_option(model),
+            *start_options(default=4),
             Option(
                 "samples_per_edge",
                 "int",
@@ -72,90 +159,16 @@ class CuboidSynthesis(SynthesisFormulation):
             check_per_edge_option(9),
         ]
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        raw = dict(raw) if isinstance(raw, Mapping) else raw
-        if not isinstance(raw, dict):
-            raise InputError(f"expected a mapping of inputs, got {raw!r}", path=path)
-        if "design" not in raw:
-            raise InputError(
-                "missing required input 'design' (the parameters to vary: a list of names, which vary within "
-                "their declared bounds, or a mapping name -> [low, high]; e.g. design: {L: [90 mm, 130 mm]}); "
-                f"parameters of {model.name}: {', '.join(model.closure.parameters)}",
-                path=path,
-            )
-        design = self._design(raw.pop("design"), model, path + ("design",))
-        footprint = self._footprint(raw.pop("footprint", None), model, path + ("footprint",))
-        inputs = validate_mapping(raw, self.input_options(model), path, what="input")
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         check_grid_sizes(model.closure.nq, inputs["samples_per_edge"], inputs["check_per_edge"], path)
-        inputs["design"], inputs["footprint"] = design, footprint
-        for name, e in footprint.items():
+        design = inputs["design"]
+        for name, e in inputs["footprint"].items():
             low = design[name][0] if name in design else model.parameters[name]
             if e != 0 and not low > 0:
                 raise InputError(
                     f"the footprint takes the log of {name}; its lower bound must be positive, got {low:g}",
                     path=path + ("design", name),
                 )
-        return inputs
-
-    def _name(self, name: Any, model: Model, path: tuple) -> str:
-        names = model.closure.parameters
-        if not isinstance(name, str) or name not in names:
-            raise InputError(
-                f"unknown parameter {name!r}; expected one of: {', '.join(names)}",
-                path=path,
-                suggestions=suggest(str(name), names),
-            )
-        return name
-
-    def _design(self, raw: Any, model: Model, path: tuple) -> dict[str, tuple[float, float]]:
-        declared = _declared(model)
-        if isinstance(raw, (list, tuple)) and raw:
-            out = {}
-            for k, n in enumerate(raw):
-                name = self._name(n, model, path + (k,))
-                opt = declared.get(name)
-                lo, hi = (opt.lower, opt.upper) if opt is not None else (None, None)
-                if lo is None or hi is None:
-                    raise InputError(
-                        f"parameter {name} declares no finite bounds; give them: design: {{{name}: [low, high]}}",
-                        path=path + (k,),
-                    )
-                out[name] = (float(lo), float(hi))
-            return out
-        if isinstance(raw, Mapping) and raw:
-            out = {}
-            for n, value in raw.items():
-                name = self._name(n, model, path + (n,))
-                opt = declared.get(name)
-                kind = opt.kind if opt is not None else _dim(model, name)
-                rng = Option(
-                    name,
-                    kind,
-                    f"bounds of {name}",
-                    shape="range",
-                    lower=opt.lower if opt else None,
-                    upper=opt.upper if opt else None,
-                )
-                out[name] = rng.parse(value, path + (n,))
-            return out
-        raise InputError(
-            f"expected a non-empty list of parameter names or a mapping name -> [low, high], got {raw!r}", path=path
-        )
-
-    def _footprint(self, raw: Any, model: Model, path: tuple) -> dict[str, float]:
-        if raw is None:
-            return {}
-        if not isinstance(raw, Mapping):
-            raise InputError(
-                f"expected a mapping parameter -> exponent (footprint = product of parameter powers, e.g. "
-                f"{{b: 2}}), got {raw!r}",
-                path=path,
-            )
-        out = {}
-        for n, e in raw.items():
-            name = self._name(n, model, path + (n,))
-            out[name] = Option(name, "dimensionless", "exponent", lower=-10.0, upper=10.0).parse(e, path + (n,))
-        return out
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         rep = cuboid_synthesis(
@@ -255,8 +268,11 @@ class Synthesis(ProblemKind):
     def input_options(self, model: Model) -> list[Option]:
         return formulation(model).input_options(model)
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        return formulation(model).parse_inputs(raw, model, path)
+    def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        formulation(model).resolve(inputs, model, path)
+
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        formulation(model).check_inputs(inputs, model, path)
 
     def check_solver(self, solver: SolverConfig) -> None:
         require_ipopt(solver, self.name)

@@ -38,7 +38,7 @@ from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS, size_dimension
-from .compliance import STRESS_LIMIT_OPTION, split_stress_limit
+from .hinge_inputs import stress_limit_option
 from .kinematic import _model_info
 
 
@@ -93,12 +93,6 @@ class InscribedCuboid(ProblemKind):
     description = "largest axis-aligned box of task coordinates inside the reachable workspace (IPOPT, multi-start)"
     plots = ("workspace",)
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        raw, limited = split_stress_limit(raw, model, path)  # hinge stress limits -> joint limits
-        inputs = super().parse_inputs(raw, limited or model, path)
-        inputs["stress_limited_model"] = limited
-        return inputs
-
     def input_options(self, model: Model) -> list[Option]:
         rounds = EXTRA_SLOTS // ADDED_PER_ROUND
         opts = start_options() + [
@@ -133,7 +127,7 @@ class InscribedCuboid(ProblemKind):
         opts += _region_options(model)
         extras = _cuboid_extras(model)
         opts += list(extras.options) if extras else []
-        return opts + [STRESS_LIMIT_OPTION]
+        return opts + [stress_limit_option(model)]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _region(inputs, model, path)
@@ -164,7 +158,7 @@ class InscribedCuboid(ProblemKind):
         return names + (list(extras.value_names) if extras else [])
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
-        model = inputs.get("stress_limited_model") or model
+        model = inputs.get("stress_limit") or model
         require_ipopt(solver, self.name)
         c = model.closure
         res = inscribed_cuboid(
@@ -253,12 +247,6 @@ class Workspace(ProblemKind):
     description = "membership of given points and a seeded point cloud of the reachable workspace"
     plots = ("workspace",)
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        raw, limited = split_stress_limit(raw, model, path)  # hinge stress limits -> joint limits
-        inputs = super().parse_inputs(raw, limited or model, path)
-        inputs["stress_limited_model"] = limited
-        return inputs
-
     def input_options(self, model: Model) -> list[Option]:
         c = model.closure
         opts = [
@@ -269,7 +257,7 @@ class Workspace(ProblemKind):
             Option("samples", "int", "points drawn for the point cloud (0: none)", default=0, lower=0, upper=200_000),
             Option("seed", "int", "seed of the point cloud", default=0, lower=0, upper=2**32 - 1),
         ]
-        return opts + _region_options(model) + [STRESS_LIMIT_OPTION]
+        return opts + _region_options(model) + [stress_limit_option(model)]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _region(inputs, model, path)
@@ -292,7 +280,7 @@ class Workspace(ProblemKind):
         )
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
-        model = inputs.get("stress_limited_model") or model
+        model = inputs.get("stress_limit") or model
         c = model.closure
         task = list(c.task)
         values: dict[str, Any] = {}

@@ -9,7 +9,10 @@ its first shipped problem file (``Mechanism.problem_files``), else from its defa
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+from collections import Counter
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,7 +22,8 @@ from ..core.kind import ProblemKind
 from ..core.mechanism import Mechanism
 from ..core.model import Model
 from ..core.options import Option
-from ..core.units import DIMENSIONS
+from ..core.schema import Either, ListOf, MappingOf, Named, Node, Quantity, Record, children, type_text
+from ..core.units import DIMENSIONS, format_quantity
 from ..mechanisms.registry import PluginError, build_model, mechanism_names, mechanism_type
 from .reader import read_yaml
 from .registry import kind_names, kind_origin, problem_kind
@@ -31,12 +35,23 @@ log = logging.getLogger(__name__)
 @dataclass(frozen=True)
 class InputRow:
     """One input of a kind: name, unit (the display unit of its dimension, or its type),
-    default ("required", "optional" or the value) and meaning (description and what it accepts)."""
+    default ("required", "optional" or the value) and meaning (description and what it accepts);
+    ``children``: the keys nested in it (a record's keys, a mapping's value, the alternatives
+    of an input that takes one of several forms), from the declared schema."""
 
     name: str
     unit: str
     default: str
     meaning: str
+    children: tuple[InputRow, ...] = ()
+
+    def walk(self, depth: int = 0, prefix: str = "") -> list[tuple[int, str, InputRow]]:
+        """This row and every nested one, depth first: (depth, dotted key path, row)."""
+        path = f"{prefix}.{self.name}" if prefix else self.name
+        out = [(depth, path, self)]
+        for child in self.children:
+            out += child.walk(depth + 1, path)
+        return out
 
 
 @dataclass(frozen=True)
@@ -88,20 +103,22 @@ def model_of(mech: Mechanism) -> tuple[Model | None, str]:
         return None, f"the parameters of {source} do not build a model: {exc.message}"
 
 
-def _unit(option: Option) -> str:
-    if option.kind in DIMENSIONS:
-        return DIMENSIONS[option.kind].display or "1"
-    return option.kind
+def _unit(option: Any) -> str:
+    return type_text(option)
 
 
-def _default(option: Option) -> str:
+def _default(option: Any) -> str:
     if option.required:
         return "required"
     value = option.default
-    if value is None:
+    if value is None or (isinstance(value, Mapping) and not value):
         return "optional"
     if isinstance(value, bool):
         return "true" if value else "false"
+    if isinstance(option, Quantity) and isinstance(value, (int, float)):
+        return format_quantity(float(value), option.kinds[0])
+    if isinstance(option, Node):
+        return str(value)
     if isinstance(value, (int, float)) and option.kind in DIMENSIONS:
         return option.format_value(float(value))
     if isinstance(value, (list, tuple)):
@@ -122,11 +139,45 @@ _SHAPES = {
 }
 
 
-def _meaning(option: Option) -> str:
+def _meaning(option: Any) -> str:
+    text = option.description.rstrip(".")
+    if isinstance(option, Named):
+        return f"{text}; a name ({', '.join(option.table)}) or a mapping"
+    if isinstance(option, Quantity):
+        return f"{text}; {option.expectation()}"
+    if isinstance(option, Node):
+        return text
     accepts = "" if option.kind == "str" else option.expectation()
     prefix = _SHAPES.get(option.shape, "")
-    text = option.description.rstrip(".")
     return f"{text}; {prefix}{accepts}" if accepts else text
+
+
+def _form(alt: Any) -> str:
+    """The label of one form of an input that takes one of several (true, a mapping, 'rigid' ...)."""
+    if isinstance(alt, Record):
+        return "{...}"
+    if isinstance(alt, MappingOf):
+        return f"{{<{alt.key_what}>: ...}}"
+    if isinstance(alt, ListOf):
+        return "[...]"
+    if isinstance(alt, Node):
+        return f"<{alt.kind}>"
+    if alt.kind == "choice":
+        return " | ".join(alt.choices)
+    return {"bool": "true | false", "str": "<text>", "int": "<integer>"}.get(alt.kind, "<number>")
+
+
+def _row(option: Any, name: str | None = None, slot: bool = False) -> InputRow:
+    """The row of a declared input, with the rows nested in it; a ``slot`` (a form of an
+    input, a mapping's value, a list's item) is not a key and has no default."""
+    if isinstance(option, Either):  # its forms, by what each takes
+        kids = [_row(alt, _form(alt), slot=True) for alt in option.alternatives]
+    elif isinstance(option, (MappingOf, ListOf)):
+        kids = [_row(c, slot=True) for c in children(option)]
+    else:
+        kids = [_row(c) for c in children(option)]
+    default = "" if slot else _default(option)
+    return InputRow(name or option.name, _unit(option), default, _meaning(option), tuple(kids))
 
 
 def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, source: str = "") -> KindDescription:
@@ -153,7 +204,7 @@ def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, so
         raise
     except Exception as exc:
         raise PluginError(f"problem kind {kind.name!r} ({origin}): describing its inputs failed: {exc}") from exc
-    rows = tuple(InputRow(o.name, _unit(o), _default(o), _meaning(o)) for o in options)
+    rows = tuple(_row(o) for o in options)
     return KindDescription(kind.name, kind.description, origin, mechanism, source, None, rows, values)
 
 
@@ -167,9 +218,12 @@ def kind_text(desc: KindDescription) -> str:
     lines.append("inputs:")
     if not desc.inputs:
         lines.append("  (none)")
-    for row in desc.inputs:
-        lines.append(f"  {row.name:<14} [{row.unit}] {row.default}")
-        lines.append(f"  {'':<14} {row.meaning}")
+    for top in desc.inputs:
+        for depth, _path, row in top.walk():
+            pad = "  " * (depth + 1)
+            width = max(14 - 2 * depth, 1)
+            lines.append(f"{pad}{row.name:<{width}} [{row.unit}] {row.default}".rstrip())
+            lines.append(f"{pad}{'':<{width}} {row.meaning}")
     lines.append("values:")
     lines.append("  " + (", ".join(desc.values) if desc.values else "(none)"))
     return "\n".join(lines) + "\n"
@@ -179,8 +233,46 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
 
 
-def kind_markdown(desc: KindDescription, level: int = 3) -> str:
-    """One kind on one mechanism as a Markdown section (a table of inputs, the values)."""
+def _table(rows: list[tuple[str, InputRow]]) -> list[str]:
+    out = ["| input | unit | default | meaning |", "| --- | --- | --- | --- |"]
+    out += [f"| `{_cell(p)}` | {_cell(r.unit)} | {_cell(r.default)} | {_cell(r.meaning)} |" for p, r in rows]
+    return out
+
+
+def _schema_key(top: InputRow) -> tuple:
+    """What identifies the schema nested in an input: its name and every nested row."""
+    return (top.name, tuple((p, r.unit, r.default, r.meaning) for _d, p, r in top.walk()[1:]))
+
+
+class _Nested:
+    """The nested keys of the inputs on the reference page: a schema that several tables
+    share (the hinges of six kinds on every mechanism) is one table the kinds link to; one
+    that a single table has (a mechanism's load coordinates) stays in it."""
+
+    def __init__(self, counts: Mapping[tuple, int]) -> None:
+        self.counts = counts
+        self.anchors: dict[tuple, str] = {}
+        self.sections: list[str] = []
+
+    def link(self, top: InputRow) -> str | None:
+        """The anchor of the schema nested in ``top`` (its table added on first sight), or
+        None when no other table has it."""
+        key = _schema_key(top)
+        if self.counts.get(key, 0) < 2:
+            return None
+        if key not in self.anchors:
+            n = sum(1 for k in self.anchors if k[0] == top.name)
+            anchor = (f"nested-{top.name}" + (f"-{n + 1}" if n else "")).replace("_", "-").lower()
+            self.anchors[key] = anchor
+            title = f"`{top.name}`" + (f" ({n + 1})" if n else "")
+            rows = [(p, r) for _d, p, r in top.walk()[1:]]
+            self.sections += [f"### {title} {{ #{anchor} }}", "", *_table(rows), ""]
+        return self.anchors[key]
+
+
+def kind_markdown(desc: KindDescription, level: int = 3, nested: _Nested | None = None) -> str:
+    """One kind on one mechanism as a Markdown section (a table of inputs, the values); the
+    keys nested in an input follow it, or, with ``nested``, are linked to its one table."""
     head = "#" * level
     out = [f"{head} `{desc.kind}` on `{desc.mechanism}`", ""]
     if desc.unsupported:
@@ -188,8 +280,15 @@ def kind_markdown(desc: KindDescription, level: int = 3) -> str:
     out.append(f"Defaults and bounds for the model of `{desc.model_from}`.")
     out.append("")
     if desc.inputs:
-        out += ["| input | unit | default | meaning |", "| --- | --- | --- | --- |"]
-        out += [f"| `{r.name}` | {_cell(r.unit)} | {_cell(r.default)} | {_cell(r.meaning)} |" for r in desc.inputs]
+        rows: list[tuple[str, InputRow]] = []
+        for top in desc.inputs:
+            anchor = nested.link(top) if nested is not None and top.children else None
+            if anchor is None:
+                rows += [(p, r) for _d, p, r in top.walk()]
+                continue
+            link = f"{top.meaning}; its keys: [{top.name}](#{anchor})"
+            rows.append((top.name, dataclasses.replace(top, meaning=link)))
+        out += _table(rows)
     else:
         out.append("No inputs.")
     out += ["", "Values: " + (", ".join(f"`{v}`" for v in desc.values) if desc.values else "none") + ".", ""]
@@ -207,22 +306,26 @@ def reference_markdown() -> str:
     out = [
         "# Problem kinds",
         "",
-        "Generated from the declared options when the site is built "
-        "(`cpm_nlp/problems/describe.py`); `cpm-nlp describe KIND --mechanism NAME` prints the same. "
-        "Units are the display units; a bare number is read in SI. A list makes a batch where the "
-        "kind allows it.",
+        "Generated from the declared inputs (options and the nested schema of `cpm_nlp/core/schema.py`) "
+        "when the site is built (`cpm_nlp/problems/describe.py`); `cpm-nlp describe KIND --mechanism NAME` "
+        "prints the same. Units are the display units; a bare number is read in SI. A list makes a batch "
+        "where the kind allows it. The keys nested in an input (hinges, materials, stress limits ...) are "
+        "in [Nested inputs](#nested-inputs), each schema once.",
         "",
     ]
-    for kind_name in kind_names():
+    descs = {k: [describe_kind(k, m, model, source) for m, (model, source) in models.items()] for k in kind_names()}
+    counts = Counter(_schema_key(top) for ds in descs.values() for d in ds for top in d.inputs if top.children)
+    nested = _Nested(counts)
+    for kind_name, kind_descs in descs.items():
         kind = problem_kind(kind_name)
         out += [f"## `{kind_name}`", "", f"{_cell(kind.description)} ({kind_origin(kind_name)}).", ""]
         skipped = []
-        for mech, (model, source) in models.items():
-            desc = describe_kind(kind_name, mech, model, source)
+        for desc in kind_descs:
             if desc.unsupported:
-                skipped.append(f"`{mech}` ({_cell(desc.unsupported)})")
+                skipped.append(f"`{desc.mechanism}` ({_cell(desc.unsupported)})")
                 continue
-            out.append(kind_markdown(desc))
+            out.append(kind_markdown(desc, nested=nested))
         if skipped:
             out += ["Does not apply to: " + "; ".join(skipped) + ".", ""]
-    return "\n".join(out)
+    out += ["## Nested inputs", "", "The keys of the inputs that nest, by the kinds' tables that link here.", ""]
+    return "\n".join(out + nested.sections)

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..core.errors import InputError, suggest, unknown_key_error
 from ..core.options import MAX_GRID_POINTS, Option, validate_mapping
+from ..core.schema import Node
 from ..core.units import DIMENSIONS
 from ..mechanisms.registry import mechanism_type
 from .overrides import apply_overrides
@@ -192,8 +193,10 @@ def _jsonable_raw(raw: Any) -> Any:
 def _parse_axis(
     key: str, spec: Any, data: Mapping[str, Any], kind: Any, model: Any, base_dir: Path | None, path: tuple
 ) -> Axis:
-    axis = _axis(key, spec, data, kind, model, base_dir, path)
     option = _resolve(key, kind, model, path)[0]
+    if isinstance(option, Node):
+        return _nested_axis(key, spec, option, path)
+    axis = _axis(key, spec, data, kind, model, base_dir, path)
     return dataclasses.replace(axis, base=_base_value(data, key, option))
 
 
@@ -246,6 +249,15 @@ def _axis(
         return Axis(key, "list", tuple(parsed), dimension=dimension)
     parsed = [_jsonable(option.parse(v, w)) for v, w in zip(values, where)]
     return Axis(key, "list", tuple(parsed), dimension=dimension)
+
+
+def _nested_axis(key: str, spec: Any, node: Node, path: tuple) -> Axis:
+    """The values of a nested input (a material, hinges), each checked by its schema and
+    swept as written."""
+    values = list(spec) if isinstance(spec, list) else [spec]
+    for i, v in enumerate(values):
+        node.parse(v, path + (i,) if isinstance(spec, list) else path)
+    return Axis(key, "list", tuple(_jsonable_raw(v) for v in values), dimension=None)
 
 
 def _check_each(option: Option, values: list, path: tuple) -> list:

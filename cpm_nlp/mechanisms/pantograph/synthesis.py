@@ -48,8 +48,9 @@ from ...analysis.workspace import CHECK_OPTION, check_box
 from ...core.errors import InputError
 from ...core.model import Model
 from ...core.multistart import AGREEMENT, best_and_agreement, start_options, uniform_starts
-from ...core.options import Option, validate_mapping
+from ...core.options import Option
 from ...core.result import Result, SolverInfo, Status
+from ...core.schema import Record
 from ...core.solver import SolverConfig
 from ...core.units import DIMENSIONS
 from ...kinds.synthesis import SynthesisFormulation
@@ -169,7 +170,7 @@ class PantographSynthesis(SynthesisFormulation):
                     lower=0.0,
                     strict=True,
                 ),
-                Option("material", "str", f"hinge material, one of: {', '.join(flexure.MATERIALS)}"),
+                flexure.material_node("material", f"hinge material, one of: {', '.join(flexure.MATERIALS)}"),
                 *(o for o in flexure.HINGE_LIMIT_OPTIONS if o.name in ("E", "sigma_all")),
                 Option(
                     "weights",
@@ -210,19 +211,17 @@ class PantographSynthesis(SynthesisFormulation):
                 ),
             ]
             + start_options()
-            + [CHECK_OPTION]
+            + [
+                CHECK_OPTION,
+                Record(
+                    "reference",
+                    "a design to evaluate beside the optimum",
+                    REFERENCE_OPTIONS,
+                    default=None,
+                    what="design value",
+                ),
+            ]
         )
-
-    def parse_inputs(self, raw: Any, model: Model, path: tuple) -> dict[str, Any]:
-        raw = dict(raw) if isinstance(raw, Mapping) else raw
-        ref = raw.pop("reference", None) if isinstance(raw, dict) else None
-        inputs = super().parse_inputs(raw, model, path)
-        inputs["reference"] = (
-            None
-            if ref is None
-            else validate_mapping(ref, REFERENCE_OPTIONS, path + ("reference",), what="design value")
-        )
-        return inputs
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         for name, n in (("cuboid", 3), ("weights", 4), ("stroke", 3)):

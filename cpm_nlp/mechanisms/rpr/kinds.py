@@ -13,6 +13,7 @@ problems/mechanisms/rpr.yaml, and runs on its closures (pose, passive joints, Ja
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -24,8 +25,9 @@ from ...core.errors import InputError
 from ...core.kind import ProblemKind, require_ipopt
 from ...core.kinematics import forward_kinematics, inverse_kinematics
 from ...core.model import Model
-from ...core.options import Option, validate_mapping
+from ...core.options import Option
 from ...core.result import STATUS_TEXT, Result, SolverInfo, Status
+from ...core.schema import Record
 from ...core.solver import SolverConfig
 from ...kinds.kinematic import Jacobian, _model_info, _si
 from . import compliance as rpr_compliance
@@ -86,19 +88,17 @@ def _finish(
     )
 
 
-def _pop_mapping(raw: Any, key: str) -> tuple[Any, Any]:
-    """Split a nested mapping input off the raw inputs (validated separately)."""
-    if not isinstance(raw, Mapping):
-        return raw, None
-    raw = dict(raw)
-    return raw, raw.pop(key, None)
-
-
-def _material(raw: Any, path: tuple) -> flexure.Material:
-    mat = flexure.material("Al 7075-T6" if raw is None else raw, path)
+def _check_material(mat: Any, path: tuple) -> flexure.Material:
+    mat = flexure.material(mat, path)
     if mat.nu is None or mat.yield_strength is None:
         raise InputError(f"material '{mat.name}' needs nu and yield_strength (eq 32 and the shear modulus)", path=path)
     return mat
+
+
+def _material_option() -> Any:
+    """``material``: a name or inline, with nu and yield strength (eq 32 and the shear modulus)."""
+    node = flexure.material_node("material", "the joints' material, with nu and yield_strength", "Al 7075-T6")
+    return dataclasses.replace(node, convert=_check_material)
 
 
 # -- eq 7-13 --------------------------------------------------------------------------------------
@@ -525,6 +525,23 @@ _JOINT_GEOMETRY = {
 }
 
 
+def _joints_option(name: str, description: str) -> Record:
+    """Circular-notch R and U joints by their dimensions ({R: {r, t, b}, U: {r, t, h}}); only those given."""
+    return Record(
+        name,
+        description,
+        tuple(
+            Record(j, f"the {j} joint's notch", _JOINT_GEOMETRY[j], default=None, what="joint dimension")
+            for j in rpr_compliance.JOINTS
+        ),
+        default=None,
+        sparse=True,
+        mismatch="expected a mapping {R: {r, t, b}, U: {r, t, h}}",
+        unknown="unknown joint {key}; expected R or U",
+        convert=lambda value, _path: {j: g for j, g in (value or {}).items() if g is not None},
+    )
+
+
 def _joint_dims(joint: str, geometry: Mapping[str, Any]) -> tuple[float, float, float]:
     return (geometry["r"], geometry["t"], geometry["b" if joint == "R" else "h"])
 
@@ -581,6 +598,8 @@ class JointDesign(RprKind):
                 choices=rpr_compliance.ROTATION_LIMITS,
             ),
             Option("starts", "int", "number of IPOPT starts per joint", default=6, lower=1, upper=100),
+            _material_option(),
+            _joints_option("compare", "joints to evaluate beside the optimum: {R: {r, t, b}, U: {r, t, h}}"),
         ]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
@@ -590,24 +609,6 @@ class JointDesign(RprKind):
                 f"{inputs['t_min'] * 1e3:g} mm, box = {inputs['box'] * 1e3:g} mm",
                 path=path + ("t_min",),
             )
-
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
-        raw, material = _pop_mapping(raw, "material")
-        raw, compare = _pop_mapping(raw, "compare")
-        inputs = super().parse_inputs(raw, model, path)
-        inputs["material"] = _material(material, path + ("material",))
-        inputs["compare"] = {}
-        if compare is not None:
-            if not isinstance(compare, Mapping):
-                raise InputError("expected a mapping {R: {r, t, b}, U: {r, t, h}}", path=path + ("compare",))
-            for key in compare:
-                if key not in rpr_compliance.JOINTS:
-                    raise InputError(f"unknown joint {key!r}; expected R or U", path=path + ("compare",))
-            for joint, geometry in compare.items():
-                inputs["compare"][joint] = validate_mapping(
-                    geometry, _JOINT_GEOMETRY[joint], path + ("compare", joint), what="joint dimension"
-                )
-        return inputs
 
     def check_solver(self, solver: SolverConfig) -> None:
         require_ipopt(solver, self.name)
@@ -720,6 +721,15 @@ _LEAF = (
 )
 
 
+def _leaf_or_stiffness(amp: Mapping[str, Any], path: tuple) -> None:
+    """The amplifier's hinges: by the leaf's dimensions, or by both stiffnesses k_r and k_t."""
+    given = [k for k in ("k_r", "k_t") if amp[k] is not None]
+    if amp["leaf"] is not None and given:
+        raise InputError("give either leaf or k_r and k_t, not both", path=path)
+    if amp["leaf"] is None and len(given) != 2:
+        raise InputError("expected leaf: {length, thickness, width} or both k_r and k_t", path=path)
+
+
 class Compliance(RprKind):
     name = "rpr_compliance"
     plots = ("matrices",)
@@ -743,48 +753,23 @@ class Compliance(RprKind):
                 lower=0.0,
                 strict=True,
             ),
+            _material_option(),
+            Record(
+                "amplifier",
+                "the displacement amplifier: {l1, l2, leaf: {length, thickness, width}} or {l1, l2, k_r, k_t}",
+                (*_AMPLIFIER, Record("leaf", "the leaf hinges", _LEAF, default=None, what="leaf dimension")),
+                what="amplifier key",
+                check=_leaf_or_stiffness,
+            ),
+            _joints_option("joints", "the R and U joints by their dimensions: {R: {r, t, b}, U: {r, t, h}}"),
         ]
 
-    def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:  # noqa: C901 - one rule per input of the compliance model
-        raw, material = _pop_mapping(raw, "material")
-        raw, amplifier = _pop_mapping(raw, "amplifier")
-        raw, joints = _pop_mapping(raw, "joints")
-        inputs = super().parse_inputs(raw, model, path)
-        inputs["material"] = _material(material, path + ("material",))
-        amp_raw, leaf = _pop_mapping(amplifier, "leaf")
-        if amp_raw is None:
-            raise InputError(
-                "missing required input 'amplifier' ({l1, l2, leaf: {length, thickness, width}} or {l1, l2, k_r, k_t})",
-                path=path,
-            )
-        amp = validate_mapping(amp_raw, _AMPLIFIER, path + ("amplifier",), what="amplifier key")
-        given = [k for k in ("k_r", "k_t") if amp[k] is not None]
-        if leaf is not None and given:
-            raise InputError("give either leaf or k_r and k_t, not both", path=path + ("amplifier",))
-        if leaf is None and len(given) != 2:
-            raise InputError(
-                "expected leaf: {length, thickness, width} or both k_r and k_t", path=path + ("amplifier",)
-            )
-        if leaf is not None:
-            amp["leaf"] = validate_mapping(leaf, _LEAF, path + ("amplifier", "leaf"), what="leaf dimension")
-        inputs["amplifier"] = amp
-        inputs["joints"] = {}
-        if joints is not None:
-            if not isinstance(joints, Mapping):
-                raise InputError("expected a mapping {R: {r, t, b}, U: {r, t, h}}", path=path + ("joints",))
-            for key in joints:
-                if key not in rpr_compliance.JOINTS:
-                    raise InputError(f"unknown joint {key!r}; expected R or U", path=path + ("joints",))
-            for joint, geometry in joints.items():
-                inputs["joints"][joint] = validate_mapping(
-                    geometry, _JOINT_GEOMETRY[joint], path + ("joints", joint), what="joint dimension"
-                )
+    def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         for joint in rpr_compliance.JOINTS:
             has_k = inputs[f"k_{joint}"] is not None
             has_geometry = joint in inputs["joints"]
             if has_k == has_geometry:
                 raise InputError(f"give either joints.{joint} (its dimensions) or k_{joint} (its stiffness)", path=path)
-        return inputs
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         mat = inputs["material"]
@@ -793,7 +778,7 @@ class Compliance(RprKind):
         if not sol.ok:
             return _finish(self.name, model, sol.status, {}, {}, message=sol.message)
         amp = inputs["amplifier"]
-        if "leaf" in amp:
+        if amp["leaf"] is not None:
             leaf = amp["leaf"]
             c_r, c_t = rpr_compliance.leaf_compliances(mat, leaf["length"], leaf["thickness"], leaf["width"])
         else:
