@@ -213,3 +213,18 @@ def test_a_plot_type_registered_in_code_is_validated_and_removed(tmp_path):
     finally:
         unregister("flat")
     assert "flat" not in plot_type_names()
+
+
+def test_a_bad_plot_of_an_addon_is_an_error_naming_it(monkeypatch):
+    from cpm_nlp.core.mechanism import Addon
+    from cpm_nlp.plot import registry
+
+    monkeypatch.setattr(registry, "addon_of", lambda name: Addon(plots=("cpm_nlp.plot.builtin:NOPE",)))
+    with pytest.raises(PlotPluginError, match="of the add-on of mechanism 'prc3' failed to load: AttributeError"):
+        registry._Registry().mechanism_plots("prc3")
+    monkeypatch.setattr(registry, "addon_of", lambda name: Addon(plots=("cpm_nlp.plot.builtin:BUILTIN",)))
+    with pytest.raises(PlotDeclarationError, match="the plot type 'workspace' is declared twice"):
+        registry._Registry().mechanism_plots("prc3")
+    monkeypatch.setattr(registry, "addon_of", lambda name: Addon(plots=("no colon",)))
+    with pytest.raises(PlotPluginError, match="expected 'module:attribute', got 'no colon'"):
+        registry._Registry().mechanism_plots("prc3")

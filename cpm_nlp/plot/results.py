@@ -22,9 +22,6 @@ from ..io.inputs import MAX_RESULTS_BYTES, read_input_text
 from ..io.results import FORMATS, read_results
 from ..mechanisms.registry import closure_of, mechanism_type
 
-#: plot types that may draw a sweep results file, the default first
-SWEEP_PLOTS = ("map", "lines", "workspace")
-
 #: sweep statuses of points outside the design space (drawn apart from points that did not solve)
 OUTSIDE = ("infeasible", "invalid_input")
 
