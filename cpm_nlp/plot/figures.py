@@ -94,7 +94,7 @@ def figure(
 def check_plot_type(plot_type: str | None) -> None:
     """An :class:`InputError` (``--type``, with "did you mean") unless ``plot_type``
     is None or a registered plot type (checked before anything is solved)."""
-    if plot_type is None:
+    if plot_type is None or REGISTRY.has(plot_type):
         return
     names = plot_type_names()
     if plot_type not in names:

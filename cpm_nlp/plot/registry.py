@@ -138,6 +138,12 @@ class _Registry:
                 return self._load_plugin(name)
             return self.mechanism_plots(mechanism).get(name) if mechanism else None
 
+    def has(self, name: str) -> bool:
+        """Whether ``name`` is a registered plot type (nothing loaded that need not be: a
+        mechanism's add-on is read only for a name that is neither built-in nor a plugin's)."""
+        with self._lock:
+            return name in self._types or name in self._plugin_specs() or bool(self.owners(name))
+
     def owners(self, name: str) -> list[str]:
         """The built-in mechanisms whose add-ons declare the plot type ``name``."""
         return [m for m in sorted(ADDONS) if name in self.mechanism_plots(m)]
