@@ -5,6 +5,7 @@ generic modules that name no mechanism."""
 from __future__ import annotations
 
 import ast
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -73,7 +74,19 @@ def graph():
     return {name: _imports(name, path, modules) for name, path in modules.items()}
 
 
+#: modules of a mechanism's package that belong to the plot layer: a paper's own plot types,
+#: named by its add-on (``Addon.plots``, "module:attribute"), never imported below the plots
+PLOT_MODULES = re.compile(r"cpm_nlp\.mechanisms\.\w+\.plots")
+
+
 def _layer(module: str) -> str | None:
+    if PLOT_MODULES.fullmatch(module):
+        return "plot"
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else None
+
+
+def _package(module: str) -> str | None:
     parts = module.split(".")
     return parts[1] if len(parts) > 1 else None
 
@@ -148,11 +161,39 @@ def _code_words(path: Path) -> set[str]:
 def test_generic_modules_name_no_mechanism():
     bad = []
     for name, path in _modules().items():
-        if _layer(name) in GENERIC:
+        if _package(name) in GENERIC:
             hits = sorted(w for w in _code_words(path) if w.lower() in MECHANISM_WORDS)
             if hits:
                 bad.append(f"{name}: {', '.join(hits)}")
     assert not bad, "generic modules that name a mechanism:\n" + "\n".join(bad)
+
+
+def test_a_mechanisms_plots_are_named_not_imported(graph):
+    """A paper's plot module (mechanisms/<m>/plots.py) imports the plot layer; the layers
+    below reach it only by name (the add-on's ``plots``), so nothing there imports it."""
+    plots = [m for m in graph if PLOT_MODULES.fullmatch(m)]
+    assert plots, "no mechanism declares plots of its own"
+    bad = [f"{m} imports {t}" for m, ts in graph.items() for t in ts if t in plots and _layer(m) != "plot"]
+    assert not bad
+
+
+def test_plot_modules_stay_small():
+    """One concept per module (issue 22, item 6): none of the plot layer over 800 lines."""
+    big = {f.name: n for f in (PKG / "plot").glob("*.py") if (n := len(f.read_text().splitlines())) > 800}
+    assert not big, big
+
+
+def test_plot_modules_import_no_private_name():
+    """What a plot module shares with another is public (the common helpers in
+    cpm_nlp.plot.style): no ``from .x import _name`` in the plot layer."""
+    bad = []
+    for name, path in _modules().items():
+        if _layer(name) != "plot":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module != "__future__":
+                bad += [f"{name}: {a.name}" for a in node.names if a.name.startswith("_")]
+    assert not bad
 
 
 def test_every_module_imports_in_a_fresh_interpreter():

@@ -26,7 +26,7 @@ from cpm_nlp.core.chains import JOINT_DOF
 from cpm_nlp.core.joints import JOINT_LETTERS, JOINT_TYPES, joint_type, joint_types
 from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import generate, spec
-from cpm_nlp.plot import draw, interactive
+from cpm_nlp.plot import draw_mechanism, interactive
 
 ROOT = Path(__file__).resolve().parent.parent
 MECH = ROOT / "problems" / "mechanisms"
@@ -124,7 +124,8 @@ def test_letters_and_the_drawings():
         "planar_P": "P",
         "distance": "S",  # an S-S strut
     }
-    assert set(JOINT_LETTERS) == set(draw._JOINT_MARKER) == set(draw._JOINT_NAME) == set(interactive._JOINT_SYMBOL)
+    drawn = (draw_mechanism.JOINT_MARKER, draw_mechanism.JOINT_NAME, interactive._JOINT_SYMBOL)
+    assert set(JOINT_LETTERS) == set(drawn[0]) == set(drawn[1]) == set(drawn[2])
     assert generate._LETTER == {n: t.letter for n, t in JOINT_TYPES.items()}
 
 

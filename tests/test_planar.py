@@ -20,6 +20,7 @@ import cpm_nlp as cn
 from cpm_nlp.cli.main import render_result
 from cpm_nlp.core.units import format_quantity, size_dimension
 from cpm_nlp.plot import figures
+from cpm_nlp.plot import pose as plot_pose
 from cpm_nlp.plot.draw import save
 from cpm_nlp.problems.registry import problem_kind
 
@@ -231,9 +232,9 @@ def test_the_pose_title_has_no_rounding_noise():
     model = cn.load_problem(PROBLEMS / "five_bar_forward_kinematics.yaml").model
     x = np.array(model.x_home, dtype=float)
     x[0] = -7.939e-15  # what Newton leaves of x = 0
-    pose, home, k = figures._drawings(model, x, model.q_home)
+    pose, home, k = plot_pose.drawings(model, x, model.q_home)
     assert k == 1.0  # at home: nothing to exaggerate
-    title = figures._pose_title(model, x, k, figures._span(home))
+    title = plot_pose.pose_title(model, x, k, plot_pose.span_of(home))
     assert title.startswith("five_bar at x = 0 mm, y = 198.4 mm"), title
     assert "e-" not in title and "nm" not in title
 

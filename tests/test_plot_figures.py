@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from cpm_nlp.mechanisms.registry import build_model, mechanism_names, mechanism_type
-from cpm_nlp.plot import figures
+from cpm_nlp.plot import compliance_plots, figures
+from cpm_nlp.plot import pose as plot_pose
 from cpm_nlp.plot.draw import (
     BoundarySlice,
     Comparison,
@@ -30,9 +31,8 @@ from cpm_nlp.plot.draw import (
     value_text,
     workspace_figure,
 )
-from cpm_nlp.plot.draw import (
-    _number as draw_number,
-)
+from cpm_nlp.plot.registry import plot_type_names
+from cpm_nlp.plot.style import number as draw_number
 from cpm_nlp.problems.registry import kind_names, problem_kind
 
 from .figure_checks import assert_figure_readable
@@ -75,7 +75,7 @@ def test_every_problem_kind_has_a_plot():
     for name in kind_names():
         plots = problem_kind(name).plots
         assert plots, f"problem kind {name} has no plot"
-        assert set(plots) <= set(figures.PLOTS), (name, plots)
+        assert set(plots) <= set(plot_type_names()), (name, plots)
 
 
 # -- the mechanism drawn from its kinematics ---------------------------------------------------------
@@ -164,15 +164,15 @@ def test_a_mechanism_without_geometry_says_so():
         mechanism = replace(mechanism_type("prs3"), geometry=None)
 
     with pytest.raises(figures.NotApplicable, match="no drawing of the mechanism: bare declares no geometry"):
-        figures._geometry(Bare())
-    assert figures._geometry(model) is not None
+        plot_pose.geometry_of(Bare())
+    assert plot_pose.geometry_of(model) is not None
 
 
 def test_small_motions_are_drawn_exaggerated_and_said_so():
     """A compliant mechanism moves micrometres: the drawing scales the displacements from home by a
     round factor and the title says it."""
     model, x, q = pose_of("prc3")
-    pose, home, k = figures._drawings(model, x, q)
+    pose, home, k = plot_pose.drawings(model, x, q)
     true = model.mechanism.geometry(model, x, q)
     H = np.array([np.asarray(v) for v in home.points.values()])
     span = np.ptp(H, axis=0).max()
@@ -182,7 +182,7 @@ def test_small_motions_are_drawn_exaggerated_and_said_so():
     for n in true.points:
         moved = np.asarray(true.points[n]) - np.asarray(home.points[n])
         assert np.asarray(pose.points[n]) == pytest.approx(np.asarray(home.points[n]) + k * moved)
-    assert "displacements from home drawn ×10)" in figures._pose_title(model, x, k)
+    assert "displacements from home drawn ×10)" in plot_pose.pose_title(model, x, k)
 
 
 # -- labels and values --------------------------------------------------------------------------------
@@ -253,8 +253,8 @@ def synthetic_lines():
 
 def prs3_drawing():
     model, x, q = pose_of("prs3")
-    pose, home, k = figures._drawings(model, x, q)
-    return mechanism_figure(pose, home=home, title=figures._pose_title(model, x, k), note=pose.note)
+    pose, home, k = plot_pose.drawings(model, x, q)
+    return mechanism_figure(pose, home=home, title=plot_pose.pose_title(model, x, k), note=pose.note)
 
 
 def synthetic_comparison():
@@ -269,8 +269,8 @@ def five_bar_file_drawing():
     model = build_model("five_bar")
     q = model.q_home + np.array([0.15, -0.1])
     x = cn.forward_kinematics(model, q, cn.SolverConfig("newton")).x
-    pose, home, k = figures._drawings(model, x, q)
-    return mechanism_figure(pose, home=home, title=figures._pose_title(model, x, k), note=pose.note)
+    pose, home, k = plot_pose.drawings(model, x, q)
+    return mechanism_figure(pose, home=home, title=plot_pose.pose_title(model, x, k), note=pose.note)
 
 
 def _solved_figure(name):
@@ -579,11 +579,11 @@ def test_mode_shapes_as_arrows_on_the_mechanism(solved):
     assert kind == "modes"
     titles = [ax.get_title() for ax in fig.axes]
     assert titles == [f"mode {k + 1}: {draw_number(data.values[f'f{k + 1}'])} Hz" for k in range(3)]
-    model, geometry, x, q = figures._drawn_pose(data)
+    model, geometry, x, q = compliance_plots.drawn_pose(data)
     c = model.closure
     idx = [c.x_names.index(n) for n in ("px", "py", "pz")]
     for mx, mq in zip(data.values["modes_x"], data.values["modes_q"]):
-        arrows = figures._mode_arrows(model, geometry, x, q, mx, mq)
+        arrows = compliance_plots.mode_arrows(model, geometry, x, q, mx, mq)
         at_p = [a for a in arrows if np.allclose(a.origin, geometry(model, x, q).points["P"])]
         t = np.array(mx)[idx]
         if np.linalg.norm(t) > 1e-6 * np.abs(mx).max():

@@ -739,7 +739,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="count", default=0, help="log progress to stderr (-vv: debug)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
-    p = sub.add_parser("solve", help="solve a problem file and print the result")
+    p = sub.add_parser(
+        "solve",
+        help="solve a problem file and print the result",
+        epilog=PLOT_TYPES,
+        formatter_class=_PlotTypesFormatter,
+    )
     p.add_argument("file", help="problem file (YAML)")
     p.add_argument(
         "--set",
@@ -759,6 +764,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Solve the problem of FILE at every point of its 'sweep' section (each point as "
         "'cpm-nlp solve FILE --set KEY=VALUE' would), on a local Dask cluster or an existing one, "
         "streaming one row per point to a Parquet or CSV file; a sweep run again resumes.",
+        epilog=PLOT_TYPES,
+        formatter_class=_PlotTypesFormatter,
     )
     p.add_argument("file", help="problem file (YAML) with a sweep section")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file (repeatable)")
@@ -777,7 +784,12 @@ def build_parser() -> argparse.ArgumentParser:
     _add_plot_arguments(p, "--plot")
     p.set_defaults(func=cmd_sweep)
 
-    p = sub.add_parser("plot", help="plot a result (JSON of solve -o) or a sweep results file")
+    p = sub.add_parser(
+        "plot",
+        help="plot a result (JSON of solve -o) or a sweep results file",
+        epilog=PLOT_TYPES,
+        formatter_class=_PlotTypesFormatter,
+    )
     p.add_argument("result", help="JSON result of 'cpm-nlp solve -o', or a sweep results file (.parquet, .csv)")
     p.add_argument("-o", "--output", metavar="FIGURE", required=True, help="figure file: .png, .svg or .pdf")
     p.add_argument("--x", metavar="NAME", help="map: parameter (or value) on the horizontal axis")
@@ -854,6 +866,46 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Deferred(str):
+    """Help text made only when the help is printed (it reads a registry: a subcommand
+    that runs never pays for it)."""
+
+
+#: the epilog of the commands that plot: the registered plot types, listed by :func:`_plot_types_text`
+PLOT_TYPES = _Deferred("plot types")
+
+
+class _PlotTypesFormatter(argparse.HelpFormatter):
+    """Lists the registered plot types (:mod:`cpm_nlp.plot.registry`) under the help, one a line."""
+
+    def _format_text(self, text: str) -> str:
+        if isinstance(text, _Deferred):
+            return _plot_types_text(self._width) + "\n\n"
+        return super()._format_text(text)
+
+
+def _plot_types_text(width: int) -> str:
+    import textwrap
+
+    from ..plot.registry import plot_type_names, plot_types
+
+    try:
+        types = plot_types()
+    except CpmError as exc:  # a broken plugin: the names, and what is wrong (the help is still printed)
+        return f"plot types (--type): {', '.join(plot_type_names())}\n(error: {exc})"
+    column = max(len(t.name) for t in types) + 4
+    lines = ["plot types (--type):"]
+    for t in types:
+        text = t.description + ("" if t.origin == "built-in" else f" [{t.origin}]")
+        lines += textwrap.wrap(
+            text,
+            max(width, column + 30),
+            initial_indent=f"  {t.name:<{column - 2}}",
+            subsequent_indent=" " * column,
+        )
+    return "\n".join(lines)
+
+
 def _add_plot_arguments(p: argparse.ArgumentParser, flag: str | None) -> None:
     if flag:
         p.add_argument(
@@ -864,8 +916,7 @@ def _add_plot_arguments(p: argparse.ArgumentParser, flag: str | None) -> None:
     p.add_argument(
         "--type",
         metavar="TYPE",
-        help="plot type: workspace, map, requirements, io, lines, mechanism, jacobian, twists, comparison, matrices, "
-        "dynamics or amplifier (default: chosen from the result)",
+        help="plot type, one of those listed below (default: chosen from the result)",
     )
     p.add_argument("--value", metavar="NAME", help="the value to plot (map colour, curves)")
     p.add_argument("--best", choices=("max", "min"), help="map: mark the largest or smallest value")

@@ -336,6 +336,10 @@ class Addon:
     complete: ``(model, limits) -> None``: completes the file's model with what ``limits``
         gives (joint limits on the file's coordinates) and the paper's derived quantities
         (``model.derived``), from the file's closure and model, never a copy of them.
+    plots: the paper's own plot types, each ``"module:attribute"`` of a
+        :class:`~cpm_nlp.plot.plot_type.PlotType` (named, not imported: a plot belongs to
+        the plot layer, above the mechanisms); drawn only for results of this mechanism
+        (:mod:`cpm_nlp.plot.registry`).
     """
 
     parameters: tuple[Option, ...] = ()
@@ -350,6 +354,7 @@ class Addon:
     chains: Callable[[Any], Any] | None = None
     limits: tuple[Option, ...] = ()
     complete: Callable[[Any, dict], None] | None = None
+    plots: tuple[str, ...] = ()
 
 
 #: the add-on's parts taken as they are (each must not be given by the file too)

@@ -276,6 +276,13 @@ def _addon(name: str, target: str) -> Addon:
     return obj
 
 
+def addon_of(name: str) -> Addon | None:
+    """The add-on of a built-in file mechanism (or of the one an old name stands for), None
+    if it has none: its plot types (``Addon.plots``) are read by :mod:`cpm_nlp.plot.registry`."""
+    name = ALIASES.get(name, name)
+    return _addon(name, ADDONS[name]) if name in ADDONS else None
+
+
 def _with_origin(mech: Mechanism, origin: str) -> Mechanism:
     return dataclasses.replace(mech, origin=origin)
 

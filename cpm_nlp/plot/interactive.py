@@ -13,17 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from .draw import (
-    _BOX_EDGES,
-    _JOINT_NAME,
-    _OTHER_BOXES,
-    _PART_STYLE,
-    Arrow,
-    BoundarySlice,
-    _box_corners,
-    _slice_lines,
-    display_unit,
-)
+from .draw_mechanism import JOINT_NAME, PART_STYLE, Arrow
+from .draw_workspace import BOX_EDGES, OTHER_BOXES, BoundarySlice, box_corners, slice_lines
+from .style import display_unit
 
 _PLOTLY_COLOURS = {
     "tab:blue": "#1f77b4",
@@ -132,7 +124,7 @@ def workspace_html(
     for sl in slices:
         i, j = sl.axes
         k = 3 - i - j
-        for line in _slice_lines(sl):
+        for line in slice_lines(sl):
             xyz = np.zeros((len(line), 3))
             xyz[:, i], xyz[:, j], xyz[:, k] = line[:, 0], line[:, 1], sl.at
             xyz = xyz * f
@@ -150,13 +142,11 @@ def workspace_html(
             )
             first = False
     all_boxes = [] if cuboid is None else [(*np.asarray(cuboid, dtype=float).reshape(2, 3), cuboid_label, "#d62728")]
-    all_boxes += [
-        (np.asarray(lo), np.asarray(hi), label, _colour(c)) for (lo, hi, label), c in zip(boxes, _OTHER_BOXES)
-    ]
+    all_boxes += [(np.asarray(lo), np.asarray(hi), label, _colour(c)) for (lo, hi, label), c in zip(boxes, OTHER_BOXES)]
     for lo, hi, label, colour in all_boxes:
-        corners = _box_corners(np.minimum(lo, hi) * f, np.maximum(lo, hi) * f)
+        corners = box_corners(np.minimum(lo, hi) * f, np.maximum(lo, hi) * f)
         xyz = []
-        for a, b in _BOX_EDGES:
+        for a, b in BOX_EDGES:
             xyz += [corners[a], corners[b], [np.nan] * 3]
         xyz = np.array(xyz)
         fig.add_trace(
@@ -200,7 +190,7 @@ def mechanism_html(
             )
         seen: set[str] = set()
         for a, b, part in d.segments:
-            colour, width = _PART_STYLE[part]
+            colour, width = PART_STYLE[part]
             xyz = np.array([pts[a], pts[b]])
             fig.add_trace(
                 go.Scatter3d(
@@ -227,7 +217,7 @@ def mechanism_html(
                         mode="markers+text",
                         text=names,
                         marker={"size": 5, "color": "black", "symbol": _JOINT_SYMBOL[letter]},
-                        name=f"{_JOINT_NAME[letter]} joint ({letter})",
+                        name=f"{JOINT_NAME[letter]} joint ({letter})",
                     )
                 )
     for arrow in arrows:

@@ -46,4 +46,5 @@ ADDON = Addon(
     check_parameters=check_parameters,
     dynamics=dynamics_model,
     kinds={"amplifier": Amplifier},
+    plots=("cpm_nlp.mechanisms.prc3.plots:PLOTS",),
 )

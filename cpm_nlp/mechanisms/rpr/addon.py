@@ -19,4 +19,5 @@ from .kinds import Compliance, JointDesign, ScrewJacobian, Synthesis, Transmissi
 ADDON = Addon(
     kinds={k.name: k for k in (ScrewJacobian, Twists, TransmissionMap, JointDesign, Compliance)},
     synthesis=Synthesis,
+    plots=("cpm_nlp.mechanisms.rpr.plots:PLOTS",),
 )

@@ -1,0 +1,40 @@
+"""The 3-PRC paper's own plot: the lever amplifier's output against its input (eq 1-2).
+
+Declared here and named by the add-on (``Addon.plots``), so that it is drawn only for
+results of the 3-PRC; this module belongs to the plot layer (it imports
+:mod:`cpm_nlp.plot`; nothing in the mechanisms layer imports it).
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from ...plot.draw_panels import Panel, panels_figure
+from ...plot.plot_type import PlotType
+from ...plot.results import NotApplicable, PlotOptions, ResultData
+
+
+def amplifier_plot(data: ResultData, _options: PlotOptions) -> Any:
+    """Output against input of the lever amplifier, d = A2 q (prc3 paper, eq 1-2)."""
+    v = data.values
+    pairs = [(k, "d" + k[1:]) for k in v if re.fullmatch(r"q\d+", k) and isinstance(v[k], list)]
+    pairs = [(a, b) for a, b in pairs if isinstance(v.get(b), list)]
+    if not pairs or not isinstance(v.get("A2"), (int, float)):
+        raise NotApplicable("an amplifier plot needs A2 and lists q<i>, d<i>")
+    panels = []
+    x = None
+    for qn, dn in pairs:
+        x = v[qn]
+        panels.append(
+            Panel(dn, "length", {dn: v[dn]}, title=f"{dn} = A2 {qn}, A2 = {v['A2']:.4g} (A1 = {v['A1']:.4g})")
+        )
+    return panels_figure(
+        x, panels, xname=pairs[0][0], xdimension="length", title="Lever amplifier output (prc3, eq 1-2)"
+    )
+
+
+AMPLIFIER = PlotType("amplifier", amplifier_plot, "output against input of the 3-PRC's lever amplifier (eq 1-2)")
+
+#: the plot types of the 3-PRC's add-on
+PLOTS = (AMPLIFIER,)

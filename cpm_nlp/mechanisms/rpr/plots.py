@@ -1,0 +1,71 @@
+"""The RPR paper's own plot: the displacement twists of the platform on the mechanism (eq 45).
+
+Declared here and named by the add-on (``Addon.plots``), so that it is drawn only for
+results of the RPR; this module belongs to the plot layer (it imports
+:mod:`cpm_nlp.plot`; nothing in the mechanisms layer imports it).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ...plot.draw_mechanism import Arrow, mechanism_figure
+from ...plot.interactive import mechanism_html
+from ...plot.plot_type import PlotType
+from ...plot.pose import geometry_of, model_for
+from ...plot.results import NotApplicable, PlotOptions, ResultData
+
+
+def twists_plot(data: ResultData, options: PlotOptions) -> Any:
+    """The displacement twists of the platform, one per actuator, as arrows on the
+    mechanism at the pose: the rotation (ω) and the translation (v) of the
+    reference point, each scaled to the drawing (RPR paper, eq 45)."""
+    T = data.values.get("T")
+    if not isinstance(T, list) or len(T) != 6:
+        raise NotApplicable("a twists plot needs the 6 x n twist matrix T")
+    model = model_for(data)
+    c = model.closure
+    x = np.array([float(data.values.get(n, h)) for n, h in zip(c.x_names, model.x_home)])
+    q = model.q_home if not all(n in data.values for n in c.q_names) else [data.values[n] for n in c.q_names]
+    pose = geometry_of(model)(model, x, np.asarray(q, dtype=float))
+    ref = np.asarray(data.values.get("reference_point") or pose.points.get("P", np.zeros(3)), dtype=float)
+    T = np.asarray(T, dtype=float)
+    span = float(np.ptp(np.array([np.asarray(v, dtype=float) for v in pose.points.values()]), axis=0).max())
+    colours = ("tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
+    arrows = []
+    for block, what, style in ((slice(0, 3), "ω", "rotation"), (slice(3, 6), "v", "translation")):
+        big = float(np.abs(T[block]).max())
+        if big == 0:
+            continue
+        scale = 0.35 * span / big
+        for j in range(T.shape[1]):
+            vec = T[block, j]
+            if np.linalg.norm(vec) > 0:
+                arrows.append(
+                    Arrow(
+                        ref + (0 if style == "rotation" else 0.02 * span),
+                        vec * scale,
+                        f"{what} of actuator {j + 1} ({style}, ×{scale:.3g})",
+                        colours[j % len(colours)] if style == "rotation" else colours[(j + 3) % len(colours)],
+                    )
+                )
+    draw = mechanism_html if options.interactive else mechanism_figure
+    return draw(
+        pose,
+        arrows=arrows,
+        title=f"Displacement twists ({data.model.get('type')}, {data.problem}), at the reference point",
+        note=data.units.get("T", ""),
+    )
+
+
+TWISTS = PlotType(
+    "twists",
+    twists_plot,
+    "the RPR platform's displacement twists as arrows on the mechanism (eq 45)",
+    interactive=True,
+)
+
+#: the plot types of the RPR's add-on
+PLOTS = (TWISTS,)

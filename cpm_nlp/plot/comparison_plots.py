@@ -1,0 +1,90 @@
+"""The ``comparison`` and ``matrices`` plot types: values beside their references
+(a paper's printed values, a reference design, the design in the file) and every
+matrix of a result.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .draw_tables import Comparison, comparison_figure, matrices_figure
+from .results import NotApplicable, PlotOptions, ResultData, dimension_of
+
+# -- comparisons, matrices ----------------------------------------------------------------------------
+
+#: how a result names a reference value beside its own (prefix or suffix, legend label)
+REFERENCES = (
+    ("reference_", "", "reference design"),
+    ("paper_", "", "paper"),
+    ("", "_printed", "paper (printed)"),
+    ("", "_compare", "compared design"),
+    ("", "_design", "design in the file"),
+)
+
+
+def comparisons(data: ResultData) -> list[tuple[str, list[Comparison]]]:
+    """Pairs (ours, reference) of scalar values, grouped by kind of reference."""
+    v = data.values
+    groups = []
+    for prefix, suffix, label in REFERENCES:
+        rows = []
+        for name, ref in v.items():
+            if not (name.startswith(prefix) and name.endswith(suffix)) or name == prefix + suffix:
+                continue
+            base = name[len(prefix) : len(name) - len(suffix) if suffix else None]
+            ours = v.get(base)
+            if base == name or not all(isinstance(u, (int, float)) and not isinstance(u, bool) for u in (ours, ref)):
+                continue
+            rows.append(Comparison(base, float(ours), float(ref), dimension_of(data, base)))
+        if rows:
+            groups.append((label, rows))
+    return groups
+
+
+def comparison_plot(data: ResultData, _options: PlotOptions) -> Any:
+    """Values computed here beside their references (a paper's printed values, a
+    reference design, the design in the file): the reference's ratio to ours,
+    both values written out; a multi-start spread where the result has one."""
+    if data.sweep:
+        raise NotApplicable("'comparison' plots one result")
+    groups = comparisons(data)
+    if not groups:
+        raise NotApplicable("the result has no value beside a reference (reference_*, paper_*, *_printed ...)")
+    spread = _multistart(data)
+    return comparison_figure(
+        groups, spread, title=f"{data.problem} ({data.model.get('type')}): ours against references"
+    )
+
+
+def _multistart(data: ResultData) -> dict[str, Any]:
+    v = data.values
+    out = {k: v[k] for k in ("starts", "starts_converged", "starts_agreed", "converged", "at_best") if k in v}
+    if isinstance(v.get("optima"), list) and v["optima"] and isinstance(v["optima"][0], list):
+        out["optima"] = v["optima"]
+    return out
+
+
+def _matrices(data: ResultData) -> list[tuple[str, np.ndarray]]:
+    out = []
+    for name, value in data.values.items():
+        if isinstance(value, list) and value and isinstance(value[0], list):
+            try:
+                M = np.array(value, dtype=float)
+            except (TypeError, ValueError):
+                continue
+            if M.ndim == 2 and M.size <= 100 and np.isfinite(M).all():
+                out.append((name, M))
+    return out
+
+
+def matrices_plot(data: ResultData, _options: PlotOptions) -> Any:
+    """Every matrix of the result (up to 10 x 10) as a heat map of its entries'
+    magnitudes, each entry written in (units from the result)."""
+    if data.sweep:
+        raise NotApplicable("'matrices' plots one result")
+    mats = _matrices(data)
+    if not mats:
+        raise NotApplicable("the result has no matrix")
+    return matrices_figure(mats, data.units, title=f"{data.problem} ({data.model.get('type')})")

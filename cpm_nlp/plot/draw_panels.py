@@ -1,0 +1,100 @@
+"""Curves against one abscissa, one panel per quantity: the joint requirements
+over the studied poses (3-PRS paper, Fig. 6-7), outputs against an input
+displacement (pantograph paper, Fig. 20-22), a value against one swept parameter.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import InputError
+from .style import (
+    as_floats,
+    axis_label,
+    display_unit,
+    figure_class,
+    pretty,
+    wrap,
+)
+
+# -- (c), (d) curves in panels ----------------------------------------------------------------------
+
+
+@dataclass
+class Panel:
+    """One panel of :func:`panels_figure`: curves of one quantity.
+
+    series: label -> values (SI, one per abscissa point; None/NaN = not
+    solved, a gap); annotate_range: write the range of the values in the
+    panel's title (for requirements).
+    """
+
+    name: str
+    dimension: str | None
+    series: Mapping[str, Any] = field(default_factory=dict)
+    annotate_range: bool = False
+    title: str = ""
+    #: published points drawn over the curves: (x SI, value SI, label)
+    points: Sequence[tuple[float, float, str]] = ()
+
+
+def panels_figure(  # noqa: C901 - one branch per optional layer of a panel
+    x: Any,
+    panels: Sequence[Panel],
+    *,
+    xname: str = "pose",
+    xdimension: str | None = None,
+    title: str = "",
+    ncols: int | None = None,
+    markers: bool = True,
+) -> Any:
+    """Curves against one abscissa ``x`` (SI), one panel per quantity.
+
+    ``xdimension`` None means a count (e.g. the number of a studied pose)."""
+    Figure = figure_class()
+    if not panels:
+        raise InputError("nothing to plot (no quantity given)")
+    xs = as_floats(x)
+    fx, ux = display_unit(xdimension, xs) if xdimension else (1.0, "")
+    n = len(panels)
+    ncols = ncols or min(n, 3 if n in (3, 5, 6, 9) else 4)
+    nrows = math.ceil(n / ncols)
+    width = max(4.2 * ncols, 6.5)
+    fig = Figure(figsize=(width, 3.3 * nrows + 0.5 + 0.25 * title.count("\n")), layout="constrained")
+    drawn = 0
+    for k, panel in enumerate(panels):
+        ax = fig.add_subplot(nrows, ncols, k + 1)
+        ys_all = [as_floats(v) for v in panel.series.values()]
+        both = np.concatenate(ys_all) if ys_all else np.array([])
+        fy, uy = display_unit(panel.dimension, both)
+        for label, ys in zip(panel.series, ys_all):
+            if len(ys) != len(xs):
+                raise InputError(f"{label}: expected {len(xs)} values (one per point), got {len(ys)}")
+            ax.plot(xs * fx, ys * fy, marker="o" if markers else None, ms=3, lw=1.2, label=pretty(label))
+            drawn += int(np.isfinite(ys).any())
+        if panel.points:
+            label = panel.points[0][2]
+            px_, py_ = np.array([(p[0], p[1]) for p in panel.points]).T
+            ax.plot(px_ * fx, py_ * fy, "D", ms=7, mfc="none", mec="tab:red", mew=1.5, label=label)
+            drawn += 1
+        ax.set_ylabel(axis_label(panel.name, uy))
+        ax.set_xlabel(axis_label(xname, ux) if xdimension else xname)
+        ax.grid(True, alpha=0.3)
+        if len(panel.series) + bool(panel.points) > 1:
+            ax.legend(fontsize="x-small", ncol=min(3, len(panel.series) + bool(panel.points)))
+        finite = both[np.isfinite(both)] * fy
+        text = panel.title
+        if panel.annotate_range and finite.size:
+            text = (text + "\n" if text else "") + f"{finite.min():.3g} … {finite.max():.3g} {uy}".strip()
+        if text:
+            ax.set_title(wrap(text, int(4.2 * 9)), fontsize="small")
+    if not drawn:
+        raise InputError("no point has a value to plot (no point solved)")
+    if title:
+        fig.suptitle("\n".join(wrap(line, int(width * 9)) for line in title.split("\n")))
+    return fig

@@ -1,0 +1,188 @@
+"""The results a plot reads: a JSON result (``cpm-nlp solve -o``, or a
+:class:`~cpm_nlp.core.result.Result`) or a sweep results file, read into
+:class:`ResultData`; the options of a plot; and the small readers of values every
+plot type shares.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..core.errors import InputError
+from ..core.result import ResultWarning
+from ..core.units import DIMENSIONS
+from ..io.inputs import MAX_RESULTS_BYTES, read_input_text
+from ..io.results import FORMATS, read_results
+from ..mechanisms.registry import closure_of, mechanism_type
+
+#: sweep statuses of points outside the design space (drawn apart from points that did not solve)
+OUTSIDE = ("infeasible", "invalid_input")
+
+_BY_SI = {d.si: name for name, d in DIMENSIONS.items() if name != "dimensionless"}
+
+
+class NotApplicable(InputError):
+    """This plot type does not fit the result (the message says why)."""
+
+
+class NothingSolved(InputError):
+    """The result has no solved point: there is nothing to draw."""
+
+
+@dataclass
+class PlotOptions:
+    """value: the quantity of a map or curves; x, y: the map's axes (names of
+    swept keys or values); best: mark the "max" or "min" of a map."""
+
+    value: str | None = None
+    x: str | None = None
+    y: str | None = None
+    best: str | None = None
+    #: an interactive Plotly figure (``.html``) of the 3-D view, not a Matplotlib one
+    interactive: bool = False
+
+
+@dataclass
+class ResultData:
+    """A result to plot.
+
+    problem: the problem kind; sweep: True for a sweep results file, whose
+    ``values`` are its columns (lists, one entry per point) and ``parameters``
+    its swept keys; dimensions: of every value ("length", "angle" ...).
+    """
+
+    source: str
+    problem: str
+    values: dict[str, Any]
+    dimensions: dict[str, str]
+    statuses: list[str] | None = None
+    model: dict[str, Any] = field(default_factory=dict)
+    sweep: bool = False
+    status: str = "solved"  # of the whole result
+    live: Any = None  # the Model solved, when at hand (solve --plot): lets a plot sample its workspace
+    parameters: list[dict[str, Any]] = field(default_factory=list)
+    recorded: list[str] = field(default_factory=list)  # value columns of a sweep
+    units: dict[str, str] = field(
+        default_factory=dict
+    )  # as the result writes them (matrices: what rows and columns are)
+    #: published figures to draw beside the values: (value expression "dz[2]", published SI, label)
+    published: list[tuple[str, float, str]] = field(default_factory=list)
+    #: the result's warnings (:class:`~cpm_nlp.core.result.ResultWarning`), read back from its JSON
+    warnings: list[Any] = field(default_factory=list)
+
+    @property
+    def kind(self) -> str:
+        return "sweep" if self.sweep else self.problem
+
+    @property
+    def ok(self) -> np.ndarray | None:
+        return None if self.statuses is None else np.array([s == "solved" for s in self.statuses])
+
+
+def _dimension_of_unit(unit: Any) -> str | None:
+    if unit == "":
+        return "dimensionless"
+    return _BY_SI.get(unit) if isinstance(unit, str) else None
+
+
+def from_result(result: Any, source: str = "") -> ResultData:
+    """A :class:`~cpm_nlp.core.result.Result` or its JSON dict."""
+    d = result if isinstance(result, Mapping) or not hasattr(result, "to_dict") else result.to_dict()
+    if not isinstance(d, Mapping) or not isinstance(d.get("values"), Mapping) or not isinstance(d.get("problem"), str):
+        raise InputError("expected a cpm-nlp result (JSON with problem, status, values, units)", file=source or None)
+    dims = {k: dim for k, u in (d.get("units") or {}).items() if (dim := _dimension_of_unit(u))}
+    return ResultData(
+        source,
+        d["problem"],
+        dict(d["values"]),
+        dims,
+        d.get("statuses"),
+        dict(d.get("model") or {}),
+        status=str(d.get("status")),
+        units={k: str(u) for k, u in (d.get("units") or {}).items()},
+        warnings=[ResultWarning.from_dict(w) for w in d.get("warnings") or [] if isinstance(d.get("warnings"), list)],
+    )
+
+
+def from_table(table: Any) -> ResultData:
+    """A sweep results file read by :func:`cpm_nlp.io.results.read_results`."""
+    meta = table.meta
+    names = ["point", *(p["key"] for p in table.parameters), "status", "message", "seconds", "warnings"]
+    names += table.values
+    values = {n: table.column(n) for n in names}
+    dims = {p["key"]: p["dimension"] for p in table.parameters if p.get("dimension")}
+    dims.update(meta.get("dimensions") or {})
+    for n, u in (meta.get("units") or {}).items():
+        if n not in dims and (dim := _dimension_of_unit(u)):
+            dims[n] = dim
+    model = {"type": meta.get("mechanism")}
+    return ResultData(
+        table.path,
+        str(meta.get("problem")),
+        values,
+        dims,
+        statuses=[str(s) for s in table.column("status")],
+        model=model,
+        sweep=True,
+        parameters=table.parameters,
+        recorded=table.values,
+    )
+
+
+def load(path: str | os.PathLike) -> ResultData:
+    """Read a JSON result (``cpm-nlp solve -o``) or a sweep results file."""
+    p = Path(path)
+    if p.suffix.lower() in FORMATS:
+        return from_table(read_results(p))
+    text = read_input_text(p, MAX_RESULTS_BYTES)
+    try:
+        data = json.loads(text)
+    except ValueError:
+        raise InputError(
+            "expected a JSON result written by 'cpm-nlp solve -o' or a sweep results file (.parquet, .csv)",
+            file=str(path),
+        ) from None
+    return from_result(data, str(path))
+
+
+# -- helpers ------------------------------------------------------------------------------------
+
+
+def result_closure(data: ResultData) -> Any:
+    """The symbolic mechanism of the result (names of its coordinates)."""
+    name = data.model.get("type")
+    if not name:
+        raise NotApplicable("the result does not name its mechanism (model.type)")
+    return closure_of(mechanism_type(name, path=("model", "type")))
+
+
+def value_list(data: ResultData, name: str) -> list | None:
+    v = data.values.get(name)
+    return v if isinstance(v, list) else None
+
+
+def pose_name(data: ResultData, closure: Any, coord: str) -> str:
+    """A coordinate, by its offset from home where the result has it (dz for pz)."""
+    for off, target in closure.offsets.items():
+        if target == coord and off in data.values:
+            return off
+    return coord
+
+
+def require_lists(data: ResultData, names: list[str], what: str) -> None:
+    missing = [n for n in names if value_list(data, n) is None]
+    if missing:
+        raise NotApplicable(
+            f"{what} needs per-point lists of {', '.join(missing)} (solve a batch, without an outputs selection)"
+        )
+
+
+def dimension_of(data: ResultData, name: str) -> str | None:
+    return data.dimensions.get(name)
