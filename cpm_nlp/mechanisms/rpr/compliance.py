@@ -58,7 +58,6 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
-from scipy.stats import qmc
 
 from ...analysis import compliance as cm
 from ...analysis import flexure
@@ -259,6 +258,8 @@ def joint_design(model: Model, joint: str, spec: JointSpec, config: SolverConfig
     mid = (lbx + ubx) / 2.0
     scale = float(built.objective(mid, np.r_[p, 1.0]))
     p = np.r_[p, scale if scale > 0 else 1.0]
+    from scipy.stats import qmc  # here: scipy.stats takes 0.5 s to import (start-up of every rpr problem)
+
     sampler = qmc.Halton(d=3, scramble=False)
     x0s = lbx + (ubx - lbx) * sampler.random(starts)
     found = []

@@ -45,7 +45,6 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
-from scipy.stats import qmc
 
 from ...core import screws
 from ...core.errors import InputError
@@ -241,6 +240,8 @@ class _SynthesisSolver:
 def start_points(count: int, l_min: float) -> np.ndarray:
     """``count`` deterministic starts spread over the eq 22 triangle (a Halton
     sequence in (s, t), the points outside the design space skipped)."""
+    from scipy.stats import qmc  # here: scipy.stats takes 0.5 s to import (start-up of every rpr problem)
+
     sampler = qmc.Halton(d=2, scramble=False)
     out: list[tuple[float, float, float]] = []
     while len(out) < count:
