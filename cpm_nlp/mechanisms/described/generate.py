@@ -100,12 +100,19 @@ _BASE_AXES = {"x": ca.DM([1.0, 0, 0]), "y": ca.DM([0, 1.0, 0]), "z": ca.DM([0, 0
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
-    """Rotation by ``angle`` about a unit axis (Rodrigues), or about "x", "y", "z"."""
+    """Rotation by ``angle`` about a unit axis k, or about "x", "y", "z" (Rodrigues):
+    R = cos I + sin [k]x + (1 - cos) k kᵀ.
+
+    Written with k kᵀ rather than I + sin [k]x + (1 - cos) [k]x² (equal for a unit k: [k]x² =
+    k kᵀ - I): about a base axis the zero entries of k drop out when the expression is built and
+    R is the elementary rotation itself (cos, ±sin, 1), as a hand-written module has it -- the
+    [k]x² form left 1 - (1 - cos) on the diagonal, two more operations per entry on every pose
+    evaluation (the same value while cos >= 1/2, where 1 - cos is exact; a rounded one below)."""
     if isinstance(axis, str):
         axis = ca.DM([1.0 if axis == a else 0.0 for a in "xyz"])
     k = ca.SX(axis)
-    K = ca.skew(k)
-    return ca.SX.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
+    c, s = ca.cos(angle), ca.sin(angle)
+    return c * ca.SX.eye(3) + s * ca.skew(k) + (1 - c) * (k @ k.T)
 
 
 def _xyz_angles(M: ca.SX) -> list[ca.SX]:
@@ -879,13 +886,17 @@ class Generator:
     def functions(self, q: ca.SX) -> dict[str, Any]:
         x, p = self.x, self.p
         io = ["x", "q", "p"]
-        phi = ca.Function("phi", [x, q, p], [ca.vertcat(*[r[0] for r in self.rows])], io, ["phi"])
-        g = ca.vertcat(*[b[0] for b in self.branch])
+        # common subexpressions merged (ca.cse: each distinct operation on the same operands once;
+        # the values are the same to the bit): the legs share the platform's rotation and its
+        # sines and cosines, each indicator the squared norm of its leg's closure
+        phi = ca.Function("phi", [x, q, p], [ca.cse(ca.vertcat(*[r[0] for r in self.rows]))], io, ["phi"])
+        g = ca.cse(ca.vertcat(*[b[0] for b in self.branch]))
         branch = ca.Function("branch", [x, q, p], [g], io, ["g"]) if self.branch else None
-        frame = ca.Function("frame", [x, p], [self.R, self.P], ["x", "p"], ["R", "position"])
+        frame = ca.Function("frame", [x, p], ca.cse([self.R, self.P]), ["x", "p"], ["R", "position"])
         passive = None
         if self.reported:
-            passive = ca.Function("passive", [x, q, p], [ca.vertcat(*[r.value for r in self.reported])], io, ["j"])
+            j = ca.cse(ca.vertcat(*[r.value for r in self.reported]))
+            passive = ca.Function("passive", [x, q, p], [j], io, ["j"])
         home = ca.Function("home", [p], [self.x_home, ca.vertcat(*self.q_home)], ["p"], ["x", "q"])
         radius = ca.mmax(ca.vertcat(*self.platform_radius)) if self.platform_radius else ca.SX(0)
         if self.d.characteristic_length is not None:
@@ -971,7 +982,7 @@ class Generator:
             raise InputError("missing 'reach': an expression < 0 where the pose cannot be assembled", path=("ik",))
         reach = self.scalar(ik.reach, ("ik", "reach"), env)
         return ca.Function(
-            "ik", [t, self.p], [ca.vertcat(*xs), ca.vertcat(*qs), reach], ["t", "p"], ["x", "q", "reach"]
+            "ik", [t, self.p], ca.cse([ca.vertcat(*xs), ca.vertcat(*qs), reach]), ["t", "p"], ["x", "q", "reach"]
         )
 
     # -- declared options -----------------------------------------------------------------------
