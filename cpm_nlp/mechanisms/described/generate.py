@@ -573,8 +573,11 @@ class Generator:
                 rate = Rk @ b.axis
                 what = _WORKING_P
                 # e·vp = e·v - (v·w)(e·w): a P moves its link without turning it, so e·w is the
-                # product of the two axes in the leg's frame, a constant of the file (0 for the usual
-                # P normal to the R: e·vp is then e·v; taken on the turned axes it was a rounded 0)
+                # product of the two axes in the leg's frame, a constant of the file (an exact 0 for
+                # the usual P normal to the R: e·vp is e·v).  Same branch decisions as e·vp on the
+                # turned axes, whose e·w was a rounded 0 (|e·w| <= 1e-16): the two differ by at most
+                # |v·w| 1e-16 plus rounding, so their signs agree wherever |e·v| exceeds that
+                # (tests/test_generated_lean.py: 900 legs, 600 within 1e-14..1e-3 L of e·v = 0)
                 working = ca.dot(rate, v)
                 if along is not None:
                     e_l, w_l = b.local.get("axis"), elim.local.get("axis")
