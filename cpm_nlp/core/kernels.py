@@ -29,10 +29,13 @@ conservative, it never misses a pose the single check would flag -- and the
 batch path recomputes κ₂ with numpy for the (rare) flagged poses, so batch
 and single statuses agree exactly.  Exported code keeps the conservative flag.
 A closure solved through normal equations (``LoopClosure.loops``: an
-overconstrained linkage) squares the condition number and makes the symbolic
-inverse of Φ_x costly; its kernels use :func:`cond1_block_bound`, an upper
-bound of κ₁ from the inverses of Φ_x's diagonal blocks at the pose, so the
-screen stays conservative and the 2-norm still decides.
+overconstrained linkage, Φ = Aᵀ e with e every closure equation) would square
+the condition number in Φ_x (≈ e_xᵀ e_x up to scaling where e = 0): its
+conditioning is measured on e_x instead (``LoopClosure.cond_matrix``), the
+2-norm deciding on κ₂(e_x) = σ_max/σ_min and the kernels reporting as
+``cond1`` the upper bound of κ₂(e_x) of :func:`cond2_left_inverse_bound` (a
+block left inverse at the pose; first derivatives only), flagged at
+10¹⁰/2 (the bound is of κ₂ itself; 2 covers rounding: :func:`screen_factor`).
 """
 
 from __future__ import annotations
@@ -119,6 +122,27 @@ def is_singular(cond: Any, ops: _Ops, factor: float = 1.0) -> Any:
     return ops.not_(cond < SINGULAR_CONDITION / factor)
 
 
+def condition_number(cond_x: np.ndarray, nx: int) -> float:
+    """κ₂ = σ_max/σ_min of a closure's :attr:`~cpm_nlp.core.model.LoopClosure.cond_matrix` at a
+    pose (flat, column-major, as a Function returns it; Φ_x, or the m x nx Jacobian of every
+    closure equation of normal equations): the 2-norm that decides a flagged pose; inf where
+    σ_min = 0."""
+    sv = np.linalg.svd(np.asarray(cond_x, dtype=float).reshape(nx, -1), compute_uv=False)  # its transpose
+    return float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+
+
+#: the screen's margin where ``cond1`` bounds κ₂ itself (normal equations): rounding in the bound
+#: and in the SVD that decides, both of relative size ~κ u (1e-6 at the threshold)
+KAPPA2_SCREEN_MARGIN = 2.0
+
+
+def screen_factor(closure: LoopClosure) -> float:
+    """The kernels flag a pose singular where ``cond1 >= SINGULAR_CONDITION / factor``: n for κ₁ of
+    Φ_x (κ₂ <= n κ₁), :data:`KAPPA2_SCREEN_MARGIN` for a closure solved through normal equations
+    (cond1 an upper bound of κ₂ of every closure equation's Jacobian)."""
+    return float(closure.nx) if closure.loops is None else KAPPA2_SCREEN_MARGIN
+
+
 # -- symbolic checks ----------------------------------------------------------------------------
 
 
@@ -151,6 +175,13 @@ def check_expressions(
     the exact 1-norm condition number (which needs a symbolic inverse of Φ_x).
     block_bound: ``cond1`` is the upper bound of :func:`cond1_block_bound` (inverses of
     Φ_x's diagonal blocks at the pose; takes precedence over phi_x_home_inv).
+
+    A closure solved through normal equations (``closure.loops``): ``cond1`` is instead the upper
+    bound of :func:`cond2_left_inverse_bound` on κ₂ of e_x, the Jacobian of every closure
+    equation (``cond_matrix``), whatever the flags: the conditioning a square closure's Φ_x
+    measures, not the square of it that Φ_x of the normal equations carries.  Since it bounds
+    κ₂ itself, the screen's margin is :data:`KAPPA2_SCREEN_MARGIN` there (:func:`screen_factor`).
+    ``cond_matrix``: the matrix the 2-norm check decides on (Φ_x or e_x).
     """
     c = closure
     out: dict[str, ca.SX] = {"finite": _all_finite(ca.vertcat(x, q))}
@@ -174,16 +205,19 @@ def check_expressions(
         out["round_trip_error"] = ca.if_else(reach >= 0, err, ca.inf)
     else:
         out["round_trip_error"] = ca.SX(0)
-    phi_x = c.phi_x(x, q, p)
-    out["phi_x"] = phi_x
-    if block_bound:
-        out["cond1"] = cond1_block_bound(phi_x)
+    out["cond_matrix"] = c.cond_matrix(x, q, p)  # Φ_x, or every closure equation's Jacobian e_x
+    if c.loops is not None:  # normal equations: κ₂(e_x) bounded at the pose (no Φ_x: no second derivatives)
+        out["cond1"] = cond2_left_inverse_bound(out["cond_matrix"], closure_blocks(c))
+    elif block_bound:
+        out["cond1"] = cond1_block_bound(c.phi_x(x, q, p))
     elif phi_x_home_inv is not None:
-        out["cond1"] = cond1_bound(ca.densify(phi_x), phi_x_home_inv)
-    elif ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
-        out["cond1"] = ca.SX(ca.inf)
+        out["cond1"] = cond1_bound(ca.densify(c.phi_x(x, q, p)), phi_x_home_inv)
     else:
-        out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
+        phi_x = c.phi_x(x, q, p)
+        if ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
+            out["cond1"] = ca.SX(ca.inf)
+        else:
+            out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
     passive = c.passive(x, q, p) if c.passive is not None else ca.SX(0, 1)
     n0 = c.nq + c.nx
     passive = (
@@ -330,6 +364,113 @@ def cond1_block_bound(phi_x: ca.SX) -> ca.SX:
     return _robust_norm_1(phi_x) * _robust_max_abs(ca.vertcat(*sums))  # inf where a sum is NaN
 
 
+@dataclass(frozen=True)
+class LeftInverseBlocks:
+    """A block upper triangular form of e_x (m x n, m >= n: the Jacobian of every closure
+    equation of a closure solved through normal equations) with tall diagonal blocks: ``rows[i]``
+    (the rows of group i) and ``cols[i]`` (column block i), in order.  A row of group i has
+    nonzeros in column blocks i, i+1, ... only; each diagonal block has at least as many rows as
+    columns and full structural column rank.  Rows of e_x with no structural nonzero are left
+    out (they add nothing to e_xᵀ e_x)."""
+
+    rows: tuple[tuple[int, ...], ...]
+    cols: tuple[tuple[int, ...], ...]
+
+
+def left_inverse_blocks(e_sp: ca.Sparsity, phi_sp: ca.Sparsity) -> LeftInverseBlocks | None:
+    """The column blocks of Φ_x's block triangular (Dulmage-Mendelsohn) form, in upper order, and
+    each row of e_x in the group of the first column block it touches: e_x is then block upper
+    triangular by construction.  Where a diagonal block would be wide or structurally singular, one
+    block (the whole of e_x); None if e_x is structurally rank deficient."""
+    m, n = e_sp.shape
+    touched = [[] for _ in range(m)]
+    for r, c in zip(*e_sp.get_triplet()):
+        touched[r].append(c)
+    live = [r for r in range(m) if touched[r]]
+    whole = LeftInverseBlocks((tuple(live),), (tuple(range(n)),))
+    if ca.sprank(e_sp) < n:
+        return None
+    if ca.sprank(phi_sp) < n:
+        return whole
+    nb, rowperm, colperm, rowblock, colblock, *_ = phi_sp.btf()
+    rows = [list(range(rowblock[k], rowblock[k + 1])) for k in range(nb)]
+    cols = [list(range(colblock[k], colblock[k + 1])) for k in range(nb)]
+    u = ca.DM(phi_sp, 1)[rowperm, colperm]
+    if not _block_upper(u, rows, cols):  # the lower form: reverse the blocks' order
+        colperm = colperm[::-1]
+        cols = [[n - 1 - c for c in cols[k][::-1]] for k in reversed(range(nb))]
+    blocks = [tuple(colperm[c] for c in block) for block in cols]
+    block_of = {c: k for k, block in enumerate(blocks) for c in block}
+    groups: list[list[int]] = [[] for _ in blocks]
+    for r in live:
+        groups[min(block_of[c] for c in touched[r])].append(r)
+    for g, b in zip(groups, blocks):
+        if len(g) < len(b) or ca.sprank(ca.DM(e_sp, 1)[g, list(b)].sparsity()) < len(b):
+            return whole
+    return LeftInverseBlocks(tuple(tuple(g) for g in groups), tuple(blocks))
+
+
+def _left_inverse_norm(d: ca.SX) -> ca.SX:
+    """An upper bound of ‖D⁺‖₂ = 1/σ_min(D) for a tall block D (full column rank): 1/‖d‖₂ for a
+    single column (exact), else ‖T⁻¹‖_F with D = QT its QR factorization (CasADi's modified
+    Gram-Schmidt; σ_min(T) = σ_min(D), and ‖T⁻¹‖₂ <= ‖T⁻¹‖_F).  No DᵀD is formed: the bound is
+    as accurate as D's smallest singular value is in floating point (κ(D) u), never κ(D)² u."""
+    d = ca.densify(d)
+    if d.size2() == 1:
+        return 1 / ca.norm_2(d)
+    _q, t = ca.qr(d)
+    return ca.norm_fro(ca.solve(t, ca.SX.eye(t.size1())))
+
+
+def closure_blocks(closure: LoopClosure) -> LeftInverseBlocks | None:
+    """:func:`left_inverse_blocks` of a closure's e_x (built once per closure)."""
+    c = closure
+    return c.solvers.memo(
+        ("left_inverse_blocks",),
+        lambda: left_inverse_blocks(c.cond_matrix.sparsity_out(0), c.phi_x.sparsity_out(0)),
+    )
+
+
+def cond2_left_inverse_bound(e_x: ca.SX, blocks: LeftInverseBlocks | None) -> ca.SX:
+    """An upper bound of the 2-norm condition number κ₂(e_x) = σ_max/σ_min of the (tall) Jacobian
+    of every closure equation, from a block left inverse at the pose: no SVD, no e_xᵀ e_x.
+
+    Any left inverse X (X e_x = I) bounds the smallest singular value: |v| = |X e_x v| <=
+    ‖X‖₂ |e_x v|, so σ_min(e_x) >= 1/‖X‖₂.  In the form of :func:`left_inverse_blocks` (block
+    upper triangular U, tall diagonal blocks D_i) one left inverse is block upper triangular:
+    X_ii = D_i⁺ (the pseudo-inverse) and X_ij = -D_i⁺ Σ_{i<k<=j} U_ik X_kj, so with
+    α_i >= ‖D_i⁺‖₂ (:func:`_left_inverse_norm`) the norms obey ‖X_ij‖₂ <= β_ij = α_i Σ_k ‖U_ik‖_F
+    β_kj (‖·‖₂ <= ‖·‖_F), and ‖X‖₂ <= ‖(β_ij)‖₂ <= ‖(β_ij)‖_F (a block matrix's 2-norm is at most
+    that of its blocks' norms).  So κ₂(e_x) <= ‖e_x‖_F ‖(β_ij)‖_F.  For a square closure e_x is Φ_x
+    itself: this is the same measure the 2-norm check decides on.  +inf where e_x is structurally
+    rank deficient (``blocks`` None), a block is singular or a value is not finite (NaN too).
+    """
+    if blocks is None:
+        return ca.SX(ca.inf)
+    rows, cols = blocks.rows, blocks.cols
+    nb = len(rows)
+    alpha = [_left_inverse_norm(e_x[list(rows[i]), list(cols[i])]) for i in range(nb)]
+    beta: dict[tuple[int, int], ca.SX] = {}
+    squares = []
+    for j in range(nb):
+        for i in range(j, -1, -1):
+            if i == j:
+                b = alpha[j]
+            else:
+                terms = [
+                    ca.norm_fro(e_x[list(rows[i]), list(cols[k])]) * beta[k, j]
+                    for k in range(i + 1, j + 1)
+                    if (k, j) in beta and e_x[list(rows[i]), list(cols[k])].nnz()
+                ]
+                if not terms:
+                    continue
+                b = alpha[i] * ca.sum1(ca.vertcat(*terms))
+            beta[i, j] = b
+            squares.append(b**2)
+    bound = ca.norm_fro(e_x) * ca.sqrt(ca.sum1(ca.vertcat(*squares)))
+    return ca.if_else(bound < ca.inf, bound, ca.inf)  # NaN and inf: +inf
+
+
 def limited_coordinates(closure: LoopClosure) -> tuple[Coordinate, ...]:
     """Every coordinate a limit may apply to, in the kernels' order: actuators q,
     pose coordinates x (some are joint angles, e.g. the pantograph's phi) and
@@ -357,22 +498,22 @@ def n_joints(closure: LoopClosure) -> int:
 
 def checks_function(closure: LoopClosure) -> ca.Function:
     """``pose_checks: (x, q, p, lower, upper, tol) -> (passive, residual,
-    branch_margin, round_trip_error, cond1, limit_margin, phi_x, status)``;
-    status with the conservative (1-norm) singularity screen.  For a closure
-    solved through normal equations (``loops``), cond1 is the upper bound of
-    :func:`cond1_block_bound`."""
+    branch_margin, round_trip_error, cond1, limit_margin, cond_matrix, status)``;
+    status with the conservative (1-norm) singularity screen; ``cond_matrix`` is
+    :attr:`LoopClosure.cond_matrix` (Φ_x; for a closure solved through normal
+    equations, ``loops``, the Jacobian of every closure equation, and cond1 the
+    upper bound of :func:`cond2_left_inverse_bound` on its κ₂)."""
 
     def build() -> ca.Function:
         c = closure
         x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
         nl = n_joints(c)
         lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
-        # normal equations: the block bound (a symbolic inverse of the whole Φ_x costs twice the rest of
-        # the checks); any upper bound of κ₁ keeps the screen conservative, and the 2-norm decides
-        chk = check_expressions(c, x, q, p, lower, upper, block_bound=c.loops is not None)
-        singular = is_singular(chk["cond1"], CASADI, factor=c.nx)
+        # normal equations: an upper bound of κ₂ of every closure equation's Jacobian (see check_expressions)
+        chk = check_expressions(c, x, q, p, lower, upper)
+        singular = is_singular(chk["cond1"], CASADI, factor=screen_factor(c))
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
-        names = ["passive", *CHECKS, "phi_x"]
+        names = ["passive", *CHECKS, "cond_matrix"]
         return ca.Function(
             f"{c.name}_pose_checks",
             [x, q, p, lower, upper, tol],
@@ -533,9 +674,8 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
     residual of the full Φ, branch, reach and IK round trip, limits, with
     ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x;
     for a closure solved through normal equations, the bound of
-    :func:`cond1_block_bound` at the pose: Φ_x⁻¹ at home certifies only near
-    home when the condition number is squared) and a margin of 2 on the
-    singularity threshold.  Any other status means
+    :func:`cond2_left_inverse_bound` at the pose on κ₂ of every closure
+    equation's Jacobian) and a margin of 2 on the singularity threshold.  Any other status means
     "not settled here": the full path decides (see :func:`fk_kernel`).
     """
     opts = newton_options(config)
@@ -566,10 +706,10 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
             t = step(t, q, p)
         x, q_ik, _reach = c.ik(t, p)
         converged = _robust_max_abs(q_ik - q) <= abstol
-        # normal equations (an overconstrained graph) square Φ_x's condition number: Φ_x⁻¹ at home
-        # stops certifying a short way from home, so certify at the pose, block by block
-        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b, block_bound=c.loops is not None)
-        singular = is_singular(chk["cond1"], CASADI, factor=2 * c.nx)  # margin 2 over the certified bound
+        # normal equations (an overconstrained graph): κ₂ of every closure equation's Jacobian, bounded at
+        # the pose block by block (check_expressions); Φ_x⁻¹ at home serves the square closures
+        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
+        singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))  # margin 2 over the certified bound
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)
         names = ("x", "passive", *_STATUS_OUTPUTS)

@@ -658,9 +658,13 @@ class GraphGenerator(Generator):
         self.check_task_count()
         fns = self.functions(q)
         fns["assemble"] = self.assembler
-        if self.normal_form:  # the normal equations also vanish where |r| is least but not zero: check r
-            r = ca.vertcat(*[row[0] for row in self.loop_rows])
-            fns["loops"] = ca.Function("loops", [self.x, q, self.p], [r], ["x", "q", "p"], ["r"])
+        if self.normal_form:
+            # every closure equation: the loop rows, then Φ's own rows (actuation, platform).  The
+            # normal equations also vanish where |r| is least but not zero: a pose is checked on
+            # these, and the closure's conditioning is their Jacobian's (LoopClosure.cond_matrix)
+            act = self.actuation()
+            e = ca.vertcat(*[row[0] for row in self.loop_rows], *[r[0] for r in act + self.platform_rows])
+            fns["loops"] = ca.Function("loops", [self.x, q, self.p], [e], ["x", "q", "p"], ["r"])
         fns["graph_drawing"] = self.drawing_function(q)
         self.info = self.assembler.info
         return fns
