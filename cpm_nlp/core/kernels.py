@@ -630,7 +630,31 @@ def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> 
     not within ``tol`` after the iterations is ``not_converged``; then the
     checks.  The FK of mechanisms without a closed-form IK, and the fallback
     of :func:`fk_kernel` for the others.
+
+    A closure solved through normal equations (``loops``): first
+    :func:`gauss_newton_fk_kernel` (first derivatives only); a pose it does not
+    settle as ``solved`` goes to Newton on the normal equations from x0 exactly
+    as before (a CasADi Switch: only that branch is evaluated), so every status
+    other than ``solved`` is Newton's.
     """
+    opts = newton_options(config)
+
+    def build() -> Kernel:
+        c = closure
+        newton = newton_fk_kernel(c, config)
+        if c.loops is None:
+            return newton
+        gn = gauss_newton_fk_kernel(c, config).function
+        fn = _settled_or(gn, newton.function, f"{c.name}_fk" if c.ik is None else f"{c.name}_fk_full", newton.outputs)
+        return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, SHARED_INPUTS)
+
+    key = ("full_fk_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
+
+
+def newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
+    """Newton on Φ(x, q) = 0 from x0 (CasADi ``fast_newton``) and the checks: :func:`full_fk_kernel`
+    itself for a square closure, its fallback for normal equations (named ``..._newton``)."""
     opts = newton_options(config)
 
     def build() -> Kernel:
@@ -643,11 +667,114 @@ def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> 
         status = _first(ca.logic_not(_converged(x, chk["residual"], shared[3])), Status.NOT_CONVERGED, chk["status"])
         names = ("x", "passive", *_STATUS_OUTPUTS)
         outs = [x] + [chk[n] for n in names[1:-1]] + [status]
-        name = f"{c.name}_fk" if c.ik is None else f"{c.name}_fk_full"  # the FK itself, or the fallback
+        suffix = "_newton" if c.loops is not None else ""
+        name = (f"{c.name}_fk" if c.ik is None else f"{c.name}_fk_full") + suffix
         fn = ca.Function(name, [q, x0, *shared], outs, ["q", "x0", *SHARED_INPUTS], list(names))
         return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
 
-    key = ("full_fk_kernel", _options_key(opts))
+    key = ("newton_fk_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
+
+
+def _settled_or(first: ca.Function, fallback: ca.Function, name: str, names: Sequence[str]) -> ca.Function:
+    """``first``'s outputs where its status is ``solved``, else ``fallback``'s on the same inputs
+    (a CasADi Switch: only the branch taken is evaluated).  Both take (q, x0, shared...) and give
+    ``names`` (status last)."""
+    ins = [ca.MX.sym(first.name_in(k), first.sparsity_in(k)) for k in range(first.n_in())]
+    r = first(*ins)
+    r_in = [ca.MX.sym(f"first_{n}", first.sparsity_out(k)) for k, n in enumerate(names)]
+    io = ([*first.name_in(), *[f"first_{n}" for n in names]], list(names))
+    keep = ca.Function(f"{name}_keep", ins + r_in, r_in, *io)
+    f = fallback(*ins)
+    other = ca.Function(f"{name}_fallback", ins + r_in, list(f), *io)
+    switch = ca.Function.if_else(f"{name}_switch", keep, other)
+    outs = switch(r[-1] == code_of(Status.SOLVED), *ins, *r)
+    return ca.Function(name, ins, list(outs), first.name_in(), list(names))
+
+
+#: Gauss-Newton steps of the full FK of normal equations (unrolled); from home, four reach
+#: machine precision within +-2 mm strokes of the shipped pantograph file, five within +-10 mm
+GAUSS_NEWTON_STEPS = 5
+
+
+def left_inverse_step(e_x: ca.SX, e: ca.SX, blocks: LeftInverseBlocks) -> ca.SX:
+    """v = X e with X the block left inverse of e_x of :func:`cond2_left_inverse_bound`: block by
+    block from the last, v_i = D_i⁺ (e_i - Σ_{k>i} U_ik v_k), D_i⁺ by the QR of the diagonal block
+    (a single column: dᵀ/‖d‖²).  Where e_x v = e has a solution (every closure equation holds to
+    first order) v is it; x - v is then a Gauss-Newton step with the rows grouped as the blocks,
+    quadratically convergent to a root of e (e_x X projects onto e_x's range, where e lies to
+    first order near the root)."""
+    rows, cols = blocks.rows, blocks.cols
+    nb = len(rows)
+    v: list[ca.SX | None] = [None] * nb
+    for i in reversed(range(nb)):
+        r = list(rows[i])
+        rhs = e[r]
+        for k in range(i + 1, nb):
+            u = e_x[r, list(cols[k])]
+            if u.nnz():
+                rhs = rhs - ca.mtimes(u, v[k])
+        d = ca.densify(e_x[r, list(cols[i])])
+        if d.size2() == 1:
+            v[i] = ca.dot(d, rhs) / ca.dot(d, d)
+        else:
+            qf, t = ca.qr(d)
+            v[i] = ca.solve(t, ca.mtimes(qf.T, rhs))
+    out = [None] * e_x.size2()
+    for i in range(nb):
+        for k, col in enumerate(cols[i]):
+            out[col] = v[i][k]
+    return ca.vertcat(*out)
+
+
+def gauss_newton_fk_kernel(
+    closure: LoopClosure, config: SolverConfig | None = None, steps: int = GAUSS_NEWTON_STEPS
+) -> Kernel:
+    """``<name>_fk_gauss_newton: (q, x0, p, lower, upper, tol) -> (x, passive, residual, ...,
+    status)``: the full FK of a closure solved through normal equations (``loops``), by
+    ``steps`` unrolled Gauss-Newton steps x <- x - X(x) e(x) on every closure equation e
+    (:func:`left_inverse_step`; first derivatives only, where Newton on the normal equations
+    needs their second) from x0.  One flat SX graph.
+
+    ``status`` is ``solved`` only where max |e| <= abstol after the steps (as Newton's stopping
+    test, on every equation) and every check passes, with a margin of 2 on the singularity
+    screen; any other status means "not settled here": :func:`full_fk_kernel` then runs Newton.
+    """
+    opts = newton_options(config)
+    abstol = float(opts.get("abstol", DEFAULT_OPTIONS["newton"]["abstol"]))
+
+    def build() -> Kernel:
+        c = closure
+        if c.loops is None:  # pragma: no cover - guarded by full_fk_kernel
+            raise ValueError(f"{c.name} is not solved through normal equations")
+        blocks = closure_blocks(c)
+        nl = n_joints(c)
+        q, x0, p = ca.SX.sym("q", c.nq), ca.SX.sym("x0", c.nx), ca.SX.sym("p", c.np)
+        lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
+        x_sym = ca.SX.sym("x", c.nx)
+        e = c.loops(x_sym, q, p)
+        if blocks is None:  # structurally rank deficient: nothing settles here
+            x_next = x_sym + ca.nan
+        else:
+            x_next = x_sym - left_inverse_step(ca.jacobian(e, x_sym), e, blocks)
+        # one step as a Function (inlined below: calls on SX expand)
+        step = ca.Function(f"{c.name}_fk_gauss_newton_step", [x_sym, q, p], [x_next], ["x", "q", "p"], ["x_next"])
+        x = x0
+        for _ in range(steps):
+            x = step(x, q, p)
+        converged = _robust_max_abs(c.loops(x, q, p)) <= abstol
+        chk = check_expressions(c, x, q, p, lower, upper)
+        singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))
+        status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
+        status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)
+        names = ("x", "passive", *_STATUS_OUTPUTS)
+        outs = ca.cse([x] + [ca.densify(chk[n]) for n in names[1:-1]] + [status])
+        fn = ca.Function(
+            f"{c.name}_fk_gauss_newton", [q, x0, p, lower, upper, tol], outs, ["q", "x0", *SHARED_INPUTS], list(names)
+        )
+        return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
+
+    key = ("gauss_newton_fk_kernel", _options_key(opts), steps)
     return closure.solvers.memo(key, build)
 
 
