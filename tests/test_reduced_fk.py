@@ -506,3 +506,20 @@ def test_pantograph_file_near_full_reach_agrees_with_the_module():
             assert np.linalg.cond(np.asarray(c.phi_x(res.x[i], q[i], file.p))) >= 1e10
     full = np.array([[2 * a, 0.0, 0.0]])
     assert not cn.batch_forward_kinematics(file, full).ok[0] and not cn.batch_forward_kinematics(module, full).ok[0]
+
+
+def test_pantograph_file_workspace_near_full_reach_agrees_with_the_module():
+    """Workspace membership judges a normal-equation closure on every closure equation's
+    Jacobian too: near full reach along x (px = (1 + b/a) 2a (1 - eps)) the file and the module
+    give the same verdict, binding indicator and margin (before: the file's points at eps = 1e-8
+    and 1e-10 were `outside`, `singular`)."""
+    from cpm_nlp.analysis.workspace import membership
+
+    file, _ = _pantographs()
+    module = _module({"a": "20 mm", "b": "50 mm"})
+    a, b = 0.020, 0.050
+    T = np.array([[(1 + b / a) * 2 * a * (1 - eps), 0.0, 0.0] for eps in (1e-3, 1e-8, 1e-10)])
+    got, ref = membership(file, T), membership(module, T)
+    assert list(got.status) == list(ref.status) == ["inside"] * 3
+    assert list(got.binding) == list(ref.binding)
+    np.testing.assert_allclose(got.margin, ref.margin, rtol=1e-9)
