@@ -205,19 +205,12 @@ def check_expressions(
         out["round_trip_error"] = ca.if_else(reach >= 0, err, ca.inf)
     else:
         out["round_trip_error"] = ca.SX(0)
-    out["cond_matrix"] = c.cond_matrix(x, q, p)  # Φ_x, or every closure equation's Jacobian e_x
     if c.loops is not None:  # normal equations: κ₂(e_x) bounded at the pose (no Φ_x: no second derivatives)
+        out["cond_matrix"] = c.cond_matrix(x, q, p)  # every closure equation's Jacobian e_x
         out["cond1"] = cond2_left_inverse_bound(out["cond_matrix"], closure_blocks(c))
-    elif block_bound:
-        out["cond1"] = cond1_block_bound(c.phi_x(x, q, p))
-    elif phi_x_home_inv is not None:
-        out["cond1"] = cond1_bound(ca.densify(c.phi_x(x, q, p)), phi_x_home_inv)
     else:
-        phi_x = c.phi_x(x, q, p)
-        if ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
-            out["cond1"] = ca.SX(ca.inf)
-        else:
-            out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
+        phi_x = out["cond_matrix"] = c.phi_x(x, q, p)
+        out["cond1"] = _cond1(phi_x, phi_x_home_inv, block_bound)
     passive = c.passive(x, q, p) if c.passive is not None else ca.SX(0, 1)
     n0 = c.nq + c.nx
     passive = (
@@ -247,6 +240,17 @@ def check_expressions(
     else:  # pragma: no cover - every mechanism has actuators
         out["limit_margin"] = ca.SX(ca.inf)
     return out
+
+
+def _cond1(phi_x: ca.SX, phi_x_home_inv: ca.SX | None, block_bound: bool) -> ca.SX:
+    """κ₁(Φ_x) of a square closure, or the upper bound :func:`check_expressions` asks for."""
+    if block_bound:
+        return cond1_block_bound(phi_x)
+    if phi_x_home_inv is not None:
+        return cond1_bound(ca.densify(phi_x), phi_x_home_inv)
+    if ca.sprank(phi_x.sparsity()) < phi_x.size1():  # structurally singular: no inverse to take
+        return ca.SX(ca.inf)
+    return ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
 
 
 def _turns_off(d: ca.SX) -> ca.SX:
