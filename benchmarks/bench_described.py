@@ -175,7 +175,7 @@ def main() -> None:
         "poses_on_the_reduced_path": reduced,
         # the full path alone (the fallback of poses the reduced one does not settle; for the file
         # Gauss-Newton first, then Newton on the normal equations): CPU per pose, mapped, one thread
-        "full_path_cpu_seconds_per_pose": full_cpu,
+        "full_path_cpu_seconds_per_pose": {k: v for k, v in full_cpu.items() if k != "ratio"},
         "ratio_full_path_cpu_file_over_hand": full_cpu.get("ratio"),
         "target": f"<= {TARGET}",
         "met": ratio <= TARGET and (ratio_single is None or ratio_single <= TARGET),
