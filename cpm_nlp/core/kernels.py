@@ -736,9 +736,10 @@ def gauss_newton_fk_kernel(
 ) -> Kernel:
     """``<name>_fk_gauss_newton: (q, x0, p, lower, upper, tol) -> (x, passive, residual, ...,
     status)``: the full FK of a closure solved through normal equations (``loops``), by
-    ``steps`` unrolled Gauss-Newton steps x <- x - X(x) e(x) on every closure equation e
+    ``steps`` Gauss-Newton steps x <- x - X(x) e(x) on every closure equation e
     (:func:`left_inverse_step`; first derivatives only, where Newton on the normal equations
-    needs their second) from x0.  One flat SX graph.
+    needs their second) from x0: an MX graph of ``steps`` calls of one SX step (its C code
+    generated once) and one SX call of the checks.
 
     ``status`` is ``solved`` only where max |e| <= abstol after the steps (as Newton's stopping
     test, on every equation) and every check passes, with a margin of 2 on the singularity
@@ -753,7 +754,7 @@ def gauss_newton_fk_kernel(
             raise ValueError(f"{c.name} is not solved through normal equations")
         blocks = closure_blocks(c)
         nl = n_joints(c)
-        q, x0, p = ca.SX.sym("q", c.nq), ca.SX.sym("x0", c.nx), ca.SX.sym("p", c.np)
+        q, p = ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
         lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
         x_sym = ca.SX.sym("x", c.nx)
         e = c.loops(x_sym, q, p)
@@ -761,20 +762,35 @@ def gauss_newton_fk_kernel(
             x_next = x_sym + ca.nan
         else:
             x_next = x_sym - left_inverse_step(ca.jacobian(e, x_sym), e, blocks)
-        # one step as a Function (inlined below: calls on SX expand)
+        # one step, and the checks of the last iterate, as Functions called from an MX graph: the
+        # step's code is generated once, not once per step (straight-line SX would repeat it)
         step = ca.Function(f"{c.name}_fk_gauss_newton_step", [x_sym, q, p], [x_next], ["x", "q", "p"], ["x_next"])
-        x = x0
-        for _ in range(steps):
-            x = step(x, q, p)
-        converged = _robust_max_abs(c.loops(x, q, p)) <= abstol
-        chk = check_expressions(c, x, q, p, lower, upper)
+        converged = _robust_max_abs(c.loops(x_sym, q, p)) <= abstol
+        chk = check_expressions(c, x_sym, q, p, lower, upper)
         singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)
         names = ("x", "passive", *_STATUS_OUTPUTS)
-        outs = ca.cse([x] + [ca.densify(chk[n]) for n in names[1:-1]] + [status])
+        outs = ca.cse([ca.densify(chk[n]) for n in names[1:-1]] + [status])
+        shared_names = list(SHARED_INPUTS)
+        finish = ca.Function(
+            f"{c.name}_fk_gauss_newton_checks",
+            [x_sym, q, p, lower, upper, tol],
+            outs,
+            ["x", "q", *shared_names],
+            list(names[1:]),
+        )
+        mq, mx0 = ca.MX.sym("q", c.nq), ca.MX.sym("x0", c.nx)
+        shared = _shared_symbols(c)
+        x = mx0
+        for _ in range(steps):
+            x = step(x, mq, shared[0])
         fn = ca.Function(
-            f"{c.name}_fk_gauss_newton", [q, x0, p, lower, upper, tol], outs, ["q", "x0", *SHARED_INPUTS], list(names)
+            f"{c.name}_fk_gauss_newton",
+            [mq, mx0, *shared],
+            [x, *finish(x, mq, *shared)],
+            ["q", "x0", *shared_names],
+            list(names),
         )
         return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
 
