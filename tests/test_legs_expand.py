@@ -419,3 +419,51 @@ def test_describe_says_why_a_legs_file_has_no_graph_view():
     text = summary_text(d, None, "the declared defaults")
     assert "(no bodies-and-joints view: the loops' rank needs a value of b, L" in text
     assert "leg leg1: ground -> leg1_link1 -> leg1_link2 -> platform" in text  # the legs are still listed
+
+
+#: the lever's input as a planar link J-I (an R joint about z at each end) instead of a rod: the
+#: loop ground-piezo-link-lever is a planar slider-crank written in space, so its loop rows repeat
+#: each other (Grübler-Kutzbach counts it -2 too few) and the whole graph is solved through its
+#: normal equations -- with the platform placed by its coordinates (a tree joint, no platform rows)
+OVERCONSTRAINED = (
+    MIXED.replace("name: stage_lever", "name: stage_lever_planar")
+    .replace("  lever: [O, T, I]\n", "  lever: [O, T, I]\n  link: [J, I]\n")
+    .replace(
+        "  - {type: distance, between: [piezo, lever], at: J, to: I}\n",
+        "  - {type: R, between: [piezo, link], at: J, axis: [0, 0, 1]}\n"
+        "  - {type: R, between: [link, lever], at: I, axis: [0, 0, 1]}\n",
+    )
+)
+
+
+def test_an_overconstrained_mixed_file_solves_its_platform_through_the_normal_equations(tmp_path):
+    """An overconstrained file of legs and bodies (issue 23 item 4): the normal equations have a
+    row for each placed platform coordinate (they are tree coordinates of the expanded graph), so
+    it loads with mobility 3 and its FK equals the lever (numpy, :func:`_lever`: the planar link
+    keeps |J - I| = f as the rod did) and the stage alone -- every closure equation holds."""
+    f = tmp_path / "stage_lever_planar.yaml"
+    f.write_text(OVERCONSTRAINED)
+    mech = load_file(f)
+    model = mech.model(mech.closure(), {}, {}, ())
+    c = model.closure
+    gen, _fns = closure_parts(read_description(f))
+    assert gen.normal_form and gen.info.mobility == 3 and gen.info.gruebler < 3
+    assert c.loops is not None
+    normal = [n for n in _fns["row_names"] if n.startswith("loops, normal equation of")]
+    assert {"loops, normal equation of x", "loops, normal equation of y", "loops, normal equation of z"} <= set(normal)
+    (tmp_path / "stage_alone.yaml").write_text(STAGE)
+    alone = load_file(tmp_path / "stage_alone.yaml")
+    ref = alone.model(alone.closure(), {}, {}, ())
+    names, qn = list(c.x_names), list(c.q_names)
+    for q1, q2, q3 in ([2e-4, 0.0, 0.0], [-1e-4, 1e-4, -2e-4], [3e-4, -1e-4, 1e-4]):
+        given = {"q1": q1, "q2": q2, "q3": q3}
+        q = [given[n] for n in qn]
+        sol = cn.forward_kinematics(model, q, NEWTON)
+        assert sol.status == Status.SOLVED, sol.message
+        x = np.asarray(sol.x)
+        assert np.max(np.abs(np.asarray(c.loops(x, q, model.p)))) < 1e-12
+        theta, d1 = _lever(q1)
+        _close([x[names.index("theta")], x[names.index("d1")]], [theta, d1], TOL)
+        stage = cn.forward_kinematics(ref, [d1, q2, q3], NEWTON)
+        assert stage.status == Status.SOLVED
+        _close(x[:3], stage.x, TOL)

@@ -49,6 +49,7 @@ from .kernels import (
     STATUSES,
     Kernel,
     code_of,
+    condition_number,
     fast,
     fk_kernel,
     ik_kernel,
@@ -123,10 +124,14 @@ class BatchResult:
         (``statuses`` gives the :class:`Status` values);
     x (N, nx), q (N, nq), passive (N, n_passive): SI, NaN where a pose is not solved;
     checks: per-pose check values: ``residual``, ``branch_margin``,
-        ``round_trip_error``, ``cond1`` (1-norm condition number of Φ_x),
+        ``round_trip_error``, ``cond1`` (1-norm condition number of Φ_x, or
+        an upper bound of it; for a closure solved through normal equations
+        an upper bound of the 2-norm condition number of the Jacobian of
+        every closure equation, see :mod:`cpm_nlp.core.kernels`),
         ``limit_margin`` (distance to the nearest joint limit, negative
-        outside), ``cond_phi_x`` (2-norm, computed where the 1-norm screen
-        flagged a pose), and ``reach`` for the closed-form IK.
+        outside), ``cond_phi_x`` (2-norm condition number of
+        ``LoopClosure.cond_matrix`` -- Φ_x, or that Jacobian -- computed
+        where the screen flagged a pose), and ``reach`` for the closed-form IK.
     """
 
     kind: str
@@ -423,11 +428,9 @@ def _refine_singular(model: Model, codes: np.ndarray, x: np.ndarray, q: np.ndarr
     cond = np.full(codes.shape, np.nan)
     flagged = np.flatnonzero(codes == code_of(Status.SINGULAR))
     if flagged.size:
-        phi_x = fast(c, ("phi_x",), lambda: c.phi_x)
+        cond_x = fast(c, ("cond_matrix",), lambda: c.cond_matrix)  # Φ_x, or e_x of normal equations
         for i in flagged:
-            a = phi_x(x[i], q[i], model.p)[0].reshape(c.nx, c.nx)  # (transposed: same singular values)
-            sv = np.linalg.svd(a, compute_uv=False)
-            cond[i] = sv[0] / sv[-1] if sv[-1] > 0 else np.inf
+            cond[i] = condition_number(cond_x(x[i], q[i], model.p)[0], c.nx)
         rows = {k: checks[k][flagged] for k in ("residual", "branch_margin", "round_trip_error", "limit_margin")}
         rows["finite"] = np.ones(flagged.size, dtype=bool)  # they passed every earlier rule
         codes[flagged] = status_code(status_rules(rows, tol, is_singular(cond[flagged], NUMPY), NUMPY), NUMPY)

@@ -29,10 +29,13 @@ conservative, it never misses a pose the single check would flag -- and the
 batch path recomputes κ₂ with numpy for the (rare) flagged poses, so batch
 and single statuses agree exactly.  Exported code keeps the conservative flag.
 A closure solved through normal equations (``LoopClosure.loops``: an
-overconstrained linkage) squares the condition number and makes the symbolic
-inverse of Φ_x costly; its kernels use :func:`cond1_block_bound`, an upper
-bound of κ₁ from the inverses of Φ_x's diagonal blocks at the pose, so the
-screen stays conservative and the 2-norm still decides.
+overconstrained linkage, Φ = Aᵀ e with e every closure equation) would square
+the condition number in Φ_x (≈ e_xᵀ e_x up to scaling where e = 0): its
+conditioning is measured on e_x instead (``LoopClosure.cond_matrix``), the
+2-norm deciding on κ₂(e_x) = σ_max/σ_min and the kernels reporting as
+``cond1`` the upper bound of κ₂(e_x) of :func:`cond2_left_inverse_bound` (a
+block left inverse at the pose; first derivatives only), flagged at
+10¹⁰/2 (the bound is of κ₂ itself; 2 covers rounding: :func:`screen_factor`).
 """
 
 from __future__ import annotations
@@ -119,6 +122,27 @@ def is_singular(cond: Any, ops: _Ops, factor: float = 1.0) -> Any:
     return ops.not_(cond < SINGULAR_CONDITION / factor)
 
 
+def condition_number(cond_x: np.ndarray, nx: int) -> float:
+    """κ₂ = σ_max/σ_min of a closure's :attr:`~cpm_nlp.core.model.LoopClosure.cond_matrix` at a
+    pose (flat, column-major, as a Function returns it; Φ_x, or the m x nx Jacobian of every
+    closure equation of normal equations): the 2-norm that decides a flagged pose; inf where
+    σ_min = 0."""
+    sv = np.linalg.svd(np.asarray(cond_x, dtype=float).reshape(nx, -1), compute_uv=False)  # its transpose
+    return float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+
+
+#: the screen's margin where ``cond1`` bounds κ₂ itself (normal equations): rounding in the bound
+#: and in the SVD that decides, both of relative size ~κ u (1e-6 at the threshold)
+KAPPA2_SCREEN_MARGIN = 2.0
+
+
+def screen_factor(closure: LoopClosure) -> float:
+    """The kernels flag a pose singular where ``cond1 >= SINGULAR_CONDITION / factor``: n for κ₁ of
+    Φ_x (κ₂ <= n κ₁), :data:`KAPPA2_SCREEN_MARGIN` for a closure solved through normal equations
+    (cond1 an upper bound of κ₂ of every closure equation's Jacobian)."""
+    return float(closure.nx) if closure.loops is None else KAPPA2_SCREEN_MARGIN
+
+
 # -- symbolic checks ----------------------------------------------------------------------------
 
 
@@ -151,6 +175,13 @@ def check_expressions(
     the exact 1-norm condition number (which needs a symbolic inverse of Φ_x).
     block_bound: ``cond1`` is the upper bound of :func:`cond1_block_bound` (inverses of
     Φ_x's diagonal blocks at the pose; takes precedence over phi_x_home_inv).
+
+    A closure solved through normal equations (``closure.loops``): ``cond1`` is instead the upper
+    bound of :func:`cond2_left_inverse_bound` on κ₂ of e_x, the Jacobian of every closure
+    equation (``cond_matrix``), whatever the flags: the conditioning a square closure's Φ_x
+    measures, not the square of it that Φ_x of the normal equations carries.  Since it bounds
+    κ₂ itself, the screen's margin is :data:`KAPPA2_SCREEN_MARGIN` there (:func:`screen_factor`).
+    ``cond_matrix``: the matrix the 2-norm check decides on (Φ_x or e_x).
     """
     c = closure
     out: dict[str, ca.SX] = {"finite": _all_finite(ca.vertcat(x, q))}
@@ -174,16 +205,12 @@ def check_expressions(
         out["round_trip_error"] = ca.if_else(reach >= 0, err, ca.inf)
     else:
         out["round_trip_error"] = ca.SX(0)
-    phi_x = c.phi_x(x, q, p)
-    out["phi_x"] = phi_x
-    if block_bound:
-        out["cond1"] = cond1_block_bound(phi_x)
-    elif phi_x_home_inv is not None:
-        out["cond1"] = cond1_bound(ca.densify(phi_x), phi_x_home_inv)
-    elif ca.sprank(phi_x.sparsity()) < c.nx:  # structurally singular: no inverse to take
-        out["cond1"] = ca.SX(ca.inf)
+    if c.loops is not None:  # normal equations: κ₂(e_x) bounded at the pose (no Φ_x: no second derivatives)
+        out["cond_matrix"] = c.cond_matrix(x, q, p)  # every closure equation's Jacobian e_x
+        out["cond1"] = cond2_left_inverse_bound(out["cond_matrix"], closure_blocks(c))
     else:
-        out["cond1"] = ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
+        phi_x = out["cond_matrix"] = c.phi_x(x, q, p)
+        out["cond1"] = _cond1(phi_x, phi_x_home_inv, block_bound)
     passive = c.passive(x, q, p) if c.passive is not None else ca.SX(0, 1)
     n0 = c.nq + c.nx
     passive = (
@@ -213,6 +240,17 @@ def check_expressions(
     else:  # pragma: no cover - every mechanism has actuators
         out["limit_margin"] = ca.SX(ca.inf)
     return out
+
+
+def _cond1(phi_x: ca.SX, phi_x_home_inv: ca.SX | None, block_bound: bool) -> ca.SX:
+    """κ₁(Φ_x) of a square closure, or the upper bound :func:`check_expressions` asks for."""
+    if block_bound:
+        return cond1_block_bound(phi_x)
+    if phi_x_home_inv is not None:
+        return cond1_bound(ca.densify(phi_x), phi_x_home_inv)
+    if ca.sprank(phi_x.sparsity()) < phi_x.size1():  # structurally singular: no inverse to take
+        return ca.SX(ca.inf)
+    return ca.norm_1(phi_x) * ca.norm_1(ca.inv(phi_x))
 
 
 def _turns_off(d: ca.SX) -> ca.SX:
@@ -330,6 +368,113 @@ def cond1_block_bound(phi_x: ca.SX) -> ca.SX:
     return _robust_norm_1(phi_x) * _robust_max_abs(ca.vertcat(*sums))  # inf where a sum is NaN
 
 
+@dataclass(frozen=True)
+class LeftInverseBlocks:
+    """A block upper triangular form of e_x (m x n, m >= n: the Jacobian of every closure
+    equation of a closure solved through normal equations) with tall diagonal blocks: ``rows[i]``
+    (the rows of group i) and ``cols[i]`` (column block i), in order.  A row of group i has
+    nonzeros in column blocks i, i+1, ... only; each diagonal block has at least as many rows as
+    columns and full structural column rank.  Rows of e_x with no structural nonzero are left
+    out (they add nothing to e_xᵀ e_x)."""
+
+    rows: tuple[tuple[int, ...], ...]
+    cols: tuple[tuple[int, ...], ...]
+
+
+def left_inverse_blocks(e_sp: ca.Sparsity, phi_sp: ca.Sparsity) -> LeftInverseBlocks | None:
+    """The column blocks of Φ_x's block triangular (Dulmage-Mendelsohn) form, in upper order, and
+    each row of e_x in the group of the first column block it touches: e_x is then block upper
+    triangular by construction.  Where a diagonal block would be wide or structurally singular, one
+    block (the whole of e_x); None if e_x is structurally rank deficient."""
+    m, n = e_sp.shape
+    touched = [[] for _ in range(m)]
+    for r, c in zip(*e_sp.get_triplet()):
+        touched[r].append(c)
+    live = [r for r in range(m) if touched[r]]
+    whole = LeftInverseBlocks((tuple(live),), (tuple(range(n)),))
+    if ca.sprank(e_sp) < n:
+        return None
+    if ca.sprank(phi_sp) < n:
+        return whole
+    nb, rowperm, colperm, rowblock, colblock, *_ = phi_sp.btf()
+    rows = [list(range(rowblock[k], rowblock[k + 1])) for k in range(nb)]
+    cols = [list(range(colblock[k], colblock[k + 1])) for k in range(nb)]
+    u = ca.DM(phi_sp, 1)[rowperm, colperm]
+    if not _block_upper(u, rows, cols):  # the lower form: reverse the blocks' order
+        colperm = colperm[::-1]
+        cols = [[n - 1 - c for c in cols[k][::-1]] for k in reversed(range(nb))]
+    blocks = [tuple(colperm[c] for c in block) for block in cols]
+    block_of = {c: k for k, block in enumerate(blocks) for c in block}
+    groups: list[list[int]] = [[] for _ in blocks]
+    for r in live:
+        groups[min(block_of[c] for c in touched[r])].append(r)
+    for g, b in zip(groups, blocks):
+        if len(g) < len(b) or ca.sprank(ca.DM(e_sp, 1)[g, list(b)].sparsity()) < len(b):
+            return whole
+    return LeftInverseBlocks(tuple(tuple(g) for g in groups), tuple(blocks))
+
+
+def _left_inverse_norm(d: ca.SX) -> ca.SX:
+    """An upper bound of ‖D⁺‖₂ = 1/σ_min(D) for a tall block D (full column rank): 1/‖d‖₂ for a
+    single column (exact), else ‖T⁻¹‖_F with D = QT its QR factorization (CasADi's modified
+    Gram-Schmidt; σ_min(T) = σ_min(D), and ‖T⁻¹‖₂ <= ‖T⁻¹‖_F).  No DᵀD is formed: the bound is
+    as accurate as D's smallest singular value is in floating point (κ(D) u), never κ(D)² u."""
+    d = ca.densify(d)
+    if d.size2() == 1:
+        return 1 / ca.norm_2(d)
+    _q, t = ca.qr(d)
+    return ca.norm_fro(ca.solve(t, ca.SX.eye(t.size1())))
+
+
+def closure_blocks(closure: LoopClosure) -> LeftInverseBlocks | None:
+    """:func:`left_inverse_blocks` of a closure's e_x (built once per closure)."""
+    c = closure
+    return c.solvers.memo(
+        ("left_inverse_blocks",),
+        lambda: left_inverse_blocks(c.cond_matrix.sparsity_out(0), c.phi_x.sparsity_out(0)),
+    )
+
+
+def cond2_left_inverse_bound(e_x: ca.SX, blocks: LeftInverseBlocks | None) -> ca.SX:
+    """An upper bound of the 2-norm condition number κ₂(e_x) = σ_max/σ_min of the (tall) Jacobian
+    of every closure equation, from a block left inverse at the pose: no SVD, no e_xᵀ e_x.
+
+    Any left inverse X (X e_x = I) bounds the smallest singular value: |v| = |X e_x v| <=
+    ‖X‖₂ |e_x v|, so σ_min(e_x) >= 1/‖X‖₂.  In the form of :func:`left_inverse_blocks` (block
+    upper triangular U, tall diagonal blocks D_i) one left inverse is block upper triangular:
+    X_ii = D_i⁺ (the pseudo-inverse) and X_ij = -D_i⁺ Σ_{i<k<=j} U_ik X_kj, so with
+    α_i >= ‖D_i⁺‖₂ (:func:`_left_inverse_norm`) the norms obey ‖X_ij‖₂ <= β_ij = α_i Σ_k ‖U_ik‖_F
+    β_kj (‖·‖₂ <= ‖·‖_F), and ‖X‖₂ <= ‖(β_ij)‖₂ <= ‖(β_ij)‖_F (a block matrix's 2-norm is at most
+    that of its blocks' norms).  So κ₂(e_x) <= ‖e_x‖_F ‖(β_ij)‖_F.  For a square closure e_x is Φ_x
+    itself: this is the same measure the 2-norm check decides on.  +inf where e_x is structurally
+    rank deficient (``blocks`` None), a block is singular or a value is not finite (NaN too).
+    """
+    if blocks is None:
+        return ca.SX(ca.inf)
+    rows, cols = blocks.rows, blocks.cols
+    nb = len(rows)
+    alpha = [_left_inverse_norm(e_x[list(rows[i]), list(cols[i])]) for i in range(nb)]
+    beta: dict[tuple[int, int], ca.SX] = {}
+    squares = []
+    for j in range(nb):
+        for i in range(j, -1, -1):
+            if i == j:
+                b = alpha[j]
+            else:
+                terms = [
+                    ca.norm_fro(e_x[list(rows[i]), list(cols[k])]) * beta[k, j]
+                    for k in range(i + 1, j + 1)
+                    if (k, j) in beta and e_x[list(rows[i]), list(cols[k])].nnz()
+                ]
+                if not terms:
+                    continue
+                b = alpha[i] * ca.sum1(ca.vertcat(*terms))
+            beta[i, j] = b
+            squares.append(b**2)
+    bound = ca.norm_fro(e_x) * ca.sqrt(ca.sum1(ca.vertcat(*squares)))
+    return ca.if_else(bound < ca.inf, bound, ca.inf)  # NaN and inf: +inf
+
+
 def limited_coordinates(closure: LoopClosure) -> tuple[Coordinate, ...]:
     """Every coordinate a limit may apply to, in the kernels' order: actuators q,
     pose coordinates x (some are joint angles, e.g. the pantograph's phi) and
@@ -357,22 +502,22 @@ def n_joints(closure: LoopClosure) -> int:
 
 def checks_function(closure: LoopClosure) -> ca.Function:
     """``pose_checks: (x, q, p, lower, upper, tol) -> (passive, residual,
-    branch_margin, round_trip_error, cond1, limit_margin, phi_x, status)``;
-    status with the conservative (1-norm) singularity screen.  For a closure
-    solved through normal equations (``loops``), cond1 is the upper bound of
-    :func:`cond1_block_bound`."""
+    branch_margin, round_trip_error, cond1, limit_margin, cond_matrix, status)``;
+    status with the conservative (1-norm) singularity screen; ``cond_matrix`` is
+    :attr:`LoopClosure.cond_matrix` (Φ_x; for a closure solved through normal
+    equations, ``loops``, the Jacobian of every closure equation, and cond1 the
+    upper bound of :func:`cond2_left_inverse_bound` on its κ₂)."""
 
     def build() -> ca.Function:
         c = closure
         x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
         nl = n_joints(c)
         lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
-        # normal equations: the block bound (a symbolic inverse of the whole Φ_x costs twice the rest of
-        # the checks); any upper bound of κ₁ keeps the screen conservative, and the 2-norm decides
-        chk = check_expressions(c, x, q, p, lower, upper, block_bound=c.loops is not None)
-        singular = is_singular(chk["cond1"], CASADI, factor=c.nx)
+        # normal equations: an upper bound of κ₂ of every closure equation's Jacobian (see check_expressions)
+        chk = check_expressions(c, x, q, p, lower, upper)
+        singular = is_singular(chk["cond1"], CASADI, factor=screen_factor(c))
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
-        names = ["passive", *CHECKS, "phi_x"]
+        names = ["passive", *CHECKS, "cond_matrix"]
         return ca.Function(
             f"{c.name}_pose_checks",
             [x, q, p, lower, upper, tol],
@@ -489,7 +634,31 @@ def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> 
     not within ``tol`` after the iterations is ``not_converged``; then the
     checks.  The FK of mechanisms without a closed-form IK, and the fallback
     of :func:`fk_kernel` for the others.
+
+    A closure solved through normal equations (``loops``): first
+    :func:`gauss_newton_fk_kernel` (first derivatives only); a pose it does not
+    settle as ``solved`` goes to Newton on the normal equations from x0 exactly
+    as before (a CasADi Switch: only that branch is evaluated), so every status
+    other than ``solved`` is Newton's.
     """
+    opts = newton_options(config)
+
+    def build() -> Kernel:
+        c = closure
+        newton = newton_fk_kernel(c, config)
+        if c.loops is None:
+            return newton
+        gn = gauss_newton_fk_kernel(c, config).function
+        fn = _settled_or(gn, newton.function, f"{c.name}_fk" if c.ik is None else f"{c.name}_fk_full", newton.outputs)
+        return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, SHARED_INPUTS)
+
+    key = ("full_fk_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
+
+
+def newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
+    """Newton on Φ(x, q) = 0 from x0 (CasADi ``fast_newton``) and the checks: :func:`full_fk_kernel`
+    itself for a square closure, its fallback for normal equations (named ``..._newton``)."""
     opts = newton_options(config)
 
     def build() -> Kernel:
@@ -502,11 +671,130 @@ def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> 
         status = _first(ca.logic_not(_converged(x, chk["residual"], shared[3])), Status.NOT_CONVERGED, chk["status"])
         names = ("x", "passive", *_STATUS_OUTPUTS)
         outs = [x] + [chk[n] for n in names[1:-1]] + [status]
-        name = f"{c.name}_fk" if c.ik is None else f"{c.name}_fk_full"  # the FK itself, or the fallback
+        suffix = "_newton" if c.loops is not None else ""
+        name = (f"{c.name}_fk" if c.ik is None else f"{c.name}_fk_full") + suffix
         fn = ca.Function(name, [q, x0, *shared], outs, ["q", "x0", *SHARED_INPUTS], list(names))
         return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
 
-    key = ("full_fk_kernel", _options_key(opts))
+    key = ("newton_fk_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
+
+
+def _settled_or(first: ca.Function, fallback: ca.Function, name: str, names: Sequence[str]) -> ca.Function:
+    """``first``'s outputs where its status is ``solved``, else ``fallback``'s on the same inputs
+    (a CasADi Switch: only the branch taken is evaluated).  Both take (q, x0, shared...) and give
+    ``names`` (status last)."""
+    ins = [ca.MX.sym(first.name_in(k), first.sparsity_in(k)) for k in range(first.n_in())]
+    r = first(*ins)
+    r_in = [ca.MX.sym(f"first_{n}", first.sparsity_out(k)) for k, n in enumerate(names)]
+    io = ([*first.name_in(), *[f"first_{n}" for n in names]], list(names))
+    keep = ca.Function(f"{name}_keep", ins + r_in, r_in, *io)
+    f = fallback(*ins)
+    other = ca.Function(f"{name}_fallback", ins + r_in, list(f), *io)
+    switch = ca.Function.if_else(f"{name}_switch", keep, other)
+    outs = switch(r[-1] == code_of(Status.SOLVED), *ins, *r)
+    return ca.Function(name, ins, list(outs), first.name_in(), list(names))
+
+
+#: Gauss-Newton steps of the full FK of normal equations (unrolled); from home, four reach
+#: machine precision within +-2 mm strokes of the shipped pantograph file, five within +-10 mm
+GAUSS_NEWTON_STEPS = 5
+
+
+def left_inverse_step(e_x: ca.SX, e: ca.SX, blocks: LeftInverseBlocks) -> ca.SX:
+    """v = X e with X the block left inverse of e_x of :func:`cond2_left_inverse_bound`: block by
+    block from the last, v_i = D_i⁺ (e_i - Σ_{k>i} U_ik v_k), D_i⁺ by the QR of the diagonal block
+    (a single column: dᵀ/‖d‖²).  Where e_x v = e has a solution (every closure equation holds to
+    first order) v is it; x - v is then a Gauss-Newton step with the rows grouped as the blocks,
+    quadratically convergent to a root of e (e_x X projects onto e_x's range, where e lies to
+    first order near the root)."""
+    rows, cols = blocks.rows, blocks.cols
+    nb = len(rows)
+    v: list[ca.SX | None] = [None] * nb
+    for i in reversed(range(nb)):
+        r = list(rows[i])
+        rhs = e[r]
+        for k in range(i + 1, nb):
+            u = e_x[r, list(cols[k])]
+            if u.nnz():
+                rhs = rhs - ca.mtimes(u, v[k])
+        d = ca.densify(e_x[r, list(cols[i])])
+        if d.size2() == 1:
+            v[i] = ca.dot(d, rhs) / ca.dot(d, d)
+        else:
+            qf, t = ca.qr(d)
+            v[i] = ca.solve(t, ca.mtimes(qf.T, rhs))
+    out = [None] * e_x.size2()
+    for i in range(nb):
+        for k, col in enumerate(cols[i]):
+            out[col] = v[i][k]
+    return ca.vertcat(*out)
+
+
+def gauss_newton_fk_kernel(
+    closure: LoopClosure, config: SolverConfig | None = None, steps: int = GAUSS_NEWTON_STEPS
+) -> Kernel:
+    """``<name>_fk_gauss_newton: (q, x0, p, lower, upper, tol) -> (x, passive, residual, ...,
+    status)``: the full FK of a closure solved through normal equations (``loops``), by
+    ``steps`` Gauss-Newton steps x <- x - X(x) e(x) on every closure equation e
+    (:func:`left_inverse_step`; first derivatives only, where Newton on the normal equations
+    needs their second) from x0: an MX graph of ``steps`` calls of one SX step (its C code
+    generated once) and one SX call of the checks.
+
+    ``status`` is ``solved`` only where max |e| <= abstol after the steps (as Newton's stopping
+    test, on every equation) and every check passes, with a margin of 2 on the singularity
+    screen; any other status means "not settled here": :func:`full_fk_kernel` then runs Newton.
+    """
+    opts = newton_options(config)
+    abstol = float(opts.get("abstol", DEFAULT_OPTIONS["newton"]["abstol"]))
+
+    def build() -> Kernel:
+        c = closure
+        if c.loops is None:  # pragma: no cover - guarded by full_fk_kernel
+            raise ValueError(f"{c.name} is not solved through normal equations")
+        blocks = closure_blocks(c)
+        nl = n_joints(c)
+        q, p = ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
+        lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
+        x_sym = ca.SX.sym("x", c.nx)
+        e = c.loops(x_sym, q, p)
+        if blocks is None:  # structurally rank deficient: nothing settles here
+            x_next = x_sym + ca.nan
+        else:
+            x_next = x_sym - left_inverse_step(ca.jacobian(e, x_sym), e, blocks)
+        # one step, and the checks of the last iterate, as Functions called from an MX graph: the
+        # step's code is generated once, not once per step (straight-line SX would repeat it)
+        step = ca.Function(f"{c.name}_fk_gauss_newton_step", [x_sym, q, p], [x_next], ["x", "q", "p"], ["x_next"])
+        converged = _robust_max_abs(c.loops(x_sym, q, p)) <= abstol
+        chk = check_expressions(c, x_sym, q, p, lower, upper)
+        singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))
+        status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
+        status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)
+        names = ("x", "passive", *_STATUS_OUTPUTS)
+        outs = ca.cse([ca.densify(chk[n]) for n in names[1:-1]] + [status])
+        shared_names = list(SHARED_INPUTS)
+        finish = ca.Function(
+            f"{c.name}_fk_gauss_newton_checks",
+            [x_sym, q, p, lower, upper, tol],
+            outs,
+            ["x", "q", *shared_names],
+            list(names[1:]),
+        )
+        mq, mx0 = ca.MX.sym("q", c.nq), ca.MX.sym("x0", c.nx)
+        shared = _shared_symbols(c)
+        x = mx0
+        for _ in range(steps):
+            x = step(x, mq, shared[0])
+        fn = ca.Function(
+            f"{c.name}_fk_gauss_newton",
+            [mq, mx0, *shared],
+            [x, *finish(x, mq, *shared)],
+            ["q", "x0", *shared_names],
+            list(names),
+        )
+        return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
+
+    key = ("gauss_newton_fk_kernel", _options_key(opts), steps)
     return closure.solvers.memo(key, build)
 
 
@@ -533,9 +821,8 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
     residual of the full Φ, branch, reach and IK round trip, limits, with
     ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x;
     for a closure solved through normal equations, the bound of
-    :func:`cond1_block_bound` at the pose: Φ_x⁻¹ at home certifies only near
-    home when the condition number is squared) and a margin of 2 on the
-    singularity threshold.  Any other status means
+    :func:`cond2_left_inverse_bound` at the pose on κ₂ of every closure
+    equation's Jacobian) and a margin of 2 on the singularity threshold.  Any other status means
     "not settled here": the full path decides (see :func:`fk_kernel`).
     """
     opts = newton_options(config)
@@ -566,10 +853,10 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
             t = step(t, q, p)
         x, q_ik, _reach = c.ik(t, p)
         converged = _robust_max_abs(q_ik - q) <= abstol
-        # normal equations (an overconstrained graph) square Φ_x's condition number: Φ_x⁻¹ at home
-        # stops certifying a short way from home, so certify at the pose, block by block
-        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b, block_bound=c.loops is not None)
-        singular = is_singular(chk["cond1"], CASADI, factor=2 * c.nx)  # margin 2 over the certified bound
+        # normal equations (an overconstrained graph): κ₂ of every closure equation's Jacobian, bounded at
+        # the pose block by block (check_expressions); Φ_x⁻¹ at home serves the square closures
+        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
+        singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))  # margin 2 over the certified bound
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)
         names = ("x", "passive", *_STATUS_OUTPUTS)

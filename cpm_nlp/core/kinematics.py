@@ -31,6 +31,7 @@ from .kernels import (
     batch_newton_supported,
     checks_function,
     code_of,
+    condition_number,
     fast,
     fk_kernel,
     is_singular,
@@ -143,10 +144,16 @@ def failure_message(model: Model, status: Status, details: dict, x, q, passive, 
             return "the closed-form IK has no real solution at this pose's task coordinates"
         return f"closed-form IK of this pose gives other joints (max difference {err:.3g})"
     if status is Status.SINGULAR:
-        return f"cond(Φ_x) = {details['cond_phi_x']:.3g}"
+        return _singular_message(model, details["cond_phi_x"])
     if status is Status.OUTSIDE_JOINT_LIMITS:
         return "; ".join(_limit_violations(model, x, q, passive))
     return ""
+
+
+def _singular_message(model: Model, cond: float) -> str:
+    if model.closure.loops is not None:  # normal equations: measured on every closure equation
+        return f"cond(∂e/∂x) = {cond:.3g} (e: every closure equation; Φ holds their normal equations)"
+    return f"cond(Φ_x) = {cond:.3g}"
 
 
 def branch_failure(model: Model, x, q, margin: float) -> str:
@@ -176,8 +183,7 @@ def _assess(
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(q))):
         return Status.NOT_CONVERGED, "the solver returned non-finite values", {}, None
     chk = pose_checks(model, x, q, tolerance)
-    sv = np.linalg.svd(chk["phi_x"].reshape(c.nx, c.nx), compute_uv=False)  # cond is transpose-invariant
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    cond = condition_number(chk["cond_matrix"], c.nx)
     values = {k: float(chk[k][0]) for k in ("residual", "branch_margin", "round_trip_error", "limit_margin")}
     values["finite"] = True
     code = status_code(status_rules(values, tolerance, is_singular(cond, SCALAR), SCALAR), SCALAR)
@@ -277,9 +283,7 @@ def pose_from_kernel(
     x = outs[i_x].copy()
     passive = outs[i_passive].copy()
     if code == code_of(Status.SINGULAR):
-        a = fast(c, ("phi_x",), lambda: c.phi_x)(x, q, model.p)[0].reshape(c.nx, c.nx)
-        sv = np.linalg.svd(a, compute_uv=False)
-        cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+        cond = condition_number(fast(c, ("cond_matrix",), lambda: c.cond_matrix)(x, q, model.p)[0], c.nx)
         rows = {k: details[k] for k in ("residual", "branch_margin", "round_trip_error", "limit_margin")}
         rows["finite"] = True
         code = int(status_code(status_rules(rows, tolerance, is_singular(cond, SCALAR), SCALAR), SCALAR))

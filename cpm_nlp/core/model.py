@@ -116,8 +116,9 @@ class LoopClosure:
         loops: ca.Function | None = None,
     ) -> None:
         self.name = name
-        #: every closure equation, when phi holds a square combination of them (an overconstrained
-        #: linkage's normal equations): a pose is checked against these too (None: phi's own)
+        #: every closure equation (m >= nx rows), when phi holds a square combination of them (an
+        #: overconstrained linkage's normal equations): a pose is checked against these too, and the
+        #: closure's conditioning is that of their Jacobian (:attr:`cond_matrix`); None: phi's own
         self.loops = loops
         self.x = tuple(x)
         self.q = tuple(q)
@@ -170,6 +171,12 @@ class LoopClosure:
         jac_inv = dy_dt[len(self.dep_index) :, :]
         io = (["x", "q", "p"],)
         self.phi_x = ca.Function("phi_x", [x, q, p], [phi_x], *io, ["phi_x"])
+        # the matrix whose 2-norm condition number says how near a singularity the pose is: Φ_x, or
+        # for normal equations (phi = Aᵀ e with e every closure equation, where Φ_x ≈ e_xᵀ e_x up to
+        # scaling squares the condition number) the Jacobian e_x of every closure equation -- the
+        # same measure as a square closure's, which is its own e
+        cond_x = phi_x if self.loops is None else ca.jacobian(self.loops(x, q, p), x)
+        self.cond_matrix = ca.Function("cond_matrix", [x, q, p], [cond_x], *io, ["cond_x"])
         self.phi_q = ca.Function("phi_q", [x, q, p], [phi_q], *io, ["phi_q"])
         self.phi_y = ca.Function("phi_y", [x, q, p], [phi_y], *io, ["phi_y"])
         self.jacobian = ca.Function("jacobian", [x, q, p], [jac], *io, ["J"])

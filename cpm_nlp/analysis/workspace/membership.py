@@ -107,14 +107,19 @@ TASK_POINT_KEY = ("workspace", "task_point")
 
 def _pose_values(c: LoopClosure, x, q, p) -> list:
     """Symbolic values the membership test needs at a pose: the limited
-    quantities, the loop-closure residuals and Φ_x (dense, column-major),
-    common subexpressions shared."""
+    quantities, the loop-closure residuals and the matrix whose condition number
+    decides a singularity, :attr:`LoopClosure.cond_matrix` (dense, column-major;
+    Φ_x, or for normal equations the Jacobian of every closure equation, whose
+    rows then join the residuals), common subexpressions shared."""
     fn, _names = limited_function(c)
-    return ca.cse([fn(x, q, p), c.phi(x, q, p), ca.vec(ca.densify(c.phi_x(x, q, p)))])
+    res = c.phi(x, q, p) if c.loops is None else ca.vertcat(c.phi(x, q, p), c.loops(x, q, p))
+    return ca.cse([fn(x, q, p), res, ca.vec(ca.densify(c.cond_matrix(x, q, p)))])
 
 
 def pose_check_function(closure: LoopClosure) -> ca.Function:
-    """``<name>_pose_values: (x, q, p) -> (v, phi, phi_x)`` (built once per mechanism type)."""
+    """``<name>_pose_values: (x, q, p) -> (v, phi, phi_x)`` (built once per mechanism type; see
+    :func:`_pose_values`: for normal equations ``phi`` also holds every closure equation and
+    ``phi_x`` is their Jacobian)."""
 
     def build() -> ca.Function:
         c = closure
@@ -181,14 +186,13 @@ def judge(
     lo, hi = limit_bounds(model)
     finite = np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
     V = np.full((M, len(names)), np.nan)
-    R = np.full((M, c.nx), np.nan)
-    PX = np.full((M, c.nx * c.nx), np.nan)
+    fn = pose_check_function(c)
+    R = np.full((M, fn.nnz_out(1)), np.nan)
+    PX = np.full((M, fn.nnz_out(2)), np.nan)
     if values is not None:
         V, R, PX = (np.array(v, dtype=float) for v in values)
     elif np.any(finite):
-        V[finite], R[finite], PX[finite] = evaluate_points(
-            c, POSE_VALUES_KEY, pose_check_function(c), [X[finite], Q[finite]], model.p
-        )
+        V[finite], R[finite], PX[finite] = evaluate_points(c, POSE_VALUES_KEY, fn, [X[finite], Q[finite]], model.p)
     with np.errstate(invalid="ignore"):
         resid = np.where(finite, np.max(np.abs(R), axis=1), np.inf)
         converged = finite & (resid <= config.tolerance)
@@ -208,7 +212,7 @@ def judge(
     binding = np.where(converged, binding, "no assembly")
     idx = np.flatnonzero(converged)
     if idx.size:  # forward singularities: Φ_x rank deficient
-        sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, c.nx)) < SINGULAR_CONDITION)
+        sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, -1)) < SINGULAR_CONDITION)  # transposed
         margin[idx[sing]], binding[idx[sing]] = -np.inf, "singular"
     return _Judged(converged, on_branch, margin, binding.astype(object), X, Q, tolerance)
 
@@ -349,7 +353,14 @@ def condition_numbers(PX: np.ndarray) -> np.ndarray:
     where they may reach :data:`SINGULAR_CONDITION`: κ₂ ≤ ‖A‖_F^n / |det A| (since
     σ_max ≤ ‖A‖_F and σ_min ≥ |det A| / σ_max^(n-1)); elsewhere the returned value
     is that bound (below the threshold, so the verdict is the same); inf for a
-    matrix with a NaN or infinite entry."""
+    matrix with a NaN or infinite entry.  Rectangular matrices (the transposed
+    Jacobian of every closure equation of normal equations): by SVD."""
+    if PX.shape[-1] != PX.shape[-2]:
+        finite = np.all(np.isfinite(PX), axis=(1, 2))
+        out = np.full(PX.shape[0], np.inf)
+        if np.any(finite):
+            out[finite] = np.linalg.cond(PX[finite])
+        return out
     n = PX.shape[-1]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         bound = np.sqrt(np.sum(PX * PX, axis=(1, 2))) ** n / np.abs(np.linalg.det(PX))

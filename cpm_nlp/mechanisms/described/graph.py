@@ -658,9 +658,13 @@ class GraphGenerator(Generator):
         self.check_task_count()
         fns = self.functions(q)
         fns["assemble"] = self.assembler
-        if self.normal_form:  # the normal equations also vanish where |r| is least but not zero: check r
-            r = ca.vertcat(*[row[0] for row in self.loop_rows])
-            fns["loops"] = ca.Function("loops", [self.x, q, self.p], [r], ["x", "q", "p"], ["r"])
+        if self.normal_form:
+            # every closure equation: the loop rows, then Φ's own rows (actuation, platform).  The
+            # normal equations also vanish where |r| is least but not zero: a pose is checked on
+            # these, and the closure's conditioning is their Jacobian's (LoopClosure.cond_matrix)
+            act = self.actuation()
+            e = ca.vertcat(*[row[0] for row in self.loop_rows], *[r[0] for r in act + self.platform_rows])
+            fns["loops"] = ca.Function("loops", [self.x, q, self.p], [e], ["x", "q", "p"], ["r"])
         fns["graph_drawing"] = self.drawing_function(q)
         self.info = self.assembler.info
         return fns
@@ -713,13 +717,11 @@ class GraphGenerator(Generator):
         as the Bennett linkage's): Φ's loop part is J_tᵀ r / size, r every loop row, J_t its
         Jacobian in the passive tree coordinates -- square, zero on the mechanism's motion, and
         regular wherever the loops' Jacobian keeps its rank (any fixed choice of rows loses rank
-        somewhere along the motion, where the rows it left out would not)."""
+        somewhere along the motion, where the rows it left out would not).  The passive tree
+        coordinates are :meth:`tree_columns` less the actuated joints': with a placed platform (an
+        expanded legs file) the platform coordinates too, which then have no rows of their own."""
         r = ca.vertcat(*[row[0] for row in self.loop_rows])
-        tree = [
-            k
-            for k, n in enumerate(self.x_names)
-            if n not in self.d.platform.coordinates and n not in self.actuated_coords
-        ]
+        tree = [k for k in self.tree_columns() if self.x_names[k] not in self.actuated_coords]
         xt = ca.vertcat(*[self.x[k] for k in tree])
         g = ca.jacobian(r, xt).T @ r / scale
         return [(g[k], f"loops, normal equation of {self.x_names[tree[k]]}") for k in range(len(tree))]
