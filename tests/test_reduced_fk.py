@@ -11,6 +11,7 @@ first-order guess against central differences, and batch = single solves
 """
 
 import math
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
@@ -34,8 +35,10 @@ from cpm_nlp.core.kernels import (
     shared_values,
 )
 from cpm_nlp.core.result import Status
+from cpm_nlp.mechanisms.described import load_file
 
 from .conftest import PAPER_PRS3, central_difference
+from .reference import pantograph_closures
 
 NEWTON = cn.SolverConfig("newton")
 LIMITED = {"s": ["-2 mm", "2 mm"], "beta_m": ["-1.5 deg", "1.5 deg"]}
@@ -52,9 +55,17 @@ def build(name, limited=True):
     if name == "rpr":
         return cn.build_model("rpr", {"r1": "40 mm", "r2": "80 mm", "P0": "40 mm"})
     if name == "pantograph_file":  # bodies and joints, solved through normal equations (no limits declared)
-        return cn.build_model("pantograph_file", {"a": "20 mm", "b": "50 mm"})
+        return overconstrained_pantograph()
     limits = {"psi_min": "1.49 rad", "psi_max": "1.65 rad", "phi_max": "0.0795 rad"}
     return cn.build_model("pantograph", {"a": "20 mm", "b": "50 mm"}, limits if limited else {})
+
+
+def overconstrained_pantograph(params=None):
+    """The pantograph with the paper's R hinges at C and F (tests/corpus/pantograph_joints.yaml):
+    Gruebler-Kutzbach -1, solved through normal equations.  (The shipped file closes its loops
+    with S joints at C and F since the pantograph became its file: not overconstrained.)"""
+    mech = load_file(Path(__file__).resolve().parent / "corpus" / "pantograph_joints.yaml")
+    return mech.model(mech.closure(), params or {"a": "20 mm", "b": "50 mm"}, {}, ())
 
 
 #: half-widths of random task coordinates about home (SI), per mechanism: the papers' working ranges and beyond
@@ -291,7 +302,7 @@ def test_auto_backend_falls_back_to_the_virtual_machine_when_compiling_fails(tmp
 
 def _pantographs():
     panto = {"a": "20 mm", "b": "50 mm"}
-    return cn.build_model("pantograph_file", panto), cn.build_model("pantograph", panto)
+    return overconstrained_pantograph(panto), pantograph_closures.reference_model(panto)
 
 
 def test_pantograph_file_answers_on_the_reduced_path_as_the_module():
@@ -360,12 +371,8 @@ def _wrap_angles(c, d):
 
 
 def _module(params):
-    """The hand-written pantograph (eq 1-8): the test reference where it has moved, else the built-in."""
-    try:
-        from .reference import pantograph_closures
-    except ImportError:
-        return cn.build_model("pantograph", params)
-    return pantograph_closures.reference_model(params)  # pragma: no cover - after the move
+    """The hand-written pantograph (eq 1-8), kept as the test reference."""
+    return pantograph_closures.reference_model(params)
 
 
 def _e_x_central(c, x, q, p, h=1e-7):
