@@ -586,7 +586,7 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
         out.write("mechanisms:\n")
         for name in mechanism_names():
             mt = mechanism_type(name)
-            origin = "" if mt.origin == "built-in" else f"  ({mt.origin})"
+            origin = "" if mt.origin.kind == "built-in" else f"  ({mt.origin})"
             out.write(f"  {name:<12} {mt.title}{origin}\n")
         out.write("problem kinds:\n")
         for name in kind_names():
