@@ -23,15 +23,15 @@ from ..core.model import Model
 from ..core.options import REQUIRED, Option
 from ..core.result import Result, ResultWarning, SolverInfo, Status
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS, size_dimension
+from ..core.units import DIMENSIONS, result_unit, size_dimension
 from .hinge_inputs import mass_node, stress_limit_option
-from .kinematic import _model_info, _si
+from .kinematic import _model_info
 
 
 def closed_form_result(
     kind: str, model: Model, values: dict, dims: dict, status=Status.SOLVED, message="", solver=None
 ):
-    units = {k: (_si(d) if d in DIMENSIONS else d) for k, d in dims.items()}
+    units = {k: result_unit(d) for k, d in dims.items()}
     return Result(
         kind, status, values, units, dims, solver or SolverInfo("closed_form"), message, None, _model_info(model)
     )
@@ -128,7 +128,7 @@ class ActuatorWorkspace(ProblemKind):
             )
         corners = "box corners that assemble" if missing else "box corners"
         res.units["vertices"] = f"rows: {corners}; columns " + ", ".join(
-            f"{n} [{_si(dims[n + '_min'])}]" for n in names
+            f"{n} [{result_unit(dims[n + '_min'])}]" for n in names
         )
         if inputs["points"]:
             res.values["points"] = rep.t[np.all(np.isfinite(rep.t), axis=1)].tolist()

@@ -36,7 +36,7 @@ from ..core.progress import track
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS
+from ..core.units import result_unit
 
 
 def _pose_names(model: Model) -> tuple[list[str], dict[str, str]]:
@@ -109,7 +109,7 @@ def _result(
         kind,
         status,
         values,
-        {n: _si(dims[n]) for n in names},
+        {n: result_unit(dims[n]) for n in names},
         dims,
         _solver_info(sols, solver.name),
         message,
@@ -143,10 +143,6 @@ def _singularity_warning(model: Model, sols: Sequence[PoseSolution]) -> Any:
     cond, k = max(near)
     points = f" (at {len(near)} of {len(sols)} points; the worst, point {k})" if len(sols) > 1 else ""
     return near_singular_warning(cond, "Phi_x", "Phi_x", points)
-
-
-def _si(dimension: str) -> str:
-    return DIMENSIONS[dimension].si if dimension in DIMENSIONS else dimension
 
 
 def _model_info(model: Model) -> dict[str, Any]:
@@ -340,7 +336,7 @@ def _modes_result(
     )
     res = _result(kind, model, [work], False, solver, extra)
     res.dimensions.update(dims)
-    res.units.update({k: _si(d) for k, d in dims.items()})
+    res.units.update({k: result_unit(d) for k, d in dims.items()})
     res.status = Status.SOLVED
     designated = sum(m.designated for m in modes)
     summary = f"{found.count} assembly mode(s) found, {designated} on the designated branch"
@@ -460,9 +456,9 @@ class Jacobian(ProblemKind):
                 "manipulability": rep.manipulability,
                 "characteristic_length": rep.characteristic_length,
             }
-            rows = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
-            task_rows = ", ".join(f"{c.x[i].name} [{_si(c.x[i].kind)}]" for i in c.task_index)
-            cols = ", ".join(f"{q.name} [{_si(q.kind)}]" for q in c.q)
+            rows = ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in c.x)
+            task_rows = ", ".join(f"{c.x[i].name} [{result_unit(c.x[i].kind)}]" for i in c.task_index)
+            cols = ", ".join(f"{q.name} [{result_unit(q.kind)}]" for q in c.q)
             units = {
                 "J": f"rows {rows} per columns {cols}",
                 "J_task": f"rows {task_rows} per columns {cols}",
@@ -532,7 +528,7 @@ class JointRequirements(ProblemKind):
         res = _result(self.name, model, sols, True, solver)
         res.values.update(rep.ranges)
         res.dimensions.update(rep.range_dimensions)
-        res.units.update({k: _si(d) for k, d in rep.range_dimensions.items()})
+        res.units.update({k: result_unit(d) for k, d in rep.range_dimensions.items()})
         if rep.status.ok:
             res.message = (
                 f"{len(sols)} poses ({' x '.join(str(len(g)) for g in grid)} over {', '.join(c.task)}) solved by IK"
