@@ -48,6 +48,12 @@ class Output:
         return self.unit if self.unit is not None else result_unit(self.dimension)
 
 
+def outputs_of(dims: Mapping[str, str]) -> list[Output]:
+    """Outputs of the given dimensions, in their order (a matrix's and a text's role said by
+    their dimension, every other one a value)."""
+    return [Output(n, d, d if d in ("matrix", "text") else "value") for n, d in dims.items()]
+
+
 def output_names(outputs: Sequence[Output]) -> list[str]:
     return [o.name for o in outputs]
 

@@ -21,6 +21,7 @@ from ..core.kind import ProblemKind
 from ..core.mechanism import DynamicsModel
 from ..core.model import Model
 from ..core.options import REQUIRED, Option
+from ..core.outputs import declared_result, outputs_of
 from ..core.result import Result, ResultWarning, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS, result_unit, size_dimension
@@ -31,9 +32,15 @@ from .kinematic import _model_info
 def closed_form_result(
     kind: str, model: Model, values: dict, dims: dict, status=Status.SOLVED, message="", solver=None
 ):
-    units = {k: result_unit(d) for k, d in dims.items()}
-    return Result(
-        kind, status, values, units, dims, solver or SolverInfo("closed_form"), message, None, _model_info(model)
+    """The result of a closed-form kind: its outputs declared by their dimensions (``dims``)."""
+    return declared_result(
+        kind,
+        status,
+        outputs_of(dims),
+        values,
+        solver=solver or SolverInfo("closed_form"),
+        message=message,
+        model=_model_info(model),
     )
 
 

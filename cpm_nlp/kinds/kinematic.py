@@ -32,7 +32,7 @@ from ..core.kind import (
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
 from ..core.model import Model
 from ..core.options import Option
-from ..core.outputs import Output, declared_result, output_names
+from ..core.outputs import Output, declared_result, output_names, outputs_of
 from ..core.progress import track
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.schema import Record
@@ -57,11 +57,6 @@ def _pose_outputs(model: Model) -> list[Output]:
     offsets = model.closure.offsets
     names, dims = _pose_names(model)
     return [Output(n, dims[n], "reference", offsets[n]) if n in offsets else Output(n, dims[n]) for n in names]
-
-
-def _as_outputs(dims: Mapping[str, str]) -> list[Output]:
-    """Outputs of the given dimensions (a matrix's and a text's role said by their dimension)."""
-    return [Output(n, d, d if d in ("matrix", "text") else "value") for n, d in dims.items()]
 
 
 def _pose_values(model: Model, sols: Sequence[PoseSolution], batch: bool) -> dict[str, Any]:
@@ -349,7 +344,7 @@ def _modes_result(
         mode_completeness="text",
         mode_search="text",
     )
-    res = _result(kind, model, [work], False, solver, extra, _as_outputs(dims))
+    res = _result(kind, model, [work], False, solver, extra, outputs_of(dims))
     res.status = Status.SOLVED
     designated = sum(m.designated for m in modes)
     summary = f"{found.count} assembly mode(s) found, {designated} on the designated branch"
@@ -514,7 +509,7 @@ class JointRequirements(ProblemKind):
         grid = [v if isinstance(v, list) else [v] for v in task_values(inputs, model, ("inputs",))]
         rep = joint_requirements(model, grid, solver)
         sols = rep.solutions
-        res = _result(self.name, model, sols, True, solver, rep.ranges, _as_outputs(rep.range_dimensions))
+        res = _result(self.name, model, sols, True, solver, rep.ranges, outputs_of(rep.range_dimensions))
         if rep.status.ok:
             res.message = (
                 f"{len(sols)} poses ({' x '.join(str(len(g)) for g in grid)} over {', '.join(c.task)}) solved by IK"
