@@ -18,8 +18,8 @@ def _shipped_names() -> list[str]:
     the order of the tests (test_described's inline prc3 without defaults)."""
     shipped = {f"file {f.resolve()}" for f in shipped_files()}
 
-    def kept(origin: str) -> bool:
-        return origin == "built-in" or origin.startswith("plugin ") or origin in shipped
+    def kept(origin) -> bool:
+        return origin.kind in ("built-in", "plugin") or str(origin) in shipped
 
     return [n for n in mechanism_names() if kept(mechanism_type(n).origin)]
 

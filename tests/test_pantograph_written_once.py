@@ -94,7 +94,7 @@ def _assert_same_pantograph(fm: cn.Model, rm: cn.Model, poses: np.ndarray) -> No
 
 def test_the_registered_pantograph_is_the_file_with_its_addon():
     mech = registry.mechanism_type("pantograph")
-    assert mech.origin.startswith("file ") and mech.origin.endswith("pantograph.yaml")
+    assert mech.origin.kind == "file" and mech.origin.path.endswith("pantograph.yaml")
     assert registry.BUILTIN_FILES["pantograph"] == "pantograph.yaml" and "pantograph" not in registry.BUILTIN
     assert registry.ADDONS["pantograph"] == "cpm_nlp.mechanisms.pantograph.addon:ADDON"
     with pytest.raises(ModuleNotFoundError):

@@ -241,7 +241,7 @@ def site(tmp_path, monkeypatch):
 
     def reset():
         REGISTRY._specs = None
-        REGISTRY._loaded = {k: v for k, v in REGISTRY._loaded.items() if v.origin == "built-in"}
+        REGISTRY._loaded = {k: v for k, v in REGISTRY._loaded.items() if v.origin.kind == "built-in"}
         REGISTRY.version += 1
         for name in [m for m in sys.modules if m.startswith("plug")]:
             del sys.modules[name]
@@ -325,7 +325,7 @@ def test_in_process_plugin_cannot_take_a_builtin_name(site, caplog):
     _install(site, "plugclash", BIGLIDE, {"cpm_nlp.mechanisms": {"prs3": "plugclash:MECHANISM"}})
     # the built-in prs3 is its shipped mechanism file (issue 21), not the plugin; a built-in's
     # name resolves without discovering the plugins, so the clash is told at the discovery
-    assert cn.mechanism_type("prs3").origin.startswith("file ") and cn.mechanism_type("prs3").name == "prs3"
+    assert cn.mechanism_type("prs3").origin.kind == "file" and cn.mechanism_type("prs3").name == "prs3"
     assert "prs3" in cn.mechanism_names()
     assert "mechanism plugin plugin 'prs3'" in caplog.text and "ignored" in caplog.text
 

@@ -69,7 +69,7 @@ def _poses(model, n=20, seed=21):
 
 def test_the_registered_prc3_is_the_file_with_its_addon():
     mech = registry.mechanism_type("prc3")
-    assert mech.origin.startswith("file ") and mech.origin.endswith("prc3.yaml")
+    assert mech.origin.kind == "file" and mech.origin.path.endswith("prc3.yaml")
     assert registry.BUILTIN_FILES["prc3"] == "prc3.yaml" and "prc3" not in registry.BUILTIN
     assert registry.ADDONS["prc3"] == "cpm_nlp.mechanisms.prc3.addon:ADDON"
     with pytest.raises(ModuleNotFoundError):

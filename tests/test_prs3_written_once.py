@@ -58,7 +58,7 @@ def _poses(model, n=20, seed=21):
 
 def test_the_registered_prs3_is_the_file():
     mech = registry.mechanism_type("prs3")
-    assert mech.origin.startswith("file ") and mech.origin.endswith("prs3.yaml")
+    assert mech.origin.kind == "file" and mech.origin.path.endswith("prs3.yaml")
     assert "prs3" in registry.BUILTIN_FILES and "prs3" not in registry.BUILTIN
     with pytest.raises(ModuleNotFoundError):
         __import__("cpm_nlp.mechanisms.prs3")
@@ -74,7 +74,7 @@ def test_the_name_resolves_to_the_file_without_reading_the_others(monkeypatch):
     monkeypatch.setattr(registry, "_file_mechanism_name", lambda path: read.append(path))
     fresh = registry._Registry()
     mech = fresh.lookup("prs3")
-    assert mech is not None and mech.name == "prs3" and mech.origin.endswith("prs3.yaml")
+    assert mech is not None and mech.name == "prs3" and mech.origin.path.endswith("prs3.yaml")
     assert fresh._specs is None and read == []
     assert fresh.lookup("prs3_file") is mech  # the old name: the discovery runs, and maps it
     assert fresh.lookup("prs3_nonesuch") is None

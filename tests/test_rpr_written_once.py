@@ -77,7 +77,7 @@ def _central(f, x, h):
 
 def test_the_registered_rpr_is_the_file_with_its_addon():
     mech = registry.mechanism_type("rpr")
-    assert mech.origin.startswith("file ") and mech.origin.endswith("rpr.yaml")
+    assert mech.origin.kind == "file" and mech.origin.path.endswith("rpr.yaml")
     assert registry.BUILTIN_FILES["rpr"] == "rpr.yaml" and "rpr" not in registry.BUILTIN
     assert registry.ADDONS["rpr"] == "cpm_nlp.mechanisms.rpr.addon:ADDON"
     with pytest.raises(ModuleNotFoundError):

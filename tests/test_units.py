@@ -161,3 +161,25 @@ def test_published_quantities_find_the_same_dimension_either_way(monkeypatch):
     fast = [outcome(v) for v in published]
     monkeypatch.setattr(U, "FAST_UNITS", {})
     assert fast == [outcome(v) for v in published]
+
+
+def test_one_place_gives_the_si_unit_of_a_dimension():
+    """core.units.si_unit says the SI unit of a dimension (issue 22, item 2): its one fallback
+    is "" for a dimension that is no physical one, and no other module reads DIMENSIONS[...].si."""
+    import re
+    from pathlib import Path
+
+    from cpm_nlp.core.units import DIMENSIONS, result_unit, si_unit
+
+    assert si_unit("length") == "m" and si_unit("angle") == "rad" and si_unit("stiffness") == "N/m"
+    assert si_unit("dimensionless") == "" and si_unit("matrix") == "" and si_unit("text") == ""
+    assert all(si_unit(name) == d.si for name, d in DIMENSIONS.items())
+    assert result_unit("length") == "m" and result_unit("matrix") == "matrix"
+    root = Path(__file__).resolve().parents[1] / "cpm_nlp"
+    pattern = re.compile(r"DIMENSIONS\[[^\]]+\]\.si\b|\.si if \w+ in DIMENSIONS")
+    offenders = [
+        str(p.relative_to(root))
+        for p in root.rglob("*.py")
+        if p.name != "units.py" and pattern.search(p.read_text(encoding="utf-8"))
+    ]
+    assert offenders == []

@@ -619,11 +619,11 @@ def hinge_set(
 def _material_at(mech: Any, out: list[Hinge], merged: Mapping, hinges: Any, material_spec: Any, path: tuple) -> dict:
     """Where each hinge material was given: the problem file's key, or a mechanism file's
     ``stiffness`` section (named in the message, as the problem file holds no such key)."""
-    origin = getattr(mech, "origin", "") or ""
+    origin = mech.origin if mech is not None else None
 
     def declared(*keys: str) -> tuple[tuple, str] | None:
-        if origin.startswith("file "):
-            return ("mechanism", "file"), f"in the mechanism file {origin[5:]}: stiffness.{'.'.join(keys)}: "
+        if origin is not None and origin.kind == "file":
+            return ("mechanism", "file"), f"in the mechanism file {origin.path}: stiffness.{'.'.join(keys)}: "
         return None
 
     default = (path + ("material",), "")

@@ -46,15 +46,15 @@ EXIT_INTERRUPTED, EXIT_BROKEN_PIPE = 130, 141
 
 
 def _fmt_scalar(value: Any, dim: str | None) -> tuple[str, str]:
-    from ..core.units import DIMENSIONS, format_quantity
+    from ..core.units import DIMENSIONS, format_quantity, si_unit
 
     if value is None:
         return "—", ""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return str(value), ""
-    si_unit = DIMENSIONS[dim].si if dim in DIMENSIONS else ""
-    si = f"{value:.10g}" + (f" {si_unit}" if si_unit else "")
-    friendly = format_quantity(value, dim) if dim in DIMENSIONS and DIMENSIONS[dim].display != si_unit else ""
+    unit = si_unit(dim)
+    si = f"{value:.10g}" + (f" {unit}" if unit else "")
+    friendly = format_quantity(value, dim) if dim in DIMENSIONS and DIMENSIONS[dim].display != unit else ""
     return si, friendly
 
 
@@ -586,7 +586,7 @@ def cmd_describe(args: argparse.Namespace, out: TextIO) -> int:  # noqa: C901 - 
         out.write("mechanisms:\n")
         for name in mechanism_names():
             mt = mechanism_type(name)
-            origin = "" if mt.origin == "built-in" else f"  ({mt.origin})"
+            origin = "" if mt.origin.kind == "built-in" else f"  ({mt.origin})"
             out.write(f"  {name:<12} {mt.title}{origin}\n")
         out.write("problem kinds:\n")
         for name in kind_names():

@@ -44,6 +44,7 @@ from typing import Any
 from .errors import suggest
 from .joints import JOINT_LETTERS
 from .options import Option, validate_mapping
+from .origin import Origin, as_origin
 
 
 class MechanismDeclarationError(TypeError):
@@ -203,10 +204,13 @@ class Mechanism:
     #: section) its paper's figures; names under the shipped ``problems/`` directory, or
     #: absolute paths for a plugin's own files
     problem_files: tuple[str, ...] = ()
-    #: where the declaration came from ("built-in", a plugin's entry point, a file)
-    origin: str = "built-in"
+    #: where the declaration came from (:class:`~cpm_nlp.core.origin.Origin`; a text given in
+    #: code, e.g. "built-in", is made one)
+    origin: Origin | str = "built-in"
 
     def __post_init__(self) -> None:
+        origin = as_origin(self.origin, self.name)
+        object.__setattr__(self, "origin", origin if origin.name else replace(origin, name=self.name))
         validate(self)
 
     def model(

@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from .origin import Origin
+
 
 class Status(str, Enum):
     """Outcome of a solve (the string value is what files and JSON carry)."""
@@ -183,6 +185,8 @@ class Result:
     model: dict[str, Any] = field(default_factory=dict)  # parameters used, SI
     #: where the numbers are outside their model's validity (empty when clean)
     warnings: list[ResultWarning] = field(default_factory=list)
+    #: where the mechanism came from (recorded as ``origin``; None: not known, e.g. a model built in code)
+    origin: Origin | None = None
 
     @property
     def ok(self) -> bool:
@@ -210,6 +214,8 @@ class Result:
             out["statuses"] = [s.value for s in self.statuses]
         if self.model:
             out["model"] = jsonable(self.model)
+        if self.origin is not None:
+            out["origin"] = jsonable(self.origin.to_dict())
         out["warnings"] = [w.to_dict() for w in self.warnings]
         return out
 

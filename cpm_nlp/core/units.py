@@ -231,6 +231,21 @@ def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # no
     return si
 
 
+def si_unit(dimension: str) -> str:
+    """The SI unit of a dimension of :data:`DIMENSIONS` ("length" -> "m"), the one place
+    that says it.  Fallback: a dimension that is no physical one ("matrix", "vector",
+    "text", "bool", a kind's own label) has no SI unit, and gives ""."""
+    dim = DIMENSIONS.get(dimension) if isinstance(dimension, str) else None
+    return dim.si if dim is not None else ""
+
+
+def result_unit(dimension: str) -> str:
+    """The unit a result of the generic kinds writes for a value of ``dimension``:
+    :func:`si_unit`, and for a value with no SI unit (a matrix, a text ...) the name of
+    what it is, as their results have always written it (kept for byte-identical JSON)."""
+    return si_unit(dimension) if dimension in DIMENSIONS else dimension
+
+
 def to_display(value: float, dimension: str) -> tuple[float, str]:
     """Convert an SI value to the display unit of its dimension."""
     dim = DIMENSIONS[dimension]

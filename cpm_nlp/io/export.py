@@ -60,7 +60,7 @@ from ..core.kernels import (
 from ..core.model import Coordinate, Model
 from ..core.result import STATUS_TEXT
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS
+from ..core.units import si_unit
 from ..core.version import __version__
 from .atomic import check_output_path
 
@@ -111,7 +111,7 @@ def check_format(fmt: str, path: tuple = ("--format",)) -> str:
 
 
 def _unit(coord: Coordinate) -> str:
-    return DIMENSIONS[coord.kind].si if coord.kind in DIMENSIONS else ""
+    return si_unit(coord.kind)
 
 
 def _vector(name: str, coords: Sequence[Coordinate], meaning: str) -> dict[str, Any]:
@@ -305,7 +305,7 @@ def manifest(
 
     def quantity(value: float | list[float], dim: str) -> dict[str, Any]:
         number = [float(v) for v in value] if isinstance(value, (list, tuple)) else float(value)  # a derived vector
-        return {"value": number, "unit": DIMENSIONS[dim].si if dim in DIMENSIONS else ""}
+        return {"value": number, "unit": si_unit(dim)}
 
     funcs = []
     for kern, fn in exported:

@@ -21,19 +21,26 @@ from ..core.kind import ProblemKind
 from ..core.mechanism import DynamicsModel
 from ..core.model import Model
 from ..core.options import REQUIRED, Option
+from ..core.outputs import declared_result, outputs_of
 from ..core.result import Result, ResultWarning, SolverInfo, Status
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS, size_dimension
+from ..core.units import DIMENSIONS, result_unit, size_dimension
 from .hinge_inputs import mass_node, stress_limit_option
-from .kinematic import _model_info, _si
+from .kinematic import _model_info
 
 
 def closed_form_result(
     kind: str, model: Model, values: dict, dims: dict, status=Status.SOLVED, message="", solver=None
 ):
-    units = {k: (_si(d) if d in DIMENSIONS else d) for k, d in dims.items()}
-    return Result(
-        kind, status, values, units, dims, solver or SolverInfo("closed_form"), message, None, _model_info(model)
+    """The result of a closed-form kind: its outputs declared by their dimensions (``dims``)."""
+    return declared_result(
+        kind,
+        status,
+        outputs_of(dims),
+        values,
+        solver=solver or SolverInfo("closed_form"),
+        message=message,
+        model=_model_info(model),
     )
 
 
@@ -128,7 +135,7 @@ class ActuatorWorkspace(ProblemKind):
             )
         corners = "box corners that assemble" if missing else "box corners"
         res.units["vertices"] = f"rows: {corners}; columns " + ", ".join(
-            f"{n} [{_si(dims[n + '_min'])}]" for n in names
+            f"{n} [{result_unit(dims[n + '_min'])}]" for n in names
         )
         if inputs["points"]:
             res.values["points"] = rep.t[np.all(np.isfinite(rep.t), axis=1)].tolist()

@@ -41,8 +41,9 @@ from ..core.options import Option
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
+from ..core.units import result_unit
 from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
-from .kinematic import _model_info, _pose_names, _pose_values, _si
+from .kinematic import _model_info, _pose_names, _pose_values
 
 log = logging.getLogger(__name__)
 
@@ -197,7 +198,7 @@ class ActuatorForces(_HingeKind):
         status, message, statuses = _summary(sols, batch)
         names, dims = _pose_names(model)
         values = _pose_values(model, sols, batch)
-        units = {n: _si(dims[n]) for n in names}
+        units = {n: result_unit(dims[n]) for n in names}
         for j in range(c.nq):
             col = [None if sp is None else float(sp.F[j]) for sp in points]
             values[f"F{j + 1}"] = col if batch else col[0]
@@ -232,7 +233,7 @@ class ActuatorForces(_HingeKind):
             )
             values.update(lim_values)
             dims.update(lim_dims)
-            units.update({k: _si(d) for k, d in lim_dims.items()})
+            units.update({k: result_unit(d) for k, d in lim_dims.items()})
             message += "; " + lim_msg
         info = SolverInfo(
             "+".join(sorted({s.solver for s in sols if s.solver})) or solver.name,
@@ -404,7 +405,7 @@ class PlatformCompliance(_HingeKind):
         f, ka = inputs["load"], inputs["k_actuator"]
         sol = _commanded_pose(model, inputs, solver)
         names, dims = _pose_names(model)
-        units = {n: _si(dims[n]) for n in names}
+        units = {n: result_unit(dims[n]) for n in names}
         values = _pose_values(model, [sol], False)
         info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
         if not sol.ok:
@@ -430,7 +431,7 @@ class PlatformCompliance(_HingeKind):
             return Result(self.name, Status.SINGULAR, values, units, dims, info, msg, None, _model_info(model))
         lin = C @ f
         loaded = cm.compliant_fk(model, hs, sol.x, sol.q, sp.F, f, ka)
-        xs = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
+        xs = ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in c.x)
         values.update(C=C.tolist(), deflection_linear=lin.tolist())
         dims.update(C="matrix", deflection_linear="vector")
         units.update(C=f"rows and columns {xs}; m/N, rad/(N*m) and mixed", deflection_linear=xs)
@@ -449,7 +450,7 @@ class PlatformCompliance(_HingeKind):
             for i, x in enumerate(c.x):
                 values[f"d_{x.name}"] = float(d[i])
                 dims[f"d_{x.name}"] = x.kind
-                units[f"d_{x.name}"] = _si(x.kind)
+                units[f"d_{x.name}"] = result_unit(x.kind)
             spl = cm.static_point(model, hs, loaded.x, loaded.q)
             sv, sd = _stress_values(hs, [spl], False)
             values.update({k + "_loaded": v for k, v in sv.items()})
@@ -457,7 +458,7 @@ class PlatformCompliance(_HingeKind):
             units.update({k + "_loaded": "Pa" for k in sd})
             values["q_loaded"] = loaded.q.tolist()
             dims["q_loaded"] = "vector"
-            units["q_loaded"] = ", ".join(f"{q.name} [{_si(q.kind)}]" for q in c.q)
+            units["q_loaded"] = ", ".join(f"{q.name} [{result_unit(q.kind)}]" for q in c.q)
         else:
             status = Status.NOT_CONVERGED
         if ka is None:
@@ -477,7 +478,7 @@ class PlatformCompliance(_HingeKind):
         c = model.closure
         sm: SixAxisModel = inputs["six_axis"]
         f, ka = inputs["load"], inputs["k_actuator"]
-        xs = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
+        xs = ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in c.x)
         try:
             z0 = sm.start(sol.x, sol.q)
             ok, z_u, lam_u, it_u = sm.newton(z0, np.zeros(c.nx), sol.q, None, None)
@@ -523,11 +524,11 @@ class PlatformCompliance(_HingeKind):
         for i, x in enumerate(c.x):
             values[f"d_{x.name}"] = float(d[i])
             dims[f"d_{x.name}"] = x.kind
-            units[f"d_{x.name}"] = _si(x.kind)
+            units[f"d_{x.name}"] = result_unit(x.kind)
         q_l = z_l[c.nx : c.nx + c.nq]
         values["q_loaded"] = q_l.tolist()
         dims["q_loaded"] = "vector"
-        units["q_loaded"] = ", ".join(f"{q.name} [{_si(q.kind)}]" for q in c.q)
+        units["q_loaded"] = ", ".join(f"{q.name} [{result_unit(q.kind)}]" for q in c.q)
         loaded = sm.stresses(z_l)
         values["stress_max_loaded"] = max((v for v in loaded.values() if v is not None), default=None)
         dims["stress_max_loaded"], units["stress_max_loaded"] = "stress", "Pa"
@@ -625,7 +626,7 @@ class NaturalFrequencies(_HingeKind):
         hs: cm.HingeSet = inputs["hinge_set"]
         sol = _commanded_pose(model, inputs, solver)
         names, dims = _pose_names(model)
-        units = {n: _si(dims[n]) for n in names}
+        units = {n: result_unit(dims[n]) for n in names}
         values = _pose_values(model, [sol], False)
         info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
         if not sol.ok:

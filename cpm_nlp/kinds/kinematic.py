@@ -32,11 +32,12 @@ from ..core.kind import (
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
 from ..core.model import Model
 from ..core.options import Option
+from ..core.outputs import Output, declared_result, output_names, outputs_of
 from ..core.progress import track
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS
+from ..core.units import result_unit
 
 
 def _pose_names(model: Model) -> tuple[list[str], dict[str, str]]:
@@ -48,6 +49,14 @@ def _pose_names(model: Model) -> tuple[list[str], dict[str, str]]:
     dims.update(coordinate_dims(c.passive_coords))
     dims["residual"] = "length" if c.residual_unit == "m" else "dimensionless"
     return list(dims), dims
+
+
+def _pose_outputs(model: Model) -> list[Output]:
+    """The pose a kinematic kind returns: task and dependent coordinates, their offsets from
+    home (references to them), actuators, passive joints, the loop-closure residual."""
+    offsets = model.closure.offsets
+    names, dims = _pose_names(model)
+    return [Output(n, dims[n], "reference", offsets[n]) if n in offsets else Output(n, dims[n]) for n in names]
 
 
 def _pose_values(model: Model, sols: Sequence[PoseSolution], batch: bool) -> dict[str, Any]:
@@ -98,24 +107,25 @@ def _result(
     batch: bool,
     solver: SolverConfig,
     extra: Mapping[str, Any] | None = None,
+    outputs: Sequence[Output] = (),
 ) -> Result:
-    names, dims = _pose_names(model)
+    """The result of solved poses: the pose (:func:`_pose_outputs`), then ``extra`` values
+    (declared by ``outputs``)."""
     status, message, statuses = _summary(sols, batch)
     values = _pose_values(model, sols, batch)
     if extra:
         values.update(extra)
     warning = _singularity_warning(model, sols)
-    return Result(
+    return declared_result(
         kind,
         status,
+        _pose_outputs(model) + list(outputs),
         values,
-        {n: _si(dims[n]) for n in names},
-        dims,
-        _solver_info(sols, solver.name),
-        message,
-        statuses,
-        _model_info(model),
-        [warning] if warning else [],
+        solver=_solver_info(sols, solver.name),
+        message=message,
+        statuses=statuses,
+        model=_model_info(model),
+        warnings=[warning] if warning else [],
     )
 
 
@@ -143,10 +153,6 @@ def _singularity_warning(model: Model, sols: Sequence[PoseSolution]) -> Any:
     cond, k = max(near)
     points = f" (at {len(near)} of {len(sols)} points; the worst, point {k})" if len(sols) > 1 else ""
     return near_singular_warning(cond, "Phi_x", "Phi_x", points)
-
-
-def _si(dimension: str) -> str:
-    return DIMENSIONS[dimension].si if dimension in DIMENSIONS else dimension
 
 
 def _model_info(model: Model) -> dict[str, Any]:
@@ -338,9 +344,7 @@ def _modes_result(
         mode_completeness="text",
         mode_search="text",
     )
-    res = _result(kind, model, [work], False, solver, extra)
-    res.dimensions.update(dims)
-    res.units.update({k: _si(d) for k, d in dims.items()})
+    res = _result(kind, model, [work], False, solver, extra, outputs_of(dims))
     res.status = Status.SOLVED
     designated = sum(m.designated for m in modes)
     summary = f"{found.count} assembly mode(s) found, {designated} on the designated branch"
@@ -445,7 +449,6 @@ class Jacobian(ProblemKind):
         else:
             sol = inverse_kinematics(model, task_values(inputs, model, ("inputs",)), solver)
         extra: dict[str, Any] = {}
-        units: dict[str, str] = {}
         if sol.ok:
             rep = jacobians(model, sol.x, sol.q, inputs.get("characteristic_length"))
             extra = {
@@ -460,52 +463,29 @@ class Jacobian(ProblemKind):
                 "manipulability": rep.manipulability,
                 "characteristic_length": rep.characteristic_length,
             }
-            rows = ", ".join(f"{x.name} [{_si(x.kind)}]" for x in c.x)
-            task_rows = ", ".join(f"{c.x[i].name} [{_si(c.x[i].kind)}]" for i in c.task_index)
-            cols = ", ".join(f"{q.name} [{_si(q.kind)}]" for q in c.q)
-            units = {
-                "J": f"rows {rows} per columns {cols}",
-                "J_task": f"rows {task_rows} per columns {cols}",
-                "J_inv": f"rows {cols} per columns {task_rows}",
-                "Phi_x": f"d(phi) [{c.residual_unit}] / d({', '.join(c.x_names)})",
-                "Phi_q": f"d(phi) [{c.residual_unit}] / d({', '.join(c.q_names)})",
-                "det_Phi_x": "",
-                "det_Phi_y": "",
-                "cond": "",
-                "manipulability": "",
-                "characteristic_length": "m",
-            }
-        res = _result(self.name, model, [sol], False, solver, extra)
+        res = _result(self.name, model, [sol], False, solver, extra, _jacobian_outputs(c) if extra else ())
         if extra:  # an inverse (type I) singularity: the homogenized J_task loses rank
             res.warn(*filter(None, [near_singular_warning(extra["cond"], "J_task, homogenized", "cond")]))
-        res.units.update(units)
-        res.dimensions.update(
-            {
-                k: (
-                    "length"
-                    if k == "characteristic_length"
-                    else "matrix"
-                    if k.startswith(("J", "Phi"))
-                    else "dimensionless"
-                )
-                for k in extra
-            }
-        )
         return res
 
     def output_names(self, model: Model) -> list[str]:
-        return _pose_names(model)[0] + [
-            "J",
-            "J_task",
-            "J_inv",
-            "Phi_x",
-            "Phi_q",
-            "det_Phi_x",
-            "det_Phi_y",
-            "cond",
-            "manipulability",
-            "characteristic_length",
-        ]
+        return output_names(_pose_outputs(model) + _jacobian_outputs(model.closure))
+
+
+def _jacobian_outputs(c: Any) -> list[Output]:
+    """The Jacobians of a solved pose (their units say their rows and columns)."""
+    rows = ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in c.x)
+    task_rows = ", ".join(f"{c.x[i].name} [{result_unit(c.x[i].kind)}]" for i in c.task_index)
+    cols = ", ".join(f"{q.name} [{result_unit(q.kind)}]" for q in c.q)
+    return [
+        Output("J", "matrix", "matrix", unit=f"rows {rows} per columns {cols}"),
+        Output("J_task", "matrix", "matrix", unit=f"rows {task_rows} per columns {cols}"),
+        Output("J_inv", "matrix", "matrix", unit=f"rows {cols} per columns {task_rows}"),
+        Output("Phi_x", "matrix", "matrix", unit=f"d(phi) [{c.residual_unit}] / d({', '.join(c.x_names)})"),
+        Output("Phi_q", "matrix", "matrix", unit=f"d(phi) [{c.residual_unit}] / d({', '.join(c.q_names)})"),
+        *(Output(n, "dimensionless") for n in ("det_Phi_x", "det_Phi_y", "cond", "manipulability")),
+        Output("characteristic_length", "length"),
+    ]
 
 
 class JointRequirements(ProblemKind):
@@ -529,10 +509,7 @@ class JointRequirements(ProblemKind):
         grid = [v if isinstance(v, list) else [v] for v in task_values(inputs, model, ("inputs",))]
         rep = joint_requirements(model, grid, solver)
         sols = rep.solutions
-        res = _result(self.name, model, sols, True, solver)
-        res.values.update(rep.ranges)
-        res.dimensions.update(rep.range_dimensions)
-        res.units.update({k: _si(d) for k, d in rep.range_dimensions.items()})
+        res = _result(self.name, model, sols, True, solver, rep.ranges, outputs_of(rep.range_dimensions))
         if rep.status.ok:
             res.message = (
                 f"{len(sols)} poses ({' x '.join(str(len(g)) for g in grid)} over {', '.join(c.task)}) solved by IK"

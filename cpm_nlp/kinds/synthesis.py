@@ -27,7 +27,7 @@ from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
 from ..core.schema import Either, ListOf, Record
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS
+from ..core.units import si_unit
 from .workspace import _volume_dimension
 
 
@@ -201,7 +201,7 @@ class CuboidSynthesis(SynthesisFormulation):
             )
         values.update(starts=rep.starts, starts_converged=rep.converged, starts_agreed=rep.agreed)
         status = Status.SOLVED if rep.found else Status.INFEASIBLE if rep.infeasible else Status.NOT_CONVERGED
-        units = {k: (DIMENSIONS[v].si if v in DIMENSIONS else "") for k, v in dims.items()}
+        units = {k: si_unit(v) for k, v in dims.items()}
         units["volume"] = _volume_dimension(model)[1]
         return Result(
             "synthesis",

@@ -37,7 +37,7 @@ from ..core.multistart import start_options
 from ..core.options import Option
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
-from ..core.units import DIMENSIONS, size_dimension
+from ..core.units import si_unit, size_dimension
 from .hinge_inputs import stress_limit_option
 from .kinematic import _model_info
 
@@ -51,9 +51,7 @@ def _paper_membership(model: Model) -> Any:
 
 
 def _unit(dim: str) -> str:
-    if dim in DIMENSIONS:
-        return DIMENSIONS[dim].si
-    return {"si": "SI unit of the binding quantity"}.get(dim, "")
+    return "SI unit of the binding quantity" if dim == "si" else si_unit(dim)
 
 
 def _region_options(model: Model) -> list[Option]:

@@ -33,6 +33,7 @@ from typing import Any
 from ..core.errors import CpmError, InputError, suggest
 from ..core.mechanism import PARTS, Addon, Mechanism, MechanismDeclarationError, validate, with_addon
 from ..core.model import LoopClosure, Model
+from ..core.origin import Origin
 from . import described
 
 log = logging.getLogger(__name__)
@@ -72,10 +73,12 @@ ALIASES = {
 }
 
 
-def _builtin_specs() -> dict[str, tuple[str, str]]:
+def _builtin_specs() -> dict[str, tuple[str, Origin]]:
     """name -> (target, origin) of the built-in mechanisms (nothing read)."""
-    specs = {name: (target, "built-in") for name, target in BUILTIN.items()}
-    specs.update({name: (f"file:{described.SHIPPED_DIR / f}", "built-in") for name, f in BUILTIN_FILES.items()})
+    specs = {name: (target, Origin("built-in", name)) for name, target in BUILTIN.items()}
+    specs.update(
+        {name: (f"file:{described.SHIPPED_DIR / f}", Origin("built-in", name)) for name, f in BUILTIN_FILES.items()}
+    )
     return specs
 
 
@@ -92,18 +95,19 @@ class _Registry:
 
     def __init__(self) -> None:
         self._lock = threading.RLock()
-        self._specs: dict[str, tuple[str, str]] | None = None  # name -> (target, origin)
+        self._specs: dict[str, tuple[str, Origin]] | None = None  # name -> (target, origin)
         self._loaded: dict[str, Mechanism] = {}
         self._closures: dict[str, LoopClosure] = {}
         #: bumped by every register/unregister, so that tables derived from the registry refresh
         self.version = 0
 
-    def _discover(self) -> dict[str, tuple[str, str]]:
+    def _discover(self) -> dict[str, tuple[str, Origin]]:
         if self._specs is None:
             specs = _builtin_specs()
             builtin_files = {target for target, _origin in specs.values()}
             for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
-                origin = f"plugin {ep.name!r} ({ep.value}" + (f", package {ep.dist.name})" if ep.dist else ")")
+                detail = ep.value + (f", package {ep.dist.name}" if ep.dist else "")
+                origin = Origin("plugin", ep.name, detail=detail)
                 if ep.name in specs:
                     log.warning(
                         "mechanism plugin %s ignored: the name %r is taken (%s)", origin, ep.name, specs[ep.name][1]
@@ -117,7 +121,7 @@ class _Registry:
                 if name is None or name in specs:
                     log.warning("mechanism file %s ignored: no valid name, or the name is taken", path)
                     continue
-                specs[name] = (f"file:{path}", f"file {path}")
+                specs[name] = (f"file:{path}", Origin("file", name, path=str(path)))
             self._specs = specs
         return self._specs
 
@@ -165,7 +169,7 @@ class _Registry:
             self._closures.pop(name, None)
             self.version += 1
 
-    def _spec(self, name: str) -> tuple[str, str] | None:
+    def _spec(self, name: str) -> tuple[str, Origin] | None:
         """The (target, origin) of ``name``: a built-in's without discovering the plugins and
         reading the shipped files (nothing registered yet, so no spec can differ from it)."""
         if self._specs is None and name in BUILTIN.keys() | BUILTIN_FILES.keys():
@@ -230,7 +234,7 @@ def _file_mechanism_name(path: Any) -> str | None:
     return name if isinstance(name, str) and name.isidentifier() else None
 
 
-def _load(name: str, target: str, origin: str) -> Mechanism:
+def _load(name: str, target: str, origin: Origin) -> Mechanism:
     """Import and validate one declaration; every failure names its origin."""
     if target.startswith("file:"):
         return _load_file(name, target[len("file:") :], origin)
@@ -254,15 +258,15 @@ def _load(name: str, target: str, origin: str) -> Mechanism:
         raise PluginError(f"mechanism {name!r} ({origin}) must name a Mechanism declaration, got {type(obj).__name__}")
     if obj.name != name:
         raise PluginError(f"mechanism {name!r} ({origin}) declares the name {obj.name!r}; the two must agree")
-    if origin != "built-in" and obj.origin == "built-in":
+    if origin.kind != "built-in" and obj.origin.kind == "built-in":
         obj = _with_origin(obj, origin)
     return obj
 
 
-def _load_file(name: str, path: str, origin: str) -> Mechanism:
+def _load_file(name: str, path: str, origin: Origin) -> Mechanism:
     """A mechanism file; a built-in one with its add-on (:data:`ADDONS`), if it has one."""
     mech = described.load_file(path)
-    if origin == "built-in" and name in ADDONS:
+    if origin.kind == "built-in" and name in ADDONS:
         mech = described.with_same_text(with_addon(mech, _addon(name, ADDONS[name])), mech)
     return mech
 
@@ -283,7 +287,7 @@ def addon_of(name: str) -> Addon | None:
     return _addon(name, ADDONS[name]) if name in ADDONS else None
 
 
-def _with_origin(mech: Mechanism, origin: str) -> Mechanism:
+def _with_origin(mech: Mechanism, origin: Origin) -> Mechanism:
     return dataclasses.replace(mech, origin=origin)
 
 
@@ -324,7 +328,7 @@ def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
     an earlier description of that name; a built-in or plugin of that name is an error."""
     with REGISTRY._lock:
         current = REGISTRY._discover().get(mech.name)
-        if current is not None and current[0].startswith("file:") and current[1] == "built-in":
+        if current is not None and current[0].startswith("file:") and current[1].kind == "built-in":
             builtin = REGISTRY.get(mech.name)
             if builtin is mech or described.same_text(builtin, mech):
                 return builtin  # the built-in's own file, or an unchanged copy of it (cpm-nlp init)
@@ -335,7 +339,7 @@ def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
                 hint="a changed copy of a shipped mechanism file needs a name of its own "
                 f"(e.g. {mech.name}_edited), so that 'type: {mech.name}' keeps meaning the shipped one",
             )
-        if current is not None and not current[1].startswith(("file ", "described")):
+        if current is not None and current[1].kind not in ("file", "inline"):
             raise InputError(
                 f"the described mechanism's name {mech.name!r} is taken by a {current[1]} mechanism; rename it",
                 path=path + ("name",),
@@ -425,7 +429,7 @@ def build_model(
     """
     mech = mechanism_type(type_name, path + ("type",))
     closure = closure_of(mech)
-    if mech.origin == "built-in":
+    if mech.origin.kind == "built-in":
         return mech.model(closure, parameters, limits, path)
     try:
         return mech.model(closure, parameters, limits, path)

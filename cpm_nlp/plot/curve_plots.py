@@ -11,9 +11,17 @@ import numpy as np
 
 from ..core.errors import InputError, suggest
 from ..core.kinematics import passive_joints
-from ..mechanisms.registry import build_model
 from .draw_panels import Panel, panels_figure
-from .results import NotApplicable, PlotOptions, ResultData, dimension_of, pose_name, require_lists, result_closure
+from .results import (
+    NotApplicable,
+    PlotOptions,
+    ResultData,
+    dimension_of,
+    pose_name,
+    require_lists,
+    result_closure,
+    result_model,
+)
 from .style import as_floats, display_unit
 
 
@@ -44,7 +52,7 @@ def requirements_plot(data: ResultData, _options: PlotOptions) -> Any:
     home: dict[str, float] = {}
     if c.passive is not None:
         try:
-            model = build_model(data.model["type"], {p: data.model[p] for p in c.parameters})
+            model = result_model(data, {p: data.model[p] for p in c.parameters})
             home = passive_joints(model, model.x_home, model.q_home)
         except (InputError, KeyError):
             home = {}

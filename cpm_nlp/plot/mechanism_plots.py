@@ -12,11 +12,10 @@ import numpy as np
 from ..analysis.workspace import membership, probe_region
 from ..core.errors import InputError
 from ..core.kinematics import jacobians
-from ..mechanisms.registry import build_model, mechanism_type
 from .draw_mechanism import jacobian_figure, mechanism_figure
 from .interactive import mechanism_html
 from .pose import drawings, geometry_of, model_for, pose_title, single_pose, span_of
-from .results import NotApplicable, PlotOptions, ResultData
+from .results import NotApplicable, PlotOptions, ResultData, result_mechanism, result_model
 from .style import display_unit
 
 
@@ -36,10 +35,8 @@ def design_plot(data: ResultData, options: PlotOptions) -> Any:
     the result's values), the design of the file faintly where it differs."""
     if data.sweep:
         raise NotApplicable("'design' draws one result")
-    name = data.model.get("type")
-    if not name:
-        raise NotApplicable("the result does not name its mechanism (model.type)")
-    mech = mechanism_type(name, path=("model", "type"))
+    mech = result_mechanism(data)
+    name = mech.name
     given = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
     found = {o.name: data.values[o.name] for o in mech.parameters if isinstance(data.values.get(o.name), (int, float))}
     if not found:
@@ -47,8 +44,8 @@ def design_plot(data: ResultData, options: PlotOptions) -> Any:
             f"the result gives none of the {name} parameters ({', '.join(o.name for o in mech.parameters)})"
         )
     try:
-        model = build_model(name, {**given, **found})
-        start = build_model(name, given) if given and any(given.get(k) != v for k, v in found.items()) else None
+        model = result_model(data, {**given, **found})
+        start = result_model(data, given) if given and any(given.get(k) != v for k, v in found.items()) else None
     except InputError as exc:
         raise NotApplicable(f"cannot build the designed {name} ({exc.message})") from None
     geometry = geometry_of(model)

@@ -12,8 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import InputError
-from ..mechanisms.registry import build_model, mechanism_type
-from .results import NotApplicable, ResultData
+from .results import NotApplicable, ResultData, result_mechanism, result_model
 from .style import display_unit
 
 # -- the mechanism ------------------------------------------------------------------------------------
@@ -24,15 +23,12 @@ def model_for(data: ResultData) -> Any:
     parameters the result records (without its joint limits)."""
     if data.live is not None:
         return data.live
-    name = data.model.get("type")
-    if not name:
-        raise NotApplicable("the result does not name its mechanism (model.type)")
-    mech = mechanism_type(name, path=("model", "type"))
+    mech = result_mechanism(data)  # a changed or missing mechanism file: an InputError (exit 2)
     params = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
     try:
-        return build_model(name, params)
+        return result_model(data, params)
     except InputError as exc:
-        raise NotApplicable(f"cannot rebuild the {name} model from the result ({exc.message})") from None
+        raise NotApplicable(f"cannot rebuild the {mech.name} model from the result ({exc.message})") from None
 
 
 def geometry_of(model: Any) -> Any:

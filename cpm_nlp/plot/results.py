@@ -20,7 +20,7 @@ from ..core.result import ResultWarning
 from ..core.units import DIMENSIONS
 from ..io.inputs import MAX_RESULTS_BYTES, read_input_text
 from ..io.results import FORMATS, read_results
-from ..mechanisms.registry import closure_of, mechanism_type
+from ..mechanisms.provenance import recorded_closure, recorded_mechanism, recorded_model
 
 #: sweep statuses of points outside the design space (drawn apart from points that did not solve)
 OUTSIDE = ("infeasible", "invalid_input")
@@ -76,6 +76,8 @@ class ResultData:
     published: list[tuple[str, float, str]] = field(default_factory=list)
     #: the result's warnings (:class:`~cpm_nlp.core.result.ResultWarning`), read back from its JSON
     warnings: list[Any] = field(default_factory=list)
+    #: where the mechanism came from, as the result records it (``origin``; None in older results)
+    origin: Any = None
 
     @property
     def kind(self) -> str:
@@ -108,6 +110,7 @@ def from_result(result: Any, source: str = "") -> ResultData:
         status=str(d.get("status")),
         units={k: str(u) for k, u in (d.get("units") or {}).items()},
         warnings=[ResultWarning.from_dict(w) for w in d.get("warnings") or [] if isinstance(d.get("warnings"), list)],
+        origin=d.get("origin"),
     )
 
 
@@ -157,10 +160,28 @@ def load(path: str | os.PathLike) -> ResultData:
 
 def result_closure(data: ResultData) -> Any:
     """The symbolic mechanism of the result (names of its coordinates)."""
+    return recorded_closure(result_mechanism(data)) if data.live is None else data.live.closure
+
+
+def result_mechanism(data: ResultData) -> Any:
+    """The mechanism of the result: the one its ``origin`` records (a mechanism file only
+    if it is unchanged at its path, see :mod:`cpm_nlp.mechanisms.provenance`), else the
+    registered type ``model.type`` (a result written before results recorded their origin)."""
+    if data.live is not None and data.live.mechanism is not None:
+        return data.live.mechanism
     name = data.model.get("type")
-    if not name:
+    if not name and data.origin is None:
         raise NotApplicable("the result does not name its mechanism (model.type)")
-    return closure_of(mechanism_type(name, path=("model", "type")))
+    return recorded_mechanism(data.origin, name, data.source or None)
+
+
+def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None) -> Any:
+    """A model of the result's mechanism (:func:`result_mechanism`) from ``parameters``
+    (default: the ones the result records), without registering it."""
+    mech = result_mechanism(data)
+    if parameters is None:
+        parameters = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
+    return recorded_model(mech, parameters)
 
 
 def value_list(data: ResultData, name: str) -> list | None:

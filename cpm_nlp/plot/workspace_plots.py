@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 
 from ..analysis.workspace import membership, probe_region, sample_workspace
-from ..mechanisms.registry import mechanism_type
 from .draw_workspace import BoundarySlice, slice_lines, workspace_figure_2d
 from .draw_workspace import workspace_figure as workspace_figure_png
 from .interactive import workspace_html
@@ -23,6 +22,7 @@ from .results import (
     pose_name,
     require_lists,
     result_closure,
+    result_mechanism,
     value_list,
 )
 from .style import as_floats
@@ -134,10 +134,9 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
 
 def _paper_boxes(data: ResultData) -> list[tuple]:
     """The box of the paper's own formulation, where the mechanism reads one from the result."""
-    name = data.model.get("type")
-    if not name:
+    if not data.model.get("type") and data.origin is None:
         return []
-    extras = mechanism_type(name, path=("model", "type")).cuboid
+    extras = result_mechanism(data).cuboid
     if extras is None or extras.paper_box is None:
         return []
     box = extras.paper_box(data.values)

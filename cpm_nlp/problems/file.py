@@ -30,10 +30,12 @@ from ..core.errors import InputError, suggest, unknown_key_error
 from ..core.finite import check_numbers, finite_status
 from ..core.kind import ProblemKind
 from ..core.model import Model
+from ..core.origin import Origin
 from ..core.result import Result
 from ..core.solver import SolverConfig
 from ..io.datafile import data_file_of, merge_data_file
 from ..io.inputs import display_name, input_dir
+from ..mechanisms.provenance import section_origin
 from ..mechanisms.registry import SECTION_KEYS, section_model
 from .overrides import apply_overrides
 from .published import parse_reproduce
@@ -68,6 +70,8 @@ class Problem:
     description: str = ""
     data: dict[str, Any] = field(default_factory=dict)
     sweep: Any = None  # a cpm_nlp.sweep.run.SweepSpec when the file has a sweep section
+    #: where the mechanism came from (recorded in the result)
+    origin: Origin | None = None
 
 
 def problem_from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Problem:
@@ -100,6 +104,7 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
         if key not in SECTION_KEYS:
             raise unknown_key_error(str(key), SECTION_KEYS, ("mechanism",), "mechanism key")
     model = section_model(mech, base_dir)
+    origin = section_origin(mech, base_dir, model)
     reason = kind.supports(model)
     if reason:
         raise InputError(
@@ -122,7 +127,7 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
     sweep = None
     if data.get("sweep") is not None:
         sweep = parse_sweep(data["sweep"], data, kind, model, base_dir)
-    return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data, sweep)
+    return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data, sweep, origin)
 
 
 def _check_reproduced_values(raw: Any, spec: Any, names: list[str]) -> None:
@@ -182,6 +187,8 @@ def solve(problem: Problem) -> Result:
         result = problem.kind.run(problem.model, problem.inputs, problem.solver)
     except InputError as exc:  # an input found wrong only while solving (e.g. an allowable stress)
         raise exc.at(file=problem.file) from None
+    if result.origin is None:
+        result.origin = problem.origin
     result = finite_status(result)  # a NaN or an inf is a failed status, never an answer
     if problem.outputs is not None:
         keep = set(problem.outputs)

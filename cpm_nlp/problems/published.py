@@ -50,7 +50,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..core.errors import InputError, suggest, unknown_key_error
-from ..core.units import DIMENSIONS, article, fast_dimension, format_quantity, parse_quantity
+from ..core.units import DIMENSIONS, article, fast_dimension, format_quantity, parse_quantity, si_unit
 
 ROW_KEYS = (
     "quantity",
@@ -144,7 +144,7 @@ class Comparison:
             "published": num(self.published),
             "published_text": self.published_text,
             "computed": num(self.computed),
-            "unit": DIMENSIONS[self.dimension].si if self.dimension in DIMENSIONS else "",
+            "unit": si_unit(self.dimension),
             "rel_error": num(self.rel_error),
             "verdict": self.verdict,
             "echoes_input": self.echoes or None,

@@ -48,7 +48,7 @@ def plugin_problem_files() -> list[Path]:
     out: list[Path] = []
     for name in mechanism_names():
         mech = mechanism_type(name)
-        if mech.origin.startswith("plugin "):
+        if mech.origin.kind == "plugin":
             out += [Path(f) for f in mech.problem_files if Path(f).is_absolute()]
     return out
 

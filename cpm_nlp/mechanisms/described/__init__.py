@@ -24,6 +24,7 @@ from ...analysis.compliance import check_declared
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
+from ...core.origin import Origin
 from ...io.inputs import display_name, input_dir, read_input_text
 from ...io.yamlfile import load_yaml_text, parse_yaml, read_yaml
 from . import expr as ex
@@ -196,7 +197,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         geometry=graph_geometry(*fns["graph_drawing"], gen)
         if d.is_graph
         else geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
-        origin=f"file {d.file}" if d.file else "described in code",
+        origin=Origin("file", d.name, path=d.file) if d.file else Origin("inline", d.name),
         chains=chains_function(gen) if chains_supported(gen) else None,  # legs only: a graph has none
     )
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults

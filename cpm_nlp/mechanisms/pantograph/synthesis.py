@@ -52,7 +52,7 @@ from ...core.options import Option
 from ...core.result import Result, SolverInfo, Status
 from ...core.schema import Record
 from ...core.solver import SolverConfig
-from ...core.units import DIMENSIONS
+from ...core.units import si_unit
 from ...kinds.synthesis import SynthesisFormulation
 from . import analysis as P
 
@@ -371,7 +371,7 @@ class PantographSynthesis(SynthesisFormulation):
 
     def _result(self, status, values, message, iterations, t0, model, material) -> Result:
         dims = {k: OUTPUT_DIMS.get(k, "dimensionless") for k in values}
-        units = {k: (DIMENSIONS[v].si if v in DIMENSIONS else "") for k, v in dims.items()}
+        units = {k: si_unit(v) for k, v in dims.items()}
         return Result(
             "synthesis",
             status,

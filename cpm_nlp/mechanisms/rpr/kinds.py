@@ -29,7 +29,8 @@ from ...core.options import Option
 from ...core.result import STATUS_TEXT, Result, SolverInfo, Status
 from ...core.schema import Record
 from ...core.solver import SolverConfig
-from ...kinds.kinematic import Jacobian, _model_info, _si
+from ...core.units import result_unit
+from ...kinds.kinematic import Jacobian, _model_info
 from . import compliance as rpr_compliance
 from . import design as rpr_design
 from . import screws as rpr_screws
@@ -73,7 +74,7 @@ def _finish(
 ) -> Result:
     if not status.ok:
         values = {}
-    u = {k: "" if d in ("matrix", "bool") else _si(d) for k, d in dims.items()}
+    u = {k: "" if d in ("matrix", "bool") else result_unit(d) for k, d in dims.items()}
     u.update(units or {})
     return Result(
         kind,
