@@ -258,7 +258,8 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     if args.json:
         out.write(result.to_json() + "\n")
     elif not args.quiet:
-        title = mechanism_type(problem.model.name).title
+        mech = problem.model.mechanism  # a problem's own mechanism file is not registered
+        title = (mech if mech is not None else mechanism_type(problem.model.name)).title
         out.write(render_result(result, title) + "\n")
     if args.output:
         write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])

@@ -39,7 +39,8 @@ def design_plot(data: ResultData, options: PlotOptions) -> Any:
     name = data.model.get("type")
     if not name:
         raise NotApplicable("the result does not name its mechanism (model.type)")
-    mech = mechanism_type(name, path=("model", "type"))
+    live = data.live.mechanism if data.live is not None else None  # solve --plot: a file's is not registered
+    mech = live or mechanism_type(name, path=("model", "type"))
     given = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
     found = {o.name: data.values[o.name] for o in mech.parameters if isinstance(data.values.get(o.name), (int, float))}
     if not found:
@@ -47,8 +48,8 @@ def design_plot(data: ResultData, options: PlotOptions) -> Any:
             f"the result gives none of the {name} parameters ({', '.join(o.name for o in mech.parameters)})"
         )
     try:
-        model = build_model(name, {**given, **found})
-        start = build_model(name, given) if given and any(given.get(k) != v for k, v in found.items()) else None
+        model = build_model(mech, {**given, **found})
+        start = build_model(mech, given) if given and any(given.get(k) != v for k, v in found.items()) else None
     except InputError as exc:
         raise NotApplicable(f"cannot build the designed {name} ({exc.message})") from None
     geometry = geometry_of(model)

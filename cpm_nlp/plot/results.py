@@ -157,6 +157,8 @@ def load(path: str | os.PathLike) -> ResultData:
 
 def result_closure(data: ResultData) -> Any:
     """The symbolic mechanism of the result (names of its coordinates)."""
+    if data.live is not None:  # solve --plot: the model solved (its mechanism file is not registered)
+        return data.live.closure
     name = data.model.get("type")
     if not name:
         raise NotApplicable("the result does not name its mechanism (model.type)")

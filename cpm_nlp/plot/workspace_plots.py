@@ -137,7 +137,8 @@ def _paper_boxes(data: ResultData) -> list[tuple]:
     name = data.model.get("type")
     if not name:
         return []
-    extras = mechanism_type(name, path=("model", "type")).cuboid
+    live = data.live.mechanism if data.live is not None else None  # solve --plot: a file's is not registered
+    extras = (live or mechanism_type(name, path=("model", "type"))).cuboid
     if extras is None or extras.paper_box is None:
         return []
     box = extras.paper_box(data.values)
