@@ -49,6 +49,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 from .errors import InputError, suggest
@@ -131,18 +132,49 @@ NLPSOL_ALLOWED: dict[str, str] = {
     "expand": "bool",
 }
 
-#: CasADi options of the Newton rootfinder (method newton) a file may set
-NEWTON_ALLOWED: dict[str, str] = {
-    "abstol": "real",
-    "abstolStep": "real0",  # 0: no test on the step, iterate to abstol
-    "max_iter": "int",
-    "line_search": "bool",
-    "print_iteration": "bool",
-    "error_on_fail": "bool",
-    "print_time": "bool",
-    "record_time": "bool",
-    "verbose": "bool",
-}
+
+@dataclass(frozen=True)
+class NewtonOption:
+    """One CasADi option of the Newton rootfinder (method ``newton``) a file may set.
+
+    kind: "real" (> 0), "real0" (>= 0), "int" or "bool";
+    default: the value cpm_nlp sets when the file gives none (None: CasADi's own);
+    batch: how the kernels' ``fast_newton`` (batch and exported solvers) treats it:
+        "honoured", "ignored" (no meaning there: it never raises or prints) or
+        "refused" (a file giving it cannot be solved by the kernels).
+    """
+
+    name: str
+    kind: str
+    default: Any = None
+    batch: str = "refused"
+
+
+#: the Newton options: one table, read by the option check (:data:`NEWTON_ALLOWED`), the
+#: defaults (:data:`cpm_nlp.core.solver.DEFAULT_OPTIONS`) and the kernels
+#: (:data:`cpm_nlp.core.kernels.NEWTON_OPTIONS`)
+NEWTON_TABLE: tuple[NewtonOption, ...] = (
+    NewtonOption("abstol", "real", 1e-14, "honoured"),
+    NewtonOption("abstolStep", "real0", None, "honoured"),  # 0: no test on the step, iterate to abstol
+    NewtonOption("max_iter", "int", 50, "honoured"),
+    NewtonOption("line_search", "bool"),
+    NewtonOption("error_on_fail", "bool", False, "ignored"),
+    NewtonOption("print_iteration", "bool", False, "ignored"),
+    NewtonOption("print_time", "bool"),
+    NewtonOption("record_time", "bool"),
+    NewtonOption("verbose", "bool"),
+)
+
+#: CasADi options of the Newton rootfinder (method newton) a file may set: name -> kind
+NEWTON_ALLOWED: Mapping[str, str] = MappingProxyType({o.name: o.kind for o in NEWTON_TABLE})
+#: cpm_nlp's defaults of the Newton rootfinder
+NEWTON_DEFAULTS: Mapping[str, Any] = MappingProxyType(
+    {o.name: o.default for o in NEWTON_TABLE if o.default is not None}
+)
+#: the Newton options the kernels' rootfinder (CasADi ``fast_newton``) honours
+NEWTON_BATCH = tuple(o.name for o in NEWTON_TABLE if o.batch == "honoured")
+#: the Newton options without meaning for ``fast_newton`` (it never raises or prints)
+NEWTON_BATCH_IGNORED = tuple(o.name for o in NEWTON_TABLE if o.batch == "ignored")
 
 #: CasADi options refused, and why: (reason, what to do instead[, what the refusal adds; default DATA_ONLY])
 CASADI_REFUSED: dict[str, tuple[str, ...]] = {
