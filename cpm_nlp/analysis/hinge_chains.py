@@ -54,7 +54,7 @@ from ..core.chains import Chains
 from ..core.errors import InputError
 from ..core.kernels import FastFunction
 from ..core.model import Model
-from ..core.screws import skew, vee
+from ..core.screws import axis_rotation, vee
 from .compliance import HINGE_TYPES, SIX_AXES, HingeSet, six_axis_stiffness
 
 log = logging.getLogger(__name__)
@@ -63,9 +63,8 @@ _ROT_AXES = ("bend", "bend2", "torsion")
 
 
 def _rot(axis: np.ndarray, angle: Any) -> Any:
-    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues)."""
-    K = ca.DM(skew(axis))
-    return ca.DM.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
+    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues: :func:`~cpm_nlp.core.screws.axis_rotation`)."""
+    return axis_rotation(ca.DM(np.asarray(axis, dtype=float).reshape(3, 1)), angle)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

@@ -83,6 +83,18 @@ def skew(a: Any) -> Any:
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
+def axis_rotation(axis: Any, angle: Any) -> Any:
+    """The rotation by ``angle`` about the unit ``axis`` (Rodrigues' formula),
+    R = I + sin θ [k]× + (1 - cos θ) [k]×²: a CasADi matrix if the axis or the angle is
+    CasADi (SX in, SX out), else a numpy array.  The one rotation of the package: the file
+    mechanisms' joints, the hinge chains and the URDF importer use it."""
+    if _symbolic(axis, angle):
+        K = ca.skew(axis if isinstance(axis, (ca.SX, ca.MX)) else _ca(axis))
+        return ca.DM.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
+    K = skew(axis)
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
+
+
 def vee(M: Any) -> Any:
     """The axial vector of a 3 x 3 matrix's skew part, (M - Mᵀ)/2 = [v]× (the inverse of
     :func:`skew`; for a rotation by a small angle about w: the angle times w)."""

@@ -66,6 +66,7 @@ from ...core.errors import InputError, format_key_path, suggest
 from ...core.joints import JOINT_TYPES, joint_types
 from ...core.model import Coordinate
 from ...core.options import Option, validate_mapping
+from ...core.screws import axis_rotation
 from ...core.units import parse_quantity
 from . import expr as ex
 from .spec import Description, Joint, Leg
@@ -100,12 +101,11 @@ _BASE_AXES = {"x": ca.DM([1.0, 0, 0]), "y": ca.DM([0, 1.0, 0]), "z": ca.DM([0, 0
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
-    """Rotation by ``angle`` about a unit axis (Rodrigues), or about "x", "y", "z"."""
+    """Rotation by ``angle`` about a unit axis (Rodrigues: :func:`~cpm_nlp.core.screws.axis_rotation`),
+    or about "x", "y", "z"."""
     if isinstance(axis, str):
         axis = ca.DM([1.0 if axis == a else 0.0 for a in "xyz"])
-    k = ca.SX(axis)
-    K = ca.skew(k)
-    return ca.SX.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
+    return ca.SX(axis_rotation(ca.SX(axis), angle))
 
 
 def _xyz_angles(M: ca.SX) -> list[ca.SX]:
