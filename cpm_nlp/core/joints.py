@@ -12,14 +12,14 @@ entry k of its ``axes`` list (``k``; an S without ``axes`` turns about the base
 frame's x, y, z).
 
 The flexure hinges that can sit at a joint are given by name (the hinge types
-of :data:`cpm_nlp.analysis.compliance.HINGE_TYPES` and of
-:data:`cpm_nlp.analysis.flexure.HINGES`): where the project's mechanisms put
-them, and by a hinge's geometry where none does.
+of :data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, which reads this table for
+where each may sit): where the project's mechanisms put them, and by a hinge's
+geometry where none does.
 
 * As a revolute: a circular notch (prs3-ruiz.md section 5; the pantograph,
   pantograph-3d-elgammal-2016.md eq 38; the five-bar's and 3-RRR's elbows in
   problems/), a corner-filleted (cantilever) notch (pantograph eq 30-31), a
-  leaf spring (offered for the pantograph's joints by flexure.HINGES; it bends
+  leaf spring (offered for the pantograph's joints as a rotation limit; it bends
   about one axis).
 * As a U: a circular notch on each axis (rpr-2rpu-upr-zhang-2022.md Table 1 as
   problems/mechanisms/rpr.yaml reads it); a round neck (circular or filleted rod), which bends

@@ -59,7 +59,7 @@ from typing import Any
 
 import casadi as ca
 
-from ...analysis import flexure
+from ...analysis import hinge_types
 from ...core.aspect import ASPECT, ASPECT_DESCRIPTION, ASPECT_MAX_NX, twist_determinant
 from ...core.aspect import aspect as aspect_indicator
 from ...core.errors import InputError, format_key_path, suggest
@@ -723,10 +723,10 @@ class Generator:
     def _limit(self, j: _Joint, dim: str) -> tuple | None:
         if j.spec.flexure is not None:
             path = j.spec.path + ("flexure",)
-            values = validate_mapping(j.spec.flexure.values, flexure.HINGE_LIMIT_OPTIONS, path, what="flexure key")
+            values = validate_mapping(j.spec.flexure.values, hinge_types.HINGE_LIMIT_OPTIONS, path, what="flexure key")
             if values.get("hinge") is None:
-                raise InputError(f"missing key 'hinge' (one of: {', '.join(flexure.HINGES)})", path=path)
-            rot = flexure.hinge_rotation(values, path)
+                raise InputError(f"missing key 'hinge' (one of: {', '.join(hinge_types.LIMIT_TYPES)})", path=path)
+            rot = hinge_types.hinge_rotation(values, path)
             return (-rot, rot)
         if j.spec.range is not None:
             rng = tuple(parse_quantity(v, dim, j.spec.path + ("range", k)) for k, v in enumerate(j.spec.range))
