@@ -31,7 +31,9 @@ geometry where none does.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 from .errors import InputError, suggest
 
@@ -89,81 +91,83 @@ class JointType:
 _REVOLUTE_HINGES = ("circular_notch", "cantilever_notch", "leaf_spring")
 
 #: the joint types, in the order the reader lists them
-JOINT_TYPES: dict[str, JointType] = {
-    t.name: t
-    for t in (
-        JointType("P", "prismatic (spatial)", "P", (("P", "axis"),), axis="given", actuable=True, twin="planar_P"),
-        JointType(
-            "R",
-            "revolute (spatial)",
-            "R",
-            (("R", "axis"),),
-            axis="given",
-            actuable=True,
-            twin="planar_R",
-            hinges=_REVOLUTE_HINGES,
-        ),
-        JointType(
-            "C",
-            "cylindrical: a revolute and a prismatic on one axis",
-            "C",
-            (("R", "axis"), ("P", "axis")),
-            axis="given",
-        ),
-        JointType(
-            "U",
-            "universal: two revolutes, axes[0] on the proximal body, axes[1] on the distal one",
-            "U",
-            (("R", 0), ("R", 1)),
-            n_axes=2,
-            sphere=True,
-            hinges=("circular_notch", "circular_rod", "filleted_rod"),
-        ),
-        JointType(
-            "S",
-            "spherical",
-            "S",
-            (("R", 0), ("R", 1), ("R", 2)),
-            n_axes=3,
-            default_axes=("x", "y", "z"),
-            point=True,
-            sphere=True,
-            hinges=("circular_rod", "filleted_rod"),
-        ),
-        JointType(
-            "planar_R",
-            "revolute of a planar mechanism (axis z)",
-            "R",
-            (("R", "axis"),),
-            axis="z",
-            planar=True,
-            spatial=False,
-            actuable=True,
-            point=True,
-            sphere=True,
-            twin="R",
-            hinges=_REVOLUTE_HINGES,
-        ),
-        JointType(
-            "planar_P",
-            "prismatic of a planar mechanism (axis in the plane)",
-            "P",
-            (("P", "axis"),),
-            axis="given",
-            planar=True,
-            spatial=False,
-            actuable=True,
-            twin="P",
-        ),
-        JointType(
-            "distance",
-            "rigid distance between two points (an S-S strut or a parallelogram's link)",
-            "S",
-            (),
-            planar=True,
-        ),
-    )
-}
+JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
+    {
+        t.name: t
+        for t in (
+            JointType("P", "prismatic (spatial)", "P", (("P", "axis"),), axis="given", actuable=True, twin="planar_P"),
+            JointType(
+                "R",
+                "revolute (spatial)",
+                "R",
+                (("R", "axis"),),
+                axis="given",
+                actuable=True,
+                twin="planar_R",
+                hinges=_REVOLUTE_HINGES,
+            ),
+            JointType(
+                "C",
+                "cylindrical: a revolute and a prismatic on one axis",
+                "C",
+                (("R", "axis"), ("P", "axis")),
+                axis="given",
+            ),
+            JointType(
+                "U",
+                "universal: two revolutes, axes[0] on the proximal body, axes[1] on the distal one",
+                "U",
+                (("R", 0), ("R", 1)),
+                n_axes=2,
+                sphere=True,
+                hinges=("circular_notch", "circular_rod", "filleted_rod"),
+            ),
+            JointType(
+                "S",
+                "spherical",
+                "S",
+                (("R", 0), ("R", 1), ("R", 2)),
+                n_axes=3,
+                default_axes=("x", "y", "z"),
+                point=True,
+                sphere=True,
+                hinges=("circular_rod", "filleted_rod"),
+            ),
+            JointType(
+                "planar_R",
+                "revolute of a planar mechanism (axis z)",
+                "R",
+                (("R", "axis"),),
+                axis="z",
+                planar=True,
+                spatial=False,
+                actuable=True,
+                point=True,
+                sphere=True,
+                twin="R",
+                hinges=_REVOLUTE_HINGES,
+            ),
+            JointType(
+                "planar_P",
+                "prismatic of a planar mechanism (axis in the plane)",
+                "P",
+                (("P", "axis"),),
+                axis="given",
+                planar=True,
+                spatial=False,
+                actuable=True,
+                twin="P",
+            ),
+            JointType(
+                "distance",
+                "rigid distance between two points (an S-S strut or a parallelogram's link)",
+                "S",
+                (),
+                planar=True,
+            ),
+        )
+    }
+)
 
 #: the letters a drawing marks joints with
 JOINT_LETTERS = tuple(dict.fromkeys(t.letter for t in JOINT_TYPES.values()))
