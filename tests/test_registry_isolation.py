@@ -82,6 +82,15 @@ def test_loading_and_solving_a_problem_registers_nothing(tmp_path):
     assert mechanism_names() == before and "my_five_bar" not in before
     with pytest.raises(cn.InputError, match="unknown mechanism type 'my_five_bar'"):
         mechanism_type("my_five_bar")
+    # solve --plot draws the model solved (its mechanism read from the result's live model)
+    pytest.importorskip("matplotlib")
+    from cpm_nlp.plot import figures
+
+    data = figures.from_result(result)
+    data.live = problem.model
+    _fig, kind = figures.figure(data, "mechanism")
+    assert kind == "mechanism"
+    assert mechanism_names() == before
 
 
 def test_two_files_of_one_name_load_side_by_side(tmp_path):
