@@ -101,11 +101,17 @@ _BASE_AXES = {"x": ca.DM([1.0, 0, 0]), "y": ca.DM([0, 1.0, 0]), "z": ca.DM([0, 0
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
-    """Rotation by ``angle`` about a unit axis (Rodrigues: :func:`~cpm_nlp.core.screws.axis_rotation`),
-    or about "x", "y", "z"."""
+    """Rotation by ``angle`` about a unit axis k, or about "x", "y", "z" (Rodrigues,
+    :func:`~cpm_nlp.core.screws.axis_rotation`: R = cos I + sin [k]x + (1 - cos) k kᵀ, whose
+    zero entries of k drop out about a base axis)."""
     if isinstance(axis, str):
         axis = ca.DM([1.0 if axis == a else 0.0 for a in "xyz"])
     return ca.SX(axis_rotation(ca.SX(axis), angle))
+
+
+def _is_identity(M: ca.SX) -> bool:
+    """M is the constant identity (a proximal chain that only slides)."""
+    return bool(M.is_constant()) and float(ca.norm_inf(ca.DM(M) - ca.DM.eye(M.size1()))) == 0.0
 
 
 def _xyz_angles(M: ca.SX) -> list[ca.SX]:
@@ -130,6 +136,10 @@ class _Joint:
     names: tuple = ()
     #: a distance joint's given length (None: |to - at| in the drawing)
     length: ca.SX | None = None
+    #: at, to, axis and axes in the leg's own frame, before a repeated leg's turn (the same as them
+    #: for a leg that is not turned): the scalar products of the leg's constant vectors are taken
+    #: there, where a leg's axes are the file's own (a zero product of perpendicular axes is zero)
+    local: dict = field(default_factory=dict)
 
     @property
     def type(self) -> str:
@@ -314,7 +324,7 @@ class Generator:
             turn = _rot(leg.rotate_axis, self.scalar(leg.rotate, leg.path + ("repeat", "rotate"), env, "angle"))
         joints = [self.resolve(j, env, turn) for j in leg.joints]
         self.leg_joints.append((leg, joints))
-        self.close(leg, joints)
+        self.close(leg, joints, turn if leg.rotate is not None else None)
 
     def resolve(self, j: Joint, env: Mapping[str, ex.Value], turn: ca.SX) -> _Joint:  # noqa: C901 - one rule per joint part
         out = _Joint(j)
@@ -330,11 +340,13 @@ class Generator:
             )
         if j.at is None:
             raise InputError(f"a {j.type} joint needs its location 'at'", path=j.path)
-        out.at = turn @ self.vector(j.at, j.path + ("at",), env, "length")
+        out.local["at"] = self.vector(j.at, j.path + ("at",), env, "length")
+        out.at = turn @ out.local["at"]
         if j.type == "distance":
             if j.to is None:
                 raise InputError("a distance joint needs 'to' (the point on the distal body)", path=j.path)
-            out.to = turn @ self.vector(j.to, j.path + ("to",), env, "length")
+            out.local["to"] = self.vector(j.to, j.path + ("to",), env, "length")
+            out.to = turn @ out.local["to"]
             if j.length is not None:  # the rod's length, the drawing's `to` only roughly there (assembled)
                 out.length = self.scalar(j.length, j.path + ("length",), env, "length")
                 self.requirements.append(
@@ -350,12 +362,18 @@ class Generator:
         if kind.axis == "given":
             if j.axis is None:
                 raise InputError(f"a {j.type} joint needs its 'axis'", path=j.path)
-            a = turn @ self.vector(j.axis, j.path + ("axis",), env, None)
+            a = self.vector(j.axis, j.path + ("axis",), env, None)
+            out.local["axis"] = a / ca.norm_2(a)
+            a = turn @ a
             out.axis = a / ca.norm_2(a)
         elif kind.axis == "z":
             out.axis = ca.SX(_BASE_AXES["z"])
+            out.local["axis"] = turn.T @ out.axis  # z itself when the leg turns about z (planar)
+        out.local["axes"] = []
         for k, a in enumerate(j.axes):
-            v = turn @ self.vector(a, j.path + ("axes", k), env, None)
+            v = self.vector(a, j.path + ("axes", k), env, None)
+            out.local["axes"].append(v / ca.norm_2(v))
+            v = turn @ v
             out.axes.append(v / ca.norm_2(v))
         need = kind.n_axes
         if j.axes and len(j.axes) != need:
@@ -400,15 +418,17 @@ class Generator:
         text = f"expected three independent axes; with these parameters {text}"
         self.requirements.append((ca.if_else(ca.fabs(det) > self.DEPENDENT_AXES, 0, 1), text, path))
 
-    def close(self, leg: Leg, joints: list[_Joint]) -> None:  # noqa: C901 - one branch per leg ending
+    def close(self, leg: Leg, joints: list[_Joint], turn: ca.SX | None = None) -> None:  # noqa: C901 - one branch per leg ending
+        """The leg's closure rows, indicators and reported joint values (turn: a repeated leg's turn)."""
         last = joints[-1]
         rod = None  # a distance joint's given length
         if last.type == "distance":
-            tip, elim = last.to, _Joint(Joint("S", path=last.spec.path), at=last.at)
+            tip, elim = last.to, _Joint(Joint("S", path=last.spec.path), at=last.at, local={"at": last.local["at"]})
+            tip_l = last.local["to"]
             rod = last.length
             before = joints[:-1]
         elif last.type in POINT_JOINTS and (last.type == "S") != self.d.platform.planar:
-            tip = last.at
+            tip, tip_l = last.at, last.local["at"]
             before = joints[:-1]
             elim = None
             if before and before[-1].value is None and before[-1].type in ("R", "C", *SPHERE_JOINTS):
@@ -442,7 +462,9 @@ class Generator:
         u0 = tip - elim.at
         u = Rm @ u0
         v = B - c
-        r = ca.norm_2(u0)
+        # the link's constants in the leg's frame (the same for every copy of a repeated leg)
+        u0_l, axis_l = tip_l - elim.local["at"], elim.local.get("axis")
+        r = ca.norm_2(u0_l)
         Rb = Rm
         if slide is not None:
             if slide.value is None:
@@ -463,7 +485,7 @@ class Generator:
             self.indicator(ca.dot(u, v) / (r * ca.norm_2(v)), leg, elim, _COSINE)
             if elim.type == "R":  # R-P-S: the leg also stays in the plane normal to the R axis
                 w = Rm @ elim.axis
-                self.rows.append((ca.dot(v, w) - ca.dot(u0, elim.axis), f"leg {leg.name}: plane of the R joint"))
+                self.rows.append((ca.dot(v, w) - ca.dot(u0_l, axis_l), f"leg {leg.name}: plane of the R joint"))
                 theta = ca.atan2(ca.dot(w, ca.cross(u, v)), ca.dot(u, v))
                 self.report(elim, [theta], leg.name)
                 Rb = _rot(w, theta) @ Rm
@@ -471,26 +493,39 @@ class Generator:
                 Rb = self.report_sphere(elim, Rm, u0, v, leg)
         elif elim.type == "R":
             w = Rm @ elim.axis
-            h = ca.dot(u0, elim.axis)
+            h = ca.dot(u0_l, axis_l)
             up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
             self.rows.append((ca.dot(v, w) - h, f"leg {leg.name}: plane of the R joint"))
-            self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: radius about the R joint"))
-            self.eliminated(leg, elim, before, c, vp, 2)
+            self.rows.append(
+                ((ca.dot(v, v) - ca.dot(u0_l, u0_l)) / (2 * r), f"leg {leg.name}: radius about the R joint")
+            )
+            self.eliminated(leg, elim, before, c, v, 2, w)
+            if turn is not None and _is_identity(Rm):
+                # a turned leg whose proximal chain only slides: its angle and its link's rotation in
+                # the leg's own frame (v_l = turnᵀ v), where the file's axes are (0, 1, 0) and the
+                # like -- the rotation about w_l keeps a U or S axis along w_l exactly, and the tip's
+                # angles need no turned constant (:meth:`report_tip`)
+                v_l, w_l = turn.T @ v, axis_l
+                # w·(up × vp) = v·(w × u) and up·vp = u·v - (u·w)(v·w), with u·w = h
+                theta = ca.atan2(ca.dot(v_l, ca.cross(w_l, u0_l)), ca.dot(u0_l, v_l) - h * ca.dot(v_l, w_l))
+                self.report(elim, [theta], leg.name)
+                self.report_tip(last, _rot(w_l, theta), R_rel, leg.name, turn)
+                return
             theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
             self.report(elim, [theta], leg.name)
             Rb = _rot(w, theta) @ Rm
         elif elim.type == "C":
             w = Rm @ elim.axis
             up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
-            rp = ca.norm_2(u0 - ca.dot(u0, elim.axis) * elim.axis)
+            rp = ca.norm_2(u0_l - ca.dot(u0_l, axis_l) * axis_l)
             self.rows.append(((ca.dot(vp, vp) - rp**2) / (2 * rp), f"leg {leg.name}: cylinder of the C joint"))
-            self.eliminated(leg, elim, before, c, vp, 1)
+            self.eliminated(leg, elim, before, c, v, 1, w)
             theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
-            self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0, elim.axis)], leg.name)
+            self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0_l, axis_l)], leg.name)
             Rb = _rot(w, theta) @ Rm
         else:
             if rod is None:
-                self.rows.append(((ca.dot(v, v) - ca.dot(u0, u0)) / (2 * r), f"leg {leg.name}: distance"))
+                self.rows.append(((ca.dot(v, v) - ca.dot(u0_l, u0_l)) / (2 * r), f"leg {leg.name}: distance"))
             else:  # its given length: the drawing need not close (the reference is assembled)
                 self.rows.append(((ca.dot(v, v) - rod**2) / (2 * rod), f"leg {leg.name}: distance"))
             self.eliminated(leg, elim, before, c, v, 1)
@@ -504,12 +539,22 @@ class Generator:
         name = f"{leg.name}.{JOINT_TYPES[j.type].letter}{n}"
         self.branch.append((value, name, f"leg {leg.name}, joint {n} ({j.type}): {what}"))
 
-    def eliminated(self, leg: Leg, elim: _Joint, before: list[_Joint], c: ca.SX, vp: ca.SX, nrows: int) -> None:
-        """Record an eliminated link c -> B (its last ``nrows`` closure rows; vp: c -> B, for an R or
-        C normal to its axis) and its working-mode expression: the closure's rate with respect to
-        the joint before it, w·((c - a) × vp) for a revolute (axis w at a), e·vp for a P along e
-        (None: no joint before it, or one with several motions).  The indicator itself is chosen
-        once Φ_x is known (:meth:`elimination_indicators`)."""
+    def eliminated(
+        self,
+        leg: Leg,
+        elim: _Joint,
+        before: list[_Joint],
+        c: ca.SX,
+        v: ca.SX,
+        nrows: int,
+        along: ca.SX | None = None,
+    ) -> None:
+        """Record an eliminated link c -> B (its last ``nrows`` closure rows; v: c -> B, vp: its part
+        normal to the axis ``along`` of an eliminated R or C, else v) and its working-mode expression:
+        the closure's rate with respect to the joint before it, w·((c - a) × vp) for a revolute (axis
+        w at a), e·vp for a P along e (None: no joint before it, or one with several motions).  The
+        indicator itself is chosen once Φ_x is known (:meth:`elimination_indicators`)."""
+        vp = v if along is None else v - ca.dot(v, along) * along
         working, what = None, ""
         if before and JOINT_TYPES[before[-1].type].dof == 1:
             b = before[-1]
@@ -517,10 +562,21 @@ class Generator:
             if JOINT_TYPES[b.type].motion[0][0] == "R":
                 rate = ca.cross(Rk @ b.axis, c - (Rk @ b.at + tk))
                 what = _WORKING_PLANAR if self.d.platform.planar else _WORKING_R
+                working = ca.dot(rate, vp)
             else:
                 rate = Rk @ b.axis
                 what = _WORKING_P
-            working = ca.dot(rate, vp)
+                # e·vp = e·v - (v·w)(e·w): a P moves its link without turning it, so e·w is the
+                # product of the two axes in the leg's frame, a constant of the file (an exact 0 for
+                # the usual P normal to the R: e·vp is e·v).  Same branch decisions as e·vp on the
+                # turned axes, whose e·w was a rounded 0 (|e·w| <= 1e-16): the two differ by at most
+                # |v·w| 1e-16 plus rounding, so their signs agree wherever |e·v| exceeds that
+                # (tests/test_generated_lean.py: 900 legs, 600 within 1e-14..1e-3 L of e·v = 0)
+                working = ca.dot(rate, v)
+                if along is not None:
+                    e_l, w_l = b.local.get("axis"), elim.local.get("axis")
+                    ew = ca.dot(rate, along) if e_l is None or w_l is None else ca.dot(e_l, w_l)
+                    working = working - ca.dot(v, along) * ew
         rows = list(range(len(self.rows) - nrows, len(self.rows)))
         self.pending.append((len(self.branch), rows, working, what))
         self.indicator(None, leg, elim, "")
@@ -704,7 +760,11 @@ class Generator:
             )
         return None
 
-    def report_tip(self, last: _Joint, Rb: ca.SX | None, R_rel: ca.SX, leg_name: str) -> None:
+    def report_tip(
+        self, last: _Joint, Rb: ca.SX | None, R_rel: ca.SX, leg_name: str, turn: ca.SX | None = None
+    ) -> None:
+        """The tip joint's angles from the rotation Rb of the link before it and the platform's
+        R_rel (turn: Rb is in the turned leg's own frame, Rb_world = turn Rb turnᵀ)."""
         names = last.spec.coordinates
         if not names or last.type == "distance":
             return
@@ -713,6 +773,13 @@ class Generator:
                 "the rotation of this joint is not determined (the link before it may spin); report no coordinates",
                 path=last.spec.path + ("coordinates",),
             )
+        if turn is not None:  # Rb in the leg's frame: back to the base frame for a planar R
+            if last.type == "planar_R":
+                Rb = turn @ Rb @ turn.T
+            else:  # Fᵀ Rb_worldᵀ R_rel F with F = turn F_l: (Rb F_l)ᵀ (turnᵀ R_rel turn F_l)
+                F = ca.horzcat(*last.local["axes"]) if last.axes else ca.SX.eye(3)
+                self.report(last, _xyz_angles((Rb @ F).T @ (turn.T @ (R_rel @ (turn @ F)))), leg_name)
+                return
         if last.type == "planar_R":
             M = Rb.T @ R_rel
             self.report(last, [ca.atan2(M[1, 0], M[0, 0])], leg_name)
@@ -879,13 +946,17 @@ class Generator:
     def functions(self, q: ca.SX) -> dict[str, Any]:
         x, p = self.x, self.p
         io = ["x", "q", "p"]
-        phi = ca.Function("phi", [x, q, p], [ca.vertcat(*[r[0] for r in self.rows])], io, ["phi"])
-        g = ca.vertcat(*[b[0] for b in self.branch])
+        # common subexpressions merged (ca.cse: each distinct operation on the same operands once;
+        # the values are the same to the bit): the legs share the platform's rotation and its
+        # sines and cosines, each indicator the squared norm of its leg's closure
+        phi = ca.Function("phi", [x, q, p], [ca.cse(ca.vertcat(*[r[0] for r in self.rows]))], io, ["phi"])
+        g = ca.cse(ca.vertcat(*[b[0] for b in self.branch]))
         branch = ca.Function("branch", [x, q, p], [g], io, ["g"]) if self.branch else None
-        frame = ca.Function("frame", [x, p], [self.R, self.P], ["x", "p"], ["R", "position"])
+        frame = ca.Function("frame", [x, p], ca.cse([self.R, self.P]), ["x", "p"], ["R", "position"])
         passive = None
         if self.reported:
-            passive = ca.Function("passive", [x, q, p], [ca.vertcat(*[r.value for r in self.reported])], io, ["j"])
+            j = ca.cse(ca.vertcat(*[r.value for r in self.reported]))
+            passive = ca.Function("passive", [x, q, p], [j], io, ["j"])
         home = ca.Function("home", [p], [self.x_home, ca.vertcat(*self.q_home)], ["p"], ["x", "q"])
         radius = ca.mmax(ca.vertcat(*self.platform_radius)) if self.platform_radius else ca.SX(0)
         if self.d.characteristic_length is not None:
@@ -971,7 +1042,7 @@ class Generator:
             raise InputError("missing 'reach': an expression < 0 where the pose cannot be assembled", path=("ik",))
         reach = self.scalar(ik.reach, ("ik", "reach"), env)
         return ca.Function(
-            "ik", [t, self.p], [ca.vertcat(*xs), ca.vertcat(*qs), reach], ["t", "p"], ["x", "q", "reach"]
+            "ik", [t, self.p], ca.cse([ca.vertcat(*xs), ca.vertcat(*qs), reach]), ["t", "p"], ["x", "q", "reach"]
         )
 
     # -- declared options -----------------------------------------------------------------------
