@@ -709,11 +709,11 @@ def _describe_kind(args: argparse.Namespace, out: TextIO) -> int:
         name = args.mechanism
         if _names_a_file(name):  # a mechanism file, wherever a mechanism name is taken
             from ..mechanisms.described import load_file
-            from ..mechanisms.registry import use_described
+            from ..mechanisms.registry import resolve_described
 
             check_input_file(name, allow_pipe=True)
-            with solver_output(args):
-                name = use_described(load_file(name, allow_pipe=True), ("--mechanism",)).name
+            with solver_output(args):  # described on its own model: the registry is not changed
+                name = resolve_described(load_file(name, allow_pipe=True), ("--mechanism",))
         out.write(kind_text(describe_kind(args.name, name)))
         return EXIT_OK
     descriptions = [describe_kind(args.name, m) for m in mechanism_names()]

@@ -348,7 +348,7 @@ def mechanism_type(name: Any, path: tuple = ("mechanism", "type")) -> Mechanism:
     )
 
 
-def _described_in_problem(mech: Mechanism, path: tuple) -> Mechanism:
+def resolve_described(mech: Mechanism, path: tuple) -> Mechanism:
     """The mechanism a problem file describes (a file or inline), checked against the registry
     without changing it: the built-in itself where the description is the built-in's own file
     or an unchanged copy of it; a changed copy under a built-in's name, or a description named
@@ -372,17 +372,6 @@ def _described_in_problem(mech: Mechanism, path: tuple) -> Mechanism:
                 f"the described mechanism's name {mech.name!r} is taken by a {current[1]} mechanism; rename it",
                 path=path + ("name",),
             )
-    return mech
-
-
-def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
-    """Register a mechanism read from a file (or described inline) under its name, replacing
-    an earlier description of that name; a built-in or plugin of that name is an error.
-    (``describe --mechanism FILE`` uses it; loading a problem file never registers.)"""
-    with REGISTRY._lock:
-        mech = _described_in_problem(mech, path)
-        if REGISTRY._loaded.get(mech.name) is not mech:
-            REGISTRY.register(mech, replace=True)
     return mech
 
 
@@ -436,7 +425,7 @@ def section_model(section: Mapping[str, Any], base_dir: Any = None, path: tuple 
     described_mech = _section_described(section, base_dir, path)
     if described_mech is None:
         return build_model(section["type"], section.get("parameters"), section.get("limits"))
-    mech = _described_in_problem(described_mech, path)
+    mech = resolve_described(described_mech, path)
     return _model(mech, section.get("parameters"), section.get("limits"), path)
 
 
