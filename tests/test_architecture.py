@@ -235,3 +235,52 @@ def test_the_removed_prs3_module_says_where_the_mechanism_is():
         importlib.import_module("cpm_nlp.prs3")
     with pytest.raises(ModuleNotFoundError):
         importlib.import_module("cpm_nlp.mechanisms.prs3")
+
+
+#: module globals of cpm_nlp.core that may be mutable containers, and why: process caches of
+#: compiled code and threads (never problem data), and read-only tables of a module another
+#: change is reworking (issue 22, item 2), to be wrapped read-only with it
+CORE_MUTABLE_ALLOWED = {
+    "cpm_nlp.core.batch._MAPPED": "LRU cache of mapped CasADi functions (code, not problem data)",
+    "cpm_nlp.core.batch._POOLS": "thread pools by worker count, made once per process",
+    "cpm_nlp.core.blas._STATE": "the process's BLAS thread controller, set up once",
+    "cpm_nlp.core.result.STATUS_TEXT": "read-only table; core/result.py is being reworked (item 2)",
+    "cpm_nlp.core.result.WARNING_CODES": "read-only table; core/result.py is being reworked (item 2)",
+}
+
+
+def _core_mutable_globals() -> dict[str, str]:
+    """'module.NAME' -> type of every module global of cpm_nlp.core that is a mutable
+    container (dict, list, set, bytearray, deque and their subclasses), or a read-only
+    mapping holding one; a re-exported object counts once, where it is defined first."""
+    import collections
+    import importlib
+    import pkgutil
+    from types import MappingProxyType
+
+    import cpm_nlp.core as core
+
+    mutable = (dict, list, set, bytearray, collections.deque)
+    seen: set[int] = set()
+    found: dict[str, str] = {}
+    for info in sorted(pkgutil.walk_packages(core.__path__, "cpm_nlp.core."), key=lambda i: i.name):
+        module = importlib.import_module(info.name)
+        for name, value in vars(module).items():
+            if name.startswith("__") or id(value) in seen:
+                continue
+            inner = list(value.values()) if isinstance(value, MappingProxyType) else []
+            if isinstance(value, mutable) or any(isinstance(v, mutable) for v in inner):
+                seen.add(id(value))
+                found[f"{info.name}.{name}"] = type(value).__name__
+    return found
+
+
+def test_core_holds_no_mutable_module_state():
+    """Issue 22: core's tables are read-only (MappingProxyType, tuples, frozensets), so nothing
+    at run time can change what a later problem in the same process sees; the only mutable
+    module globals are the declared process caches above."""
+    found = _core_mutable_globals()
+    unexpected = sorted(set(found) - set(CORE_MUTABLE_ALLOWED))
+    assert not unexpected, f"mutable module state in cpm_nlp.core: {unexpected}"
+    stale = sorted(set(CORE_MUTABLE_ALLOWED) - set(found))
+    assert not stale, f"no longer mutable (drop from CORE_MUTABLE_ALLOWED): {stale}"

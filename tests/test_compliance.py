@@ -15,6 +15,7 @@ import pytest
 
 import cpm_nlp as cn
 from cpm_nlp.analysis import compliance as cm
+from cpm_nlp.analysis import hinge_types as ht
 from cpm_nlp.core.errors import InputError
 from cpm_nlp.core.kinematics import forward_kinematics
 from cpm_nlp.core.solver import SolverConfig
@@ -131,7 +132,7 @@ def test_revolute_stiffness_with_the_fem_arms():
     notch stiffness (R = 8 mm, t = 2 mm, 10 mm wide, E = 72 GPa, nu = 0.33) in series
     with two 20 mm arms of the 10 x 10 mm^2 leg (bending 2 l/(E I)) gives the printed
     K_Rrev = 98.37 N*m/rad."""
-    k = cm._notch_stiffness(72e9, 72e9 / 2.66, {"t": 2e-3, "r": 8e-3, "w": 10e-3})["bend"]
+    k = cm.HINGE_TYPES["circular_notch"].stiffness(72e9, 72e9 / 2.66, {"t": 2e-3, "r": 8e-3, "w": 10e-3})["bend"]
     arms = 2 * 20e-3 / (72e9 * 10e-3 * (10e-3) ** 3 / 12)
     assert 1 / (1 / k + arms) == pytest.approx(98.37, rel=5e-3)
 
@@ -535,13 +536,14 @@ def test_hinge_stress_formulas_against_hand_values():
     """Roark Table 10.7 case 4: a square section's largest torsional shear stress is
     T/(0.208 a^3); a round neck: 32M/(pi d^3) and 16T/(pi d^3), von Mises."""
     a, T = 2e-3, 0.3
-    assert cm.rectangle_torsion_stress(T, a, a) == pytest.approx(T / (0.208 * a**3), rel=2e-3)
+    assert ht.rectangle_torsion_stress(T, a, a) == pytest.approx(T / (0.208 * a**3), rel=2e-3)
     d = {"d": 3e-3, "Kt": 1.0}
     M, Tq = 0.4, 0.1
     sigma, tau = 32 * M / (math.pi * 3e-9 * 9), 16 * Tq / (math.pi * 27e-9)
-    assert cm._rod_stress(d, {"bend": M, "torsion": Tq}) == pytest.approx(math.sqrt(sigma**2 + 3 * tau**2))
+    rod_stress = cm.HINGE_TYPES["circular_rod"].stress
+    assert rod_stress(d, {"bend": M, "torsion": Tq}) == pytest.approx(math.sqrt(sigma**2 + 3 * tau**2))
     # two bending moments combine as the resultant
-    assert cm._rod_stress(d, {"bend": 0.3, "bend2": 0.4}) == pytest.approx(32 * 0.5 / (math.pi * 27e-9))
+    assert rod_stress(d, {"bend": 0.3, "bend2": 0.4}) == pytest.approx(32 * 0.5 / (math.pi * 27e-9))
 
 
 def test_allowable_stress_rules():

@@ -382,10 +382,14 @@ def test_describe_pantograph_file_lists_bodies_joints_and_loops(cli):
 
 
 def test_describe_kind_takes_a_mechanism_file(tmp_path, cli):
+    from cpm_nlp.mechanisms.registry import mechanism_names
+
+    before = mechanism_names()
     f, _p = _vector_stage(tmp_path)
     run = cli("describe", "forward_kinematics", "--mechanism", str(f))
     assert run.code == 0, run.err
     assert "mechanism: derived_vectors" in run.out and "q1" in run.out
+    assert mechanism_names() == before  # described on its own model, not registered (issue 22, item 3)
 
 
 def test_describe_kind_with_a_bad_mechanism_file_is_exit_2(tmp_path, cli):

@@ -339,3 +339,28 @@ def test_a_problem_file_reads_only_yaml_mechanism_files_and_never_echoes_another
     problem.write_text(dump({**RPR_FILE, "mechanism": {**RPR_FILE["mechanism"], "file": "secret.yaml"}}))
     line = _refused_in_time(tmp_path, ["check", str(problem)], problem, "mechanism.file:")
     assert "first line" not in line and "got str of" in line
+
+
+def test_one_table_of_newton_options():
+    """Issue 22, item 5: the allow-list, cpm_nlp's defaults and the options the kernels'
+    fast_newton honours all come from one table; every default passes the option check, and
+    every option the kernels honour or ignore is one a file may give."""
+    from types import MappingProxyType
+
+    from cpm_nlp.core import kernels, solver, solver_options
+
+    names = [o.name for o in solver_options.NEWTON_TABLE]
+    assert len(names) == len(set(names))
+    assert list(solver_options.NEWTON_ALLOWED) == names
+    assert dict(solver.DEFAULT_OPTIONS["newton"]) == {
+        "abstol": 1e-14,
+        "max_iter": 50,
+        "error_on_fail": False,
+        "print_iteration": False,
+    }
+    assert set(kernels.NEWTON_OPTIONS) | set(kernels._IGNORED_NEWTON) <= set(names)
+    assert kernels.NEWTON_OPTIONS == ("abstol", "abstolStep", "max_iter")
+    assert isinstance(solver.DEFAULT_OPTIONS, MappingProxyType)
+    config = solver.SolverConfig("newton", dict(solver.DEFAULT_OPTIONS["newton"]))
+    assert kernels.newton_options(config) == {"abstol": 1e-14, "max_iter": 50}
+    assert kernels.batch_newton_supported(config)

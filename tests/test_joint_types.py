@@ -21,7 +21,7 @@ import pytest
 import yaml
 
 import cpm_nlp as cn
-from cpm_nlp.analysis import compliance, flexure
+from cpm_nlp.analysis import compliance, hinge_types
 from cpm_nlp.core.chains import JOINT_DOF
 from cpm_nlp.core.joints import JOINT_LETTERS, JOINT_TYPES, joint_type, joint_types
 from cpm_nlp.mechanisms import described
@@ -176,13 +176,20 @@ def test_the_generator_takes_the_planar_or_the_spatial_types(tmp_path):
 
 
 def test_hinge_names_are_the_flexure_librarys():
-    library = set(compliance.HINGE_TYPES) | set(flexure.HINGES)
+    library = set(hinge_types.HINGE_TABLE)
+    assert set(compliance.HINGE_TYPES) | set(hinge_types.LIMIT_TYPES) == library
     for name, t in JOINT_TYPES.items():
         assert set(t.hinges) <= library, name
         if t.hinges:  # the library's hinges bend and twist: a joint that carries one turns
             assert any(kind == "R" for kind, _source in t.motion), name
     used = {h for t in JOINT_TYPES.values() for h in t.hinges}
     assert used == library  # every hinge of the library can sit somewhere
+    for name, h in hinge_types.HINGE_TABLE.items():  # the table reads its places from the joint types
+        assert h.name == name and h.joints == tuple(j for j, t in JOINT_TYPES.items() if name in t.hinges)
+        assert h.stiffness is not None or h.rotation is not None, name  # it gives something
+        assert (h.stiffness is None) == (h.six_axis is None) == (h.stress is None), name
+        assert (h.source != "") == (h.stiffness is not None) and (h.limit_source != "") == (h.rotation is not None)
+        assert all(o.kind == "length" for o in h.parameters), name
 
 
 def _file_joints():

@@ -105,3 +105,26 @@ def test_rotating_a_compliance_matrix():
     R = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # frame x along the reference y
     Cr = screws.rotate_compliance(C, R)
     assert np.allclose(np.diag(Cr), [2.0, 1.0, 3.0, 5.0, 4.0, 6.0])
+
+
+@pytest.mark.parametrize(
+    ("axis", "angle"),
+    [((1.0, 0.0, 0.0), 0.3), ((0.0, 0.0, 1.0), -2.0), ((1.0, 2.0, -2.0), 1.1), ((0.3, -0.4, 0.5), 3.0)],
+)
+def test_axis_rotation_is_scipy_rotvec_in_numpy_and_casadi(axis, angle):
+    """Issue 22, item 5: the one Rodrigues rotation of the package agrees with scipy's
+    Rotation.from_rotvec (an independent implementation, quaternion-based), numerically and
+    symbolically (SX angle, SX axis)."""
+    from scipy.spatial.transform import Rotation
+
+    from cpm_nlp.core.screws import axis_rotation
+
+    k = np.asarray(axis) / np.linalg.norm(axis)
+    expected = Rotation.from_rotvec(angle * k).as_matrix()
+    assert axis_rotation(k, angle) == pytest.approx(expected, abs=1e-14)
+    th = ca.SX.sym("th")
+    w = ca.SX.sym("w", 3)
+    symbolic = ca.Function("R", [th, w], [axis_rotation(w, th)], ["th", "w"], ["R"])
+    assert isinstance(axis_rotation(w, th), ca.SX)
+    assert np.asarray(symbolic(angle, k)) == pytest.approx(expected, abs=1e-14)
+    assert isinstance(axis_rotation(ca.DM(k), th), ca.SX)

@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from cpm_nlp.analysis import compliance as cm
+from cpm_nlp.analysis import hinge_types as ht
 from cpm_nlp.analysis.hinge_chains import SixAxisModel, six_axis_model
 from cpm_nlp.core.kinematics import forward_kinematics
 from cpm_nlp.core.solver import SolverConfig
@@ -245,13 +246,13 @@ def test_filleted_neck_against_adaptive_quadrature():
 
     half = length / 2 + r
     c_bend = quad(lambda x: 1 / (E * inertia(x)), -half, half, points=[-length / 2, length / 2], limit=200)[0]
-    k = cm.SIX_AXIS_STIFFNESS["filleted_rod"](E, G, {"d": d, "l": length, "r": r})
+    k = cm.HINGE_TYPES["filleted_rod"].six_axis(E, G, {"d": d, "l": length, "r": r})
     assert k["bend"] == pytest.approx(1 / c_bend, rel=1e-8)
     assert k["torsion"] == pytest.approx(1 / (c_bend * E / (2 * G)), rel=1e-8)  # J = 2 I
     assert k["bend"] / k["torsion"] == pytest.approx(1 + nu)  # the printed K_Rsph/K_Tsph = 1.336
-    rod = cm.SIX_AXIS_STIFFNESS["circular_rod"](E, G, {"d": d, "l": length})
-    thin = cm.SIX_AXIS_STIFFNESS["filleted_rod"](E, G, {"d": d, "l": length, "r": 1e-12})
-    for axis in cm.SIX_AXES:
+    rod = cm.HINGE_TYPES["circular_rod"].six_axis(E, G, {"d": d, "l": length})
+    thin = cm.HINGE_TYPES["filleted_rod"].six_axis(E, G, {"d": d, "l": length, "r": 1e-12})
+    for axis in ht.SIX_AXES:
         assert thin[axis] == pytest.approx(rod[axis], rel=1e-6)
 
 

@@ -229,59 +229,6 @@ def leaf_spring_max_rotation(E, t, l, sigma_all):
     return 2.0 * l * sigma_all / (E * t)
 
 
-# -- hinge rotation limits from a problem file --------------------------------------------------
-#
-# A mechanism whose joint limits follow from its flexure hinges declares
-# HINGE_LIMIT_OPTIONS among its LIMITS and calls :func:`hinge_rotation` on the
-# validated limits: the hinge type, its dimensions and its material give the
-# largest rotation delta_max at the allowable stress.
-
-#: hinge type -> (largest rotation at the allowable stress, its dimensions, source)
-HINGES = {
-    "cantilever_notch": (
-        lambda E, sigma, d: cantilever_notch_rotation(E, d["l"], d["t"], sigma),
-        ("l", "t"),
-        "pantograph-3d-elgammal-2016.md eq 30-31",
-    ),
-    "circular_notch": (
-        lambda E, sigma, d: circular_notch_max_rotation(E, d["t"], d["r"], sigma),
-        ("t", "r"),
-        "pantograph-3d-elgammal-2016.md eq 38",
-    ),
-    "leaf_spring": (
-        lambda E, sigma, d: leaf_spring_max_rotation(E, d["t"], d["l"], sigma),
-        ("l", "t"),
-        "Euler-Bernoulli leaf spring under a pure moment",
-    ),
-}
-
-HINGE_LIMIT_OPTIONS = (
-    Option(
-        "hinge",
-        "choice",
-        "flexure hinge that sets the joint-angle limits (instead of giving them directly)",
-        default=None,
-        choices=tuple(HINGES),
-    ),
-    Option("l", "length", "hinge length (cantilever notch, leaf spring)", default=None, lower=0.0, strict=True),
-    Option("t", "length", "hinge thickness at its thinnest point", default=None, lower=0.0, strict=True),
-    Option("r", "length", "notch radius (circular notch)", default=None, lower=0.0, strict=True),
-    Option("material", "str", f"hinge material, one of: {', '.join(MATERIALS)}", default=None),
-    Option("E", "stress", "Young's modulus (overrides the material's)", default=None, lower=0.0, strict=True),
-    Option(
-        "sigma_all",
-        "stress",
-        "allowable stress (default: the material's allowable stress, else its yield strength)",
-        default=None,
-        lower=0.0,
-        strict=True,
-    ),
-)
-
-#: names of HINGE_LIMIT_OPTIONS (a mechanism's limits may hold others too)
-HINGE_KEYS = tuple(o.name for o in HINGE_LIMIT_OPTIONS)
-
-
 def allowable_stress(m: Material, path: tuple = ("material",)) -> float:
     """The design stress of a material: its allowable stress if a source gives
     one, else its yield strength."""
@@ -290,31 +237,6 @@ def allowable_stress(m: Material, path: tuple = ("material",)) -> float:
     if m.yield_strength is not None:
         return m.yield_strength
     raise InputError(f"material '{m.name}' has no allowable stress or yield strength; give sigma_all", path=path)
-
-
-def hinge_rotation(limits: dict, path: tuple = ("mechanism", "limits")) -> float | None:
-    """Largest hinge rotation [rad] from validated HINGE_LIMIT_OPTIONS values,
-    or None when ``limits`` names no hinge.  Raises InputError for a hinge
-    that lacks a dimension, a material (or E and sigma_all), or has keys it
-    does not use."""
-    kind = limits.get("hinge")
-    given = [k for k in HINGE_KEYS if k != "hinge" and limits.get(k) is not None]
-    if kind is None:
-        if given:
-            raise InputError(
-                f"{', '.join(given)} describe a flexure hinge; also give hinge (one of: {', '.join(HINGES)})",
-                path=path,
-            )
-        return None
-    rotation, dims, _source = HINGES[kind]
-    missing = [d for d in dims if limits.get(d) is None]
-    if missing:
-        raise InputError(f"hinge {kind} needs {', '.join(missing)} (its dimensions: {', '.join(dims)})", path=path)
-    unused = [d for d in ("l", "t", "r") if d not in dims and limits.get(d) is not None]
-    if unused:
-        raise InputError(f"hinge {kind} has no dimension {', '.join(unused)} (it takes {', '.join(dims)})", path=path)
-    E, sigma = elastic_limits(limits, path, f"hinge {kind}")
-    return float(rotation(E, sigma, {d: limits[d] for d in dims}))
 
 
 def elastic_limits(values: dict, path: tuple, what: str = "the hinge") -> tuple[float, float]:

@@ -9,7 +9,7 @@ serial chain of its joints at the reference configuration (the ``chains``
 capability, :mod:`cpm_nlp.core.chains`) and every hinge adds, at its joint and
 in its own frame (length axis t, compliant axis b1, second axis b2 = b1 x t),
 the axes its joint does not move, each with the flexure library's stiffness
-(:data:`cpm_nlp.analysis.compliance.SIX_AXIS_STIFFNESS`):
+(:data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, each type's ``six_axis``):
 
     leg k:  G_k(z) = Π_j [ Π_d exp(ξ_jd θ_jd) · Π_a exp(η_ja ε_ja) ]      (product of exponentials)
     closure: G_k(z) = T_P(x) T_P(x_ref)⁻¹  at the leg's platform point (3 rows) and in rotation (3 rows)
@@ -54,8 +54,9 @@ from ..core.chains import Chains
 from ..core.errors import InputError
 from ..core.kernels import FastFunction
 from ..core.model import Model
-from ..core.screws import skew, vee
-from .compliance import HINGE_TYPES, SIX_AXES, HingeSet, six_axis_stiffness
+from ..core.screws import axis_rotation, vee
+from .compliance import HINGE_TYPES, HingeSet, six_axis_stiffness
+from .hinge_types import SIX_AXES
 
 log = logging.getLogger(__name__)
 
@@ -63,9 +64,8 @@ _ROT_AXES = ("bend", "bend2", "torsion")
 
 
 def _rot(axis: np.ndarray, angle: Any) -> Any:
-    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues)."""
-    K = ca.DM(skew(axis))
-    return ca.DM.eye(3) + ca.sin(angle) * K + (1 - ca.cos(angle)) * (K @ K)
+    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues: :func:`~cpm_nlp.core.screws.axis_rotation`)."""
+    return axis_rotation(ca.DM(np.asarray(axis, dtype=float).reshape(3, 1)), angle)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

@@ -258,7 +258,8 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     if args.json:
         out.write(result.to_json() + "\n")
     elif not args.quiet:
-        title = mechanism_type(problem.model.name).title
+        mech = problem.model.mechanism  # a problem's own mechanism file is not registered
+        title = (mech if mech is not None else mechanism_type(problem.model.name)).title
         out.write(render_result(result, title) + "\n")
     if args.output:
         write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])
@@ -708,11 +709,11 @@ def _describe_kind(args: argparse.Namespace, out: TextIO) -> int:
         name = args.mechanism
         if _names_a_file(name):  # a mechanism file, wherever a mechanism name is taken
             from ..mechanisms.described import load_file
-            from ..mechanisms.registry import use_described
+            from ..mechanisms.registry import resolve_described
 
             check_input_file(name, allow_pipe=True)
-            with solver_output(args):
-                name = use_described(load_file(name, allow_pipe=True), ("--mechanism",)).name
+            with solver_output(args):  # described on its own model: the registry is not changed
+                name = resolve_described(load_file(name, allow_pipe=True), ("--mechanism",))
         out.write(kind_text(describe_kind(args.name, name)))
         return EXIT_OK
     descriptions = [describe_kind(args.name, m) for m in mechanism_names()]

@@ -19,6 +19,7 @@ degrees of freedom (P, R: 1; C, U: 2; S: 3).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -27,7 +28,7 @@ from .joints import JOINT_TYPES
 
 #: degrees of freedom of each joint type the chains take: the spatial joints with
 #: coordinates (the joint table's P, R, C, U, S)
-JOINT_DOF = {n: t.dof for n, t in JOINT_TYPES.items() if t.spatial and t.dof}
+JOINT_DOF = MappingProxyType({n: t.dof for n, t in JOINT_TYPES.items() if t.spatial and t.dof})
 
 
 @dataclass(frozen=True)

@@ -12,14 +12,14 @@ entry k of its ``axes`` list (``k``; an S without ``axes`` turns about the base
 frame's x, y, z).
 
 The flexure hinges that can sit at a joint are given by name (the hinge types
-of :data:`cpm_nlp.analysis.compliance.HINGE_TYPES` and of
-:data:`cpm_nlp.analysis.flexure.HINGES`): where the project's mechanisms put
-them, and by a hinge's geometry where none does.
+of :data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, which reads this table for
+where each may sit): where the project's mechanisms put them, and by a hinge's
+geometry where none does.
 
 * As a revolute: a circular notch (prs3-ruiz.md section 5; the pantograph,
   pantograph-3d-elgammal-2016.md eq 38; the five-bar's and 3-RRR's elbows in
   problems/), a corner-filleted (cantilever) notch (pantograph eq 30-31), a
-  leaf spring (offered for the pantograph's joints by flexure.HINGES; it bends
+  leaf spring (offered for the pantograph's joints as a rotation limit; it bends
   about one axis).
 * As a U: a circular notch on each axis (rpr-2rpu-upr-zhang-2022.md Table 1 as
   problems/mechanisms/rpr.yaml reads it); a round neck (circular or filleted rod), which bends
@@ -31,7 +31,9 @@ them, and by a hinge's geometry where none does.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 from .errors import InputError, suggest
 
@@ -89,81 +91,83 @@ class JointType:
 _REVOLUTE_HINGES = ("circular_notch", "cantilever_notch", "leaf_spring")
 
 #: the joint types, in the order the reader lists them
-JOINT_TYPES: dict[str, JointType] = {
-    t.name: t
-    for t in (
-        JointType("P", "prismatic (spatial)", "P", (("P", "axis"),), axis="given", actuable=True, twin="planar_P"),
-        JointType(
-            "R",
-            "revolute (spatial)",
-            "R",
-            (("R", "axis"),),
-            axis="given",
-            actuable=True,
-            twin="planar_R",
-            hinges=_REVOLUTE_HINGES,
-        ),
-        JointType(
-            "C",
-            "cylindrical: a revolute and a prismatic on one axis",
-            "C",
-            (("R", "axis"), ("P", "axis")),
-            axis="given",
-        ),
-        JointType(
-            "U",
-            "universal: two revolutes, axes[0] on the proximal body, axes[1] on the distal one",
-            "U",
-            (("R", 0), ("R", 1)),
-            n_axes=2,
-            sphere=True,
-            hinges=("circular_notch", "circular_rod", "filleted_rod"),
-        ),
-        JointType(
-            "S",
-            "spherical",
-            "S",
-            (("R", 0), ("R", 1), ("R", 2)),
-            n_axes=3,
-            default_axes=("x", "y", "z"),
-            point=True,
-            sphere=True,
-            hinges=("circular_rod", "filleted_rod"),
-        ),
-        JointType(
-            "planar_R",
-            "revolute of a planar mechanism (axis z)",
-            "R",
-            (("R", "axis"),),
-            axis="z",
-            planar=True,
-            spatial=False,
-            actuable=True,
-            point=True,
-            sphere=True,
-            twin="R",
-            hinges=_REVOLUTE_HINGES,
-        ),
-        JointType(
-            "planar_P",
-            "prismatic of a planar mechanism (axis in the plane)",
-            "P",
-            (("P", "axis"),),
-            axis="given",
-            planar=True,
-            spatial=False,
-            actuable=True,
-            twin="P",
-        ),
-        JointType(
-            "distance",
-            "rigid distance between two points (an S-S strut or a parallelogram's link)",
-            "S",
-            (),
-            planar=True,
-        ),
-    )
-}
+JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
+    {
+        t.name: t
+        for t in (
+            JointType("P", "prismatic (spatial)", "P", (("P", "axis"),), axis="given", actuable=True, twin="planar_P"),
+            JointType(
+                "R",
+                "revolute (spatial)",
+                "R",
+                (("R", "axis"),),
+                axis="given",
+                actuable=True,
+                twin="planar_R",
+                hinges=_REVOLUTE_HINGES,
+            ),
+            JointType(
+                "C",
+                "cylindrical: a revolute and a prismatic on one axis",
+                "C",
+                (("R", "axis"), ("P", "axis")),
+                axis="given",
+            ),
+            JointType(
+                "U",
+                "universal: two revolutes, axes[0] on the proximal body, axes[1] on the distal one",
+                "U",
+                (("R", 0), ("R", 1)),
+                n_axes=2,
+                sphere=True,
+                hinges=("circular_notch", "circular_rod", "filleted_rod"),
+            ),
+            JointType(
+                "S",
+                "spherical",
+                "S",
+                (("R", 0), ("R", 1), ("R", 2)),
+                n_axes=3,
+                default_axes=("x", "y", "z"),
+                point=True,
+                sphere=True,
+                hinges=("circular_rod", "filleted_rod"),
+            ),
+            JointType(
+                "planar_R",
+                "revolute of a planar mechanism (axis z)",
+                "R",
+                (("R", "axis"),),
+                axis="z",
+                planar=True,
+                spatial=False,
+                actuable=True,
+                point=True,
+                sphere=True,
+                twin="R",
+                hinges=_REVOLUTE_HINGES,
+            ),
+            JointType(
+                "planar_P",
+                "prismatic of a planar mechanism (axis in the plane)",
+                "P",
+                (("P", "axis"),),
+                axis="given",
+                planar=True,
+                spatial=False,
+                actuable=True,
+                twin="P",
+            ),
+            JointType(
+                "distance",
+                "rigid distance between two points (an S-S strut or a parallelogram's link)",
+                "S",
+                (),
+                planar=True,
+            ),
+        )
+    }
+)
 
 #: the letters a drawing marks joints with
 JOINT_LETTERS = tuple(dict.fromkeys(t.letter for t in JOINT_TYPES.values()))

@@ -52,6 +52,7 @@ from .errors import InputError
 from .model import Coordinate, LoopClosure, Model
 from .result import Status
 from .solver import DEFAULT_OPTIONS, SolverConfig
+from .solver_options import NEWTON_BATCH, NEWTON_BATCH_IGNORED
 
 #: FK/IK round trips must agree to this multiple of the residual tolerance.
 ROUND_TRIP_FACTOR = 100.0
@@ -59,10 +60,11 @@ ROUND_TRIP_FACTOR = 100.0
 SINGULAR_CONDITION = 1e10
 #: status code = position in this tuple (exported code reports codes)
 STATUSES: tuple[Status, ...] = tuple(Status)
-#: Newton options the kernels' rootfinder (CasADi ``fast_newton``) accepts
-NEWTON_OPTIONS = ("abstol", "abstolStep", "max_iter")
+#: Newton options the kernels' rootfinder (CasADi ``fast_newton``) accepts (from the one table,
+#: :data:`cpm_nlp.core.solver_options.NEWTON_TABLE`)
+NEWTON_OPTIONS = NEWTON_BATCH
 #: options of CasADi's ``newton`` plugin that have no meaning here (fast_newton never raises or prints)
-_IGNORED_NEWTON = ("error_on_fail", "print_iteration")
+_IGNORED_NEWTON = NEWTON_BATCH_IGNORED
 
 #: check outputs of every kernel (besides the pose itself and the status)
 CHECKS = ("residual", "branch_margin", "round_trip_error", "cond1", "limit_margin")

@@ -83,6 +83,21 @@ def skew(a: Any) -> Any:
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
+def axis_rotation(axis: Any, angle: Any) -> Any:
+    """The rotation by ``angle`` about the unit ``axis`` k (Rodrigues' formula),
+    R = cos θ I + sin θ [k]× + (1 - cos θ) k kᵀ (= I + sin θ [k]× + (1 - cos θ) [k]×² for a
+    unit k): a CasADi matrix if the axis or the angle is CasADi (SX in, SX out), else a numpy
+    array.  The k kᵀ form lets the zero entries of an axis along a base axis drop out of a
+    symbolic R (the elementary rotation itself: cos, ±sin, 1).  The one rotation of the
+    package: the file mechanisms' joints, the hinge chains and the URDF importer use it."""
+    if _symbolic(axis, angle):
+        k = axis if isinstance(axis, (ca.SX, ca.MX)) else _ca(axis)
+        c, s = ca.cos(angle), ca.sin(angle)
+        return c * ca.DM.eye(3) + s * ca.skew(k) + (1 - c) * (k @ k.T)
+    k = np.asarray(axis, dtype=float).ravel()
+    return np.cos(angle) * np.eye(3) + np.sin(angle) * skew(k) + (1.0 - np.cos(angle)) * np.outer(k, k)
+
+
 def vee(M: Any) -> Any:
     """The axial vector of a 3 x 3 matrix's skew part, (M - Mᵀ)/2 = [v]× (the inverse of
     :func:`skew`; for a rotation by a small angle about w: the angle times w)."""

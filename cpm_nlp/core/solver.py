@@ -17,34 +17,34 @@ import threading
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 import casadi as ca
 import numpy as np
 
 from .errors import InputError, suggest
-from .solver_options import check_options, ipopt_rules
+from .solver_options import NEWTON_DEFAULTS, check_options, ipopt_rules
 
 log = logging.getLogger(__name__)
 
 METHODS = ("ipopt", "newton")
 
 #: Quiet, tight defaults.  Residuals of the shipped models are lengths in m.
-DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
-    "ipopt": {
-        "ipopt.print_level": 0,
-        "ipopt.sb": "yes",
-        "print_time": False,
-        "ipopt.tol": 1e-12,
-        "ipopt.max_iter": 200,
-    },
-    "newton": {
-        "abstol": 1e-14,
-        "max_iter": 50,
-        "error_on_fail": False,
-        "print_iteration": False,
-    },
-}
+DEFAULT_OPTIONS: Mapping[str, Mapping[str, Any]] = MappingProxyType(
+    {
+        "ipopt": MappingProxyType(
+            {
+                "ipopt.print_level": 0,
+                "ipopt.sb": "yes",
+                "print_time": False,
+                "ipopt.tol": 1e-12,
+                "ipopt.max_iter": 200,
+            }
+        ),
+        "newton": NEWTON_DEFAULTS,  # the Newton options' table (solver_options.NEWTON_TABLE)
+    }
+)
 
 
 def run_nlp(solver: ca.Function, what: str, **args: Any) -> tuple[np.ndarray, bool, str, int]:

@@ -49,6 +49,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 from .errors import InputError, suggest
@@ -84,107 +85,146 @@ _MANUAL = (
 )
 
 #: IPOPT options refused, and why: (reason, what to do instead[, what the refusal adds; default DATA_ONLY])
-IPOPT_REFUSED: dict[str, tuple[str, ...]] = {
-    "output_file": (
-        "makes IPOPT write its log into the file it names, replacing that file (the problem file itself included)",
-        "remove it; ipopt.print_level (or the preset ipopt_verbose) prints the log on the terminal",
-    ),
-    "file_print_level": ("sets the detail of ipopt.output_file, a file IPOPT writes", "remove it"),
-    "file_append": ("makes IPOPT append to ipopt.output_file, a file it writes", "remove it"),
-    "option_file_name": (
-        "makes IPOPT read the file it names (and echo its lines)",
-        "write the options under solver.options instead",
-    ),
-    "hsllib": ("names a shared library that IPOPT loads and runs (HSL)", _HSL),
-    "pardisolib": ("names a shared library that IPOPT loads and runs (Pardiso)", _HSL),
-    "print_options_documentation": _MANUAL,
-    "print_options_mode": _MANUAL,
-    "print_advanced_options": _MANUAL,
-    "skip_finalize_solution_call": ("keeps IPOPT from handing its solution back to CasADi", "remove it", NOT_HERE),
-}
+IPOPT_REFUSED: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        "output_file": (
+            "makes IPOPT write its log into the file it names, replacing that file (the problem file itself included)",
+            "remove it; ipopt.print_level (or the preset ipopt_verbose) prints the log on the terminal",
+        ),
+        "file_print_level": ("sets the detail of ipopt.output_file, a file IPOPT writes", "remove it"),
+        "file_append": ("makes IPOPT append to ipopt.output_file, a file it writes", "remove it"),
+        "option_file_name": (
+            "makes IPOPT read the file it names (and echo its lines)",
+            "write the options under solver.options instead",
+        ),
+        "hsllib": ("names a shared library that IPOPT loads and runs (HSL)", _HSL),
+        "pardisolib": ("names a shared library that IPOPT loads and runs (Pardiso)", _HSL),
+        "print_options_documentation": _MANUAL,
+        "print_options_mode": _MANUAL,
+        "print_advanced_options": _MANUAL,
+        "skip_finalize_solution_call": ("keeps IPOPT from handing its solution back to CasADi", "remove it", NOT_HERE),
+    }
+)
 
 #: IPOPT sections refused as a whole (besides those of linear solvers loaded from a library)
-IPOPT_REFUSED_SECTIONS: dict[str, tuple[str, ...]] = {
-    "Derivative Checker": (
-        "is IPOPT's finite-difference derivative checker, a development aid for hand-written derivatives "
-        "(CasADi's are exact) that prints pages of output",
-        "remove it",
-    ),
-}
+IPOPT_REFUSED_SECTIONS: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        "Derivative Checker": (
+            "is IPOPT's finite-difference derivative checker, a development aid for hand-written derivatives "
+            "(CasADi's are exact) that prints pages of output",
+            "remove it",
+        ),
+    }
+)
 
 #: IPOPT options IPOPT does not document but takes (CasADi's defaults use them)
 IPOPT_HIDDEN: tuple[Option, ...] = (Option("sb", "choice", "suppress the IPOPT banner", None, choices=("yes", "no")),)
 
 #: CasADi options of nlpsol (method ipopt) a file may set
-NLPSOL_ALLOWED: dict[str, str] = {
-    "print_time": "bool",
-    "record_time": "bool",
-    "verbose": "bool",
-    "verbose_init": "bool",
-    "error_on_fail": "bool",
-    "regularity_check": "bool",
-    "show_eval_warnings": "bool",
-    "warn_initial_bounds": "bool",
-    "eval_errors_fatal": "bool",
-    "inputs_check": "bool",
-    "bound_consistency": "bool",
-    "expand": "bool",
-}
+NLPSOL_ALLOWED: Mapping[str, str] = MappingProxyType(
+    {
+        "print_time": "bool",
+        "record_time": "bool",
+        "verbose": "bool",
+        "verbose_init": "bool",
+        "error_on_fail": "bool",
+        "regularity_check": "bool",
+        "show_eval_warnings": "bool",
+        "warn_initial_bounds": "bool",
+        "eval_errors_fatal": "bool",
+        "inputs_check": "bool",
+        "bound_consistency": "bool",
+        "expand": "bool",
+    }
+)
 
-#: CasADi options of the Newton rootfinder (method newton) a file may set
-NEWTON_ALLOWED: dict[str, str] = {
-    "abstol": "real",
-    "abstolStep": "real0",  # 0: no test on the step, iterate to abstol
-    "max_iter": "int",
-    "line_search": "bool",
-    "print_iteration": "bool",
-    "error_on_fail": "bool",
-    "print_time": "bool",
-    "record_time": "bool",
-    "verbose": "bool",
-}
+
+@dataclass(frozen=True)
+class NewtonOption:
+    """One CasADi option of the Newton rootfinder (method ``newton``) a file may set.
+
+    kind: "real" (> 0), "real0" (>= 0), "int" or "bool";
+    default: the value cpm_nlp sets when the file gives none (None: CasADi's own);
+    batch: how the kernels' ``fast_newton`` (batch and exported solvers) treats it:
+        "honoured", "ignored" (no meaning there: it never raises or prints) or
+        "refused" (a file giving it cannot be solved by the kernels).
+    """
+
+    name: str
+    kind: str
+    default: Any = None
+    batch: str = "refused"
+
+
+#: the Newton options: one table, read by the option check (:data:`NEWTON_ALLOWED`), the
+#: defaults (:data:`cpm_nlp.core.solver.DEFAULT_OPTIONS`) and the kernels
+#: (:data:`cpm_nlp.core.kernels.NEWTON_OPTIONS`)
+NEWTON_TABLE: tuple[NewtonOption, ...] = (
+    NewtonOption("abstol", "real", 1e-14, "honoured"),
+    NewtonOption("abstolStep", "real0", None, "honoured"),  # 0: no test on the step, iterate to abstol
+    NewtonOption("max_iter", "int", 50, "honoured"),
+    NewtonOption("line_search", "bool"),
+    NewtonOption("error_on_fail", "bool", False, "ignored"),
+    NewtonOption("print_iteration", "bool", False, "ignored"),
+    NewtonOption("print_time", "bool"),
+    NewtonOption("record_time", "bool"),
+    NewtonOption("verbose", "bool"),
+)
+
+#: CasADi options of the Newton rootfinder (method newton) a file may set: name -> kind
+NEWTON_ALLOWED: Mapping[str, str] = MappingProxyType({o.name: o.kind for o in NEWTON_TABLE})
+#: cpm_nlp's defaults of the Newton rootfinder
+NEWTON_DEFAULTS: Mapping[str, Any] = MappingProxyType(
+    {o.name: o.default for o in NEWTON_TABLE if o.default is not None}
+)
+#: the Newton options the kernels' rootfinder (CasADi ``fast_newton``) honours
+NEWTON_BATCH = tuple(o.name for o in NEWTON_TABLE if o.batch == "honoured")
+#: the Newton options without meaning for ``fast_newton`` (it never raises or prints)
+NEWTON_BATCH_IGNORED = tuple(o.name for o in NEWTON_TABLE if o.batch == "ignored")
 
 #: CasADi options refused, and why: (reason, what to do instead[, what the refusal adds; default DATA_ONLY])
-CASADI_REFUSED: dict[str, tuple[str, ...]] = {
-    **dict.fromkeys(
-        ("jit", "compiler", "jit_options", "jit_name", "jit_temp_suffix", "jit_cleanup", "jit_serialize"), _JIT
-    ),
-    "codegen_options": _JIT,
-    **dict.fromkeys(("dump", "dump_in", "dump_out", "dump_dir", "dump_format"), _DUMP),
-    "external_transform": ("loads a shared library and runs it on the solver's functions", "remove it"),
-    "monitor": ("prints the inner evaluations of the solver (a debugging aid)", "remove it", NOT_HERE),
-    **dict.fromkeys(
-        (
-            "cache",
-            "custom_jacobian",
-            "derivative_of",
-            "grad_f",
-            "hess_lag",
-            "jac_g",
-            "iteration_callback",
-            "jacobian_function",
-            "user_data",
-            "detect_simple_bounds_parts",
+CASADI_REFUSED: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        **dict.fromkeys(
+            ("jit", "compiler", "jit_options", "jit_name", "jit_temp_suffix", "jit_cleanup", "jit_serialize"), _JIT
         ),
-        _FUNCTION,
-    ),
-    **dict.fromkeys(
-        (
-            "common_options",
-            "specific_options",
-            "oracle_options",
-            "der_options",
-            "forward_options",
-            "reverse_options",
-            "jacobian_options",
-            "fd_options",
-            "post_expand_options",
-            "sens_linsol_options",
-            "linear_solver_options",
+        "codegen_options": _JIT,
+        **dict.fromkeys(("dump", "dump_in", "dump_out", "dump_dir", "dump_format"), _DUMP),
+        "external_transform": ("loads a shared library and runs it on the solver's functions", "remove it"),
+        "monitor": ("prints the inner evaluations of the solver (a debugging aid)", "remove it", NOT_HERE),
+        **dict.fromkeys(
+            (
+                "cache",
+                "custom_jacobian",
+                "derivative_of",
+                "grad_f",
+                "hess_lag",
+                "jac_g",
+                "iteration_callback",
+                "jacobian_function",
+                "user_data",
+                "detect_simple_bounds_parts",
+            ),
+            _FUNCTION,
         ),
-        _NESTED,
-    ),
-}
+        **dict.fromkeys(
+            (
+                "common_options",
+                "specific_options",
+                "oracle_options",
+                "der_options",
+                "forward_options",
+                "reverse_options",
+                "jacobian_options",
+                "fd_options",
+                "post_expand_options",
+                "sens_linsol_options",
+                "linear_solver_options",
+            ),
+            _NESTED,
+        ),
+    }
+)
 
 
 @dataclass(frozen=True)

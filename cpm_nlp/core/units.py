@@ -16,7 +16,9 @@ from __future__ import annotations
 import math
 import re
 import threading
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 from .errors import InputError, suggest
@@ -45,88 +47,92 @@ class Dimension:
     limit: float = math.inf
 
 
-DIMENSIONS: dict[str, Dimension] = {
-    d.name: d
-    for d in (
-        Dimension("length", "m", "mm", "47.91 mm", ("m", "mm", "um", "µm", "nm", "cm"), 1e3),
-        Dimension(
-            "angle", "rad", "deg", "0.2 deg", ("rad", "deg", "mrad", "urad", "arcmin", "arcsec"), 4 * math.pi
-        ),  # two turns: crank angles of a 3-RRR reach 380 deg
-        Dimension("stress", "Pa", "MPa", "400 MPa", ("Pa", "kPa", "MPa", "GPa"), 1e13),
-        Dimension("force", "N", "N", "20 N", ("N", "mN", "kN"), 1e7),
-        Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg"), 1e4),
-        Dimension("area", "m^2", "mm^2", "12 mm^2", ("m^2", "mm^2", "cm^2", "um^2"), 1e6),
-        Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3"), 1e3),
-        # sizes of boxes of task coordinates with angles among them (size_dimension)
-        Dimension("length_angle", "m*rad", "mm*deg", "2 mm*deg", ("m*rad", "mm*deg"), 1e4),
-        Dimension("area_angle", "m^2*rad", "mm^2*deg", "12 mm^2*deg", ("m^2*rad", "mm^2*deg"), 1e7),
-        Dimension("length_angle2", "m*rad^2", "mm*deg^2", "2 mm*deg^2", ("m*rad^2", "mm*deg^2"), 1e5),
-        Dimension("density", "kg/m^3", "kg/m^3", "2810 kg/m^3", ("kg/m^3", "g/cm^3"), 1e5),
-        Dimension("time", "s", "s", "5 ms", ("s", "ms", "us"), 1e7),
-        Dimension("frequency", "Hz", "Hz", "93.8 Hz", ("Hz", "kHz"), 1e12),
-        Dimension("stiffness", "N/m", "N/um", "2 N/um", ("N/m", "N/mm", "N/um"), 1e12),
-        Dimension("rotational_stiffness", "N*m/rad", "N*m/rad", "98.37 N*m/rad", ("N*m/rad", "N*mm/rad"), 1e9),
-        Dimension("moment", "N*m", "N*m", "0.1 N*m", ("N*m", "N*mm"), 1e7),
-        Dimension("inertia", "kg*m^2", "kg*m^2", "1e-4 kg*m^2", ("kg*m^2", "g*mm^2"), 1e6),
-        Dimension("compliance", "m/N", "um/N", "15 um/N", ("m/N", "um/N"), 1e6),
-        Dimension("rotational_compliance", "rad/(N*m)", "rad/(N*m)", "0.01 rad/(N*m)", ("rad/(N*m)",), 1e9),
-        Dimension("energy", "J", "J", "1 mJ", ("J", "mJ"), 1e9),
-        Dimension("acceleration", "m/s^2", "m/s^2", "9.81 m/s^2", ("m/s^2", "mm/s^2"), 1e6),
-        Dimension("dimensionless", "", "", "0.5", ("", "%"), 1e15),
-    )
-}
+DIMENSIONS: Mapping[str, Dimension] = MappingProxyType(
+    {
+        d.name: d
+        for d in (
+            Dimension("length", "m", "mm", "47.91 mm", ("m", "mm", "um", "µm", "nm", "cm"), 1e3),
+            Dimension(
+                "angle", "rad", "deg", "0.2 deg", ("rad", "deg", "mrad", "urad", "arcmin", "arcsec"), 4 * math.pi
+            ),  # two turns: crank angles of a 3-RRR reach 380 deg
+            Dimension("stress", "Pa", "MPa", "400 MPa", ("Pa", "kPa", "MPa", "GPa"), 1e13),
+            Dimension("force", "N", "N", "20 N", ("N", "mN", "kN"), 1e7),
+            Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg"), 1e4),
+            Dimension("area", "m^2", "mm^2", "12 mm^2", ("m^2", "mm^2", "cm^2", "um^2"), 1e6),
+            Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3"), 1e3),
+            # sizes of boxes of task coordinates with angles among them (size_dimension)
+            Dimension("length_angle", "m*rad", "mm*deg", "2 mm*deg", ("m*rad", "mm*deg"), 1e4),
+            Dimension("area_angle", "m^2*rad", "mm^2*deg", "12 mm^2*deg", ("m^2*rad", "mm^2*deg"), 1e7),
+            Dimension("length_angle2", "m*rad^2", "mm*deg^2", "2 mm*deg^2", ("m*rad^2", "mm*deg^2"), 1e5),
+            Dimension("density", "kg/m^3", "kg/m^3", "2810 kg/m^3", ("kg/m^3", "g/cm^3"), 1e5),
+            Dimension("time", "s", "s", "5 ms", ("s", "ms", "us"), 1e7),
+            Dimension("frequency", "Hz", "Hz", "93.8 Hz", ("Hz", "kHz"), 1e12),
+            Dimension("stiffness", "N/m", "N/um", "2 N/um", ("N/m", "N/mm", "N/um"), 1e12),
+            Dimension("rotational_stiffness", "N*m/rad", "N*m/rad", "98.37 N*m/rad", ("N*m/rad", "N*mm/rad"), 1e9),
+            Dimension("moment", "N*m", "N*m", "0.1 N*m", ("N*m", "N*mm"), 1e7),
+            Dimension("inertia", "kg*m^2", "kg*m^2", "1e-4 kg*m^2", ("kg*m^2", "g*mm^2"), 1e6),
+            Dimension("compliance", "m/N", "um/N", "15 um/N", ("m/N", "um/N"), 1e6),
+            Dimension("rotational_compliance", "rad/(N*m)", "rad/(N*m)", "0.01 rad/(N*m)", ("rad/(N*m)",), 1e9),
+            Dimension("energy", "J", "J", "1 mJ", ("J", "mJ"), 1e9),
+            Dimension("acceleration", "m/s^2", "m/s^2", "9.81 m/s^2", ("m/s^2", "mm/s^2"), 1e6),
+            Dimension("dimensionless", "", "", "0.5", ("", "%"), 1e15),
+        )
+    }
+)
 
 
 #: unit text -> (factor to pint's root units, dimension), for the units of DIMENSIONS: the
 #: floats pint gives (Quantity(1.0, unit).to_root_units().magnitude; tests/test_units.py
 #: checks each against pint)
-FAST_UNITS: dict[str, tuple[float, str]] = {
-    "m": (1.0, "length"),
-    "mm": (0.001, "length"),
-    "um": (1e-06, "length"),
-    "µm": (1e-06, "length"),
-    "nm": (1e-09, "length"),
-    "cm": (0.01, "length"),
-    "rad": (1.0, "angle"),
-    "deg": (0.017453292519943295, "angle"),
-    "mrad": (0.001, "angle"),
-    "urad": (1e-06, "angle"),
-    "arcmin": (0.00029088820866572163, "angle"),
-    "arcsec": (4.84813681109536e-06, "angle"),
-    "Pa": (1000.0, "stress"),
-    "kPa": (1000000.0, "stress"),
-    "MPa": (1000000000.0, "stress"),
-    "GPa": (1000000000000.0, "stress"),
-    "N": (1000.0, "force"),
-    "mN": (1.0, "force"),
-    "kN": (1000000.0, "force"),
-    "kg": (1000.0, "mass"),
-    "g": (1.0, "mass"),
-    "mg": (0.001, "mass"),
-    "m^2": (1.0, "area"),
-    "mm^2": (1e-06, "area"),
-    "cm^2": (0.0001, "area"),
-    "um^2": (1e-12, "area"),
-    "m^3": (1.0, "volume"),
-    "mm^3": (1e-09, "volume"),
-    "cm^3": (1.0000000000000002e-06, "volume"),
-    "um^3": (9.999999999999999e-19, "volume"),
-    "kg/m^3": (1000.0, "density"),
-    "g/cm^3": (999999.9999999999, "density"),
-    "s": (1.0, "time"),
-    "ms": (0.001, "time"),
-    "us": (1e-06, "time"),
-    "Hz": (1.0, "frequency"),
-    "kHz": (1000.0, "frequency"),
-    "N/m": (1000.0, "stiffness"),
-    "N/mm": (1000000.0, "stiffness"),
-    "N/um": (1000000000.0, "stiffness"),
-    "N*m/rad": (1000.0, "rotational_stiffness"),
-    "N*mm/rad": (1.0, "rotational_stiffness"),
-    "m/s^2": (1.0, "acceleration"),
-    "mm/s^2": (0.001, "acceleration"),
-    "%": (0.01, "dimensionless"),
-}
+FAST_UNITS: Mapping[str, tuple[float, str]] = MappingProxyType(
+    {
+        "m": (1.0, "length"),
+        "mm": (0.001, "length"),
+        "um": (1e-06, "length"),
+        "µm": (1e-06, "length"),
+        "nm": (1e-09, "length"),
+        "cm": (0.01, "length"),
+        "rad": (1.0, "angle"),
+        "deg": (0.017453292519943295, "angle"),
+        "mrad": (0.001, "angle"),
+        "urad": (1e-06, "angle"),
+        "arcmin": (0.00029088820866572163, "angle"),
+        "arcsec": (4.84813681109536e-06, "angle"),
+        "Pa": (1000.0, "stress"),
+        "kPa": (1000000.0, "stress"),
+        "MPa": (1000000000.0, "stress"),
+        "GPa": (1000000000000.0, "stress"),
+        "N": (1000.0, "force"),
+        "mN": (1.0, "force"),
+        "kN": (1000000.0, "force"),
+        "kg": (1000.0, "mass"),
+        "g": (1.0, "mass"),
+        "mg": (0.001, "mass"),
+        "m^2": (1.0, "area"),
+        "mm^2": (1e-06, "area"),
+        "cm^2": (0.0001, "area"),
+        "um^2": (1e-12, "area"),
+        "m^3": (1.0, "volume"),
+        "mm^3": (1e-09, "volume"),
+        "cm^3": (1.0000000000000002e-06, "volume"),
+        "um^3": (9.999999999999999e-19, "volume"),
+        "kg/m^3": (1000.0, "density"),
+        "g/cm^3": (999999.9999999999, "density"),
+        "s": (1.0, "time"),
+        "ms": (0.001, "time"),
+        "us": (1e-06, "time"),
+        "Hz": (1.0, "frequency"),
+        "kHz": (1000.0, "frequency"),
+        "N/m": (1000.0, "stiffness"),
+        "N/mm": (1000000.0, "stiffness"),
+        "N/um": (1000000000.0, "stiffness"),
+        "N*m/rad": (1000.0, "rotational_stiffness"),
+        "N*mm/rad": (1.0, "rotational_stiffness"),
+        "m/s^2": (1.0, "acceleration"),
+        "mm/s^2": (0.001, "acceleration"),
+        "%": (0.01, "dimensionless"),
+    }
+)
 
 
 def fast_dimension(value: Any) -> str | None:
@@ -261,17 +267,19 @@ def to_display(value: float, dimension: str) -> tuple[float, str]:
 
 #: the size of a box of task coordinates by its numbers of lengths and angles
 #: (a length, an area or a volume by the number of translational coordinates)
-SIZE_DIMENSIONS: dict[tuple[int, int], str] = {
-    (1, 0): "length",
-    (2, 0): "area",
-    (3, 0): "volume",
-    (0, 1): "angle",
-    (1, 1): "length_angle",
-    (2, 1): "area_angle",
-    (1, 2): "length_angle2",
-}
+SIZE_DIMENSIONS: Mapping[tuple[int, int], str] = MappingProxyType(
+    {
+        (1, 0): "length",
+        (2, 0): "area",
+        (3, 0): "volume",
+        (0, 1): "angle",
+        (1, 1): "length_angle",
+        (2, 1): "area_angle",
+        (1, 2): "length_angle2",
+    }
+)
 #: (powers of length, of angle) of the sizes whose printed unit takes an SI prefix
-_SIZE_POWERS = {d: k for k, d in SIZE_DIMENSIONS.items() if k[0] > 1 or (k[0] and k[1])}
+_SIZE_POWERS = MappingProxyType({d: k for k, d in SIZE_DIMENSIONS.items() if k[0] > 1 or (k[0] and k[1])})
 _PREFIXES = (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9))
 
 

@@ -53,6 +53,7 @@ import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError, suggest, unknown_key_error
+from ..core.screws import axis_rotation
 from .inputs import MAX_INPUT_BYTES, display_name, read_input_text
 from .yamlfile import read_yaml
 
@@ -464,10 +465,8 @@ _DOF = {"R": 1, "P": 1, "S": 3, "U": 2, "fixed": 0}
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
-    """Rodrigues: the rotation by ``angle`` about the unit ``axis``."""
-    k = ca.SX(3, 3)
-    k[0, 1], k[0, 2], k[1, 0], k[1, 2], k[2, 0], k[2, 1] = -axis[2], axis[1], axis[2], -axis[0], -axis[1], axis[0]
-    return ca.SX.eye(3) + ca.sin(angle) * k + (1 - ca.cos(angle)) * (k @ k)
+    """Rodrigues: the rotation by ``angle`` about the unit ``axis`` (:func:`~cpm_nlp.core.screws.axis_rotation`)."""
+    return ca.SX(axis_rotation(ca.SX(ca.DM(np.asarray(axis, dtype=float).reshape(3, 1))), angle))
 
 
 def _motion(j: _Joint, v: ca.SX) -> ca.SX:

@@ -198,28 +198,55 @@ class _Registry:
                 return self.get(ALIASES[name])
             return None
 
+    def holds(self, mech: Mechanism) -> bool:
+        """Whether ``mech`` is the very declaration registered under its name."""
+        with self._lock:
+            return self._loaded.get(mech.name) is mech
+
     def closure(self, mech: Mechanism) -> LoopClosure:
         with self._lock:
             c = self._closures.get(mech.name)
             # by name, for this very mechanism: two described mechanisms of one name (a file
             # and an edited copy of it, loaded in turn) never share a closure
             if c is None or c.mechanism is not mech:
-                try:
-                    c = mech.closure()
-                except CpmError:
-                    raise
-                except Exception as exc:
-                    raise PluginError(
-                        f"mechanism {mech.name!r} ({mech.origin}): building its closure failed: {exc}"
-                    ) from exc
-                if not isinstance(c, LoopClosure):
-                    raise PluginError(
-                        f"mechanism {mech.name!r} ({mech.origin}): closure() must return a LoopClosure, "
-                        f"got {type(c).__name__}"
-                    )
-                c.mechanism = mech
+                c = _build_closure(mech)
                 self._closures[mech.name] = c
             return c
+
+
+class _LoadedClosures:
+    """The closures of described mechanisms a problem file loaded (never registered): one per
+    Mechanism object, which :mod:`~cpm_nlp.mechanisms.described` caches by the content hash of
+    its file (or description), so a file read again reuses its closure and its compiled solvers.
+    Not a registry: :func:`mechanism_names` and :func:`mechanism_type` never see these."""
+
+    def __init__(self) -> None:
+        self._lock = threading.RLock()
+        self._by_id: dict[int, tuple[Mechanism, LoopClosure]] = {}  # the Mechanism kept alive: its id stays its
+
+    def closure(self, mech: Mechanism) -> LoopClosure:
+        with self._lock:
+            held = self._by_id.get(id(mech))
+            if held is None or held[0] is not mech:
+                held = (mech, _build_closure(mech))
+                self._by_id[id(mech)] = held
+            return held[1]
+
+
+def _build_closure(mech: Mechanism) -> LoopClosure:
+    """The symbolic closure of ``mech``, checked; its back-pointer set to ``mech``."""
+    try:
+        c = mech.closure()
+    except CpmError:
+        raise
+    except Exception as exc:
+        raise PluginError(f"mechanism {mech.name!r} ({mech.origin}): building its closure failed: {exc}") from exc
+    if not isinstance(c, LoopClosure):
+        raise PluginError(
+            f"mechanism {mech.name!r} ({mech.origin}): closure() must return a LoopClosure, got {type(c).__name__}"
+        )
+    c.mechanism = mech
+    return c
 
 
 _UNEXPECTED = re.compile(r"unexpected keyword argument '(\w+)'")
@@ -292,6 +319,8 @@ def _with_origin(mech: Mechanism, origin: Origin) -> Mechanism:
 
 
 REGISTRY = _Registry()
+#: closures of the mechanisms problem files described (not registered)
+_LOADED = _LoadedClosures()
 
 
 def mechanism_names() -> list[str]:
@@ -323,11 +352,14 @@ def mechanism_type(name: Any, path: tuple = ("mechanism", "type")) -> Mechanism:
     )
 
 
-def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
-    """Register a mechanism read from a file (or described inline) under its name, replacing
-    an earlier description of that name; a built-in or plugin of that name is an error."""
+def resolve_described(mech: Mechanism, path: tuple) -> Mechanism:
+    """The mechanism a problem file describes (a file or inline), checked against the registry
+    without changing it: the built-in itself where the description is the built-in's own file
+    or an unchanged copy of it; a changed copy under a built-in's name, or a description named
+    like a mechanism declared in code or by a plugin, is an error (``type: NAME`` keeps meaning
+    the registered one).  Two files of one name but different text load side by side."""
     with REGISTRY._lock:
-        current = REGISTRY._discover().get(mech.name)
+        current = REGISTRY._spec(mech.name)
         if current is not None and current[0].startswith("file:") and current[1].kind == "built-in":
             builtin = REGISTRY.get(mech.name)
             if builtin is mech or described.same_text(builtin, mech):
@@ -344,8 +376,6 @@ def use_described(mech: Mechanism, path: tuple = ("mechanism",)) -> Mechanism:
                 f"the described mechanism's name {mech.name!r} is taken by a {current[1]} mechanism; rename it",
                 path=path + ("name",),
             )
-        if REGISTRY._loaded.get(mech.name) is not mech:
-            REGISTRY.register(mech, replace=True)
     return mech
 
 
@@ -394,28 +424,23 @@ def _section_described(section: Mapping[str, Any], base_dir: Any, path: tuple) -
 
 def section_model(section: Mapping[str, Any], base_dir: Any = None, path: tuple = ("mechanism",)) -> Model:
     """The model of a problem file's ``mechanism:`` section.  A mechanism file or inline
-    description is registered under its name only if its model builds: a refused one (an
-    edited copy of a shipped file, of the same name) leaves the registry as it was, so that a
-    later problem in the same process gets the mechanism that name had before."""
+    description gives its model directly: no global registry changes (issue 22, item 3), so
+    a later problem in the same process, and :func:`mechanism_names`, see the registry as it was."""
     described_mech = _section_described(section, base_dir, path)
     if described_mech is None:
         return build_model(section["type"], section.get("parameters"), section.get("limits"))
-    before = REGISTRY.entry(described_mech.name)
-    name = use_described(described_mech, path).name
-    try:
-        return build_model(name, section.get("parameters"), section.get("limits"))
-    except BaseException:
-        REGISTRY.restore(name, before)
-        raise
+    mech = resolve_described(described_mech, path)
+    return _model(mech, section.get("parameters"), section.get("limits"), path)
 
 
 def closure_of(mech: Mechanism) -> LoopClosure:
-    """The shared symbolic closure of a mechanism type."""
-    return REGISTRY.closure(mech)
+    """The shared symbolic closure of a mechanism type (a registered one's, or the closure of
+    a mechanism a problem file described)."""
+    return REGISTRY.closure(mech) if REGISTRY.holds(mech) else _LOADED.closure(mech)
 
 
 def build_model(
-    type_name: str,
+    type_name: str | Mechanism,
     parameters: Mapping[str, Any] | None = None,
     limits: Mapping[str, Any] | None = None,
     *,
@@ -425,9 +450,15 @@ def build_model(
 
     ``parameters`` and ``limits`` take numbers (SI) or strings with units,
     exactly as in a problem file, e.g.
-    ``build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm"})``.
+    ``build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm"})``; ``type_name`` may be a
+    :class:`Mechanism` itself (one a problem file described, not registered).
     """
-    mech = mechanism_type(type_name, path + ("type",))
+    mech = type_name if isinstance(type_name, Mechanism) else mechanism_type(type_name, path + ("type",))
+    return _model(mech, parameters, limits, path)
+
+
+def _model(mech: Mechanism, parameters: Any, limits: Any, path: tuple) -> Model:
+    """The model of the declaration ``mech`` (registered or not) with these values."""
     closure = closure_of(mech)
     if mech.origin.kind == "built-in":
         return mech.model(closure, parameters, limits, path)

@@ -83,11 +83,12 @@ def _mechanism_section(mech: Mechanism) -> tuple[dict[str, Any], str]:
     return {"type": mech.name}, "the declared defaults"
 
 
-def reference_model(mechanism: str) -> tuple[Model, str]:
-    """A model of ``mechanism`` to describe kinds on, and where its values come from."""
-    mech = mechanism_type(mechanism, path=("--mechanism",))
+def reference_model(mechanism: str | Mechanism) -> tuple[Model, str]:
+    """A model of ``mechanism`` (a name, or a declaration: a mechanism file, not registered) to
+    describe kinds on, and where its values come from."""
+    mech = mechanism if isinstance(mechanism, Mechanism) else mechanism_type(mechanism, path=("--mechanism",))
     section, source = _mechanism_section(mech)
-    return build_model(mech.name, section.get("parameters"), section.get("limits")), source
+    return build_model(mech, section.get("parameters"), section.get("limits")), source
 
 
 def model_of(mech: Mechanism) -> tuple[Model | None, str]:
@@ -180,13 +181,19 @@ def _row(option: Any, name: str | None = None, slot: bool = False) -> InputRow:
     return InputRow(name or option.name, _unit(option), default, _meaning(option), tuple(kids))
 
 
-def describe_kind(kind_name: str, mechanism: str, model: Model | None = None, source: str = "") -> KindDescription:
-    """Describe ``kind_name`` on ``mechanism`` (a model is built unless given)."""
+def describe_kind(
+    kind_name: str, mechanism: str | Mechanism, model: Model | None = None, source: str = ""
+) -> KindDescription:
+    """Describe ``kind_name`` on ``mechanism`` (a name, or a declaration read from a file and
+    not registered; a model is built unless given)."""
     kind: ProblemKind = problem_kind(kind_name, path=("describe",))
+    declared = mechanism if isinstance(mechanism, Mechanism) else None
+    mechanism = mechanism.name if isinstance(mechanism, Mechanism) else mechanism
     if model is None:
-        mechanism_type(mechanism, path=("--mechanism",))  # an unknown name, with a "did you mean"
+        if declared is None:
+            mechanism_type(mechanism, path=("--mechanism",))  # an unknown name, with a "did you mean"
         try:
-            model, source = reference_model(mechanism)
+            model, source = reference_model(declared or mechanism)
         except InputError as exc:  # a mechanism described without an example or defaults
             reason = f"no model to describe it on ({exc.message})"
             return KindDescription(kind.name, kind.description, kind_origin(kind.name), mechanism, "", reason, (), ())

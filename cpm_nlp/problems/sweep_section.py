@@ -310,7 +310,7 @@ def _resolve(key: str, kind: Any, model: Any, path: tuple) -> tuple[Option | Non
                 path=path,
                 suggestions=[f"mechanism.{h}.{parts[-1]}" for h in hint] if len(parts) == 3 else (),
             )
-        mtype = mechanism_type(model.name)
+        mtype = model.mechanism if model.mechanism is not None else mechanism_type(model.name)
         options = mtype.parameters if section == "parameters" else mtype.limits
         what = "parameter" if section == "parameters" else "limit"
     else:

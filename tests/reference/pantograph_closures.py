@@ -73,7 +73,7 @@ import math
 import casadi as ca
 import numpy as np
 
-from cpm_nlp.analysis import flexure
+from cpm_nlp.analysis import hinge_types
 from cpm_nlp.core.mechanism import Drawing, Mechanism
 from cpm_nlp.core.model import Coordinate, LoopClosure, Model
 from cpm_nlp.core.options import Option
@@ -116,7 +116,7 @@ LIMITS = (
         default=None,
         shape="range",
     ),
-) + flexure.HINGE_LIMIT_OPTIONS
+) + hinge_types.HINGE_LIMIT_OPTIONS
 
 X = (
     Coordinate("px", "length", "end-effector E, x (eq 3, 6)"),

@@ -59,13 +59,14 @@ from typing import Any
 
 import casadi as ca
 
-from ...analysis import flexure
+from ...analysis import hinge_types
 from ...core.aspect import ASPECT, ASPECT_DESCRIPTION, ASPECT_MAX_NX, twist_determinant
 from ...core.aspect import aspect as aspect_indicator
 from ...core.errors import InputError, format_key_path, suggest
 from ...core.joints import JOINT_TYPES, joint_types
 from ...core.model import Coordinate
 from ...core.options import Option, validate_mapping
+from ...core.screws import axis_rotation
 from ...core.units import parse_quantity
 from . import expr as ex
 from .spec import Description, Joint, Leg
@@ -100,19 +101,12 @@ _BASE_AXES = {"x": ca.DM([1.0, 0, 0]), "y": ca.DM([0, 1.0, 0]), "z": ca.DM([0, 0
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
-    """Rotation by ``angle`` about a unit axis k, or about "x", "y", "z" (Rodrigues):
-    R = cos I + sin [k]x + (1 - cos) k kᵀ.
-
-    Written with k kᵀ rather than I + sin [k]x + (1 - cos) [k]x² (equal for a unit k: [k]x² =
-    k kᵀ - I): about a base axis the zero entries of k drop out when the expression is built and
-    R is the elementary rotation itself (cos, ±sin, 1), as a hand-written module has it -- the
-    [k]x² form left 1 - (1 - cos) on the diagonal, two more operations per entry on every pose
-    evaluation (the same value while cos >= 1/2, where 1 - cos is exact; a rounded one below)."""
+    """Rotation by ``angle`` about a unit axis k, or about "x", "y", "z" (Rodrigues,
+    :func:`~cpm_nlp.core.screws.axis_rotation`: R = cos I + sin [k]x + (1 - cos) k kᵀ, whose
+    zero entries of k drop out about a base axis)."""
     if isinstance(axis, str):
         axis = ca.DM([1.0 if axis == a else 0.0 for a in "xyz"])
-    k = ca.SX(axis)
-    c, s = ca.cos(angle), ca.sin(angle)
-    return c * ca.SX.eye(3) + s * ca.skew(k) + (1 - c) * (k @ k.T)
+    return ca.SX(axis_rotation(ca.SX(axis), angle))
 
 
 def _is_identity(M: ca.SX) -> bool:
@@ -796,10 +790,10 @@ class Generator:
     def _limit(self, j: _Joint, dim: str) -> tuple | None:
         if j.spec.flexure is not None:
             path = j.spec.path + ("flexure",)
-            values = validate_mapping(j.spec.flexure.values, flexure.HINGE_LIMIT_OPTIONS, path, what="flexure key")
+            values = validate_mapping(j.spec.flexure.values, hinge_types.HINGE_LIMIT_OPTIONS, path, what="flexure key")
             if values.get("hinge") is None:
-                raise InputError(f"missing key 'hinge' (one of: {', '.join(flexure.HINGES)})", path=path)
-            rot = flexure.hinge_rotation(values, path)
+                raise InputError(f"missing key 'hinge' (one of: {', '.join(hinge_types.LIMIT_TYPES)})", path=path)
+            rot = hinge_types.hinge_rotation(values, path)
             return (-rot, rot)
         if j.spec.range is not None:
             rng = tuple(parse_quantity(v, dim, j.spec.path + ("range", k)) for k, v in enumerate(j.spec.range))

@@ -78,7 +78,7 @@ class Quantity:
 @dataclass
 class Flexure:
     """A flexure hinge that sets a joint's limits: hinge type, dimensions, material
-    (the keys of :data:`cpm_nlp.analysis.flexure.HINGE_LIMIT_OPTIONS`)."""
+    (the keys of :data:`cpm_nlp.analysis.hinge_types.HINGE_LIMIT_OPTIONS`)."""
 
     values: dict[str, Any]
 

@@ -50,7 +50,7 @@ import math
 import casadi as ca
 import numpy as np
 
-from ...analysis import flexure
+from ...analysis import hinge_types
 from ...analysis.certify import certify_box
 from ...analysis.workspace import check_box
 from ...core.errors import InputError
@@ -92,7 +92,7 @@ LIMITS = (
         default=None,
         shape="range",
     ),
-) + flexure.HINGE_LIMIT_OPTIONS
+) + hinge_types.HINGE_LIMIT_OPTIONS
 
 # -- limits -------------------------------------------------------------------------------------
 
@@ -105,7 +105,7 @@ def check_limits(limits: dict, path: tuple) -> None:
     """Either the joint-angle limits or the hinge that sets them (eq 31), not both; a file's
     family and the paper's limit of the same joints, not both."""
     direct = [k for k in _DIRECT if limits.get(k) is not None]
-    hinge = [k for k in flexure.HINGE_KEYS if limits.get(k) is not None]
+    hinge = [k for k in hinge_types.HINGE_KEYS if limits.get(k) is not None]
     if direct and hinge:
         raise InputError(
             f"give either the joint-angle limits ({', '.join(direct)}) or the hinge that sets them by eq 31 "
@@ -126,13 +126,13 @@ def check_limits(limits: dict, path: tuple) -> None:
         raise InputError(
             f"expected psi_min < psi_max, got psi_min = {lo:.6g} rad, psi_max = {hi:.6g} rad", path=path + ("psi_min",)
         )
-    flexure.hinge_rotation(limits, path)  # validates the hinge
+    hinge_types.hinge_rotation(limits, path)  # validates the hinge
 
 
 def joint_limits(limits: dict) -> dict:
     """psi_min, psi_max, phi_max (rad; None where unlimited) and delta_max, the hinge
     rotation of eq 30/38 (None unless a hinge is given), from validated limits."""
-    delta = flexure.hinge_rotation(limits)
+    delta = hinge_types.hinge_rotation(limits)
     if delta is not None:  # eq 31; a hinge that turns further than the geometry allows does not limit
         return {
             "psi_min": max(HALF_PI - delta, 0.0),

@@ -43,7 +43,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from ...analysis import flexure
+from ...analysis import flexure, hinge_types
 from ...analysis.workspace import CHECK_OPTION, check_box
 from ...core.errors import InputError
 from ...core.model import Model
@@ -171,7 +171,7 @@ class PantographSynthesis(SynthesisFormulation):
                     strict=True,
                 ),
                 flexure.material_node("material", f"hinge material, one of: {', '.join(flexure.MATERIALS)}"),
-                *(o for o in flexure.HINGE_LIMIT_OPTIONS if o.name in ("E", "sigma_all")),
+                *(o for o in hinge_types.HINGE_LIMIT_OPTIONS if o.name in ("E", "sigma_all")),
                 Option(
                     "weights",
                     "dimensionless",

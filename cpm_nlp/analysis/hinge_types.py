@@ -1,0 +1,351 @@
+"""The flexure hinge types: one table (:data:`HINGE_TABLE`), one frozen :class:`HingeType`
+per type, read by the compliance model (:mod:`cpm_nlp.analysis.compliance`: a hinge's
+stiffness, six-axis stiffness and stress), the hinge rotation limits of mechanisms and
+files (:func:`hinge_rotation`, a joint's ``flexure``), the file reader, ``describe`` and
+the docs.  Where a type may sit is said once, by the joint types
+(:attr:`cpm_nlp.core.joints.JointType.hinges`); :attr:`HingeType.joints` reads it there.
+
+Each type gives what its sources give: a stiffness per axis and a stress (the compliance
+model's types), and/or the largest rotation at the allowable stress (the rotation limits).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+
+from ..core.errors import InputError
+from ..core.joints import JOINT_TYPES
+from ..core.options import Option
+from .flexure import (
+    MATERIALS,
+    cantilever_notch_rotation,
+    circular_notch_max_rotation,
+    circular_notch_stiffness_exact,
+    elastic_limits,
+    leaf_spring_max_rotation,
+)
+from .flexure_compliance import circular_notch_compliances, rectangle_torsion_constant
+
+
+def rectangle_torsion_stress(T, a, c):
+    """Largest shear stress of an a x c rectangle (a >= c) under torsion T,
+    τ = 3T/(8 A B²) [1 + 0.6095 (B/A) + 0.8865 (B/A)² - 1.8023 (B/A)³ + 0.9100 (B/A)⁴]
+    with 2A = a, 2B = c (W. C. Young, R. G. Budynas, Roark's Formulas for Stress
+    and Strain, 7th ed., Table 10.7, case 4)."""
+    a, c = max(a, c), min(a, c)
+    A, B = a / 2.0, c / 2.0
+    ratio = B / A
+    return 3.0 * T / (8.0 * A * B**2) * (1 + 0.6095 * ratio + 0.8865 * ratio**2 - 1.8023 * ratio**3 + 0.91 * ratio**4)
+
+
+def _von_mises(sigma: float, tau: float) -> float:
+    return math.sqrt(sigma**2 + 3.0 * tau**2)
+
+
+def _rect_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
+    """Nominal stress at the thinnest section t x w of a rectangular hinge:
+    σ = K_t (6|M_bend|/(w t²) + 6|M_bend2|/(t w²) + |F|/(w t)), τ from Roark's
+    rectangle torsion, combined by von Mises."""
+    t, w = d["t"], d["w"]
+    sigma = 6.0 * abs(loads.get("bend", 0.0)) / (w * t**2) + 6.0 * abs(loads.get("bend2", 0.0)) / (t * w**2)
+    sigma += abs(loads.get("axial", 0.0)) / (w * t)
+    tau = rectangle_torsion_stress(abs(loads.get("torsion", 0.0)), w, t)
+    return d.get("Kt", 1.0) * _von_mises(sigma, tau)
+
+
+def _rod_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
+    """Round neck of diameter d: σ = K_t (32 |M|/(π d³) + 4|F|/(π d²)) with M the
+    resultant of both bending moments, τ = 16 T/(π d³), von Mises (Euler-Bernoulli
+    and Saint-Venant torsion of a circular section)."""
+    dia = d["d"]
+    m = math.hypot(loads.get("bend", 0.0), loads.get("bend2", 0.0))
+    sigma = 32.0 * m / (math.pi * dia**3) + 4.0 * abs(loads.get("axial", 0.0)) / (math.pi * dia**2)
+    tau = 16.0 * abs(loads.get("torsion", 0.0)) / (math.pi * dia**3)
+    return d.get("Kt", 1.0) * _von_mises(sigma, tau)
+
+
+def _notch_stiffness(E, G, d) -> dict[str, float]:
+    if G is None:  # without Poisson's ratio only the bending stiffness (Paros-Weisbord exact)
+        return {"bend": float(circular_notch_stiffness_exact(E, d["w"], d["t"], d["r"]))}
+    c = circular_notch_compliances(E, G, d["w"], d["t"], d["r"])
+    return {"bend": 1 / c["rz"], "bend2": 1 / c["ry"], "torsion": 1 / c["rx"], "axial": 1 / c["x"]}
+
+
+def _rod_stiffness(E, G, d) -> dict[str, float]:
+    dia, length = d["d"], d["l"]
+    inertia = math.pi * dia**4 / 64.0
+    out = {"bend": E * inertia / length, "bend2": E * inertia / length, "axial": E * math.pi * dia**2 / 4 / length}
+    if G is not None:
+        out["torsion"] = G * 2.0 * inertia / length
+    return out
+
+
+def _leaf_stiffness(E, G, d) -> dict[str, float]:
+    t, w, length = d["t"], d["w"], d["l"]
+    out = {"bend": E * w * t**3 / 12 / length, "bend2": E * t * w**3 / 12 / length, "axial": E * w * t / length}
+    if G is not None:
+        out["torsion"] = G * float(rectangle_torsion_constant(max(w, t), min(w, t))) / length
+    return out
+
+
+#: the six axes of a hinge in its own frame: three rotations (bend about the compliant
+#: axis, bend2 about the second bending axis, torsion about its length) and three
+#: translations (axial along its length, shear across its thinnest section, i.e. the
+#: direction bending about the compliant axis moves, shear2 along the compliant axis)
+SIX_AXES = ("bend", "bend2", "torsion", "axial", "shear", "shear2")
+
+
+def _beam_shear(E, G, length, inertia, area, alpha_s):
+    """Transverse stiffness of a straight beam at its centre, 1/(l³/(12 E I) + α_s l/(G A)):
+    the compliance of a cantilever's free end (l³/3EI, coupling l²/2EI, l/EI) transported
+    to the mid-point, where the force-moment coupling vanishes (the definition of
+    :func:`~cpm_nlp.analysis.flexure_compliance.circular_notch_compliances`), plus Timoshenko shear."""
+    return 1.0 / (length**3 / (12.0 * E * inertia) + alpha_s * length / (G * area))
+
+
+def _notch_six(E, G, d) -> dict[str, float]:
+    c = circular_notch_compliances(E, G, d["w"], d["t"], d["r"])
+    return {
+        "bend": 1 / c["rz"],
+        "bend2": 1 / c["ry"],
+        "torsion": 1 / c["rx"],
+        "axial": 1 / c["x"],
+        "shear": 1 / c["y"],
+        "shear2": 1 / c["z"],
+    }
+
+
+def _rod_six(E, G, d) -> dict[str, float]:
+    out = _rod_stiffness(E, G, d)
+    dia, length = d["d"], d["l"]
+    area, inertia = math.pi * dia**2 / 4.0, math.pi * dia**4 / 64.0
+    out["shear"] = out["shear2"] = _beam_shear(E, G, length, inertia, area, 10.0 / 9.0)
+    return out
+
+
+def _leaf_six(E, G, d) -> dict[str, float]:
+    out = _leaf_stiffness(E, G, d)
+    t, w, length = d["t"], d["w"], d["l"]
+    out["shear"] = _beam_shear(E, G, length, w * t**3 / 12.0, w * t, 1.2)
+    out["shear2"] = _beam_shear(E, G, length, t * w**3 / 12.0, w * t, 1.2)
+    return out
+
+
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(32)
+
+
+def _filleted_rod_integrals(d: Mapping[str, float]) -> dict[str, float]:
+    """The section integrals of a round neck of diameter d and straight length l with
+    circular fillets of radius r at both ends (a revolved corner-filleted flexure,
+    Lobontiu 2002 ch. 2, with a circular section): over x from the centre,
+    ∫ dx/I, ∫ dx/J, ∫ dx/A, ∫ x² dx/I, the fillet diameter D(s) = d + 2r (1 - cos φ)
+    at s = r sin φ past the neck's end (32-point Gauss-Legendre in φ)."""
+    dia, length, r = d["d"], d["l"], d["r"]
+    half = length / 2.0
+    inertia, area = math.pi * dia**4 / 64.0, math.pi * dia**2 / 4.0
+    out = {"I": length / inertia, "A": length / area, "x2I": 2.0 * half**3 / 3.0 / inertia}
+    for node, weight in zip(_GL_NODES, _GL_WEIGHTS):
+        phi = (float(node) + 1.0) * math.pi / 4.0  # [0, pi/2]
+        ds = r * math.cos(phi) * float(weight) * math.pi / 4.0
+        D = dia + 2.0 * r * (1.0 - math.cos(phi))
+        x = half + r * math.sin(phi)
+        i_x, a_x = math.pi * D**4 / 64.0, math.pi * D**2 / 4.0
+        out["I"] += 2.0 * ds / i_x  # both fillets
+        out["A"] += 2.0 * ds / a_x
+        out["x2I"] += 2.0 * ds * x**2 / i_x
+    out["J"] = out["I"] / 2.0  # J = 2 I of a circle
+    return out
+
+
+def _filleted_rod_stiffness(E, G, d) -> dict[str, float]:
+    n = _filleted_rod_integrals(d)
+    out = {"bend": E / n["I"], "bend2": E / n["I"], "axial": E / n["A"]}
+    if G is not None:
+        out["torsion"] = G / n["J"]
+    return out
+
+
+def _filleted_rod_six(E, G, d) -> dict[str, float]:
+    n = _filleted_rod_integrals(d)
+    out = _filleted_rod_stiffness(E, G, d)
+    out["shear"] = out["shear2"] = 1.0 / (n["x2I"] / E + (10.0 / 9.0) * n["A"] / G)
+    return out
+
+
+#: the dimensions a hinge type may take (each a length)
+DIM_OPTIONS: Mapping[str, Option] = MappingProxyType(
+    {
+        "t": Option("t", "length", "thickness at the thinnest section", lower=0.0, strict=True),
+        "r": Option("r", "length", "notch (or fillet) radius", lower=0.0, strict=True),
+        "w": Option("w", "length", "hinge width (along its compliant axis)", lower=0.0, strict=True),
+        "d": Option("d", "length", "neck diameter", lower=0.0, strict=True),
+        "l": Option("l", "length", "hinge length", lower=0.0, strict=True),
+    }
+)
+
+
+@dataclass(frozen=True)
+class HingeType:
+    """A flexure hinge geometry.
+
+    name: its ``type`` (a hinge's) or ``hinge`` (a joint limit's) in a file.
+    dims: the dimensions its stiffness and stress take (:data:`DIM_OPTIONS`).
+    stiffness: ``(E, G, dims) -> {axis: k}`` about the axes of
+        :data:`cpm_nlp.analysis.compliance.AXES` (G None when the material gives no
+        Poisson's ratio), None if no source gives it.
+    six_axis: ``(E, G, dims) -> {axis: k}`` over all of :data:`SIX_AXES`, at its centre.
+    stress: ``(dims, loads) -> σ``, its largest stress for the loads per axis.
+    source: the sources of stiffness, six-axis stiffness and stress.
+    limit_dims: the dimensions its largest rotation takes.
+    rotation: ``(E, σ_allow, dims) -> δ_max`` [rad], the largest rotation at the allowable
+        stress (a joint's rotation limit), None if no source gives it.
+    limit_source: the source of ``rotation``.
+    """
+
+    name: str
+    dims: tuple[str, ...] = ()
+    stiffness: Callable[..., dict[str, float]] | None = None
+    six_axis: Callable[..., dict[str, float]] | None = None
+    stress: Callable[..., float] | None = None
+    source: str = ""
+    limit_dims: tuple[str, ...] = ()
+    rotation: Callable[..., float] | None = None
+    limit_source: str = ""
+
+    @property
+    def parameters(self) -> tuple[Option, ...]:
+        """Its dimensions, each with its unit and meaning."""
+        return tuple(DIM_OPTIONS[d] for d in dict.fromkeys(self.dims + self.limit_dims))
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        """The joint types it can sit at (said by :data:`cpm_nlp.core.joints.JOINT_TYPES`)."""
+        return tuple(n for n, j in JOINT_TYPES.items() if self.name in j.hinges)
+
+
+#: the hinge types by name: the one table
+HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
+    {
+        t.name: t
+        for t in (
+            HingeType(
+                "cantilever_notch",
+                limit_dims=("l", "t"),
+                rotation=lambda E, sigma, d: cantilever_notch_rotation(E, d["l"], d["t"], sigma),
+                limit_source="pantograph-3d-elgammal-2016.md eq 30-31",
+            ),
+            HingeType(
+                "circular_notch",
+                ("t", "r", "w"),
+                _notch_stiffness,
+                _notch_six,
+                _rect_stress,
+                "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance), Paros-Weisbord exact without nu; "
+                "stress: nominal 6M/(w t^2) at the thinnest section (the stress of pantograph-3d-elgammal-2016.md "
+                "eq 38), times Kt (default 1)",
+                ("t", "r"),
+                lambda E, sigma, d: circular_notch_max_rotation(E, d["t"], d["r"], sigma),
+                "pantograph-3d-elgammal-2016.md eq 38",
+            ),
+            HingeType(
+                "circular_rod",
+                ("d", "l"),
+                _rod_stiffness,
+                _rod_six,
+                _rod_stress,
+                "stiffness: E I/l, G J/l, E A/l of a round neck of diameter d and length l (fillets ignored: "
+                "stiffer); stress: 32M/(pi d^3), 16T/(pi d^3), von Mises, times Kt (default 1)",
+            ),
+            HingeType(
+                "filleted_rod",
+                ("d", "l", "r"),
+                _filleted_rod_stiffness,
+                _filleted_rod_six,
+                _rod_stress,
+                "stiffness: Euler-Bernoulli integrals over a round neck of diameter d and straight length l with "
+                "circular fillets of radius r at both ends (a revolved corner-filleted hinge, Lobontiu 2002 ch. 2); "
+                "stress: 32M/(pi d^3), 16T/(pi d^3) at the neck, von Mises, times Kt (default 1)",
+            ),
+            HingeType(
+                "leaf_spring",
+                ("t", "l", "w"),
+                _leaf_stiffness,
+                _leaf_six,
+                _rect_stress,
+                "stiffness: E w t^3/(12 l) (Euler-Bernoulli), G J/l with Roark's rectangle J; "
+                "stress: 6M/(w t^2), Roark Table 10.7 torsion, von Mises",
+                ("l", "t"),
+                lambda E, sigma, d: leaf_spring_max_rotation(E, d["t"], d["l"], sigma),
+                "Euler-Bernoulli leaf spring under a pure moment",
+            ),
+        )
+    }
+)
+
+#: the hinge types that set a joint's rotation limit (a joint's ``flexure``, a mechanism's limits)
+LIMIT_TYPES = tuple(n for n, t in HINGE_TABLE.items() if t.rotation is not None)
+
+
+# -- hinge rotation limits from a problem file --------------------------------------------------
+#
+# A mechanism whose joint limits follow from its flexure hinges declares
+# HINGE_LIMIT_OPTIONS among its LIMITS and calls :func:`hinge_rotation` on the
+# validated limits: the hinge type, its dimensions and its material give the
+# largest rotation delta_max at the allowable stress.
+
+HINGE_LIMIT_OPTIONS = (
+    Option(
+        "hinge",
+        "choice",
+        "flexure hinge that sets the joint-angle limits (instead of giving them directly)",
+        default=None,
+        choices=LIMIT_TYPES,
+    ),
+    Option("l", "length", "hinge length (cantilever notch, leaf spring)", default=None, lower=0.0, strict=True),
+    Option("t", "length", "hinge thickness at its thinnest point", default=None, lower=0.0, strict=True),
+    Option("r", "length", "notch radius (circular notch)", default=None, lower=0.0, strict=True),
+    Option("material", "str", f"hinge material, one of: {', '.join(MATERIALS)}", default=None),
+    Option("E", "stress", "Young's modulus (overrides the material's)", default=None, lower=0.0, strict=True),
+    Option(
+        "sigma_all",
+        "stress",
+        "allowable stress (default: the material's allowable stress, else its yield strength)",
+        default=None,
+        lower=0.0,
+        strict=True,
+    ),
+)
+
+#: names of HINGE_LIMIT_OPTIONS (a mechanism's limits may hold others too)
+HINGE_KEYS = tuple(o.name for o in HINGE_LIMIT_OPTIONS)
+
+
+def hinge_rotation(limits: dict, path: tuple = ("mechanism", "limits")) -> float | None:
+    """Largest hinge rotation [rad] from validated HINGE_LIMIT_OPTIONS values,
+    or None when ``limits`` names no hinge.  Raises InputError for a hinge
+    that lacks a dimension, a material (or E and sigma_all), or has keys it
+    does not use."""
+    kind = limits.get("hinge")
+    given = [k for k in HINGE_KEYS if k != "hinge" and limits.get(k) is not None]
+    if kind is None:
+        if given:
+            raise InputError(
+                f"{', '.join(given)} describe a flexure hinge; also give hinge (one of: {', '.join(LIMIT_TYPES)})",
+                path=path,
+            )
+        return None
+    hinge = HINGE_TABLE[kind]
+    rotation, dims = hinge.rotation, hinge.limit_dims
+    missing = [d for d in dims if limits.get(d) is None]
+    if missing:
+        raise InputError(f"hinge {kind} needs {', '.join(missing)} (its dimensions: {', '.join(dims)})", path=path)
+    unused = [d for d in ("l", "t", "r") if d not in dims and limits.get(d) is not None]
+    if unused:
+        raise InputError(f"hinge {kind} has no dimension {', '.join(unused)} (it takes {', '.join(dims)})", path=path)
+    E, sigma = elastic_limits(limits, path, f"hinge {kind}")
+    return float(rotation(E, sigma, {d: limits[d] for d in dims}))
