@@ -387,8 +387,16 @@ def _long_search(tmp_path: Path) -> subprocess.Popen:
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        # Ctrl-C as at a terminal: a test run started as a background job of a script (bash
+        # "cmd &", a CI runner) has SIGINT ignored, the child would inherit it, and the CLI
+        # rightly keeps an inherited "ignore" (cli.main.main_entry)
+        preexec_fn=_sigint_default,
     )
     return proc
+
+
+def _sigint_default() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _wait_for_the_search(proc: subprocess.Popen) -> None:
