@@ -185,11 +185,10 @@ def design_parameter(s: Subject) -> str | None:
     """A length parameter of the closure to vary in the generic synthesis."""
     m = s.model
     declared = {o.name: o for o in m.mechanism.parameters}
-    for name in m.closure.parameters:
-        opt = declared.get(name)
-        if opt is not None and opt.kind == "length" and m.parameters.get(name, 0.0) > 0:
-            return name
-    return None
+    lengths = [n for n in m.closure.parameters if declared.get(n) is not None and declared[n].kind == "length"]
+    positive = [n for n in lengths if m.parameters.get(n, 0.0) > 0]
+    # a length, else a change of length about 0 (Jansen's dr1: the crank drawn at its length)
+    return (positive or lengths or [None])[0]
 
 
 def inputs_of(s: Subject, kind: str, poses: dict[str, np.ndarray]) -> dict[str, Any] | None:  # noqa: C901 - one case per kind
@@ -222,7 +221,8 @@ def inputs_of(s: Subject, kind: str, poses: dict[str, np.ndarray]) -> dict[str, 
             return None  # the mechanism's own formulation: its shipped example
         name = design_parameter(s)
         v = s.model.parameters[name]
-        return {"design": {name: [0.95 * v, 1.05 * v]}, "starts": 1, "samples_per_edge": 2, "check_per_edge": 3}
+        span = 0.05 * abs(v) if v else 1e-4  # 5 %, or 0.1 mm about a change of length of 0
+        return {"design": {name: [v - span, v + span]}, "starts": 1, "samples_per_edge": 2, "check_per_edge": 3}
     if kind == "actuator_forces":
         h = central_step(s)
         Q = np.vstack([q[0], q[0] + np.diag(h), q[0] - np.diag(h)])
