@@ -70,6 +70,19 @@ def test_a_moved_file_is_refused(tmp_path, cli):
     assert not (tmp_path / "m.png").exists()
 
 
+def test_a_result_names_only_a_yaml_mechanism_file(tmp_path, cli):
+    """A result file is data: the plot reads the mechanism file it records only if it is one
+    (.yaml, .yml), as a problem file's ``mechanism: {file:}``; never, e.g., /etc/passwd."""
+    _user_file(tmp_path)
+    out, data = _solve(tmp_path, cli, "{file: stage.yaml}")
+    data["origin"]["path"] = "/etc/passwd"
+    out.write_text(json.dumps(data))
+    run = cli("plot", str(out), "--type", "mechanism", "-o", str(tmp_path / "m.png"))
+    assert run.code == 2, run.out
+    assert "origin.path" in run.err and "ending in .yaml or .yml" in run.err and "Traceback" not in run.err
+    assert not (tmp_path / "m.png").exists()
+
+
 def test_an_inline_description_is_recorded_and_plots_again(tmp_path, cli):
     import yaml
 

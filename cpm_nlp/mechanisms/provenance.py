@@ -22,7 +22,16 @@ from ..core.model import LoopClosure, Model
 from ..core.origin import Origin, data_sha256, file_sha256
 from ..core.result import jsonable
 from . import described
-from .registry import ALIASES, BUILTIN, BUILTIN_FILES, REGISTRY, build_model, closure_of, mechanism_type
+from .registry import (
+    ALIASES,
+    BUILTIN,
+    BUILTIN_FILES,
+    MECHANISM_FILE_SUFFIXES,
+    REGISTRY,
+    build_model,
+    closure_of,
+    mechanism_type,
+)
 
 
 def _file_origin(name: str, path: Path) -> Origin:
@@ -68,6 +77,12 @@ def recorded_mechanism(record: Any, type_name: Any, source: str | None = None) -
 def _recorded_file(origin: Origin, source: str | None) -> Mechanism:
     path = Path(origin.path)
     again = "put the file back as it was, or solve the problem again"
+    if path.suffix.lower() not in MECHANISM_FILE_SUFFIXES:  # a result file reads YAML, as a problem file does
+        raise InputError(
+            f"expected a mechanism file ending in .yaml or .yml, got {origin.path!r:.200}",
+            path=("origin", "path"),
+            file=source,
+        )
     if not path.is_file():
         raise InputError(
             f"the mechanism file {path} this result was solved with is missing (moved or deleted); {again}",
