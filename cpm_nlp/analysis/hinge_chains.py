@@ -5,8 +5,8 @@ The pseudo-rigid-body model of :mod:`cpm_nlp.analysis.compliance` lets a hinge
 turn only about the axes the kinematics moves, so with the actuators held a
 mechanism of rigid links does not deflect at all.  A real flexure also bends
 about its second axis, twists, stretches and shears.  Here each leg is the
-serial chain of its joints at the reference configuration (the ``chains``
-capability, :mod:`cpm_nlp.core.chains`) and every hinge adds, at its joint and
+serial chain of its joints at the reference configuration (the part ``chains``,
+:class:`LegChains`; :mod:`cpm_nlp.core.chains`) and every hinge adds, at its joint and
 in its own frame (length axis t, compliant axis b1, second axis b2 = b1 x t),
 the axes its joint does not move, each with the flexure library's stiffness
 (:data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, each type's ``six_axis``):
@@ -42,8 +42,9 @@ from __future__ import annotations
 import logging
 import threading
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import casadi as ca
 import numpy as np
@@ -53,10 +54,30 @@ from ..core.blas import one_blas_thread
 from ..core.chains import Chains
 from ..core.errors import InputError
 from ..core.kernels import FastFunction
+from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import Model
 from ..core.screws import axis_rotation, vee
 from .compliance import HINGE_TYPES, HingeSet, six_axis_stiffness
 from .hinge_types import SIX_AXES
+
+
+@dataclass(frozen=True)
+class LegChains(Part):
+    """The legs of a mechanism as serial chains of joints at the reference configuration
+    (the part ``chains``), for the six-axis hinge model.
+
+    of: ``(model) -> Chains`` (:class:`~cpm_nlp.core.chains.Chains`), numeric at the model's
+        parameters.
+    """
+
+    capability: ClassVar[str] = "chains"
+
+    of: Callable[[Model], Chains]
+
+    def __post_init__(self) -> None:
+        if not callable(self.of):
+            raise MechanismDeclarationError(f"chains must be callable, got {self.of!r:.60}")
+
 
 log = logging.getLogger(__name__)
 
@@ -472,7 +493,8 @@ def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
     """The six-axis hinge model, or None when the mechanism gives no chains (built once per
     mechanism, parameters and hinges, then reused)."""
     mech = model.mechanism
-    if mech is None or mech.chains is None:
+    chains = mech.part(LegChains) if mech is not None else None
+    if chains is None:
         return None
     key = _key(model, hs)
     with _LOCK:
@@ -480,7 +502,7 @@ def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
         if built is not None:
             _BUILT.move_to_end(key)
             return built
-    built = SixAxisModel(model, hs, mech.chains(model))
+    built = SixAxisModel(model, hs, chains.of(model))
     with _LOCK:
         _BUILT[key] = built
         while len(_BUILT) > _BUILT_MAX:
@@ -488,4 +510,4 @@ def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
     return built
 
 
-__all__ = ["HingeFrame", "SixAxisModel", "six_axis_model"]
+__all__ = ["HingeFrame", "LegChains", "SixAxisModel", "six_axis_model"]

@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import CpmError, InputError, suggest
-from ..core.mechanism import PARTS, Addon, Mechanism, MechanismDeclarationError, validate, with_addon
+from ..core.mechanism import Addon, Mechanism, MechanismDeclarationError, unknown_field_hint, validate, with_addon
 from ..core.model import LoopClosure, Model
 from ..core.origin import Origin
 from . import described
@@ -276,8 +276,8 @@ def _load(name: str, target: str, origin: Origin) -> Mechanism:
         hint = ""
         m = _UNEXPECTED.search(str(exc))
         if m:
-            close = suggest(m.group(1), PARTS)
-            hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+            said = unknown_field_hint(m.group(1))
+            hint = f"; {said}" if said else ""
         raise PluginError(f"mechanism {name!r} ({origin}) failed to load: {exc}{hint}") from exc
     except Exception as exc:
         raise PluginError(f"mechanism {name!r} ({origin}) failed to load: {type(exc).__name__}: {exc}") from exc

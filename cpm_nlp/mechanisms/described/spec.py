@@ -36,11 +36,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ...analysis.compliance import HINGE_KEYS
+from ...analysis.compliance import HINGE_KEYS, JointStiffness
 from ...core.errors import InputError, suggest, unknown_key_error
 from ...core.finite import check_numbers
 from ...core.joints import JOINT_TYPES, joint_type
-from ...core.mechanism import JointStiffness
 from ...core.options import REQUIRED
 from ...core.units import parse_quantity
 
