@@ -246,6 +246,7 @@ CORE_MUTABLE_ALLOWED = {
     "cpm_nlp.core.blas._STATE": "the process's BLAS thread controller, set up once",
     "cpm_nlp.core.result.STATUS_TEXT": "read-only table; core/result.py is being reworked (item 2)",
     "cpm_nlp.core.result.WARNING_CODES": "read-only table; core/result.py is being reworked (item 2)",
+    "cpm_nlp.core.solver._BUILT": "each closure's built solvers and kernels (code), weakly keyed by the closure",
 }
 
 
@@ -256,11 +257,12 @@ def _core_mutable_globals() -> dict[str, str]:
     import collections
     import importlib
     import pkgutil
+    import weakref
     from types import MappingProxyType
 
     import cpm_nlp.core as core
 
-    mutable = (dict, list, set, bytearray, collections.deque)
+    mutable = (dict, list, set, bytearray, collections.deque, weakref.WeakKeyDictionary, weakref.WeakValueDictionary)
     seen: set[int] = set()
     found: dict[str, str] = {}
     for info in sorted(pkgutil.walk_packages(core.__path__, "cpm_nlp.core."), key=lambda i: i.name):

@@ -211,7 +211,8 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
                 path=("design", n),
             )
     lc = model.characteristic_length
-    build = rebuild or (lambda params: Model(c, params, model.limits, characteristic_length=lc))
+    mech = model.mechanism
+    build = rebuild or (lambda params: Model(c, params, model.limits, characteristic_length=lc, mechanism=mech))
     design_idx = tuple(c.parameters.index(n) for n in names)
     exps = tuple(float(footprint.get(n, 0.0)) for n in names)
     d = c.nq

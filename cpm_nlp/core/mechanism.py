@@ -184,14 +184,17 @@ class Mechanism:
         self, closure: Any, parameters: Mapping[str, Any] | None, limits: Mapping[str, Any] | None, path: tuple
     ) -> Any:
         """A model on ``closure`` from values given as in a problem file (numbers in SI
-        or strings with units), validated against the declared options and checks."""
+        or strings with units), validated against the declared options and checks; its
+        ``mechanism`` is this declaration."""
         params = validate_mapping(parameters or {}, self.parameters, path + ("parameters",), what="parameter")
         lims = validate_mapping(limits or {}, self.limits, path + ("limits",), what="limit")
         if self.check_parameters is not None:
             self.check_parameters(params, path + ("parameters",))
         if self.check_limits is not None:
             self.check_limits(lims, path + ("limits",))
-        return self.build(closure, params, lims)
+        model = self.build(closure, params, lims)
+        model.mechanism = self
+        return model
 
     def part(self, kind: type[P]) -> P | None:
         """The mechanism's part of type ``kind`` (a :class:`Part` subclass), or None."""

@@ -97,7 +97,8 @@ class _Registry:
         self._lock = threading.RLock()
         self._specs: dict[str, tuple[str, Origin]] | None = None  # name -> (target, origin)
         self._loaded: dict[str, Mechanism] = {}
-        self._closures: dict[str, LoopClosure] = {}
+        #: name -> (the declaration, its closure)
+        self._closures: dict[str, tuple[Mechanism, LoopClosure]] = {}
         #: bumped by every register/unregister, so that tables derived from the registry refresh
         self.version = 0
 
@@ -205,13 +206,13 @@ class _Registry:
 
     def closure(self, mech: Mechanism) -> LoopClosure:
         with self._lock:
-            c = self._closures.get(mech.name)
+            held = self._closures.get(mech.name)
             # by name, for this very mechanism: two described mechanisms of one name (a file
             # and an edited copy of it, loaded in turn) never share a closure
-            if c is None or c.mechanism is not mech:
-                c = _build_closure(mech)
-                self._closures[mech.name] = c
-            return c
+            if held is None or held[0] is not mech:
+                held = (mech, _build_closure(mech))
+                self._closures[mech.name] = held
+            return held[1]
 
 
 class _LoadedClosures:
@@ -234,7 +235,7 @@ class _LoadedClosures:
 
 
 def _build_closure(mech: Mechanism) -> LoopClosure:
-    """The symbolic closure of ``mech``, checked; its back-pointer set to ``mech``."""
+    """The symbolic closure of ``mech``, checked."""
     try:
         c = mech.closure()
     except CpmError:
@@ -245,7 +246,6 @@ def _build_closure(mech: Mechanism) -> LoopClosure:
         raise PluginError(
             f"mechanism {mech.name!r} ({mech.origin}): closure() must return a LoopClosure, got {type(c).__name__}"
         )
-    c.mechanism = mech
     return c
 
 
