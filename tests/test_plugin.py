@@ -174,7 +174,9 @@ def test_parts_are_read_by_their_type():
     with pytest.raises(MechanismDeclarationError, match=r"one of each \(twice: paper_membership\)"):
         cn.Mechanism(name="x", title="t", parameters=(), limits=(), closure=dict, build=dict, parts=(member, member))
     workspace = cn.problem_kind("workspace")
-    assert workspace.parts == (cn.PaperMembership,)
+    assert workspace.parts == (cn.PaperMembership, cn.JointStiffness)
+    for name in cn.kind_names():  # every kind declares part types, each with its capability name
+        assert all(issubclass(t, cn.Part) and t.capability for t in cn.problem_kind(name).parts), name
 
     class Model:
         mechanism = mech

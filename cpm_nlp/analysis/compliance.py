@@ -159,7 +159,9 @@ class HingeSpec:
 
     joints: str | Mapping[str, str] | None = None
     type: str | None = None
-    k: float | Mapping[str, float] | None = None
+    #: as written (one value or axis -> value): its dimension follows the joint it is on
+    #: (N*m/rad on an angle, N/m on a length), known with the closure
+    k: Any = None
     material: Material | None = None
     Kt: float | None = None
     #: the dimensions given (t, r, w, ... of :data:`~cpm_nlp.analysis.hinge_types.DIM_OPTIONS`)

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis import dynamics as dyn
+from ..analysis.compliance import JointStiffness
 from ..analysis.dynamics import DynamicsModel
 from ..analysis.flexure import material_node
 from ..analysis.workspace import joint_box, reachable_workspace
@@ -49,6 +50,8 @@ def closed_form_result(
 
 class ActuatorWorkspace(ProblemKind):
     name = "actuator_workspace"
+    #: the hinges, the defaults of ``stress_limit``
+    parts = (JointStiffness,)
     plots = ("workspace",)
     description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
     plots = ("workspace",)  # its points (inputs.points: true): the images of the stroke grid

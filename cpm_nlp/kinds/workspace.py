@@ -20,6 +20,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..analysis.certify import CERTIFICATE_NAMES, CERTIFY_OPTION, certificate_values
+from ..analysis.compliance import JointStiffness
 from ..analysis.workspace import (
     ADDED_PER_ROUND,
     CHECK_OPTION,
@@ -130,7 +131,8 @@ def _volume_dimension(model: Model) -> tuple[str, str]:
 
 class InscribedCuboid(ProblemKind):
     name = "inscribed_cuboid"
-    parts = (CuboidExtras,)
+    #: its extra inputs and values; the hinges, the defaults of ``stress_limit``
+    parts = (CuboidExtras, JointStiffness)
     description = "largest axis-aligned box of task coordinates inside the reachable workspace (IPOPT, multi-start)"
     plots = ("workspace",)
 
@@ -285,7 +287,8 @@ class InscribedCuboid(ProblemKind):
 
 class Workspace(ProblemKind):
     name = "workspace"
-    parts = (PaperMembership,)
+    #: the paper's membership test; the hinges, the defaults of ``stress_limit``
+    parts = (PaperMembership, JointStiffness)
     description = "membership of given points and a seeded point cloud of the reachable workspace"
     plots = ("workspace",)
 
