@@ -13,10 +13,10 @@ from .analysis.assembly import AssemblyMode, AssemblyModes, assembly_modes
 from .analysis.certify import Certificate, certify_box
 from .analysis.compliance import JointStiffness
 from .analysis.dynamics import DynamicsModel
-from .analysis.hinge_chains import LegChains
 from .analysis.requirements import RequirementsReport, joint_requirements
 from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
+from .core.chains import LegChains
 from .core.errors import CpmError, InputError
 from .core.kernels import status_of
 from .core.kind import ProblemKind

@@ -6,7 +6,7 @@ turn only about the axes the kinematics moves, so with the actuators held a
 mechanism of rigid links does not deflect at all.  A real flexure also bends
 about its second axis, twists, stretches and shears.  Here each leg is the
 serial chain of its joints at the reference configuration (the part ``chains``,
-:class:`LegChains`; :mod:`cpm_nlp.core.chains`) and every hinge adds, at its joint and
+:class:`~cpm_nlp.core.chains.LegChains`) and every hinge adds, at its joint and
 in its own frame (length axis t, compliant axis b1, second axis b2 = b1 x t),
 the axes its joint does not move, each with the flexure library's stiffness
 (:data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, each type's ``six_axis``):
@@ -42,42 +42,21 @@ from __future__ import annotations
 import logging
 import threading
 from collections import OrderedDict
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any
 
 import casadi as ca
 import numpy as np
 import scipy.linalg
 
 from ..core.blas import one_blas_thread
-from ..core.chains import Chains
+from ..core.chains import Chains, LegChains
 from ..core.errors import InputError
 from ..core.kernels import FastFunction
-from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import Model
 from ..core.screws import axis_rotation, vee
 from .compliance import HINGE_TYPES, HingeSet, six_axis_stiffness
 from .hinge_types import SIX_AXES
-
-
-@dataclass(frozen=True)
-class LegChains(Part):
-    """The legs of a mechanism as serial chains of joints at the reference configuration
-    (the part ``chains``), for the six-axis hinge model.
-
-    of: ``(model) -> Chains`` (:class:`~cpm_nlp.core.chains.Chains`), numeric at the model's
-        parameters.
-    """
-
-    capability: ClassVar[str] = "chains"
-
-    of: Callable[[Model], Chains]
-
-    def __post_init__(self) -> None:
-        if not callable(self.of):
-            raise MechanismDeclarationError(f"chains must be callable, got {self.of!r:.60}")
-
 
 log = logging.getLogger(__name__)
 

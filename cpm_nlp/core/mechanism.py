@@ -41,7 +41,7 @@ Parts (each declared with the kind that reads it)
 (:class:`~cpm_nlp.kinds.workspace.PaperMembership`), ``dynamics``
 (:class:`~cpm_nlp.analysis.dynamics.DynamicsModel`), ``stiffness``
 (:class:`~cpm_nlp.analysis.compliance.JointStiffness`) and ``chains``
-(:class:`~cpm_nlp.analysis.hinge_chains.LegChains`).
+(:class:`~cpm_nlp.core.chains.LegChains`, in core beside the chains it gives).
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis.compliance import check_declared
-from ...analysis.hinge_chains import LegChains
+from ...core.chains import LegChains
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
