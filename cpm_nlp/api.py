@@ -15,7 +15,6 @@ from .analysis.requirements import RequirementsReport, joint_requirements
 from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
 from .core.errors import CpmError, InputError
-from .core.kernels import status_of
 from .core.kind import ProblemKind
 from .core.kinematics import (
     JacobianReport,
@@ -29,6 +28,7 @@ from .core.kinematics import (
 )
 from .core.mechanism import CuboidExtras, DynamicsModel, JointStiffness, Mechanism, declare
 from .core.model import Coordinate, LoopClosure, Model
+from .core.pose_checks import status_of
 from .core.result import Result, ResultWarning, SolverInfo, Status
 from .core.solver import SolverConfig
 from .core.version import __version__

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.core.kernels import STATUSES, code_of
+from cpm_nlp.core.pose_checks import STATUSES, code_of
 from cpm_nlp.core.result import Status
 
 from .conftest import PAPER_PRS3, PROBLEMS, ROOT

@@ -730,7 +730,7 @@ def test_batch_progress_on_a_terminal_only(problem):
     import argparse
     import io
 
-    from cpm_nlp.cli.main import _progress_bars
+    from cpm_nlp.cli.bars import progress_bars as _progress_bars
 
     class Tty(io.StringIO):
         def isatty(self):

@@ -282,7 +282,8 @@ def test_kernel_checks_see_nan_and_inf():
     residual entry was skipped by fmax and the residual of [NaN, 1] was 1)."""
     import casadi as ca
 
-    from cpm_nlp.core.kernels import _all_finite, _robust_max_abs
+    from cpm_nlp.core.conditioning import all_finite as _all_finite
+    from cpm_nlp.core.conditioning import robust_max_abs as _robust_max_abs
 
     for sym in (ca.SX, ca.MX):
         v = sym.sym("v", 2)

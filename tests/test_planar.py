@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.cli.main import render_result
+from cpm_nlp.cli.render import render_result
 from cpm_nlp.core.units import format_quantity, size_dimension
 from cpm_nlp.plot import figures
 from cpm_nlp.plot import pose as plot_pose

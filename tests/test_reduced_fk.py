@@ -20,20 +20,15 @@ import pytest
 import cpm_nlp as cn
 from cpm_nlp.core.batch import _finish, evaluate, thread_pool
 from cpm_nlp.core.compiled import compiler_available
-from cpm_nlp.core.kernels import (
+from cpm_nlp.core.conditioning import (
     CERTIFY_DELTA,
-    PATHS,
-    SCALAR,
     LeftInverseBlocks,
     closure_blocks,
     cond1_block_bound,
     cond2_left_inverse_bound,
-    full_fk_kernel,
-    is_singular,
-    linearization,
-    reduced_fk_kernel,
-    shared_values,
 )
+from cpm_nlp.core.kernels import PATHS, full_fk_kernel, linearization, reduced_fk_kernel, shared_values
+from cpm_nlp.core.pose_checks import SCALAR, is_singular
 from cpm_nlp.core.result import Status
 from cpm_nlp.mechanisms.described import load_file
 

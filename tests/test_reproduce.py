@@ -59,7 +59,7 @@ def test_o_without_json_prints_the_table_and_writes_json(cli, tmp_path):
 
 
 def test_o_is_written_through_the_atomic_writer(cli, tmp_path, monkeypatch):
-    import cpm_nlp.cli.main as cli_main
+    import cpm_nlp.cli.reproduce as cli_main
 
     seen = []
     real = cli_main.write_atomic

@@ -354,7 +354,7 @@ def test_progress_bar_redraws_in_place_on_a_terminal():
     import argparse
     import io
 
-    from cpm_nlp.cli.main import _progress_bars
+    from cpm_nlp.cli.bars import progress_bars as _progress_bars
 
     class Tty(io.StringIO):
         def isatty(self):

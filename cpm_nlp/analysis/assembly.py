@@ -63,9 +63,9 @@ import numpy as np
 from ..core import progress
 from ..core.batch import batch_forward_kinematics, evaluate
 from ..core.errors import InputError
-from ..core.kernels import ROUND_TRIP_FACTOR, STATUSES
 from ..core.kinematics import PoseSolution, assess, forward_kinematics, passive_joints
 from ..core.model import Model
+from ..core.pose_checks import ROUND_TRIP_FACTOR, STATUSES
 from ..core.result import Status
 from ..core.solver import SolverConfig
 
