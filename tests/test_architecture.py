@@ -299,3 +299,36 @@ def test_core_holds_no_mutable_module_state():
     assert not unexpected, f"mutable module state in cpm_nlp.core: {unexpected}"
     stale = sorted(set(CORE_MUTABLE_ALLOWED) - set(found))
     assert not stale, f"no longer mutable (drop from CORE_MUTABLE_ALLOWED): {stale}"
+
+
+#: the test folders that are not a package path: suites of their own (issue 22, item 7)
+OWN_SUITES = ("hostile", "conformance", "corpus")
+#: tests of the project as a whole stay at the top of tests/
+PROJECT_TESTS = ("test_architecture.py", "test_docs.py", "test_install.py", "test_benchmarks.py")
+
+
+def test_tests_mirror_the_package():
+    """A feature's tests are found from its package path: tests/<subpackage>/test_*.py for
+    cpm_nlp/<subpackage>/, tests/mechanisms/<name>/ for a shipped mechanism (a package under
+    cpm_nlp/mechanisms/ or a file problems/mechanisms/<name>.yaml), and the hostile and
+    conformance suites and the external corpus in their own folders."""
+    tests = Path(__file__).resolve().parent
+    shipped = {p.stem for p in (PKG.parent / "problems" / "mechanisms").glob("*.yaml")}
+    misplaced = []
+    for f in sorted(tests.rglob("test_*.py")):
+        rel = f.relative_to(tests)
+        folder = rel.parent.parts
+        if not folder:
+            ok = rel.name in PROJECT_TESTS
+        elif folder[0] in OWN_SUITES:
+            ok = len(folder) == 1
+        else:
+            ok = (PKG.joinpath(*folder) / "__init__.py").is_file() or (
+                len(folder) == 2 and folder[0] == "mechanisms" and folder[1] in shipped
+            )
+        if not ok:
+            misplaced.append(str(rel))
+    assert not misplaced, f"test files outside a package path: {misplaced}"
+    # every test folder is a package (the same basename may appear in two folders)
+    for d in {f.parent for f in tests.rglob("test_*.py")} - {tests}:
+        assert (d / "__init__.py").is_file(), d

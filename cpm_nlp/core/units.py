@@ -82,7 +82,7 @@ DIMENSIONS: Mapping[str, Dimension] = MappingProxyType(
 
 
 #: unit text -> (factor to pint's root units, dimension), for the units of DIMENSIONS: the
-#: floats pint gives (Quantity(1.0, unit).to_root_units().magnitude; tests/test_units.py
+#: floats pint gives (Quantity(1.0, unit).to_root_units().magnitude; tests/core/test_units.py
 #: checks each against pint)
 FAST_UNITS: Mapping[str, tuple[float, str]] = MappingProxyType(
     {
