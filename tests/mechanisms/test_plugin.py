@@ -88,7 +88,7 @@ def test_conformance_suite_runs_over_the_plugin(installed):
             "no:cacheprovider",
             "-o",
             "addopts=",
-            str(ROOT / "tests" / "test_conformance.py"),
+            str(ROOT / "tests" / "conformance" / "test_conformance.py"),
             "-k",
             "biglide",
         ],
