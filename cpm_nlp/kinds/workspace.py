@@ -35,9 +35,10 @@ from ..core.mechanism import CuboidExtras
 from ..core.model import Model
 from ..core.multistart import start_options
 from ..core.options import Option
+from ..core.outputs import Output, declared_result, outputs_of, size
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
-from ..core.units import si_unit, size_dimension
+from ..core.units import size_dimension
 from .hinge_inputs import stress_limit_option
 from .kinematic import _model_info
 
@@ -50,8 +51,16 @@ def _paper_membership(model: Model) -> Any:
     return model.mechanism.paper_membership if model.mechanism is not None else None
 
 
-def _unit(dim: str) -> str:
-    return "SI unit of the binding quantity" if dim == "si" else si_unit(dim)
+#: the unit of a margin: that of whichever quantity binds (a length, an angle, a stress ...)
+BINDING_UNIT = "SI unit of the binding quantity"
+
+
+def _declared(model: Model, dims: Mapping[str, str]) -> list[Output]:
+    """The outputs of the workspace kinds by their dimensions: no unit for what has none, a
+    margin's of the binding quantity, a task box's size by its sides."""
+    kinds = [model.closure.x[i].kind for i in model.closure.task_index]
+    special = {"si": lambda o: Output(o.name, "si", unit=BINDING_UNIT), "task volume": lambda o: size(o.name, kinds)}
+    return [special.get(o.dimension, lambda o: o)(o) for o in outputs_of(dims, named=False)]
 
 
 def _region_options(model: Model) -> list[Option]:
@@ -169,7 +178,7 @@ class InscribedCuboid(ProblemKind):
             refinements=inputs["refinements"],
             region=_region(inputs, model, ("inputs",)),
         )
-        vdim, vunit = _volume_dimension(model)
+        vdim = _volume_dimension(model)[0]
         values: dict[str, Any] = {}
         dims: dict[str, str] = {}
         for k, t in enumerate(c.task):
@@ -226,17 +235,16 @@ class InscribedCuboid(ProblemKind):
             )
             if values.get("certificate"):
                 message += f"; {values['certificate']}"
-        units = {k: (vunit if d == "task volume" else _unit(d)) for k, d in dims.items()}
-        return Result(
+        undeclared = [k for k in values if k not in dims]  # a mechanism's values of no box: dimension not said
+        outputs = _declared(model, dims) + [Output(k, "unknown", unit="") for k in undeclared]
+        return declared_result(
             self.name,
             status,
+            outputs,
             values,
-            units,
-            dims,
-            SolverInfo("ipopt", res.iterations, res.seconds),
-            message,
-            None,
-            _model_info(model),
+            solver=SolverInfo("ipopt", res.iterations, res.seconds),
+            message=message,
+            model=_model_info(model),
         )
 
 
@@ -335,8 +343,12 @@ class Workspace(ProblemKind):
                 f"{mem.count_undecided} of {len(mem.status)} given points undecided (no pose on the designated "
                 "branch found from any start)"
             )
-        vunit = _volume_dimension(model)[1]
-        units = {k: (vunit if d == "task volume" else _unit(d)) for k, d in dims.items()}
-        return Result(
-            self.name, status, values, units, dims, SolverInfo(solver.name), message, None, _model_info(model)
+        return declared_result(
+            self.name,
+            status,
+            _declared(model, dims),
+            values,
+            solver=SolverInfo(solver.name),
+            message=message,
+            model=_model_info(model),
         )
