@@ -347,3 +347,20 @@ def test_the_mutable_state_check_sees_each_form():
         if _makes_mutable(st.value)
     }
     assert made == set("ABCDEFGH")
+
+
+def test_results_are_built_from_declared_outputs_only():
+    """Issue 22, item 2: outside cpm_nlp.core no code calls ``Result(...)``: a kind builds its
+    result from its declared outputs (core.outputs.declared_result), so it writes no unit or
+    dimension by hand."""
+    calls = []
+    for path in sorted(PKG.rglob("*.py")):
+        if path.is_relative_to(PKG / "core"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call):
+                f = node.func
+                name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+                if name == "Result":
+                    calls.append(f"{path.relative_to(PKG.parent)}:{node.lineno}")
+    assert not calls, calls

@@ -162,20 +162,26 @@ def _formula_stiffness(model: Model, hs: cm.HingeSet) -> Values:
     return out
 
 
+def _compliance_output(c: Any) -> Output:
+    """The output compliance C (rows and columns the pose coordinates)."""
+    units = f"{result_unit('compliance')}, {result_unit('rotational_compliance')} and mixed"
+    return matrix("C", f"rows and columns {_coordinate_list(c.x)}; {units}")
+
+
+def _diagonal_output(x: Coordinate) -> Output:
+    """A diagonal entry of C: a compliance along a length, a rotational one about an angle."""
+    return Output(f"C_{x.name}", "compliance" if x.kind == "length" else "rotational_compliance")
+
+
 def _compliance_matrix(c: Any, C: np.ndarray, linear: np.ndarray) -> Values:
     """The output compliance C and the linear deflection C f."""
-    xs = _coordinate_list(c.x)
-    units = f"{result_unit('compliance')}, {result_unit('rotational_compliance')} and mixed"
-    out = Values().add(matrix("C", f"rows and columns {xs}; {units}"), C.tolist())
-    return out.add(vector("deflection_linear", xs), linear.tolist())
+    out = Values().add(_compliance_output(c), C.tolist())
+    return out.add(vector("deflection_linear", _coordinate_list(c.x)), linear.tolist())
 
 
 def _diagonal_compliance(c: Any, C: np.ndarray) -> Values:
     """The diagonal of C, one value per pose coordinate."""
-    kinds = {"length": "compliance"}
-    return Values().add_all(
-        (Output(f"C_{x.name}", kinds.get(x.kind, "rotational_compliance")), float(C[i, i])) for i, x in enumerate(c.x)
-    )
+    return Values().add_all((_diagonal_output(x), float(C[i, i])) for i, x in enumerate(c.x))
 
 
 def _deflection_values(c: Any, d: np.ndarray) -> Values:
@@ -594,12 +600,26 @@ class PlatformCompliance(_HingeKind):
         res.warn(*_six_axis_warnings(sm, [z_l]))
         return res.warn(*validity.linear_range_warnings(d, C @ f, c.x_names, [x.kind for x in c.x]))
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
         c = model.closure
-        names = _pose_names(model)[0] + ["C", "deflection_linear", "deflection", "q_loaded", "stress_max_loaded"]
-        names += [f"C_{x.name}" for x in c.x] + [f"d_{x.name}" for x in c.x]
-        names += ["hinge_model", "stress_max_unloaded"] + [f"F{j + 1}_loaded" for j in range(c.nq)]
-        return names
+        xs, qs = _coordinate_list(c.x), _coordinate_list(c.q)
+        return [
+            *_pose_outputs(model),
+            _compliance_output(c),
+            vector("deflection_linear", xs),
+            vector("deflection", xs),
+            vector("q_loaded", qs),
+            Output("stress_max_loaded", "stress"),
+            *(_diagonal_output(x) for x in c.x),
+            *(Output(f"d_{x.name}", x.kind) for x in c.x),
+            text("hinge_model"),
+            Output("stress_max_unloaded", "stress"),
+            *(_force_output(f"F{j + 1}_loaded", q) for j, q in enumerate(c.q)),
+        ]
+
+
+#: how many frequencies equal each mode's own
+MULTIPLICITY = vector("multiplicity", "per mode: how many frequencies equal its own (1: a simple frequency)")
 
 
 def _mode_outputs(c: Any) -> list[Output]:
@@ -702,10 +722,7 @@ class NaturalFrequencies(_HingeKind):
         freq = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
         out.add_all((Output(f"f{k + 1}", "frequency"), float(freq[k])) for k in range(c.nq))
         out.add_all(zip(_mode_outputs(c), (M.tolist(), K.tolist(), modes.T.tolist(), (sp.J @ modes).T.tolist())))
-        out.add(
-            vector("multiplicity", "per mode: how many frequencies equal its own (1: a simple frequency)"),
-            multiplicities(clusters),
-        )
+        out.add(MULTIPLICITY, multiplicities(clusters))
         msg = "frequencies from |K_q - (2 pi f)^2 M| = 0 at the pose"
         repeated = [idx for idx in clusters if len(idx) > 1]
         if repeated:
@@ -713,7 +730,7 @@ class NaturalFrequencies(_HingeKind):
         res = _hinge_result(self.name, model, Status.SOLVED, out, info, msg)
         return res.warn(*_point_warnings(hs, [sp]))
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
         c = model.closure
-        names = _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)]
-        return names + ["M", "K", "modes_q", "modes_x", "multiplicity"]
+        frequencies = [Output(f"f{k + 1}", "frequency") for k in range(c.nq)]
+        return [*_pose_outputs(model), *frequencies, *_mode_outputs(c), MULTIPLICITY]
