@@ -260,6 +260,11 @@ class Result:
         warnings: Sequence[ResultWarning] = (),
         origin: Origin | None = None,
     ) -> None:
+        if isinstance(outputs, Mapping):  # the values, as Result took them before it held its outputs
+            raise TypeError(
+                f"{problem}: a Result takes its declared outputs (a sequence of Output), then the values; "
+                "build it with cpm_nlp.core.outputs.declared_result"
+            )
         self.problem = problem
         self.status = status
         self._outputs: dict[str, Output] = {}

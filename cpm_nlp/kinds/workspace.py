@@ -276,14 +276,19 @@ class Workspace(ProblemKind):
         if have:
             broadcast([inputs[t] for t in task], task, path)
 
-    def output_names(self, model: Model) -> list[str]:
-        task = list(model.closure.task)
-        return (
-            ["inside", "status", "margin", "binding", "inside_paper", "count_inside", "count_undecided"]
-            + [f"cloud_{t}" for t in task]
-            + ["cloud_count", "cloud_undecided", "volume_estimate", "volume_estimate_error", "volume_estimate_upper"]
-            + [f"{t}_range" for t in task]
+    def outputs(self, model: Model) -> list[Output]:
+        """Membership of the given points (inside, status, margin, binding, the paper's own
+        test where the mechanism has one), then the cloud, its volume estimate and region."""
+        c = model.closure
+        task = [c.x[i] for i in c.task_index]
+        dims = dict.fromkeys(("inside", "status"), "text") | {"margin": "si", "binding": "text", "inside_paper": "text"}
+        dims |= dict.fromkeys(("count_inside", "count_undecided"), "dimensionless")
+        dims |= {f"cloud_{x.name}": x.kind for x in task}
+        dims |= dict.fromkeys(("cloud_count", "cloud_undecided"), "dimensionless")
+        dims |= dict.fromkeys(
+            ("volume_estimate", "volume_estimate_error", "volume_estimate_upper"), _volume_dimension(model)[0]
         )
+        return _declared(model, dims | {f"{x.name}_range": x.kind for x in task})
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         model = inputs.get("stress_limit") or model
