@@ -285,6 +285,25 @@ class Result:
     def __repr__(self) -> str:
         return f"Result({self.problem!r}, {self.status.value}, {dict(self._values)!r}, message={self.message!r})"
 
+    def _key(self) -> tuple:
+        return (
+            self.problem,
+            self.status,
+            self.outputs,
+            self._values,
+            self.solver,
+            self.message,
+            self.statuses,
+            self.model,
+            self.warnings,
+            self.origin,
+        )
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Result) and self._key() == other._key()
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, as the dataclass it was
+
     # -- the declaration and the values ------------------------------------------------------
 
     def declare(self, outputs: Sequence[Output]) -> Result:
