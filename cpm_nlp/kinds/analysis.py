@@ -127,15 +127,11 @@ class ActuatorWorkspace(ProblemKind):
             not_assembled_fraction=missing / len(rep.q),
             volume_border=float(rep.details.get("volume_border", 0.0)),
         )
-        corners = "box corners that assemble" if missing else "box corners"
-        cols = ", ".join(f"{n} [{result_unit(dims[n + '_min'])}]" for n in names)
-        outputs = [
-            matrix(o.name, f"rows: {corners}; columns {cols}") if o.name == "vertices" else o for o in outputs_of(dims)
-        ]
+        vertices, points = _image_outputs(model, bool(missing))
+        outputs = [vertices if o.name == "vertices" else o for o in outputs_of(dims)]
         if inputs["points"]:
             values["points"] = rep.t[np.all(np.isfinite(rep.t), axis=1)].tolist()
-            grid = "grid points that assemble" if missing else "grid points"
-            outputs.append(matrix("points", f"rows: {grid}; columns {cols}"))
+            outputs.append(points)
         res = closed_form_result(self.name, model, values, outputs, rep.status, rep.message, info)
         if missing:
             res.warn(
@@ -151,7 +147,19 @@ class ActuatorWorkspace(ProblemKind):
         return res
 
     def outputs(self, model: Model) -> list[Output]:
-        return outputs_of(self._dims(model)) + [matrix("points", "rows: grid points; columns the task coordinates")]
+        vertices, points = _image_outputs(model, False)
+        return [vertices if o.name == "vertices" else o for o in outputs_of(self._dims(model))] + [points]
+
+
+def _image_outputs(model: Model, partly: bool) -> tuple[Output, Output]:
+    """The images of the stroke box's corners (``vertices``) and of its grid (``points``), rows
+    of task coordinates; ``partly``: only those that assemble."""
+    c = model.closure
+    cols = ", ".join(f"{c.x[i].name} [{result_unit(c.x[i].kind)}]" for i in c.task_index)
+    that = " that assemble" if partly else ""
+    return matrix("vertices", f"rows: box corners{that}; columns {cols}"), matrix(
+        "points", f"rows: grid points{that}; columns {cols}"
+    )
 
 
 # -- dynamics -------------------------------------------------------------------------------------
