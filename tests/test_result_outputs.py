@@ -116,6 +116,8 @@ def test_a_result_extended_by_a_kind_declares_what_it_adds():
         "rrr3_workspace.yaml",
         "prc3_amplifier.yaml",
         "prc3_dynamics.yaml",
+        "five_bar_synthesis.yaml",
+        "pantograph_synthesis.yaml",
     ],
 )
 def test_a_kind_writes_the_units_it_declares(name):

@@ -231,6 +231,9 @@ class CuboidSynthesis(SynthesisFormulation):
             named=False,
         )
 
+    def outputs(self, model: Model) -> list[Output]:
+        return self._outputs(model, None)
+
     def output_names(self, model: Model, inputs: Mapping[str, Any] | None = None) -> list[str]:
         return output_names(self._outputs(model, inputs))
 
@@ -276,6 +279,9 @@ class Synthesis(ProblemKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         require_ipopt(solver, self.name)
         return formulation(model).run(model, inputs, solver)
+
+    def outputs(self, model: Model) -> list[Output]:
+        return formulation(model).outputs(model)
 
     def output_names(self, model: Model) -> list[str]:
         return formulation(model).output_names(model)

@@ -49,7 +49,7 @@ from ...core.errors import InputError
 from ...core.model import Model
 from ...core.multistart import AGREEMENT, best_and_agreement, start_options, uniform_starts
 from ...core.options import Option
-from ...core.outputs import declared_result, outputs_of
+from ...core.outputs import Output, declared_result, outputs_of
 from ...core.result import Result, SolverInfo, Status
 from ...core.schema import Record
 from ...core.solver import SolverConfig
@@ -239,8 +239,8 @@ class PantographSynthesis(SynthesisFormulation):
             )
         _material(inputs, path)
 
-    def output_names(self, model: Model) -> list[str]:
-        return list(OUTPUT_DIMS)
+    def outputs(self, model: Model) -> list[Output]:
+        return outputs_of(OUTPUT_DIMS, named=False)
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         t0 = time.perf_counter()
