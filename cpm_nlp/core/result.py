@@ -196,7 +196,7 @@ class Output:
     """One value a kind returns, declared once.
 
     name: its name in the result (the papers' symbol); dimension: "length", "angle" ...
-    (or "matrix", "text" for what has no SI unit); role: one of :data:`ROLES`;
+    (or "matrix", "vector", "text" for what has no SI unit); role: one of :data:`ROLES`;
     refers_to: the output a "reference" is taken from (x0 of an offset dx); unit: the
     unit text where the dimension's SI unit does not say it (a matrix's rows and columns).
     """
@@ -308,10 +308,11 @@ class Result:
 
     def declare(self, outputs: Sequence[Output]) -> Result:
         """Add declared outputs (after those declared so far); a name is declared once."""
-        for o in outputs:
-            if o.name in self._outputs:
-                raise ValueError(f"{self.problem}: output {o.name!r} is declared twice")
-            self._outputs[o.name] = o
+        names = [o.name for o in outputs]
+        twice = sorted({n for n in names if n in self._outputs or names.count(n) > 1})
+        if twice:
+            raise ValueError(f"{self.problem}: output {', '.join(map(repr, twice))} is declared twice")
+        self._outputs.update((o.name, o) for o in outputs)
         return self
 
     def set(self, values: Mapping[str, Any]) -> Result:
