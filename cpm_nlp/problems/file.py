@@ -27,11 +27,11 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import InputError, suggest, unknown_key_error
-from ..core.finite import check_numbers, finite_status
+from ..core.finite import check_numbers
 from ..core.kind import ProblemKind
 from ..core.model import Model
 from ..core.origin import Origin
-from ..core.result import Result
+from ..core.result import Result, finite_status
 from ..core.solver import SolverConfig
 from ..io.datafile import data_file_of, merge_data_file
 from ..io.inputs import display_name, input_dir
@@ -202,6 +202,5 @@ def solve(problem: Problem) -> Result:
         result.origin = problem.origin
     result = finite_status(result)  # a NaN or an inf is a failed status, never an answer
     if problem.outputs is not None:
-        keep = set(problem.outputs)
-        result.values = {k: v for k, v in result.values.items() if k in keep}
+        result.keep(problem.outputs)
     return result

@@ -28,8 +28,8 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cpm_nlp.core.finite import finite_status
-from cpm_nlp.core.result import Result, SolverInfo, Status
+from cpm_nlp.core.outputs import Output, outputs_of
+from cpm_nlp.core.result import Result, SolverInfo, Status, finite_status
 from cpm_nlp.io.results import _cell
 from cpm_nlp.kinds.kinematic import ForwardKinematics
 from tests.conftest import PROBLEMS, run_cli
@@ -267,9 +267,7 @@ def test_a_result_that_is_not_finite_is_a_failed_status(tmp_path, monkeypatch):
 
     def run(self, model, inputs, solver):
         result = real(self, model, inputs, solver)
-        result.values["pz"] = math.inf
-        result.values["psi"] = [0.1, math.nan]
-        return result
+        return result.set({"pz": math.inf, "psi": [0.1, math.nan]})
 
     monkeypatch.setattr(ForwardKinematics, "run", run)
     problem = tmp_path / "fk.yaml"
@@ -291,7 +289,8 @@ def test_a_result_that_is_not_finite_is_a_failed_status(tmp_path, monkeypatch):
 
 
 def test_a_failed_result_keeps_its_status_and_loses_its_infs():
-    r = Result("x", Status.NOT_CONVERGED, {"a": np.array([1.0, np.inf]), "b": 2.0}, message="no")
+    outputs = outputs_of({"a": "vector", "b": "length"})
+    r = Result("x", Status.NOT_CONVERGED, outputs, {"a": np.array([1.0, np.inf]), "b": 2.0}, message="no")
     finite_status(r)
     assert r.status is Status.NOT_CONVERGED and r.values == {"a": [1.0, None], "b": 2.0}
     assert r.message.startswith("not finite") and r.message.endswith("; no")
@@ -334,7 +333,8 @@ _values = st.recursive(
     model=st.dictionaries(st.text(max_size=5), _values, max_size=3),
 )
 def test_result_to_json_never_fails_nor_holds_nan(values, model):
-    r = Result("p", Status.SOLVED, values, {"a": "m"}, {}, SolverInfo("s", 1, math.nan), "msg", None, model)
+    outputs = [Output("a", "length")] + [Output(k, "text", "text") for k in values if k != "a"]
+    r = Result("p", Status.SOLVED, outputs, values, solver=SolverInfo("s", 1, math.nan), message="msg", model=model)
     text = r.to_json()
     json.loads(text, parse_constant=_no_constant)
     finite_status(r)

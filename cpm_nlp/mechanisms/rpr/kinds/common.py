@@ -14,8 +14,8 @@ from ....core.errors import InputError
 from ....core.kind import ProblemKind
 from ....core.model import Model
 from ....core.options import Option
+from ....core.outputs import Output, declared_result
 from ....core.result import STATUS_TEXT, Result, SolverInfo, Status
-from ....core.units import result_unit
 from ....kinds.kinematic import _model_info
 
 MM = 1e-3
@@ -55,21 +55,27 @@ def _finish(
     solver: SolverInfo | None = None,
     message: str = "",
 ) -> Result:
+    """The result of an RPR kind: each value declared by its dimension (``dims``), with its
+    own unit text from ``units`` where the dimension's SI unit does not say it."""
     if not status.ok:
         values = {}
-    u = {k: "" if d in ("matrix", "bool") else result_unit(d) for k, d in dims.items()}
-    u.update(units or {})
-    return Result(
+    texts = units or {}
+    return declared_result(
         kind,
         status,
+        [_output(k, dims[k], texts.get(k)) for k in values],
         values,
-        {k: u[k] for k in values},
-        {k: dims[k] for k in values},
-        solver or SolverInfo("none"),
-        message or STATUS_TEXT[status],
-        None,
-        _model_info(model),
+        solver=solver,
+        message=message or STATUS_TEXT[status],
+        model=_model_info(model),
     )
+
+
+def _output(name: str, dimension: str, unit: str | None) -> Output:
+    """An output of an RPR kind: a matrix or a flag has no unit unless its text is given."""
+    if unit is None and dimension in ("matrix", "bool"):
+        unit = ""
+    return Output(name, dimension, dimension if dimension in ("matrix", "text") else "value", unit=unit)
 
 
 def _check_material(mat: Any, path: tuple) -> flexure.Material:

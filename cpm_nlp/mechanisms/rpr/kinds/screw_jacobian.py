@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ....core.model import Model
+from ....core.outputs import Output, Values, matrix
 from ....core.result import Result
 from ....core.solver import SolverConfig
 from ....kinds.kinematic import Jacobian
@@ -16,6 +17,13 @@ from .. import screws as rpr_screws
 from .common import RprKind, _matrix
 
 # -- eq 7-13 --------------------------------------------------------------------------------------
+
+
+def _agreement_output(name: str, difference: str) -> Output:
+    """The largest entry of a difference of two matrices (0 within rounding)."""
+    return Output(
+        name, "dimensionless", unit=f"max |{difference}| (0 where within rounding: 1e-12 of the largest entry)"
+    )
 
 
 class ScrewJacobian(RprKind, Jacobian):
@@ -31,33 +39,26 @@ class ScrewJacobian(RprKind, Jacobian):
         st = rpr_screws.screw_jacobian(model, x)
         G_p_ad = rpr_compliance.passive_rates(model, x)[1]
         J_ad = np.array(res.values["J_inv"])
-        extra = {
-            "S_t": _matrix(st.S_t),
-            "J_a": _matrix(st.J_a),
-            "J_b": _matrix(st.J_b),
-            "J_st": _matrix(st.J),
-            "G_st": _matrix(st.G),
-            "G_p": _matrix(st.G_p),
-            "G_p_ad": _matrix(G_p_ad),
-            "dJ": _agreement(st.J, J_ad),
-            "dG_p": _agreement(st.G_p, G_p_ad),
-        }
-        res.values.update(extra)
-        res.units.update(
-            {
-                "S_t": "columns theta, alpha, P; rows wx wy wz [rad] vx vy vz [m] at o'",
-                "J_a": "eq 9",
-                "J_b": "eq 9",
-                "J_st": "rows l1 l2 l3 per columns theta, alpha [rad], P [m] (eq 10; = J_inv by AD)",
-                "G_st": "rows theta, alpha [rad], P [m] per columns l1 l2 l3 [m] (eq 11; = J by AD)",
-                "G_p": "rows " + ", ".join(model.closure.passive_names) + " [rad] per l1 l2 l3 [m] (eq 13)",
-                "G_p_ad": "as G_p, by AD of the passive joint angles",
-                "dJ": "max |J_st - J_inv| (0 where within rounding: 1e-12 of the largest entry)",
-                "dG_p": "max |G_p - G_p_ad| (0 where within rounding: 1e-12 of the largest entry)",
-            }
+        passive = ", ".join(model.closure.passive_names)
+        extra = (
+            Values()
+            .add(matrix("S_t", "columns theta, alpha, P; rows wx wy wz [rad] vx vy vz [m] at o'"), _matrix(st.S_t))
+            .add(matrix("J_a", "eq 9"), _matrix(st.J_a))
+            .add(matrix("J_b", "eq 9"), _matrix(st.J_b))
+            .add(
+                matrix("J_st", "rows l1 l2 l3 per columns theta, alpha [rad], P [m] (eq 10; = J_inv by AD)"),
+                _matrix(st.J),
+            )
+            .add(
+                matrix("G_st", "rows theta, alpha [rad], P [m] per columns l1 l2 l3 [m] (eq 11; = J by AD)"),
+                _matrix(st.G),
+            )
+            .add(matrix("G_p", f"rows {passive} [rad] per l1 l2 l3 [m] (eq 13)"), _matrix(st.G_p))
+            .add(matrix("G_p_ad", "as G_p, by AD of the passive joint angles"), _matrix(G_p_ad))
+            .add(_agreement_output("dJ", "J_st - J_inv"), _agreement(st.J, J_ad))
+            .add(_agreement_output("dG_p", "G_p - G_p_ad"), _agreement(st.G_p, G_p_ad))
         )
-        res.dimensions.update({k: ("dimensionless" if k.startswith("d") else "matrix") for k in extra})
-        return res
+        return res.declare(extra.outputs).set(extra.values)
 
     def output_names(self, model: Model) -> list[str]:
         return super().output_names(model) + ["S_t", "J_a", "J_b", "J_st", "G_st", "G_p", "G_p_ad", "dJ", "dG_p"]
