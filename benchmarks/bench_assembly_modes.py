@@ -44,8 +44,8 @@ sys.path.insert(0, str(ROOT))
 from cpm_nlp.analysis import assembly  # noqa: E402
 from cpm_nlp.analysis.mode_certificate import certify_modes  # noqa: E402
 from tests import dietmaier  # noqa: E402
+from tests.analysis.test_mode_certificate import file_model, four_bar  # noqa: E402
 from tests.random_platforms import Platform66, contains  # noqa: E402
-from tests.test_mode_certificate import file_model, four_bar  # noqa: E402
 
 #: the search before this benchmark's change: 2000 starts, plain Newton from each
 BEFORE = {"starts": 2000, "damped_steps": 0}

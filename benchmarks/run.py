@@ -56,7 +56,8 @@ from scipy.optimize import fsolve
 import cpm_nlp as cn
 from cpm_nlp.core.batch import default_threads, evaluate
 from cpm_nlp.core.compiled import compiled_function, compiler_available
-from cpm_nlp.core.kernels import FastFunction, fk_kernel, full_fk_kernel, ik_kernel, shared_values
+from cpm_nlp.core.fast_calls import FastFunction
+from cpm_nlp.core.kernels import fk_kernel, full_fk_kernel, ik_kernel, shared_values
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}

@@ -18,7 +18,6 @@ from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_c
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
 from .core.chains import LegChains
 from .core.errors import CpmError, InputError
-from .core.kernels import status_of
 from .core.kind import ProblemKind
 from .core.kinematics import (
     JacobianReport,
@@ -32,6 +31,7 @@ from .core.kinematics import (
 )
 from .core.mechanism import Mechanism, Part, declare
 from .core.model import Coordinate, LoopClosure, Model
+from .core.pose_checks import status_of
 from .core.result import Result, ResultWarning, SolverInfo, Status
 from .core.solver import SolverConfig
 from .core.version import __version__

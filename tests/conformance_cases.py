@@ -1,4 +1,4 @@
-"""Generated problems of every generic kind for any mechanism (tests/test_conformance.py).
+"""Generated problems of every generic kind for any mechanism (tests/conformance/test_conformance.py).
 
 A *subject* is a mechanism as a problem file names it (its ``mechanism:`` section, from its
 first shipped problem file, or a mechanism file of the corpus) and the model built from it.

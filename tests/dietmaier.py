@@ -1,5 +1,5 @@
 """Dietmaier's 6-6 Stewart-Gough platform with 40 real assembly modes: the source's numbers
-and an independent numpy check of a pose (the leg lengths), for tests/test_dietmaier_modes.py
+and an independent numpy check of a pose (the leg lengths), for tests/analysis/test_dietmaier_modes.py
 and benchmarks/bench_assembly_modes.py.
 
 Source: P. Dietmaier, "The Stewart-Gough platform of general geometry can have 40 real
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .gallery_reference import rot_x, rot_y, rot_z
+from tests.gallery_reference import rot_x, rot_y, rot_z
 
 MECHANISM = Path(__file__).resolve().parent / "corpus" / "dietmaier_6_6.yaml"
 PROBLEM = Path(__file__).resolve().parent / "corpus" / "problems" / "dietmaier_6_6_modes.yaml"

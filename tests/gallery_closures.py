@@ -1,6 +1,6 @@
 """The gallery mechanisms as hand-written LoopClosures (CasADi), so that the
 generic machinery (FK, IK, Jacobians, all assembly modes, synthesis) can be
-exercised on them now; tests/test_gallery.py checks each against the
+exercised on them now; tests/mechanisms/described/test_gallery.py checks each against the
 independent numpy references of tests/gallery_reference.py (which share no
 code with this file).  Parameters are SI; default values are those of the
 references.

@@ -15,7 +15,7 @@ Conventions (SI, radians):
 * every ``ik_*`` returns the actuator values, every ``fk_*`` the pose; a
   pose that cannot be assembled raises :class:`Unreachable`.
 
-Each mechanism has ``selftest_*``, run by tests/test_gallery_reference.py:
+Each mechanism has ``selftest_*``, run by tests/mechanisms/described/test_gallery.py:
 round trips FK(IK(t)) = t, known poses, and the closure equations at the
 returned poses.
 """

@@ -2,7 +2,7 @@
 mechanism files (six U-P-S legs, no symmetry), with their inverse kinematics in
 numpy (the leg lengths), for the round trip of the assembly-mode search: a
 random pose -> its leg lengths -> the search must find that pose among the
-modes (tests/test_assembly_modes.py, benchmarks/bench_assembly_modes.py)."""
+modes (tests/analysis/test_assembly_modes.py, benchmarks/bench_assembly_modes.py)."""
 
 from __future__ import annotations
 

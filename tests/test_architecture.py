@@ -183,6 +183,21 @@ def test_plot_modules_stay_small():
     assert not big, big
 
 
+#: modules of the package over 800 lines, and why they still are
+LARGE_ALLOWED = {
+    "mechanisms/described/generate.py": "being split by another change (issue 22, item 6)",
+    "mechanisms/described/graph.py": "being split by another change (issue 22, item 6)",
+    "mechanisms/described/spec.py": "being split by another change (issue 22, item 6)",
+}
+
+
+def test_every_module_stays_small():
+    """One concept per module (issue 22, item 6): no module of the package over 800 lines
+    (kernels, the CLI, the URDF import and the RPR kinds were split for it)."""
+    big = {str(f.relative_to(PKG)): n for f in PKG.rglob("*.py") if (n := len(f.read_text().splitlines())) > 800}
+    assert not set(big) - set(LARGE_ALLOWED), {k: v for k, v in big.items() if k not in LARGE_ALLOWED}
+
+
 def test_plot_modules_import_no_private_name():
     """What a plot module shares with another is public (the common helpers in
     cpm_nlp.plot.style): no ``from .x import _name`` in the plot layer."""
@@ -238,14 +253,11 @@ def test_the_removed_prs3_module_says_where_the_mechanism_is():
 
 
 #: module globals of cpm_nlp.core that may be mutable containers, and why: process caches of
-#: compiled code and threads (never problem data), and read-only tables of a module another
-#: change is reworking (issue 22, item 2), to be wrapped read-only with it
+#: compiled code and threads (never problem data)
 CORE_MUTABLE_ALLOWED = {
     "cpm_nlp.core.batch._MAPPED": "LRU cache of mapped CasADi functions (code, not problem data)",
     "cpm_nlp.core.batch._POOLS": "thread pools by worker count, made once per process",
     "cpm_nlp.core.blas._STATE": "the process's BLAS thread controller, set up once",
-    "cpm_nlp.core.result.STATUS_TEXT": "read-only table; core/result.py is being reworked (item 2)",
-    "cpm_nlp.core.result.WARNING_CODES": "read-only table; core/result.py is being reworked (item 2)",
     "cpm_nlp.core.solver._BUILT": "each closure's built solvers and kernels (code), weakly keyed by the closure",
 }
 
@@ -286,3 +298,132 @@ def test_core_holds_no_mutable_module_state():
     assert not unexpected, f"mutable module state in cpm_nlp.core: {unexpected}"
     stale = sorted(set(CORE_MUTABLE_ALLOWED) - set(found))
     assert not stale, f"no longer mutable (drop from CORE_MUTABLE_ALLOWED): {stale}"
+
+
+#: the test folders that are not a package path: suites of their own (issue 22, item 7)
+OWN_SUITES = ("hostile", "conformance", "corpus")
+#: tests of the project as a whole stay at the top of tests/
+PROJECT_TESTS = ("test_architecture.py", "test_docs.py", "test_install.py", "test_benchmarks.py")
+
+
+def test_tests_mirror_the_package():
+    """A feature's tests are found from its package path: tests/<subpackage>/test_*.py for
+    cpm_nlp/<subpackage>/, tests/mechanisms/<name>/ for a shipped mechanism (a package under
+    cpm_nlp/mechanisms/ or a file problems/mechanisms/<name>.yaml), and the hostile and
+    conformance suites and the external corpus in their own folders."""
+    tests = Path(__file__).resolve().parent
+    shipped = {p.stem for p in (PKG.parent / "problems" / "mechanisms").glob("*.yaml")}
+    misplaced = []
+    for f in sorted(tests.rglob("test_*.py")):
+        rel = f.relative_to(tests)
+        folder = rel.parent.parts
+        if not folder:
+            ok = rel.name in PROJECT_TESTS
+        elif folder[0] in OWN_SUITES:
+            ok = len(folder) == 1
+        else:
+            ok = (PKG.joinpath(*folder) / "__init__.py").is_file() or (
+                len(folder) == 2 and folder[0] == "mechanisms" and folder[1] in shipped
+            )
+        if not ok:
+            misplaced.append(str(rel))
+    assert not misplaced, f"test files outside a package path: {misplaced}"
+    # every test folder is a package (the same basename may appear in two folders)
+    for d in {f.parent for f in tests.rglob("test_*.py")} - {tests}:
+        assert (d / "__init__.py").is_file(), d
+
+
+#: calls that make a mutable container (a module global made by one is module state)
+_MUTABLE_CALLS = frozenset(
+    {
+        "dict",
+        "list",
+        "set",
+        "defaultdict",
+        "OrderedDict",
+        "deque",
+        "bytearray",
+        "Counter",
+        "WeakKeyDictionary",
+        "WeakValueDictionary",
+    }
+)
+
+
+def _makes_mutable(node: ast.expr) -> bool:
+    """Whether ``node`` makes a mutable container: a dict, list or set display or
+    comprehension, or a call of :data:`_MUTABLE_CALLS` (one wrapped in MappingProxyType,
+    tuple or frozenset is a call of those, and read-only)."""
+    if isinstance(node, (ast.Dict, ast.List, ast.Set, ast.DictComp, ast.ListComp, ast.SetComp)):
+        return True
+    if isinstance(node, ast.Call):
+        f = node.func
+        name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+        return name in _MUTABLE_CALLS
+    return False
+
+
+def _core_mutable_assignments() -> dict[str, int]:
+    """'module.NAME' -> line of every module-level assignment in cpm_nlp/core whose value
+    makes a mutable container (read from the source, so a table built by a function and
+    never read at import is found too)."""
+    found: dict[str, int] = {}
+    for path in sorted((PKG / "core").rglob("*.py")):
+        module = ".".join(path.relative_to(PKG.parent).with_suffix("").parts).removesuffix(".__init__")
+        for st in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(st, ast.Assign):
+                targets, value = st.targets, st.value
+            elif isinstance(st, (ast.AnnAssign, ast.AugAssign)):
+                targets, value = [st.target], st.value
+            else:
+                continue
+            if value is None or not _makes_mutable(value):
+                continue
+            for t in targets:
+                for name in ast.walk(t):
+                    if isinstance(name, ast.Name):
+                        found[f"{module}.{name.id}"] = st.lineno
+    return found
+
+
+def test_core_source_assigns_no_mutable_module_state():
+    """Issue 22: no module of cpm_nlp.core assigns a dict, list or set (display,
+    comprehension, or dict()/list()/set()/defaultdict() ...) at module level, unless it is
+    a declared process cache; a table is a MappingProxyType, a tuple or a frozenset."""
+    found = _core_mutable_assignments()
+    unexpected = sorted(f"{name} (line {line})" for name, line in found.items() if name not in CORE_MUTABLE_ALLOWED)
+    assert not unexpected, f"mutable module state in cpm_nlp/core: {unexpected}"
+    stale = sorted(set(CORE_MUTABLE_ALLOWED) - set(found))
+    assert not stale, f"not assigned as a mutable container (drop from CORE_MUTABLE_ALLOWED): {stale}"
+
+
+def test_the_mutable_state_check_sees_each_form():
+    """The check above finds each form of a mutable module global, and passes the read-only ones."""
+    src = (
+        "A = {}\nB: list = []\nC = {1}\nD = {k: 1 for k in ()}\nE = [x for x in ()]\nF = dict(a=1)\n"
+        "G = collections.defaultdict(list)\nH = set()\nI = weakref.WeakKeyDictionary()\n"
+        "OK1 = MappingProxyType({})\nOK2 = (1, 2)\nOK3 = frozenset({1})\nOK4 = tuple([1])\n"
+    )
+    made = {
+        ast.unparse(st.targets[0] if isinstance(st, ast.Assign) else st.target)
+        for st in ast.parse(src).body
+        if _makes_mutable(st.value)
+    }
+    assert made == set("ABCDEFGHI")
+
+
+def test_results_are_built_from_declared_outputs_only():
+    """Issue 22, item 2: outside cpm_nlp.core no code calls ``Result(...)``: a kind builds its
+    result from its declared outputs (core.outputs.declared_result), so it writes no unit or
+    dimension by hand."""
+    calls = []
+    for path in sorted(PKG.rglob("*.py")):
+        if path.is_relative_to(PKG / "core"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call):
+                f = node.func
+                name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+                if name == "Result":
+                    calls.append(f"{path.relative_to(PKG.parent)}:{node.lineno}")
+    assert not calls, calls

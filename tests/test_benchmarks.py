@@ -3,7 +3,7 @@
 import importlib.util
 import json
 
-from .conftest import ROOT
+from tests.conftest import ROOT
 
 
 def test_benchmark_harness_smoke(tmp_path, capsys):

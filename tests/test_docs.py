@@ -20,7 +20,7 @@ of the page may read them):
   prose makes about that block's output, which must then contain TEXT (runs of
   whitespace compared as one space).
 * ``text`` and ``toml``: illustrative only (usage synopses, a cluster's own commands, an
-  error message, an entry-point table tested by tests/test_plugin.py); kept few.
+  error message, an entry-point table tested by tests/mechanisms/test_plugin.py); kept few.
 """
 
 from __future__ import annotations
@@ -41,8 +41,7 @@ import yaml
 import cpm_nlp as cn
 from cpm_nlp.mechanisms.registry import mechanism_names
 from cpm_nlp.mechanisms.registry import unregister as unregister_mechanism
-
-from .conftest import ROOT, run_cli
+from tests.conftest import ROOT, run_cli
 
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs" / "site").rglob("*.md"))]
 EXECUTED = ("bash", "python", "yaml")

@@ -12,8 +12,7 @@ import pytest
 
 from cpm_nlp.core.version import __version__
 from cpm_nlp.problems.shipped import example_files, shipped_configs_dir, shipped_problems_dir
-
-from .conftest import PROBLEMS, ROOT
+from tests.conftest import PROBLEMS, ROOT
 
 
 def test_version_is_the_one_of_core_version_and_of_the_installed_metadata(cli):

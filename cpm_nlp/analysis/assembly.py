@@ -63,9 +63,9 @@ import numpy as np
 from ..core import progress
 from ..core.batch import batch_forward_kinematics, evaluate
 from ..core.errors import InputError
-from ..core.kernels import ROUND_TRIP_FACTOR, STATUSES
 from ..core.kinematics import PoseSolution, assess, forward_kinematics, passive_joints
 from ..core.model import Model
+from ..core.pose_checks import ROUND_TRIP_FACTOR, STATUSES
 from ..core.result import Status
 from ..core.solver import SolverConfig
 
@@ -460,7 +460,81 @@ def completeness(basins: list[int], starts: int) -> Completeness:
     )
 
 
-def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge, check, working mode
+def _actuators(model: Model, q: Any, starts: int) -> np.ndarray:
+    """The actuator values as a vector (bad input: not nq finite values, or no start)."""
+    c = model.closure
+    qv = np.asarray(q, dtype=float).ravel()
+    if qv.size != c.nq or not np.all(np.isfinite(qv)):
+        raise InputError(f"expected {c.nq} finite actuator values, got {np.asarray(q).tolist()}", path=("q",))
+    if int(starts) < 1:
+        raise InputError(f"expected at least 1 start, got {starts}", path=("starts",))
+    return qv
+
+
+def _distinct_modes(
+    model: Model, X: np.ndarray, Xr: np.ndarray, label: np.ndarray, count: int, qv: np.ndarray, tol: float
+) -> list[AssemblyMode]:
+    """One mode per merged class of the solutions ``X`` (``Xr``: their angles reduced)."""
+    c = model.closure
+    angle = np.array([x.kind == "angle" for x in c.x])
+    scale = _scale(model)
+    modes = []
+    for j in range(count):
+        members = np.flatnonzero(label == j)
+        # the representative: of the coordinates of one pose (two angle triples of one rotation),
+        # those nearest to home, so that the working mode reads like the ordinary FK
+        d = Xr[members] - model.x_home
+        d[:, angle] = (d[:, angle] + math.pi) % (2 * math.pi) - math.pi
+        k = int(members[np.argmin(np.max(np.abs(d / scale), axis=1))])
+        mode = _mode(model, Xr[k], qv, tol, int(members.size))
+        if mode.status is Status.RESIDUAL_TOO_LARGE:  # the reduced angle broke the closure: not periodic
+            mode = _mode(model, X[k], qv, tol, int(members.size))
+        if mode.status in REAL:
+            modes.append(mode)
+    return modes
+
+
+def _scale(model: Model) -> np.ndarray:
+    """The size of each pose coordinate: the reach for a length, 1 for an angle."""
+    length = reach(model)
+    return np.array([length if x.kind == "length" else 1.0 for x in model.closure.x])
+
+
+def _with_working(
+    model: Model, modes: list[AssemblyMode], work: PoseSolution, qv: np.ndarray, config: SolverConfig, merge: float
+) -> tuple[list[AssemblyMode], int | None]:
+    """The modes with the ordinary FK's pose first (the working mode: that of the search it
+    matches, in the FK's own coordinates, else added), then by basin; None where the FK failed."""
+    angle = np.array([x.kind == "angle" for x in model.closure.x])
+    length = reach(model)
+    working = None
+    if work.ok:
+        fw = features(model, _reduce(work.x[None, :], angle), length)[0]
+        fm = features(model, np.array([m.x for m in modes]), length) if modes else np.zeros((0, fw.size))
+        dist = np.max(np.abs(fm - fw), axis=1) if len(fm) else np.zeros(0)
+        j = int(np.argmin(dist)) if dist.size else -1
+        if j >= 0 and dist[j] <= max(merge, 1e3 * config.tolerance / length):
+            working = j
+            modes[j] = _mode(model, work.x, qv, config.tolerance, modes[j].basin)  # the FK's own coordinates
+        else:  # the ordinary FK found a mode the search missed
+            log.info("the working mode was not among the modes of the search; added")
+            modes.append(_mode(model, work.x, qv, config.tolerance, 0))
+            working = len(modes) - 1
+    order = sorted(range(len(modes)), key=lambda i: (i != working, -modes[i].basin, modes[i].x.tolist()))
+    return [modes[i] for i in order], (0 if working is not None else None)
+
+
+def _nearest_mode(model: Model, modes: list[AssemblyMode], working: int | None) -> tuple[Any, Any, Any]:
+    """The mode nearest the working one, and the distances to it (lengths, angles); None without."""
+    if working is None or len(modes) <= 1:
+        return None, None, None
+    fm = features(model, np.array([m.x for m in modes]), reach(model))
+    nearest = 1 + int(np.argmin(np.linalg.norm(fm[1:] - fm[0], axis=1)))
+    dl, da = _distances(model, modes[0].x, modes[nearest].x)
+    return nearest, dl, da
+
+
+def assembly_modes(
     model: Model,
     q,
     solver: SolverConfig | None = None,
@@ -481,11 +555,7 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge,
     """
     config = solver or SolverConfig()
     c = model.closure
-    qv = np.asarray(q, dtype=float).ravel()
-    if qv.size != c.nq or not np.all(np.isfinite(qv)):
-        raise InputError(f"expected {c.nq} finite actuator values, got {np.asarray(q).tolist()}", path=("q",))
-    if int(starts) < 1:
-        raise InputError(f"expected at least 1 start, got {starts}", path=("starts",))
+    qv = _actuators(model, q, starts)
     t0 = time.perf_counter()
     region = search_region(model)
     lo, hi = region.lower, region.upper
@@ -493,9 +563,8 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge,
     X0 = lo + (hi - lo) * rng.random((int(starts), c.nx))
     X0[0] = model.x_home if guess is None else np.asarray(guess, dtype=float)
     length = reach(model)
-    scale = np.array([length if x.kind == "length" else 1.0 for x in c.x])
     w = np.r_[qv, np.asarray(model.p, dtype=float).ravel()]
-    (X0,) = evaluate(damped_newton(model), [X0, w, scale], threads, SEARCH_CHUNK, "assembly-mode search")
+    (X0,) = evaluate(damped_newton(model), [X0, w, _scale(model)], threads, SEARCH_CHUNK, "assembly-mode search")
     newton = search_solver(config)
     res = batch_forward_kinematics(
         model,
@@ -516,42 +585,11 @@ def assembly_modes(  # noqa: C901 - one pipeline: starts, Newton, reduce, merge,
     F = features(model, Xr, length)
     # a closure not periodic in an angle: the reduced pose breaks it; those keep their own value
     reps, label = _merge(F, merge_tolerance)
-    modes = []
-    for j in range(len(reps)):
-        members = np.flatnonzero(label == j)
-        # the representative: of the coordinates of one pose (two angle triples of one rotation),
-        # those nearest to home, so that the working mode reads like the ordinary FK
-        d = Xr[members] - model.x_home
-        d[:, angle] = (d[:, angle] + math.pi) % (2 * math.pi) - math.pi
-        k = int(members[np.argmin(np.max(np.abs(d / scale), axis=1))])
-        mode = _mode(model, Xr[k], qv, config.tolerance, int(members.size))
-        if mode.status is Status.RESIDUAL_TOO_LARGE:  # the reduced angle broke the closure: not periodic
-            mode = _mode(model, X[k], qv, config.tolerance, int(members.size))
-        if mode.status in REAL:
-            modes.append(mode)
+    modes = _distinct_modes(model, X, Xr, label, len(reps), qv, config.tolerance)
     work = forward_kinematics(model, qv, config, guess)
-    working = None
-    if work.ok:
-        fw = features(model, _reduce(work.x[None, :], angle), length)[0]
-        fm = features(model, np.array([m.x for m in modes]), length) if modes else np.zeros((0, fw.size))
-        dist = np.max(np.abs(fm - fw), axis=1) if len(fm) else np.zeros(0)
-        j = int(np.argmin(dist)) if dist.size else -1
-        if j >= 0 and dist[j] <= max(merge_tolerance, 1e3 * config.tolerance / length):
-            working = j
-            modes[j] = _mode(model, work.x, qv, config.tolerance, modes[j].basin)  # the FK's own coordinates
-        else:  # the ordinary FK found a mode the search missed
-            log.info("the working mode was not among the modes of the search; added")
-            modes.append(_mode(model, work.x, qv, config.tolerance, 0))
-            working = len(modes) - 1
-    order = sorted(range(len(modes)), key=lambda i: (i != working, -modes[i].basin, modes[i].x.tolist()))
-    modes = [modes[i] for i in order]
-    working = 0 if working is not None else None
+    modes, working = _with_working(model, modes, work, qv, config, merge_tolerance)
     inside = [bool(np.all((m.x >= lo - 1e-12) & (m.x <= hi + 1e-12))) for m in modes]
-    nearest = dl = da = None
-    if working is not None and len(modes) > 1:
-        fm = features(model, np.array([m.x for m in modes]), length)
-        nearest = 1 + int(np.argmin(np.linalg.norm(fm[1:] - fm[0], axis=1)))
-        dl, da = _distances(model, modes[0].x, modes[nearest].x)
+    nearest, dl, da = _nearest_mode(model, modes, working)
     return AssemblyModes(
         q=qv,
         modes=modes,

@@ -230,7 +230,74 @@ def _monotone_refine(prog: _Programs, p: np.ndarray, L, U, Glo, Ghi, Jlo, Jhi, l
     Ghi[boxes[h], rows[h]] = np.fmin(Ghi[boxes[h], rows[h]], hi_new[h])
 
 
-def certify_box(  # noqa: C901 - the branch-and-bound loop with its proof rules
+def _batch_margin(Glo, Ghi, lo_g, hi_g, proven, names) -> tuple[float, str]:
+    """The smallest margin of the proven sub-boxes of a batch, and the quantity it is of."""
+    with np.errstate(invalid="ignore"):
+        marg = np.minimum(Glo[proven] - lo_g, hi_g - Ghi[proven])
+    marg = np.where(np.isfinite(marg), marg, np.inf)
+    k_box, k_row = np.unravel_index(int(np.argmin(marg)), marg.shape)
+    return float(marg[k_box, k_row]), names[k_row]
+
+
+def _violated_centre(prog, p, mid, lo_g, hi_g, names) -> tuple[int, str, str] | None:
+    """The first centre of a sub-box where a bound is proven violated: (its index, the
+    quantity, the message); None where no centre violates one."""
+    Pm = np.broadcast_to(p, (len(mid), p.size))
+    ((clo, chi),) = prog.values.evaluate([(mid, mid), (Pm, Pm)])
+    with np.errstate(invalid="ignore"):
+        violated = (chi < lo_g) | (clo > hi_g)
+    out = np.any(violated, axis=1)
+    if not np.any(out):
+        return None
+    k = int(np.flatnonzero(out)[0])
+    r = int(np.flatnonzero(violated[k])[0])
+    what = "does not assemble (reach < 0)" if r == 0 else f"{names[r]} is outside its limits"
+    return k, names[r], f"not certified: at {mid[k].tolist()} the mechanism {what}"
+
+
+def _unproven(row_ok, Glo, Ghi, lo_g, hi_g, names, box) -> tuple[str, str]:
+    """What a sub-box left unproven: the first bound not proven (with its enclosure), else
+    the regularity of Φ_x."""
+    bad_rows = np.flatnonzero(~row_ok[box])
+    if not bad_rows.size:
+        return "singular", f"cond(Φ_x) not proven below {SINGULAR_CONDITION:g}"
+    r = int(bad_rows[0])
+    detail = (
+        f"enclosure [{Glo[box, r]:.10g}, {Ghi[box, r]:.10g}] over the sub-box, limits [{lo_g[r]:.10g}, {hi_g[r]:.10g}]"
+    )
+    return names[r], detail
+
+
+def _split(Lt, Ut, mid, Jlo, Jhi, unproven_rows, smallest, width0):
+    """Each sub-box cut in two along the coordinate of largest smear over the rows not proven."""
+    w = Ut - Lt
+    jmag = np.maximum(np.abs(Jlo), np.abs(Jhi))  # (n, m, d)
+    smear = jmag * w[:, None, :]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        smear = smear / np.sum(smear, axis=2, keepdims=True)
+    smear = np.where(np.isfinite(smear), smear, 0.0)
+    weight = np.sum(smear * unproven_rows[:, :, None], axis=1) + 1e-3 * w / np.where(width0 > 0, width0, 1.0)
+    weight = np.where(w > smallest, weight, -1.0)
+    axis = np.argmax(weight, axis=1)
+    k = np.arange(len(Lt))
+    cut = mid[k, axis]
+    L1, U1 = Lt.copy(), Ut.copy()
+    U1[k, axis] = cut
+    L2, U2 = Lt.copy(), Ut.copy()
+    L2[k, axis] = cut
+    return L1, U1, L2, U2
+
+
+def _no_certificate(model: Model, lower: np.ndarray, upper: np.ndarray) -> str | None:
+    """Why the box cannot be certified at all (no closed-form IK, an empty box), else None."""
+    if model.closure.ik is None:
+        return f"{model.closure.name} has no closed-form IK: no certificate"
+    if not np.all(upper >= lower):
+        return "the box is empty (upper < lower)"
+    return None
+
+
+def certify_box(
     model: Model,
     lower,
     upper,
@@ -244,10 +311,9 @@ def certify_box(  # noqa: C901 - the branch-and-bound loop with its proof rules
     t0 = time.perf_counter()
     c = model.closure
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    if c.ik is None:
-        return Certificate(False, f"{c.name} has no closed-form IK: no certificate", seconds=time.perf_counter() - t0)
-    if not np.all(upper >= lower):
-        return Certificate(False, "the box is empty (upper < lower)", seconds=time.perf_counter() - t0)
+    why_not = _no_certificate(model, lower, upper)
+    if why_not is not None:
+        return Certificate(False, why_not, seconds=time.perf_counter() - t0)
     lo_all, hi_all = limit_bounds(model)
     rows = tuple(int(r) for r in np.flatnonzero(np.isfinite(lo_all) | np.isfinite(hi_all)))
     try:
@@ -296,12 +362,9 @@ def certify_box(  # noqa: C901 - the branch-and-bound loop with its proof rules
         regular &= cond < SINGULAR_CONDITION
         proven = np.all(row_ok, axis=1) & regular
         if np.any(proven):
-            with np.errstate(invalid="ignore"):
-                marg = np.minimum(Glo[proven] - lo_g, hi_g - Ghi[proven])
-            marg = np.where(np.isfinite(marg), marg, np.inf)
-            k_box, k_row = np.unravel_index(int(np.argmin(marg)), marg.shape)
-            if marg[k_box, k_row] < margin:
-                margin, binding = float(marg[k_box, k_row]), names[k_row]
+            batch_margin, batch_binding = _batch_margin(Glo, Ghi, lo_g, hi_g, proven, names)
+            if batch_margin < margin:
+                margin, binding = batch_margin, batch_binding
             cond_max = max(cond_max, float(np.max(cond[proven])))
         todo = np.flatnonzero(~proven)
         if not todo.size:
@@ -310,48 +373,17 @@ def certify_box(  # noqa: C901 - the branch-and-bound loop with its proof rules
         # the centres of the sub-boxes not proven: a bound proven violated there ends the search
         Lt, Ut = L[todo], U[todo]
         mid = 0.5 * (Lt + Ut)
-        Pm = np.broadcast_to(p, (len(todo), p.size))
-        ((clo, chi),) = prog.values.evaluate([(mid, mid), (Pm, Pm)])
-        with np.errstate(invalid="ignore"):
-            violated = (chi < lo_g) | (clo > hi_g)
-        out = np.any(violated, axis=1)
-        if np.any(out):
-            k = int(np.flatnonzero(out)[0])
-            r = int(np.flatnonzero(violated[k])[0])
-            quantity = names[r]
-            what = "does not assemble (reach < 0)" if r == 0 else f"{quantity} is outside its limits"
-            return fail(f"not certified: at {mid[k].tolist()} the mechanism {what}", k, Lt, Ut, quantity, mid[k].copy())
-        w = Ut - Lt
-        small = np.all(w <= smallest, axis=1)
+        violated = _violated_centre(prog, p, mid, lo_g, hi_g, names)
+        if violated is not None:
+            k, quantity, message = violated
+            return fail(message, k, Lt, Ut, quantity, mid[k].copy())
+        small = np.all(Ut - Lt <= smallest, axis=1)
         if np.any(small) or boxes + 2 * todo.size > max_boxes:
             k = int(np.flatnonzero(small)[0]) if np.any(small) else 0
-            bad_rows = np.flatnonzero(~row_ok[todo[k]])
             why = "the smallest sub-box width" if np.any(small) else f"the budget of {max_boxes} sub-boxes"
-            if bad_rows.size:
-                r = int(bad_rows[0])
-                quantity = names[r]
-                detail = (
-                    f"enclosure [{Glo[todo[k], r]:.10g}, {Ghi[todo[k], r]:.10g}] over the sub-box, "
-                    f"limits [{lo_g[r]:.10g}, {hi_g[r]:.10g}]"
-                )
-            else:
-                quantity, detail = "singular", f"cond(Φ_x) not proven below {SINGULAR_CONDITION:g}"
+            quantity, detail = _unproven(row_ok, Glo, Ghi, lo_g, hi_g, names, todo[k])
             return fail(f"not certified: {quantity} not proven within {why} ({detail})", k, Lt, Ut, quantity)
-        # split along the coordinate of largest smear over the rows not proven
-        jmag = np.maximum(np.abs(Jlo[todo]), np.abs(Jhi[todo]))  # (n, m, d)
-        smear = jmag * w[:, None, :]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            smear = smear / np.sum(smear, axis=2, keepdims=True)
-        smear = np.where(np.isfinite(smear), smear, 0.0)
-        weight = np.sum(smear * (~row_ok[todo])[:, :, None], axis=1) + 1e-3 * w / np.where(width0 > 0, width0, 1.0)
-        weight = np.where(w > smallest, weight, -1.0)
-        axis = np.argmax(weight, axis=1)
-        k = np.arange(todo.size)
-        cut = mid[k, axis]
-        L1, U1 = Lt.copy(), Ut.copy()
-        U1[k, axis] = cut
-        L2, U2 = Lt.copy(), Ut.copy()
-        L2[k, axis] = cut
+        L1, U1, L2, U2 = _split(Lt, Ut, mid, Jlo[todo], Jhi[todo], ~row_ok[todo], smallest, width0)
         Dn = D[todo] + 1
         pending_L = np.vstack([rest[0], L1, L2])
         pending_U = np.vstack([rest[1], U1, U2])

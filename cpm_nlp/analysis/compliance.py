@@ -52,7 +52,7 @@ import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError, suggest
-from ..core.kernels import FastFunction
+from ..core.fast_calls import FastFunction
 from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import LoopClosure, Model
 from ..core.options import Option, validate_mapping
@@ -593,7 +593,7 @@ def energy_parts(closure: LoopClosure) -> Any:
     with d2Phi the Hessians of the nx residuals stacked.  With λ = Φ_x⁻ᵀ V_x (adjoint),
     F = V_q - Φ_qᵀ λ and K_q = Zᵀ (∇²V - Σ λ_i ∇²Φ_i) Z, Z = [J; I] (the reduced
     Hessian of V(x(q), q)); the small linear algebra is done in numpy.  Wrapped for
-    fast calls (:class:`~cpm_nlp.core.kernels.FastFunction`)."""
+    fast calls (:class:`~cpm_nlp.core.fast_calls.FastFunction`)."""
     c = closure
     x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
     n = c.nx + c.nq + len(c.passive_coords)

@@ -176,7 +176,7 @@ def circular_notch_stiffness_exact(E, b, t, r):
 
     obtained from int dphi / (a - c cos phi) = 4 T / sqrt(u) (x = r sin phi)
     by differentiating twice with respect to a.  For t/r -> 0 it tends to
-    :func:`circular_notch_stiffness` (tests/test_flexure.py checks both the
+    :func:`circular_notch_stiffness` (tests/analysis/test_flexure.py checks both the
     limit and the integral by quadrature).  For the 3-PRC hinge of
     prc3-li-2018.md Table 1 (t/r = 1/6) the simplified formula is 2.1 % softer.
     """

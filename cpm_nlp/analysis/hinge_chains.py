@@ -52,7 +52,7 @@ import scipy.linalg
 from ..core.blas import one_blas_thread
 from ..core.chains import Chains, LegChains
 from ..core.errors import InputError
-from ..core.kernels import FastFunction
+from ..core.fast_calls import FastFunction
 from ..core.model import Model
 from ..core.screws import axis_rotation, vee
 from .compliance import HINGE_TYPES, HingeSet, six_axis_stiffness

@@ -28,6 +28,7 @@ sharpens it with a monotonicity test (the interval Jacobian).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -231,6 +232,71 @@ def _binary(op: int):
 _OP_NAMES = {getattr(ca, n): n for n in dir(ca) if n.startswith("OP_")}
 
 
+def _group_function(key: tuple) -> Any:
+    """The interval version of a group's operation: ("constpow", e), ("u", op) or ("b", op)."""
+    if key[0] == "constpow":
+        e = key[1]
+        return lambda lo, hi: _constpow(lo, hi, e)
+    return _unary(key[1]) if key[0] == "u" else _binary(key[1])
+
+
+class _Trace:
+    """The instructions of an SX function replayed as single-assignment nodes: each node's
+    depth in the graph (``level``), the constants, inputs, outputs and operations."""
+
+    def __init__(self, fn: ca.Function) -> None:
+        self.fn = fn
+        self.reg: dict[int, int] = {}  # work register -> current node
+        self.level: list[int] = []
+        self.const: dict[int, float] = {}
+        self.inputs: list[tuple[int, int, int]] = []  # (node, input, nz)
+        self.outputs: list[tuple[int, int, int]] = []  # (node, output, nz)
+        self.ops: list[tuple] = []  # (key, node, args)
+        moves = {
+            ca.OP_INPUT: self._input,
+            ca.OP_OUTPUT: self._output,
+            ca.OP_CONST: self._const,
+            ca.OP_ASSIGN: self._assign,
+        }
+        for k in range(fn.n_instructions()):
+            op = fn.instruction_id(k)
+            ins, outs = fn.instruction_input(k), fn.instruction_output(k)
+            if op in moves:
+                moves[op](k, ins, outs)
+            else:
+                self._operation(op, ins, outs)
+
+    def _new(self, lvl: int, register: int) -> int:
+        self.level.append(lvl)
+        self.reg[register] = len(self.level) - 1
+        return self.reg[register]
+
+    def _input(self, _k: int, ins: list, outs: list) -> None:
+        self.inputs.append((self._new(0, outs[0]), ins[0], ins[1]))
+
+    def _output(self, _k: int, ins: list, outs: list) -> None:
+        self.outputs.append((self.reg[ins[0]], outs[0], outs[1]))
+
+    def _const(self, k: int, _ins: list, outs: list) -> None:
+        self.const[self._new(0, outs[0])] = float(self.fn.instruction_constant(k))
+
+    def _assign(self, _k: int, ins: list, outs: list) -> None:
+        self.reg[outs[0]] = self.reg[ins[0]]
+
+    def _operation(self, op: int, ins: list, outs: list) -> None:
+        """A unary or binary operation, a power by a constant; else no interval version."""
+        if op == ca.OP_CONSTPOW and self.reg[ins[1]] in self.const:
+            key, args = ("constpow", self.const[self.reg[ins[1]]]), (self.reg[ins[0]],)
+        elif _unary(op) is not None:
+            key, args = ("u", op), (self.reg[ins[0]],)
+        elif _binary(op) is not None or op == ca.OP_CONSTPOW:
+            key, args = ("b", ca.OP_POW if op == ca.OP_CONSTPOW else op), (self.reg[ins[0]], self.reg[ins[1]])
+        else:
+            raise UnsupportedOperation(f"{self.fn.name()}: no interval version of {_OP_NAMES.get(op, op)}")
+        node = self._new(max(self.level[a] for a in args) + 1, outs[0])
+        self.ops.append((key, node, args))
+
+
 class IntervalProgram:
     """A ``ca.Function`` (SX) compiled to layers of interval operations.
 
@@ -246,86 +312,38 @@ class IntervalProgram:
     instructions).  ``nodes`` is the number of values held per box.
     """
 
-    def __init__(self, fn: ca.Function):  # noqa: C901 - one branch per CasADi operation replayed
+    def __init__(self, fn: ca.Function):
         if not fn.is_a("SXFunction"):
             raise UnsupportedOperation(f"{fn.name()}: interval evaluation needs an SX function")
         self.name = fn.name()
         self.n_out = [fn.nnz_out(k) for k in range(fn.n_out())]
-        reg: dict[int, int] = {}  # work register -> current node
-        level: list[int] = []
-        const: dict[int, float] = {}
-        inputs: list[tuple[int, int, int]] = []  # (node, input, nz)
-        outputs: list[tuple[int, int, int]] = []  # (node, output, nz)
-        ops: list[tuple] = []  # (key, node, args)
-
-        def new(lvl: int) -> int:
-            level.append(lvl)
-            return len(level) - 1
-
-        for k in range(fn.n_instructions()):
-            op = fn.instruction_id(k)
-            ins, outs = fn.instruction_input(k), fn.instruction_output(k)
-            if op == ca.OP_INPUT:
-                node = new(0)
-                inputs.append((node, ins[0], ins[1]))
-                reg[outs[0]] = node
-            elif op == ca.OP_OUTPUT:
-                outputs.append((reg[ins[0]], outs[0], outs[1]))
-            elif op == ca.OP_CONST:
-                node = new(0)
-                const[node] = float(fn.instruction_constant(k))
-                reg[outs[0]] = node
-            elif op == ca.OP_ASSIGN:
-                reg[outs[0]] = reg[ins[0]]
-            elif op == ca.OP_CONSTPOW and reg[ins[1]] in const:
-                a = reg[ins[0]]
-                node = new(level[a] + 1)
-                ops.append((("constpow", const[reg[ins[1]]]), node, (a,)))
-                reg[outs[0]] = node
-            elif _unary(op) is not None:
-                a = reg[ins[0]]
-                node = new(level[a] + 1)
-                ops.append((("u", op), node, (a,)))
-                reg[outs[0]] = node
-            elif _binary(op) is not None or op == ca.OP_CONSTPOW:
-                a, b = reg[ins[0]], reg[ins[1]]
-                node = new(max(level[a], level[b]) + 1)
-                ops.append((("b", ca.OP_POW if op == ca.OP_CONSTPOW else op), node, (a, b)))
-                reg[outs[0]] = node
-            else:
-                raise UnsupportedOperation(f"{fn.name()}: no interval version of {_OP_NAMES.get(op, op)}")
+        t = _Trace(fn)
+        level, const = t.level, t.const
         self.nodes = len(level)
         self.const_nodes = np.array(sorted(const), dtype=int)
         self.const_values = np.array([const[n] for n in sorted(const)])
         self.inputs = [
             (
-                np.array([n for n, i, _ in inputs if i == j], dtype=int),
-                np.array([z for _, i, z in inputs if i == j], dtype=int),  # int even when empty (no parameters)
+                np.array([n for n, i, _ in t.inputs if i == j], dtype=int),
+                np.array([z for _, i, z in t.inputs if i == j], dtype=int),  # int even when empty (no parameters)
             )
             for j in range(fn.n_in())
         ]
         self.outputs = [
             (
-                np.array([n for n, o, _ in outputs if o == j], dtype=int),
-                np.array([z for _, o, z in outputs if o == j], dtype=int),
+                np.array([n for n, o, _ in t.outputs if o == j], dtype=int),
+                np.array([z for _, o, z in t.outputs if o == j], dtype=int),
             )
             for j in range(fn.n_out())
         ]
         groups: dict[tuple, list] = {}
-        for key, node, args in ops:
+        for key, node, args in t.ops:
             groups.setdefault((level[node], key), []).append((node, args))
         self.groups = []
         for (_lvl, key), members in sorted(groups.items(), key=lambda kv: kv[0][0]):
             out = np.array([n for n, _ in members], dtype=int)
             args = tuple(np.array([a[i] for _, a in members], dtype=int) for i in range(len(members[0][1])))
-            if key[0] == "constpow":
-                e = key[1]
-                f = lambda lo, hi, e=e: _constpow(lo, hi, e)  # noqa: E731
-            elif key[0] == "u":
-                f = _unary(key[1])
-            else:
-                f = _binary(key[1])
-            self.groups.append((f, out, args))
+            self.groups.append((_group_function(key), out, args))
 
     def evaluate(self, inputs: list[tuple[np.ndarray, np.ndarray]]) -> list[tuple[np.ndarray, np.ndarray]]:
         B = np.asarray(inputs[0][0]).shape[0]

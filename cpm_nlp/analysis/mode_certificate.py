@@ -101,7 +101,36 @@ def closure_program(model: Model) -> IntervalProgram:
     return c.solvers.memo(("mode_certificate",), build)
 
 
-def certify_modes(  # noqa: C901 - the branch-and-bound loop with its proof rules
+def _stop(boxes: int, max_boxes: int, t0: float, seconds: float | None) -> str:
+    """Why the search stops before its next batch (the budget, the time limit), else ""."""
+    if boxes >= max_boxes:
+        return f"budget of {max_boxes} sub-boxes spent"
+    if seconds is not None and time.perf_counter() - t0 > seconds:
+        return f"time limit of {seconds:g} s reached"
+    return ""
+
+
+def _near_a_mode(blo: np.ndarray, bhi: np.ndarray, modes: np.ndarray, margin: np.ndarray) -> np.ndarray:
+    """Which sub-boxes (widened by the margin) hold a found mode."""
+    inside = np.zeros(len(blo), dtype=bool)
+    for m in modes:
+        inside |= np.all((blo - margin <= m) & (m <= bhi + margin), axis=1)
+    return inside
+
+
+def _halves(split_lo: np.ndarray, split_hi: np.ndarray, widths: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Each sub-box cut in two across its widest coordinate (scaled): lower and upper
+    corners of the left halves, then of the right ones."""
+    k = np.argmax(widths, axis=1)
+    rows = np.arange(len(split_lo))
+    mid = 0.5 * (split_lo[rows, k] + split_hi[rows, k])
+    left_hi, right_lo = split_hi.copy(), split_lo.copy()
+    left_hi[rows, k] = mid
+    right_lo[rows, k] = mid
+    return split_lo, left_hi, right_lo, split_hi
+
+
+def certify_modes(
     model: Model, found: AssemblyModes, *, max_boxes: int = MAX_BOXES, seconds: float | None = None
 ) -> ModeCertificate:
     """Prove that the real modes in ``found.region`` are exactly ``found.modes`` (see the module
@@ -122,11 +151,8 @@ def certify_modes(  # noqa: C901 - the branch-and-bound loop with its proof rule
     reason = ""
     with progress.task("certifying the assembly modes", max_boxes) as report:
         while len(lo):
-            if boxes >= max_boxes:
-                reason = f"budget of {max_boxes} sub-boxes spent"
-                break
-            if seconds is not None and time.perf_counter() - t0 > seconds:
-                reason = f"time limit of {seconds:g} s reached"
+            reason = _stop(boxes, max_boxes, t0, seconds)
+            if reason:
                 break
             take = min(BATCH, len(lo), max_boxes - boxes)
             blo, bhi, lo, hi = lo[:take], hi[:take], lo[take:], hi[take:]
@@ -138,28 +164,20 @@ def certify_modes(  # noqa: C901 - the branch-and-bound loop with its proof rule
                 empty = np.any((plo > 0) | (phi < 0), axis=1)  # NaN compares False: not proven
             n = c.nx
             regular, _ = regularity(*(a.reshape(take, n, n).transpose(0, 2, 1) for a in (jlo, jhi)))
-            inside = np.zeros(take, dtype=bool)
-            if len(modes):
-                for m in modes:
-                    inside |= np.all((blo - margin <= m) & (m <= bhi + margin), axis=1)
-            done = empty | (regular & inside)
+            done = empty | (regular & _near_a_mode(blo, bhi, modes, margin))
             excluded += int(np.count_nonzero(empty))
             settled += int(np.count_nonzero(done & ~empty))
             split_lo, split_hi = blo[~done], bhi[~done]
-            if len(split_lo):
-                widths = (split_hi - split_lo) / scale
-                if np.any(np.max(widths, axis=1) < MIN_WIDTH):
-                    reason = "a sub-box narrower than the smallest width is neither empty nor one found mode"
-                    lo = np.vstack([lo, split_lo])
-                    break
-                k = np.argmax(widths, axis=1)
-                rows = np.arange(len(split_lo))
-                mid = 0.5 * (split_lo[rows, k] + split_hi[rows, k])
-                left_hi, right_lo = split_hi.copy(), split_lo.copy()
-                left_hi[rows, k] = mid
-                right_lo[rows, k] = mid
-                lo = np.vstack([lo, split_lo, right_lo])
-                hi = np.vstack([hi, left_hi, split_hi])
+            if not len(split_lo):
+                continue
+            widths = (split_hi - split_lo) / scale
+            if np.any(np.max(widths, axis=1) < MIN_WIDTH):
+                reason = "a sub-box narrower than the smallest width is neither empty nor one found mode"
+                lo = np.vstack([lo, split_lo])
+                break
+            left_lo, left_hi, right_lo, right_hi = _halves(split_lo, split_hi, widths)
+            lo = np.vstack([lo, left_lo, right_lo])
+            hi = np.vstack([hi, left_hi, right_hi])
     certified = not len(lo) and not reason
     return ModeCertificate(
         certified=certified,

@@ -50,7 +50,6 @@ from .workspace import (
     DEFAULT_NLP_SAMPLES,
     NLP_MARGIN,
     CuboidCheck,
-    check_box,
     default_per_edge,
     inscribed_cuboid,
     limit_bounds,
@@ -58,6 +57,7 @@ from .workspace import (
     poses,
     surface_grid,
 )
+from .workspace.cuboid import shrink_to_pass
 
 log = logging.getLogger(__name__)
 
@@ -170,7 +170,104 @@ def footprint_of(parameters: Mapping[str, float], footprint: Mapping[str, float]
     return float(math.prod(parameters[n] ** e for n, e in footprint.items()))
 
 
-def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check, shrink
+def _design_bounds(
+    model: Model, design: Mapping[str, tuple[float, float]], footprint: Mapping[str, float]
+) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """The parameters that vary (in the closure's order) and their bounds; bad input: an
+    unknown name, no parameter, bounds not finite with low < high, a footprint's log of a
+    bound not positive."""
+    c = model.closure
+    _check_names(list(design), c, ("design",))
+    _check_names(list(footprint), c, ("footprint",))
+    if not design:
+        raise InputError("expected at least one parameter to vary", path=("design",))
+    names = [n for n in c.parameters if n in design]
+    lo = np.array([float(design[n][0]) for n in names])
+    hi = np.array([float(design[n][1]) for n in names])
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(lo < hi)):
+        raise InputError(f"expected finite bounds low < high, got {dict(design)}", path=("design",))
+    for n, e in footprint.items():
+        low = float(design[n][0]) if n in design else float(model.parameters[n])
+        if e != 0 and not low > 0:
+            raise InputError(
+                f"the footprint takes the log of {n}; its lower bound must be positive, got {low:g}",
+                path=("design", n),
+            )
+    return names, lo, hi
+
+
+@dataclass
+class _Starts:
+    """What every start of the synthesis shares: the design's parameters and bounds, the
+    NLP with its constraint bounds, the sample grid, and how to build a design's model."""
+
+    model: Model
+    names: list[str]
+    lo: np.ndarray
+    hi: np.ndarray
+    build: Callable[[dict[str, float]], Model]
+    nlp: SynthesisNLP
+    lbg: np.ndarray
+    ubg: np.ndarray
+    S: np.ndarray
+    config: SolverConfig
+    seed: int
+    samples_per_edge: int
+    start_check: int
+
+    def run(self, z0: np.ndarray) -> tuple[bool, np.ndarray | None, str, int, tuple | None]:
+        """One start: the start design's own largest cuboid, then the synthesis NLP from it."""
+        model, c, names, lo, hi = self.model, self.model.closure, self.names, self.lo, self.hi
+        d, N = c.nq, len(self.S)
+        params = dict(model.parameters)
+        params.update({n: float(v) for n, v in zip(names, lo + (hi - lo) * z0)})
+        try:
+            m0 = self.build(params)
+        except (InputError, ValueError) as exc:
+            return False, None, f"design not buildable: {exc}", 0, None
+        box = inscribed_cuboid(  # the start box on the synthesis's own grid (in 6-D 5 per edge: 14896 samples)
+            m0,
+            self.config,
+            starts=1,
+            seed=self.seed,
+            samples_per_edge=self.samples_per_edge,
+            check_per_edge=self.start_check,
+            refinements=0,
+        )
+        if not box.found:
+            return False, None, f"no cuboid at the start design ({box.message})", 0, None
+        centre = 0.5 * (box.region[0] + box.region[1])
+        size = np.maximum(box.region[1] - box.region[0], 1e-12)
+        u0, w0 = (box.lower - centre) / size, (box.upper - box.lower) / size
+        X, Q, ok = poses(m0, box.lower + self.S * (box.upper - box.lower), self.config)
+        if not np.all(ok):
+            return False, None, "a sample of the start box does not assemble", 0, None
+        y0 = np.hstack([X[:, c.dep_index], Q]).ravel()
+        ylo = np.r_[m0.x_lower[c.dep_index], np.full(c.nq, -np.inf)]
+        yhi = np.r_[m0.x_upper[c.dep_index], np.full(c.nq, np.inf)]
+        lbx = np.r_[np.full(d, -np.inf), np.full(d, 1e-10), np.zeros(len(names)), np.tile(ylo, N)]
+        ubx = np.r_[np.full(d, np.inf), np.full(d, np.inf), np.ones(len(names)), np.tile(yhi, N)]
+        par = np.r_[model.p, lo, hi - lo, self.S.T.ravel(order="F"), centre, size]
+        z, conv, status, iters = self.nlp.solve(np.r_[u0, w0, z0, y0], par, lbx, ubx, self.lbg, self.ubg)
+        return conv, z if conv else None, status, iters, (centre, size)
+
+    def design(self, z: np.ndarray) -> dict[str, float]:
+        """The varied parameters of the NLP's solution ``z``."""
+        d, lo, hi = self.model.closure.nq, self.lo, self.hi
+        return dict(zip(self.names, lo + (hi - lo) * z[2 * d : 2 * d + len(self.names)]))
+
+
+def _objective(starts: _Starts, footprint: Mapping[str, float], run: tuple) -> float | None:
+    """Volume per footprint of a converged start's design; None for a failed one."""
+    if not run[0]:
+        return None
+    d = starts.model.closure.nq
+    z, (_centre, size) = run[1], run[4]
+    vol = float(np.prod(size * z[d : 2 * d]))
+    return vol / footprint_of({**starts.model.parameters, **starts.design(z)}, footprint)
+
+
+def cuboid_synthesis(
     model: Model,
     design: Mapping[str, tuple[float, float]],
     footprint: Mapping[str, float] | None = None,
@@ -194,22 +291,7 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
     config = solver or SolverConfig()
     c = model.closure
     footprint = dict(footprint or {})
-    _check_names(list(design), c, ("design",))
-    _check_names(list(footprint), c, ("footprint",))
-    if not design:
-        raise InputError("expected at least one parameter to vary", path=("design",))
-    names = [n for n in c.parameters if n in design]
-    lo = np.array([float(design[n][0]) for n in names])
-    hi = np.array([float(design[n][1]) for n in names])
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(lo < hi)):
-        raise InputError(f"expected finite bounds low < high, got {dict(design)}", path=("design",))
-    for n, e in footprint.items():
-        low = float(design[n][0]) if n in design else float(model.parameters[n])
-        if e != 0 and not low > 0:
-            raise InputError(
-                f"the footprint takes the log of {n}; its lower bound must be positive, got {low:g}",
-                path=("design", n),
-            )
+    names, lo, hi = _design_bounds(model, design, footprint)
     lc = model.characteristic_length
     mech = model.mechanism
     build = rebuild or (lambda params: Model(c, params, model.limits, characteristic_length=lc, mechanism=mech))
@@ -220,7 +302,6 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
         samples_per_edge = default_per_edge(d, 3, DEFAULT_NLP_SAMPLES)
     if check_per_edge is None:
         check_per_edge = default_per_edge(d, 9, DEFAULT_CHECK_POINTS)
-    start_check = default_per_edge(d, 5, DEFAULT_CHECK_POINTS)
     S = surface_grid(d, samples_per_edge)
     N = len(S)
     lo_b, hi_b = limit_bounds(model)
@@ -232,56 +313,14 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
     lo_a = np.where(np.isfinite(lo_a), lo_a + NLP_MARGIN, lo_a)
     hi_a = np.where(np.isfinite(hi_a), hi_a - NLP_MARGIN, hi_a)
     lbg, ubg = np.tile(np.r_[np.zeros(c.nx), lo_a], N), np.tile(np.r_[np.zeros(c.nx), hi_a], N)
+    start_check = default_per_edge(d, 5, DEFAULT_CHECK_POINTS)
+    shared = _Starts(model, names, lo, hi, build, nlp, lbg, ubg, S, config, seed, samples_per_edge, start_check)
     first = np.array([model.parameters[n] for n in names])
     z_starts = uniform_starts(np.zeros(len(names)), np.ones(len(names)), starts, seed, (first - lo) / (hi - lo))
-    runs: list[tuple[bool, np.ndarray | None, str, int, tuple | None]] = []
-    iterations = 0
-    for z0 in track(z_starts, "synthesis starts"):  # progress; Ctrl-C between starts and inside IPOPT
-        params = dict(model.parameters)
-        params.update({n: float(v) for n, v in zip(names, lo + (hi - lo) * z0)})
-        try:
-            m0 = build(params)
-        except (InputError, ValueError) as exc:
-            runs.append((False, None, f"design not buildable: {exc}", 0, None))
-            continue
-        box = inscribed_cuboid(  # the start box on the synthesis's own grid (in 6-D 5 per edge: 14896 samples)
-            m0,
-            config,
-            starts=1,
-            seed=seed,
-            samples_per_edge=samples_per_edge,
-            check_per_edge=start_check,
-            refinements=0,
-        )
-        if not box.found:
-            runs.append((False, None, f"no cuboid at the start design ({box.message})", 0, None))
-            continue
-        centre = 0.5 * (box.region[0] + box.region[1])
-        size = np.maximum(box.region[1] - box.region[0], 1e-12)
-        u0, w0 = (box.lower - centre) / size, (box.upper - box.lower) / size
-        X, Q, ok = poses(m0, box.lower + S * (box.upper - box.lower), config)
-        if not np.all(ok):
-            runs.append((False, None, "a sample of the start box does not assemble", 0, None))
-            continue
-        y0 = np.hstack([X[:, c.dep_index], Q]).ravel()
-        ylo = np.r_[m0.x_lower[c.dep_index], np.full(c.nq, -np.inf)]
-        yhi = np.r_[m0.x_upper[c.dep_index], np.full(c.nq, np.inf)]
-        lbx = np.r_[np.full(d, -np.inf), np.full(d, 1e-10), np.zeros(len(names)), np.tile(ylo, N)]
-        ubx = np.r_[np.full(d, np.inf), np.full(d, np.inf), np.ones(len(names)), np.tile(yhi, N)]
-        par = np.r_[model.p, lo, hi - lo, S.T.ravel(order="F"), centre, size]
-        z, conv, status, iters = nlp.solve(np.r_[u0, w0, z0, y0], par, lbx, ubx, lbg, ubg)
-        iterations += iters
-        runs.append((conv, z if conv else None, status, iters, (centre, size)))
-
-    def objective(run) -> float | None:
-        if not run[0]:
-            return None
-        z, (_centre, size) = run[1], run[4]
-        values = dict(zip(names, lo + (hi - lo) * z[2 * d : 2 * d + len(names)]))
-        vol = float(np.prod(size * z[d : 2 * d]))
-        return vol / footprint_of({**model.parameters, **values}, footprint)
-
-    objs = [objective(r) for r in runs]
+    # progress; Ctrl-C between starts and inside IPOPT
+    runs = [shared.run(z0) for z0 in track(z_starts, "synthesis starts")]
+    iterations = sum(r[3] for r in runs)
+    objs = [_objective(shared, footprint, r) for r in runs]
     best, agreed = best_and_agreement([-v if v is not None else None for v in objs])
     converged = [v for v in objs if v is not None]
     if best is None:
@@ -296,25 +335,12 @@ def cuboid_synthesis(  # noqa: C901 - the driver: starts, solves, best, re-check
         )
     z, (centre, size) = runs[best][1], runs[best][4]
     params = dict(model.parameters)
-    params.update({n: float(v) for n, v in zip(names, lo + (hi - lo) * z[2 * d : 2 * d + len(names)])})
+    params.update({n: float(v) for n, v in shared.design(z).items()})
     params.update({n: float(np.clip(params[n], lo[k], hi[k])) for k, n in enumerate(names)})
     lower = centre + size * z[:d]
-    upper = lower + size * z[d : 2 * d]
     m_opt = build(params)
-    check = check_box(m_opt, lower, upper, check_per_edge, config)[0]
-    shrink = 1.0
-    if not check.passed:  # the largest homothetic shrink about the centre that passes
-        mid, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
-        good, bad = 0.0, 1.0
-        for _ in range(SHRINK_STEPS):
-            f = 0.5 * (good + bad)
-            if check_box(m_opt, mid - f * half, mid + f * half, check_per_edge, config)[0].passed:
-                good = f
-            else:
-                bad = f
-        shrink = good
-        lower, upper = mid - shrink * half, mid + shrink * half
-        check = check_box(m_opt, lower, upper, check_per_edge, config)[0]
+    upper = lower + size * z[d : 2 * d]
+    lower, upper, shrink, check = shrink_to_pass(m_opt, lower, upper, check_per_edge, config, steps=SHRINK_STEPS)
     volume = float(np.prod(upper - lower))
     fp = footprint_of(params, footprint)
     msg = f"best of {len(runs)} starts ({len(converged)} converged, {agreed} agree within {AGREEMENT:g})"

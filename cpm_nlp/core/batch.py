@@ -2,7 +2,7 @@
 
 numpy in, numpy out, one status per pose.  Every pose passes the same checks
 as a single solve (residual, assembly branch, IK round trip, conditioning,
-joint limits; see :mod:`cpm_nlp.core.kernels`), so a batch reports exactly the
+joint limits; see :mod:`cpm_nlp.core.pose_checks`), so a batch reports exactly the
 statuses that N single solves would.
 
 Backends:
@@ -43,24 +43,11 @@ from . import progress
 from .compiled import BACKENDS as BACKENDS  # noqa: F401 - re-exported
 from .compiled import NativeLoop, backend_function, native_loop
 from .errors import InputError
-from .kernels import (
-    NUMPY,
-    PATHS,
-    STATUSES,
-    Kernel,
-    code_of,
-    condition_number,
-    fast,
-    fk_kernel,
-    ik_kernel,
-    is_singular,
-    jacobian_kernel,
-    shared_values,
-    status_code,
-    status_rules,
-)
+from .fast_calls import fast
+from .kernels import PATHS, Kernel, fk_kernel, ik_kernel, jacobian_kernel, shared_values
 from .kinematics import PoseSolution, failure_message
 from .model import LoopClosure, Model
+from .pose_checks import NUMPY, STATUSES, code_of, condition_number, is_singular, status_code, status_rules
 from .result import Status
 from .solver import SolverConfig
 
@@ -120,14 +107,14 @@ def default_threads() -> int:
 class BatchResult:
     """N poses solved at once.
 
-    status: int8 codes, shape (N,), positions in :data:`cpm_nlp.core.kernels.STATUSES`
+    status: int8 codes, shape (N,), positions in :data:`cpm_nlp.core.pose_checks.STATUSES`
         (``statuses`` gives the :class:`Status` values);
     x (N, nx), q (N, nq), passive (N, n_passive): SI, NaN where a pose is not solved;
     checks: per-pose check values: ``residual``, ``branch_margin``,
         ``round_trip_error``, ``cond1`` (1-norm condition number of Φ_x, or
         an upper bound of it; for a closure solved through normal equations
         an upper bound of the 2-norm condition number of the Jacobian of
-        every closure equation, see :mod:`cpm_nlp.core.kernels`),
+        every closure equation, see :mod:`cpm_nlp.core.pose_checks`),
         ``limit_margin`` (distance to the nearest joint limit, negative
         outside), ``cond_phi_x`` (2-norm condition number of
         ``LoopClosure.cond_matrix`` -- Φ_x, or that Jacobian -- computed

@@ -32,7 +32,8 @@ import casadi as ca
 import numpy as np
 
 from .errors import CpmError, InputError, suggest
-from .kernels import BoundCall, Kernel
+from .fast_calls import BoundCall
+from .kernels import Kernel
 from .model import LoopClosure
 
 log = logging.getLogger(__name__)
@@ -157,7 +158,7 @@ class NativeLoop:
 
 class BoundNative(BoundCall):
     """A compiled kernel for one model, called on one pose at a time (the
-    single-solve twin of :class:`cpm_nlp.core.kernels.BoundCall`, same
+    single-solve twin of :class:`cpm_nlp.core.fast_calls.BoundCall`, same
     interface): straight into the library's loop for one pose, through ctypes."""
 
     def __init__(self, loop: NativeLoop, shared: list[np.ndarray], defaults: list) -> None:

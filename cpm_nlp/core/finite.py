@@ -77,35 +77,14 @@ def nonfinite_paths(values: Mapping[str, Any]) -> list[str]:
     return out
 
 
-def _nulled(value: Any) -> Any:
+def nulled(value: Any) -> Any:
     """``value`` with every non-finite number replaced by None (containers as lists)."""
     if isinstance(value, Mapping):
-        return {k: _nulled(v) for k, v in value.items()}
+        return {k: nulled(v) for k, v in value.items()}
     if isinstance(value, np.ndarray):
-        return _nulled(value.tolist())
+        return nulled(value.tolist())
     if isinstance(value, (list, tuple)):
-        return [_nulled(v) for v in value]
+        return [nulled(v) for v in value]
     if isinstance(value, (float, np.floating, complex, np.complexfloating)) and not np.isfinite(value):
         return None
     return value
-
-
-def finite_status(result: Any) -> Any:
-    """``result`` (a :class:`~cpm_nlp.core.result.Result`) with no non-finite number in its
-    values: each becomes None, and a result that said ``solved`` says ``not_finite``
-    instead, naming the values (a NaN or an inf is never an answer)."""
-    from .result import Status
-
-    bad = nonfinite_paths(result.values)
-    if not bad:
-        return result
-    result.values = {
-        k: _nulled(v) if any(b == k or b.startswith((f"{k}[", f"{k}.")) for b in bad) else v
-        for k, v in result.values.items()
-    }
-    shown = ", ".join(bad[:5]) + (f" and {len(bad) - 5} more" if len(bad) > 5 else "")
-    note = f"not finite (an overflow, a division by zero or a NaN): {shown}"
-    if result.status is Status.SOLVED:
-        result.status = Status.NOT_FINITE
-    result.message = f"{note}; {result.message}" if result.message else note
-    return result

@@ -190,4 +190,10 @@ def joint_types(planar: bool) -> tuple[str, ...]:
     return tuple(n for n, t in JOINT_TYPES.items() if (t.planar if planar else t.spatial))
 
 
-__all__ = ["JOINT_LETTERS", "JOINT_TYPES", "JointType", "joint_type", "joint_types"]
+__all__ = (
+    "JOINT_LETTERS",
+    "JOINT_TYPES",
+    "JointType",
+    "joint_type",
+    "joint_types",
+)

@@ -21,7 +21,7 @@ from .errors import InputError
 from .mechanism import P, Part
 from .model import Coordinate, Model
 from .options import Option, validate_mapping
-from .result import Result
+from .result import Output, Result
 from .solver import SolverConfig
 from .units import format_quantity
 
@@ -30,7 +30,7 @@ class ProblemKind:
     """Base class of problem kinds.
 
     Subclasses set ``name`` and ``description`` and implement
-    :meth:`input_options`, :meth:`run` and :meth:`output_names`; they may
+    :meth:`input_options`, :meth:`run` and :meth:`outputs`; they may
     override :meth:`resolve` for values derived from several inputs (the hinges of
     ``hinges`` and ``material``) and :meth:`check_inputs` for rules that involve
     several inputs.  The inputs are parsed once, here, by their declaration
@@ -76,8 +76,15 @@ class ProblemKind:
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         raise NotImplementedError
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
+        """The declared outputs on ``model``: name, dimension, role (and the unit text of
+        what has no SI unit), every value the kind may return, in order; its results are
+        built from them (:func:`~cpm_nlp.core.outputs.declared_result`)."""
         raise NotImplementedError
+
+    def output_names(self, model: Model) -> list[str]:
+        """The names of :meth:`outputs`."""
+        return [o.name for o in self.outputs(model)]
 
     def supports(self, model: Model) -> str | None:
         """None if the kind applies to this model, else the reason it does not."""

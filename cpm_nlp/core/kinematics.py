@@ -23,26 +23,22 @@ import numpy as np
 
 from .compiled import BoundNative, backend_function, native_loop
 from .errors import InputError
-from .kernels import (
-    PATHS,
+from .fast_calls import BoundCall, fast
+from .kernels import PATHS, batch_newton_supported, fk_kernel, shared_values
+from .model import Model
+from .pose_checks import ROUND_TRIP_FACTOR as ROUND_TRIP_FACTOR  # noqa: F401 - re-exported (defined in pose_checks)
+from .pose_checks import (
     SCALAR,
     STATUSES,
-    BoundCall,
-    batch_newton_supported,
     checks_function,
     code_of,
     condition_number,
-    fast,
-    fk_kernel,
     is_singular,
     limit_vectors,
-    shared_values,
     status_code,
     status_rules,
 )
-from .kernels import ROUND_TRIP_FACTOR as ROUND_TRIP_FACTOR  # noqa: F401 - re-exported (defined in kernels)
-from .kernels import SINGULAR_CONDITION as SINGULAR_CONDITION  # noqa: F401
-from .model import Model
+from .pose_checks import SINGULAR_CONDITION as SINGULAR_CONDITION  # noqa: F401
 from .result import Status
 from .solver import SolverConfig
 
@@ -115,7 +111,7 @@ def _limit_violations(model: Model, x: np.ndarray, q: np.ndarray, passive: np.nd
 
 
 def pose_checks(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> dict[str, np.ndarray]:
-    """The kernel checks of one pose (see :mod:`cpm_nlp.core.kernels`), one fast call."""
+    """The kernel checks of one pose (see :mod:`cpm_nlp.core.pose_checks`), one fast call."""
     c = model.closure
     fn = fast(c, ("pose_checks",), lambda: checks_function(c))
     lower, upper = limit_vectors(model)
@@ -201,7 +197,7 @@ def _assess(
 def assess(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tuple[Status, str, dict]:
     """Check a candidate pose: residual, assembly branch, IK round trip,
     singularity, joint limits (in this order; the first failure gives the
-    status, see :func:`cpm_nlp.core.kernels.status_rules`).  Returns (status,
+    status, see :func:`cpm_nlp.core.pose_checks.status_rules`).  Returns (status,
     message, details)."""
     status, message, details, _ = _assess(model, x, q, tolerance)
     return status, message, details

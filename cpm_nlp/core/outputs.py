@@ -2,56 +2,97 @@
 
 A kind declares each value it returns once, as an :class:`Output` (name, dimension,
 role); :func:`declared_result` then writes the result's units and dimensions from
-that declaration, so that no kind writes a unit by hand (issue 22, item 2).
+that declaration, so that no kind writes a unit by hand (issue 22, item 2).  The unit
+of a physical dimension is :func:`~cpm_nlp.core.units.result_unit`'s; an output with
+no SI unit (a matrix, a list of coordinates, a text) carries a text saying what it
+holds (:func:`matrix`, :func:`vector`, :func:`text`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
-from .result import Result, ResultWarning, SolverInfo, Status
-from .units import result_unit
+from .result import ROLES, Entry, Output, Result, ResultWarning, SolverInfo, Status
+from .units import DIMENSIONS, size_dimension
 
-#: what an output is: one number per point ("value"), a number relative to another
-#: output ("reference", ``refers_to`` names it), a matrix whose rows and columns the
-#: unit text describes ("matrix"), a free text ("text")
-ROLES = ("value", "reference", "matrix", "text")
-
-
-@dataclass(frozen=True)
-class Output:
-    """One value a kind returns.
-
-    name: its name in the result (the papers' symbol); dimension: "length", "angle" ...
-    (or "matrix", "text" for what has no SI unit); role: one of :data:`ROLES`;
-    refers_to: the output a "reference" is taken from (x0 of an offset dx); unit: the
-    unit text where the dimension's SI unit does not say it (a matrix's rows and columns).
-    """
-
-    name: str
-    dimension: str
-    role: str = "value"
-    refers_to: str = ""
-    unit: str | None = None
-
-    def __post_init__(self) -> None:
-        if self.role not in ROLES:
-            raise ValueError(f"output {self.name!r}: role must be one of {', '.join(ROLES)}, got {self.role!r}")
-        if (self.role == "reference") != bool(self.refers_to):
-            raise ValueError(f"output {self.name!r}: a 'reference' output, and only it, names what it refers_to")
-
-    @property
-    def si(self) -> str:
-        """The unit the result writes (:func:`~cpm_nlp.core.units.result_unit` unless given)."""
-        return self.unit if self.unit is not None else result_unit(self.dimension)
+__all__ = (
+    "ROLES",
+    "Entry",
+    "Output",
+    "Values",
+    "declared_result",
+    "matrix",
+    "output_names",
+    "outputs_of",
+    "size",
+    "text",
+    "vector",
+)
 
 
-def outputs_of(dims: Mapping[str, str]) -> list[Output]:
+def outputs_of(dims: Mapping[str, str], *, named: bool = True) -> list[Output]:
     """Outputs of the given dimensions, in their order (a matrix's and a text's role said by
-    their dimension, every other one a value)."""
-    return [Output(n, d, d if d in ("matrix", "text") else "value") for n, d in dims.items()]
+    their dimension, every other one a value).  An output of no physical dimension (a text,
+    a matrix, a margin in the unit of whichever quantity binds) writes its dimension's name
+    as its unit, or with ``named=False`` no unit."""
+    return [
+        Output(n, d, d if d in ("matrix", "text") else "value", unit=None if named or d in DIMENSIONS else "")
+        for n, d in dims.items()
+    ]
+
+
+def size(name: str, kinds: Iterable[str]) -> Output:
+    """The size of a box whose sides are coordinates of ``kinds`` (an area, a volume, a
+    length times an angle ...): dimension and unit by :func:`~cpm_nlp.core.units.size_dimension`."""
+    dimension, unit = size_dimension(kinds)
+    return Output(name, dimension, unit=unit)
+
+
+def matrix(name: str, unit: str) -> Output:
+    """A matrix output; ``unit`` says its rows and columns (and their units)."""
+    return Output(name, "matrix", "matrix", unit=unit)
+
+
+def vector(name: str, unit: str) -> Output:
+    """A list of values of several coordinates; ``unit`` names them and their units."""
+    return Output(name, "vector", unit=unit)
+
+
+def text(name: str, unit: str = "") -> Output:
+    """A text (a name, a verdict, a note): no unit."""
+    return Output(name, "text", "text", unit=unit)
+
+
+@dataclass
+class Values:
+    """Values with their declarations, gathered in the order computed (what
+    :func:`declared_result` takes): a kind adds each value with its :class:`Output`."""
+
+    outputs: list[Output] = field(default_factory=list)
+    values: dict[str, Any] = field(default_factory=dict)
+
+    def add(self, output: Output, value: Any) -> Values:
+        """Declare ``output`` and set its value."""
+        self.outputs.append(output)
+        self.values[output.name] = value
+        return self
+
+    def add_all(self, pairs: Iterable[tuple[Output, Any]]) -> Values:
+        for output, value in pairs:
+            self.add(output, value)
+        return self
+
+    def declare(self, outputs: Iterable[Output]) -> Values:
+        """Declare outputs whose values come later (or never)."""
+        self.outputs.extend(outputs)
+        return self
+
+    def extend(self, other: Values) -> Values:
+        self.outputs.extend(other.outputs)
+        self.values.update(other.values)
+        return self
 
 
 def output_names(outputs: Sequence[Output]) -> list[str]:
@@ -70,21 +111,16 @@ def declared_result(
     model: Mapping[str, Any] | None = None,
     warnings: Sequence[ResultWarning] = (),
 ) -> Result:
-    """A result whose units and dimensions are those ``outputs`` declare, in their order."""
-    seen: set[str] = set()
-    for o in outputs:
-        if o.name in seen:
-            raise ValueError(f"{kind}: output {o.name!r} is declared twice")
-        seen.add(o.name)
+    """A result whose units and dimensions are those ``outputs`` declare, in their order;
+    every value is of a declared output."""
     return Result(
         kind,
         status,
-        dict(values),
-        {o.name: o.si for o in outputs},
-        {o.name: o.dimension for o in outputs},
-        solver or SolverInfo("none"),
-        message,
-        statuses,
-        dict(model or {}),
-        list(warnings),
+        outputs,
+        values,
+        solver=solver,
+        message=message,
+        statuses=statuses,
+        model=model,
+        warnings=warnings,
     )

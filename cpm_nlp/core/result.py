@@ -10,14 +10,17 @@ from __future__ import annotations
 import json
 import math
 import sys
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from enum import Enum
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
+from .finite import nonfinite_paths, nulled
 from .origin import Origin
+from .units import result_unit
 
 
 class Status(str, Enum):
@@ -42,17 +45,19 @@ class Status(str, Enum):
 
 
 #: Human explanation of each status (printed by the CLI, stored in results).
-STATUS_TEXT = {
-    Status.SOLVED: "converged; residual, assembly branch and joint limits checked",
-    Status.NOT_CONVERGED: "the solver did not converge",
-    Status.RESIDUAL_TOO_LARGE: "the solver stopped but the loop-closure residual is above tolerance",
-    Status.WRONG_BRANCH: "the solution lies on another assembly branch than the one the model designates",
-    Status.OUTSIDE_JOINT_LIMITS: "the pose needs a joint outside its declared limits",
-    Status.UNREACHABLE: "the pose cannot be assembled (no real solution of the loop closures)",
-    Status.SINGULAR: "the pose is singular (the loop-closure Jacobian is rank deficient)",
-    Status.INFEASIBLE: "the problem has no feasible point",
-    Status.NOT_FINITE: "a computed value is not finite (an overflow, a division by zero or a NaN)",
-}
+STATUS_TEXT: Mapping[Status, str] = MappingProxyType(
+    {
+        Status.SOLVED: "converged; residual, assembly branch and joint limits checked",
+        Status.NOT_CONVERGED: "the solver did not converge",
+        Status.RESIDUAL_TOO_LARGE: "the solver stopped but the loop-closure residual is above tolerance",
+        Status.WRONG_BRANCH: "the solution lies on another assembly branch than the one the model designates",
+        Status.OUTSIDE_JOINT_LIMITS: "the pose needs a joint outside its declared limits",
+        Status.UNREACHABLE: "the pose cannot be assembled (no real solution of the loop closures)",
+        Status.SINGULAR: "the pose is singular (the loop-closure Jacobian is rank deficient)",
+        Status.INFEASIBLE: "the problem has no feasible point",
+        Status.NOT_FINITE: "a computed value is not finite (an overflow, a division by zero or a NaN)",
+    }
+)
 
 
 def worst_status(statuses: list[Status]) -> Status:
@@ -75,30 +80,46 @@ class SolverInfo:
         return {"name": self.name, "iterations": int(self.iterations), "seconds": float(self.seconds)}
 
 
-def jsonable(value: Any) -> Any:  # noqa: C901 - one branch per kind of value
+def _bounded_int(value: Any) -> int | None:
+    return int(value) if abs(int(value)) <= sys.float_info.max else None  # no float holds it
+
+
+def _finite_float(value: Any) -> float | None:
+    v = float(value)
+    return v if math.isfinite(v) else None
+
+
+def _real_or_text(value: Any) -> Any:
+    return jsonable(value.real) if value.imag == 0 else str(value)
+
+
+def _json_mapping(value: Mapping) -> dict[str, Any]:
+    return {k if isinstance(k, str) else str(jsonable(k)): jsonable(v) for k, v in value.items()}
+
+
+#: (types, conversion) in the order tried: the first that fits converts (an enum before
+#: the str it may be, a bool before the int it is)
+_JSON_CONVERSIONS: tuple[tuple[Any, Any], ...] = (
+    (Enum, lambda v: jsonable(v.value)),
+    ((type(None), bool, str), lambda v: v),
+    (np.bool_, bool),
+    ((int, np.integer), _bounded_int),
+    ((float, np.floating), _finite_float),
+    ((complex, np.complexfloating), _real_or_text),
+    (np.ndarray, lambda v: jsonable(v.tolist())),
+    (Mapping, _json_mapping),
+    ((list, tuple, set, frozenset), lambda v: [jsonable(x) for x in v]),
+)
+
+
+def jsonable(value: Any) -> Any:
     """A copy of ``value`` that :func:`json.dumps` writes with ``allow_nan=False``, at any
     depth: numpy arrays and scalars to lists and numbers, non-finite floats (NaN, inf) to
     None (as an integer too large for any float), mapping keys to strings, enums to their
     values, anything else to its text."""
-    if isinstance(value, Enum):
-        return jsonable(value.value)
-    if value is None or isinstance(value, (bool, str)):
-        return value
-    if isinstance(value, (np.bool_,)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value) if abs(int(value)) <= sys.float_info.max else None  # no float holds it
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        return v if math.isfinite(v) else None
-    if isinstance(value, (complex, np.complexfloating)):
-        return jsonable(value.real) if value.imag == 0 else str(value)
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, Mapping):
-        return {k if isinstance(k, str) else str(jsonable(k)): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, set, frozenset)):
-        return [jsonable(v) for v in value]
+    for types, convert in _JSON_CONVERSIONS:
+        if isinstance(value, types):
+            return convert(value)
     return str(value)
 
 
@@ -151,42 +172,184 @@ class ResultWarning:
 
 
 #: Codes of :class:`ResultWarning` (docs/site/howto/read-status.md lists them).
-WARNING_CODES = {
-    "stress_above_yield": "a hinge stress above its material's yield strength",
-    "stress_above_allowable": "a hinge stress above the allowable (design) stress",
-    "deflection_beyond_formula": "a hinge deflection beyond the range of its stiffness formula",
-    "hinge_geometry": "a hinge geometry outside its formula's validity",
-    "beyond_linear_range": "compliant FK: linear and nonlinear deflection differ by more than 10 %",
-    "near_singular": "a pose near a singularity (ill-conditioned Jacobian)",
-    "strokes_partly_assemble": "part of the stroke box does not assemble: the workspace is the image of the rest",
-}
+WARNING_CODES: Mapping[str, str] = MappingProxyType(
+    {
+        "stress_above_yield": "a hinge stress above its material's yield strength",
+        "stress_above_allowable": "a hinge stress above the allowable (design) stress",
+        "deflection_beyond_formula": "a hinge deflection beyond the range of its stiffness formula",
+        "hinge_geometry": "a hinge geometry outside its formula's validity",
+        "beyond_linear_range": "compliant FK: linear and nonlinear deflection differ by more than 10 %",
+        "near_singular": "a pose near a singularity (ill-conditioned Jacobian)",
+        "strokes_partly_assemble": "part of the stroke box does not assemble: the workspace is the image of the rest",
+    }
+)
 
 
-@dataclass
+#: what an output is: one number per point ("value"), a number relative to another
+#: output ("reference", ``refers_to`` names it), a matrix whose rows and columns the
+#: unit text describes ("matrix"), a free text ("text")
+ROLES = ("value", "reference", "matrix", "text")
+
+
+@dataclass(frozen=True)
+class Output:
+    """One value a kind returns, declared once.
+
+    name: its name in the result (the papers' symbol); dimension: "length", "angle" ...
+    (or "matrix", "vector", "text" for what has no SI unit); role: one of :data:`ROLES`;
+    refers_to: the output a "reference" is taken from (x0 of an offset dx); unit: the
+    unit text where the dimension's SI unit does not say it (a matrix's rows and columns).
+    """
+
+    name: str
+    dimension: str
+    role: str = "value"
+    refers_to: str = ""
+    unit: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.role not in ROLES:
+            raise ValueError(f"output {self.name!r}: role must be one of {', '.join(ROLES)}, got {self.role!r}")
+        if (self.role == "reference") != bool(self.refers_to):
+            raise ValueError(f"output {self.name!r}: a 'reference' output, and only it, names what it refers_to")
+
+    @property
+    def si(self) -> str:
+        """The unit the result writes (:func:`~cpm_nlp.core.units.result_unit` unless given)."""
+        return self.unit if self.unit is not None else result_unit(self.dimension)
+
+
+@dataclass(frozen=True)
+class Entry:
+    """A value of a result with its declaration (its unit and dimension are the declaration's)."""
+
+    output: Output
+    value: Any
+
+
 class Result:
     """The answer to one problem.
+
+    A result holds the outputs its kind declared (:class:`Output`: name, dimension, role,
+    in the declared order) and the values computed for them (in the order computed); a
+    value is always of a declared output, so its unit and dimension cannot disagree with
+    it. ``values``, ``units`` and ``dimensions`` are read-only views of the two:
 
     values:
         SI numbers (or lists of them) under the papers' symbols.
     units:
-        SI unit of each value ("m", "rad", "" ...).
+        SI unit of each declared output ("m", "rad", "" ...).
     dimensions:
-        dimension of each value ("length", "angle", ...), used for printing.
+        dimension of each declared output ("length", "angle", ...), used for printing.
+
+    An output may be declared and have no value (one not computed, or left out by a
+    problem's ``outputs``): its unit is still written.
     """
 
-    problem: str
-    status: Status
-    values: dict[str, Any] = field(default_factory=dict)
-    units: dict[str, str] = field(default_factory=dict)
-    dimensions: dict[str, str] = field(default_factory=dict)
-    solver: SolverInfo = field(default_factory=lambda: SolverInfo("none"))
-    message: str = ""
-    statuses: list[Status] | None = None  # per point, for batches
-    model: dict[str, Any] = field(default_factory=dict)  # parameters used, SI
-    #: where the numbers are outside their model's validity (empty when clean)
-    warnings: list[ResultWarning] = field(default_factory=list)
-    #: where the mechanism came from (recorded as ``origin``; None: not known, e.g. a model built in code)
-    origin: Origin | None = None
+    def __init__(
+        self,
+        problem: str,
+        status: Status,
+        outputs: Sequence[Output] = (),
+        values: Mapping[str, Any] | None = None,
+        *,
+        solver: SolverInfo | None = None,
+        message: str = "",
+        statuses: list[Status] | None = None,
+        model: Mapping[str, Any] | None = None,
+        warnings: Sequence[ResultWarning] = (),
+        origin: Origin | None = None,
+    ) -> None:
+        if isinstance(outputs, Mapping):  # the values, as Result took them before it held its outputs
+            raise TypeError(
+                f"{problem}: a Result takes its declared outputs (a sequence of Output), then the values; "
+                "build it with cpm_nlp.core.outputs.declared_result"
+            )
+        self.problem = problem
+        self.status = status
+        self._outputs: dict[str, Output] = {}
+        self._values: dict[str, Any] = {}
+        self.declare(outputs)
+        self.set(values or {})
+        self.solver = solver or SolverInfo("none")
+        self.message = message
+        #: per point, for batches
+        self.statuses = statuses
+        #: parameters used, SI
+        self.model: dict[str, Any] = dict(model or {})
+        #: where the numbers are outside their model's validity (empty when clean)
+        self.warnings: list[ResultWarning] = list(warnings)
+        #: where the mechanism came from (recorded as ``origin``; None: not known, e.g. a model built in code)
+        self.origin = origin
+
+    def __repr__(self) -> str:
+        return f"Result({self.problem!r}, {self.status.value}, {dict(self._values)!r}, message={self.message!r})"
+
+    def _key(self) -> tuple:
+        return (
+            self.problem,
+            self.status,
+            self.outputs,
+            self._values,
+            self.solver,
+            self.message,
+            self.statuses,
+            self.model,
+            self.warnings,
+            self.origin,
+        )
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Result) and self._key() == other._key()
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, as the dataclass it was
+
+    # -- the declaration and the values ------------------------------------------------------
+
+    def declare(self, outputs: Sequence[Output]) -> Result:
+        """Add declared outputs (after those declared so far); a name is declared once."""
+        names = [o.name for o in outputs]
+        twice = sorted({n for n in names if n in self._outputs or names.count(n) > 1})
+        if twice:
+            raise ValueError(f"{self.problem}: output {', '.join(map(repr, twice))} is declared twice")
+        self._outputs.update((o.name, o) for o in outputs)
+        return self
+
+    def set(self, values: Mapping[str, Any]) -> Result:
+        """Set values of declared outputs (a new one after the others, a known one in its place)."""
+        undeclared = [k for k in values if k not in self._outputs]
+        if undeclared:
+            raise ValueError(f"{self.problem}: value(s) of no declared output: {', '.join(map(str, undeclared))}")
+        self._values.update(values)
+        return self
+
+    def keep(self, names: Iterable[str]) -> Result:
+        """Keep only the values of ``names`` (the declarations stay, with their units)."""
+        keep = set(names)
+        self._values = {k: v for k, v in self._values.items() if k in keep}
+        return self
+
+    @property
+    def outputs(self) -> tuple[Output, ...]:
+        """The declared outputs, in the declared order."""
+        return tuple(self._outputs.values())
+
+    @property
+    def entries(self) -> Mapping[str, Entry]:
+        """Each value with its declaration, in the order computed."""
+        return MappingProxyType({k: Entry(self._outputs[k], v) for k, v in self._values.items()})
+
+    @property
+    def values(self) -> Mapping[str, Any]:
+        return MappingProxyType(self._values)
+
+    @property
+    def units(self) -> Mapping[str, str]:
+        return MappingProxyType({n: o.si for n, o in self._outputs.items()})
+
+    @property
+    def dimensions(self) -> Mapping[str, str]:
+        return MappingProxyType({n: o.dimension for n, o in self._outputs.items()})
 
     @property
     def ok(self) -> bool:
@@ -205,7 +368,7 @@ class Result:
         out: dict[str, Any] = {
             "problem": self.problem,
             "status": self.status.value,
-            "values": jsonable(self.values),
+            "values": jsonable(self._values),
             "solver": self.solver.to_dict(),
             "message": self.message,
             "units": jsonable(dict(self.units)),
@@ -221,3 +384,21 @@ class Result:
 
     def to_json(self, indent: int | None = 2) -> str:
         return json.dumps(jsonable(self.to_dict()), indent=indent, allow_nan=False)
+
+
+def finite_status(result: Result) -> Result:
+    """``result`` with no non-finite number in its values: each becomes None, and a result
+    that said ``solved`` says ``not_finite`` instead, naming the values (a NaN or an inf is
+    never an answer)."""
+    bad = nonfinite_paths(result.values)
+    if not bad:
+        return result
+    result.set(
+        {k: nulled(v) for k, v in result.values.items() if any(b == k or b.startswith((f"{k}[", f"{k}.")) for b in bad)}
+    )
+    shown = ", ".join(bad[:5]) + (f" and {len(bad) - 5} more" if len(bad) > 5 else "")
+    note = f"not finite (an overflow, a division by zero or a NaN): {shown}"
+    if result.status is Status.SOLVED:
+        result.status = Status.NOT_FINITE
+    result.message = f"{note}; {result.message}" if result.message else note
+    return result

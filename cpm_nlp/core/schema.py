@@ -452,7 +452,7 @@ def parse_with(decls: Sequence[Any], raw: Any, path: tuple, *, what: str = "inpu
     return validate_mapping(raw, decls, path, what=what)
 
 
-__all__ = [
+__all__ = (
     "Either",
     "ListOf",
     "MappingOf",
@@ -466,4 +466,4 @@ __all__ = [
     "parse_with",
     "type_text",
     "walk",
-]
+)

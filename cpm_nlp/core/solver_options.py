@@ -21,7 +21,7 @@ repository root with::
 
     python tools/gen_solver_options.py
 
-and run ``tests/test_hostile_solver.py`` (it checks that the table agrees with
+and run ``tests/hostile/test_hostile_solver.py`` (it checks that the table agrees with
 the installed IPOPT).  This module is the policy over that table:
 
 * IPOPT (``ipopt.<name>``): every documented option, typed and bounded as

@@ -82,7 +82,7 @@ DIMENSIONS: Mapping[str, Dimension] = MappingProxyType(
 
 
 #: unit text -> (factor to pint's root units, dimension), for the units of DIMENSIONS: the
-#: floats pint gives (Quantity(1.0, unit).to_root_units().magnitude; tests/test_units.py
+#: floats pint gives (Quantity(1.0, unit).to_root_units().magnitude; tests/core/test_units.py
 #: checks each against pint)
 FAST_UNITS: Mapping[str, tuple[float, str]] = MappingProxyType(
     {
@@ -176,7 +176,7 @@ def _describe(dim: Dimension) -> str:
     return "a dimensionless number" if dim.name == "dimensionless" else article(dim.name.replace("_", " "))
 
 
-def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # noqa: C901 - one branch per accepted form of a quantity
+def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:
     """Return the SI value of ``value``, a quantity of the given ``dimension``.
 
     ``value`` is a bare number (already SI) or a string ``"<number> <unit>"``.
@@ -187,12 +187,7 @@ def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # no
     if isinstance(value, bool) or value is None:
         raise InputError(f"expected {expected}, got {value!r}", path=path)
     if isinstance(value, (int, float)):
-        if isinstance(value, int) and abs(value) > _LARGEST:
-            raise InputError(f"{too_large(value)}; expected {expected}", path=path)
-        number = float(value)
-        if not math.isfinite(number):
-            raise InputError(f"expected a finite number ({expected}), got {value!r}", path=path)
-        return number
+        return _bare_number(value, expected, path)
     if not isinstance(value, str):
         raise InputError(f"expected {expected}, got {type(value).__name__} {value!r}", path=path)
     match = _NUMBER.match(value)
@@ -210,10 +205,28 @@ def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # no
     fast = FAST_UNITS.get(unit_text)
     ref = FAST_UNITS.get(dim.si) if dim.si else (1.0, dimension)
     if fast is not None and ref is not None and fast[1] == dimension == ref[1]:
-        si = number * fast[0] / ref[0]  # the same operations as the pint path below, on the same factors
-        if not math.isfinite(si):
-            raise InputError(f"{value!r} overflows", path=path)
-        return si
+        factor, ref_factor = fast[0], ref[0]  # the same operations as the pint path, on the same factors
+    else:
+        factor, ref_factor = _pint_factors(value, unit_text, dim, expected, path)
+    si = number * factor / ref_factor
+    if not math.isfinite(si):
+        raise InputError(f"{value!r} overflows", path=path)
+    return si
+
+
+def _bare_number(value: int | float, expected: str, path: tuple) -> float:
+    """A bare number: already SI, finite, and (an int) within a float's range."""
+    if isinstance(value, int) and abs(value) > _LARGEST:
+        raise InputError(f"{too_large(value)}; expected {expected}", path=path)
+    number = float(value)
+    if not math.isfinite(number):
+        raise InputError(f"expected a finite number ({expected}), got {value!r}", path=path)
+    return number
+
+
+def _pint_factors(value: str, unit_text: str, dim: Dimension, expected: str, path: tuple) -> tuple[float, float]:
+    """Pint's factors to the root units of ``unit_text`` and of the dimension's SI unit; bad input
+    where the unit is unknown or of another dimension."""
     try:
         unit = _ureg().parse_units(unit_text)
         factor, root = _root(unit)
@@ -231,10 +244,7 @@ def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:  # no
             path=path,
             suggestions=suggest(unit_text, [u for u in dim.common_units if u]),
         )
-    si = number * factor / ref_factor
-    if not math.isfinite(si):
-        raise InputError(f"{value!r} overflows", path=path)
-    return si
+    return factor, ref_factor
 
 
 def si_unit(dimension: str) -> str:

@@ -44,20 +44,9 @@ import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError, suggest
-from ..core.kernels import (
-    FK_OUTPUTS,
-    REDUCED_STEPS,
-    ROUND_TRIP_FACTOR,
-    SINGULAR_CONDITION,
-    STATUSES,
-    Kernel,
-    bake,
-    kernel,
-    limit_vectors,
-    limited_coordinates,
-    newton_options,
-)
+from ..core.kernels import FK_OUTPUTS, REDUCED_STEPS, Kernel, bake, kernel, newton_options
 from ..core.model import Coordinate, Model
+from ..core.pose_checks import ROUND_TRIP_FACTOR, SINGULAR_CONDITION, STATUSES, limit_vectors, limited_coordinates
 from ..core.result import STATUS_TEXT
 from ..core.solver import SolverConfig
 from ..core.units import si_unit

@@ -365,51 +365,64 @@ def require_pyarrow() -> Any:
     require("pyarrow.parquet", "sweep", "a Parquet results file")
 
 
-def read_parquet(path: Path) -> SweepTable:  # noqa: C901 - one message per way a results file can be broken
+def read_parquet(path: Path) -> SweepTable:
     """Rows of the Parquet file and of its journal (a sweep still running or interrupted)."""
     require_pyarrow()
-    import pyarrow.parquet as pq
-
     meta: dict[str, Any] = {}
     rows: dict[int, dict[str, Any]] = {}
     if path.exists():
-        check_input_file(path, None)
-        try:
-            table = pq.read_table(path)
-        except Exception as exc:  # pyarrow raises ArrowInvalid, OSError ... for a file that is not Parquet
-            raise InputError(f"{path} is not a readable Parquet file ({exc.__class__.__name__}: {exc})") from None
-        raw_meta = (table.schema.metadata or {}).get(b"cpm_nlp")
-        if raw_meta is None:
-            raise InputError(f"{path} is not a cpm_nlp sweep results file (no cpm_nlp metadata)")
-        meta = json.loads(raw_meta)
-        json_cols = set(meta.get("json_columns", []))
-        for r in table.to_pylist():
-            for c in json_cols:
-                if r.get(c) is not None:
-                    r[c] = json.loads(r[c])
-            rows[r["point"]] = r
+        meta = _read_parquet_rows(path, rows)
     journal = journal_path(path)
     if journal.exists():
-        text = read_input_text(journal, MAX_RESULTS_BYTES, record=False)
-        lines = text[: text.rfind("\n") + 1].split("\n")[:-1]  # a last line cut short by a crash is dropped
-        if lines:
-            try:
-                head = json.loads(lines[0])
-            except ValueError:
-                head = None
-            if not isinstance(head, dict):
-                raise InputError("the journal's first line (the sweep's metadata) is damaged", file=str(journal))
-            meta = meta or head
-            if head.get("fingerprint") != meta.get("fingerprint"):
-                raise InputError(f"{journal} belongs to another sweep than {path}; remove one of them")
-        for n, line in enumerate(lines[1:], start=2):
-            try:
-                r = json.loads(line)
-                rows[int(r["point"])] = r
-            except (ValueError, TypeError, KeyError):
-                raise InputError(f"line {n} of the journal is damaged", file=str(journal)) from None
+        meta = _read_journal(journal, path, meta, rows)
     meta.pop("json_columns", None)
     return SweepTable(str(path), meta, [rows[k] for k in sorted(rows)])
+
+
+def _read_parquet_rows(path: Path, rows: dict[int, dict[str, Any]]) -> dict[str, Any]:
+    """The rows of the Parquet file itself, into ``rows`` by point; its metadata."""
+    import pyarrow.parquet as pq
+
+    check_input_file(path, None)
+    try:
+        table = pq.read_table(path)
+    except Exception as exc:  # pyarrow raises ArrowInvalid, OSError ... for a file that is not Parquet
+        raise InputError(f"{path} is not a readable Parquet file ({exc.__class__.__name__}: {exc})") from None
+    raw_meta = (table.schema.metadata or {}).get(b"cpm_nlp")
+    if raw_meta is None:
+        raise InputError(f"{path} is not a cpm_nlp sweep results file (no cpm_nlp metadata)")
+    meta = json.loads(raw_meta)
+    json_cols = set(meta.get("json_columns", []))
+    for r in table.to_pylist():
+        for c in json_cols:
+            if r.get(c) is not None:
+                r[c] = json.loads(r[c])
+        rows[r["point"]] = r
+    return meta
+
+
+def _read_journal(journal: Path, path: Path, meta: dict[str, Any], rows: dict[int, dict[str, Any]]) -> dict[str, Any]:
+    """The rows of the journal beside ``path`` (they replace the file's of the same point), into
+    ``rows``; the metadata (the file's, else the journal's first line)."""
+    text = read_input_text(journal, MAX_RESULTS_BYTES, record=False)
+    lines = text[: text.rfind("\n") + 1].split("\n")[:-1]  # a last line cut short by a crash is dropped
+    if lines:
+        try:
+            head = json.loads(lines[0])
+        except ValueError:
+            head = None
+        if not isinstance(head, dict):
+            raise InputError("the journal's first line (the sweep's metadata) is damaged", file=str(journal))
+        meta = meta or head
+        if head.get("fingerprint") != meta.get("fingerprint"):
+            raise InputError(f"{journal} belongs to another sweep than {path}; remove one of them")
+    for n, line in enumerate(lines[1:], start=2):
+        try:
+            r = json.loads(line)
+            rows[int(r["point"])] = r
+        except (ValueError, TypeError, KeyError):
+            raise InputError(f"line {n} of the journal is damaged", file=str(journal)) from None
+    return meta
 
 
 def write_parquet(path: Path, meta: Mapping[str, Any], columns: list[str], rows: list[dict[str, Any]]) -> None:

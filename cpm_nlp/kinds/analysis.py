@@ -8,7 +8,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -22,7 +22,7 @@ from ..core.errors import InputError
 from ..core.kind import ProblemKind
 from ..core.model import Model
 from ..core.options import REQUIRED, Option
-from ..core.outputs import declared_result, outputs_of
+from ..core.outputs import Output, declared_result, matrix, outputs_of, vector
 from ..core.result import Result, ResultWarning, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import DIMENSIONS, result_unit, size_dimension
@@ -31,13 +31,19 @@ from .kinematic import _model_info
 
 
 def closed_form_result(
-    kind: str, model: Model, values: dict, dims: dict, status=Status.SOLVED, message="", solver=None
+    kind: str,
+    model: Model,
+    values: dict,
+    outputs: Mapping[str, str] | Sequence[Output],
+    status=Status.SOLVED,
+    message="",
+    solver=None,
 ):
-    """The result of a closed-form kind: its outputs declared by their dimensions (``dims``)."""
+    """The result of a closed-form kind: its outputs declared (or given by their dimensions)."""
     return declared_result(
         kind,
         status,
-        outputs_of(dims),
+        outputs_of(outputs) if isinstance(outputs, Mapping) else outputs,
         values,
         solver=solver or SolverInfo("closed_form"),
         message=message,
@@ -124,7 +130,12 @@ class ActuatorWorkspace(ProblemKind):
             not_assembled_fraction=missing / len(rep.q),
             volume_border=float(rep.details.get("volume_border", 0.0)),
         )
-        res = closed_form_result(self.name, model, values, dims, rep.status, rep.message, info)
+        vertices, points = _image_outputs(model, bool(missing))
+        outputs = [vertices if o.name == "vertices" else o for o in outputs_of(dims)]
+        if inputs["points"]:
+            values["points"] = rep.t[np.all(np.isfinite(rep.t), axis=1)].tolist()
+            outputs.append(points)
+        res = closed_form_result(self.name, model, values, outputs, rep.status, rep.message, info)
         if missing:
             res.warn(
                 ResultWarning(
@@ -136,19 +147,22 @@ class ActuatorWorkspace(ProblemKind):
                     missing / len(rep.q),
                 )
             )
-        corners = "box corners that assemble" if missing else "box corners"
-        res.units["vertices"] = f"rows: {corners}; columns " + ", ".join(
-            f"{n} [{result_unit(dims[n + '_min'])}]" for n in names
-        )
-        if inputs["points"]:
-            res.values["points"] = rep.t[np.all(np.isfinite(rep.t), axis=1)].tolist()
-            res.dimensions["points"] = "matrix"
-            grid = "grid points that assemble" if missing else "grid points"
-            res.units["points"] = res.units["vertices"].replace(corners, grid)
         return res
 
-    def output_names(self, model: Model) -> list[str]:
-        return list(self._dims(model)) + ["points"]
+    def outputs(self, model: Model) -> list[Output]:
+        vertices, points = _image_outputs(model, False)
+        return [vertices if o.name == "vertices" else o for o in outputs_of(self._dims(model))] + [points]
+
+
+def _image_outputs(model: Model, partly: bool) -> tuple[Output, Output]:
+    """The images of the stroke box's corners (``vertices``) and of its grid (``points``), rows
+    of task coordinates; ``partly``: only those that assemble."""
+    c = model.closure
+    cols = ", ".join(f"{c.x[i].name} [{result_unit(c.x[i].kind)}]" for i in c.task_index)
+    that = " that assemble" if partly else ""
+    return matrix("vertices", f"rows: box corners{that}; columns {cols}"), matrix(
+        "points", f"rows: grid points{that}; columns {cols}"
+    )
 
 
 # -- dynamics -------------------------------------------------------------------------------------
@@ -201,30 +215,32 @@ class Dynamics(ProblemKind):
         f = dyn.natural_frequencies(M, K)
         n = model.closure.nq
         values: dict[str, Any] = {m: inputs[m] for m, _ in dm.masses}
-        dims = {m: "mass" for m, _ in dm.masses}
         for k in range(n):
             values[f"f{k + 1}"] = float(f[k])
-            dims[f"f{k + 1}"] = "frequency"
         values.update(M=M.tolist(), K=K.tolist(), G=G.tolist(), q_static=(-np.linalg.solve(K, G)).tolist())
-        dims.update(M="matrix", K="matrix", G="vector", q_static="vector")
         if dm.values is not None:
             values.update(dm.values(model, w, M, K, G))
-            dims.update(dm.dimensions)
-        res = closed_form_result(
+        return closed_form_result(
             self.name,
             model,
             values,
-            dims,
+            _dynamics_outputs(model, dm),
             message=f"material {inputs['material'].name}; frequencies from |K - (2 pi f)^2 M| = 0",
         )
-        qs = ", ".join(model.closure.q_names)
-        res.units.update(
-            M=f"kg (generalized coordinates {qs})", K="N/m", G="N", q_static="m (static deflection under G)"
-        )
-        return res
 
-    def output_names(self, model: Model) -> list[str]:
-        dm = self._lagrange(model)
-        names = [m for m, _ in dm.masses] + [f"f{k + 1}" for k in range(model.closure.nq)]
-        names += ["M", "K", "G", "q_static"] + list(dm.dimensions)
-        return names
+    def outputs(self, model: Model) -> list[Output]:
+        return _dynamics_outputs(model, self._lagrange(model))
+
+
+def _dynamics_outputs(model: Model, dm: DynamicsModel) -> list[Output]:
+    """The masses, the natural frequencies, M, K, G, the static deflection, then the model's own values."""
+    qs = ", ".join(model.closure.q_names)
+    return [
+        *(Output(m, "mass") for m, _ in dm.masses),
+        *(Output(f"f{k + 1}", "frequency") for k in range(model.closure.nq)),
+        matrix("M", f"{result_unit('mass')} (generalized coordinates {qs})"),
+        matrix("K", result_unit("stiffness")),
+        vector("G", result_unit("force")),
+        vector("q_static", f"{result_unit('length')} (static deflection under G)"),
+        *outputs_of(dm.dimensions),
+    ]

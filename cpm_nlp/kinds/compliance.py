@@ -14,7 +14,7 @@ joints carry hinges (declared by the mechanism's part ``stiffness``, a
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -37,14 +37,15 @@ from ..core.kind import (
     task_values,
 )
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics
-from ..core.model import Model
+from ..core.model import Coordinate, Model
 from ..core.options import Option
+from ..core.outputs import Output, Values, declared_result, matrix, text, vector
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
 from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
-from .kinematic import _model_info, _pose_names, _pose_values
+from .kinematic import _model_info, _pose_names, _pose_outputs, _pose_values
 
 
 def _pose_inputs(model: Model) -> list[Option]:
@@ -122,10 +123,9 @@ class _HingeKind(ProblemKind):
         inputs["hinge_set"] = cm.hinge_set(model, inputs["hinges"], inputs["material"], inputs.get("sigma_allow"), path)
 
 
-def _stress_values(hs: cm.HingeSet, points: list[cm.StaticPoint | None], batch: bool) -> tuple[dict, dict]:
+def _stress_values(hs: cm.HingeSet, points: list[cm.StaticPoint | None], batch: bool, suffix: str = "") -> Values:
+    """The largest stress (and each hinge group's) per point."""
     groups = sorted({h.group for h in hs.hinges if h.kind is not None})
-    values: dict[str, Any] = {}
-    dims: dict[str, str] = {}
     cols: dict[str, list] = {"stress_max": []}
     cols.update({f"stress_{g}": [] for g in groups})
     for sp in points:
@@ -137,10 +137,85 @@ def _stress_values(hs: cm.HingeSet, points: list[cm.StaticPoint | None], batch: 
         for g in groups:
             vals = [s for h, s in zip(hs.hinges, sp.stresses.values()) if h.group == g and s is not None]
             cols[f"stress_{g}"].append(max(vals) if vals else None)
-    for k, v in cols.items():
-        values[k] = v if batch else v[0]
-        dims[k] = "stress"
-    return values, dims
+    return Values().add_all((Output(k + suffix, "stress"), v if batch else v[0]) for k, v in cols.items())
+
+
+def _coordinate_list(coords: Sequence[Coordinate]) -> str:
+    """The coordinates with their units, as the unit text of a list of them."""
+    return ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in coords)
+
+
+def _force_output(name: str, coord: Coordinate) -> Output:
+    """A force on a length coordinate, a moment on an angle."""
+    return Output(name, "force" if coord.kind == "length" else "moment")
+
+
+def _formula_stiffness(model: Model, hs: cm.HingeSet) -> Values:
+    """The stiffness of each hinge group's formula about each of its axes (a group once)."""
+    c = model.closure
+    coords = [*c.x, *c.q, *c.passive_coords]
+    out, seen = Values(), set()
+    for h in hs.hinges:
+        if h.group in seen:
+            continue
+        seen.add(h.group)
+        for a, kf in h.k_formula.items():
+            kind = "rotational_stiffness" if coords[h.axes[a]].kind == "angle" else "stiffness"
+            out.add(Output(f"k_formula_{h.group}_{a}", kind), kf)
+    return out
+
+
+def _compliance_output(c: Any) -> Output:
+    """The output compliance C (rows and columns the pose coordinates)."""
+    units = f"{result_unit('compliance')}, {result_unit('rotational_compliance')} and mixed"
+    return matrix("C", f"rows and columns {_coordinate_list(c.x)}; {units}")
+
+
+def _diagonal_output(x: Coordinate) -> Output:
+    """A diagonal entry of C: a compliance along a length, a rotational one about an angle."""
+    return Output(f"C_{x.name}", "compliance" if x.kind == "length" else "rotational_compliance")
+
+
+def _compliance_matrix(c: Any, C: np.ndarray, linear: np.ndarray) -> Values:
+    """The output compliance C and the linear deflection C f."""
+    out = Values().add(_compliance_output(c), C.tolist())
+    return out.add(vector("deflection_linear", _coordinate_list(c.x)), linear.tolist())
+
+
+def _diagonal_compliance(c: Any, C: np.ndarray) -> Values:
+    """The diagonal of C, one value per pose coordinate."""
+    return Values().add_all((_diagonal_output(x), float(C[i, i])) for i, x in enumerate(c.x))
+
+
+def _deflection_values(c: Any, d: np.ndarray) -> Values:
+    """The deflection under the load, as a list and per pose coordinate."""
+    out = Values().add(vector("deflection", _coordinate_list(c.x)), d.tolist())
+    return out.add_all((Output(f"d_{x.name}", x.kind), float(d[i])) for i, x in enumerate(c.x))
+
+
+def _largest(stresses: Mapping[str, float | None]) -> float | None:
+    return max((v for v in stresses.values() if v is not None), default=None)
+
+
+def _hinge_result(
+    kind: str,
+    model: Model,
+    status: Status,
+    out: Values,
+    info: SolverInfo,
+    message: str,
+    statuses: list[Status] | None = None,
+) -> Result:
+    return declared_result(
+        kind,
+        status,
+        out.outputs,
+        out.values,
+        solver=info,
+        message=message,
+        statuses=statuses,
+        model=_model_info(model),
+    )
 
 
 def _point_warnings(hs: cm.HingeSet, points: list[cm.StaticPoint | None], sigma: float | None = None) -> list:
@@ -195,71 +270,50 @@ class ActuatorForces(_HingeKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         c = model.closure
         hs: cm.HingeSet = inputs["hinge_set"]
-        f = inputs["load"]
         sols, batch = _solve_poses(model, inputs, solver)
-        points = [cm.static_point(model, hs, s.x, s.q, f) if s.ok else None for s in sols]
+        points = [cm.static_point(model, hs, s.x, s.q, inputs["load"]) if s.ok else None for s in sols]
         status, message, statuses = _summary(sols, batch)
-        names, dims = _pose_names(model)
-        values = _pose_values(model, sols, batch)
-        units = {n: result_unit(dims[n]) for n in names}
-        for j in range(c.nq):
-            col = [None if sp is None else float(sp.F[j]) for sp in points]
-            values[f"F{j + 1}"] = col if batch else col[0]
-            dims[f"F{j + 1}"] = "force" if c.q[j].kind == "length" else "moment"
-            units[f"F{j + 1}"] = "N" if c.q[j].kind == "length" else "N*m"
-        sv, sd = _stress_values(hs, points, batch)
-        values.update(sv)
-        dims.update(sd)
-        units.update({k: "Pa" for k in sd})
-        kq = [None if sp is None else sp.K_q.tolist() for sp in points]
-        energy = [None if sp is None else sp.energy for sp in points]
-        values.update(K_q=kq if batch else kq[0], energy=energy if batch else energy[0])
-        dims.update(K_q="matrix", energy="energy")
-        units.update(K_q=f"N/m or N*m/rad (rows and columns {', '.join(c.q_names)})", energy="J")
-        seen: set[str] = set()
-        for h in hs.hinges:
-            if h.group in seen:
-                continue
-            seen.add(h.group)
-            for a, kf in h.k_formula.items():
-                kind = [model.closure.x, model.closure.q, model.closure.passive_coords]
-                coord = (list(kind[0]) + list(kind[1]) + list(kind[2]))[h.axes[a]]
-                values[f"k_formula_{h.group}_{a}"] = kf
-                dims[f"k_formula_{h.group}_{a}"] = "rotational_stiffness" if coord.kind == "angle" else "stiffness"
-                units[f"k_formula_{h.group}_{a}"] = "N*m/rad" if coord.kind == "angle" else "N/m"
+
+        def per_point(col: list) -> Any:
+            return col if batch else col[0]
+
+        out = Values(_pose_outputs(model), _pose_values(model, sols, batch))
+        for j, q in enumerate(c.q):
+            out.add(_force_output(f"F{j + 1}", q), per_point([None if sp is None else float(sp.F[j]) for sp in points]))
+        out.extend(_stress_values(hs, points, batch))
+        stiffness = f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"
+        out.add(
+            matrix("K_q", f"{stiffness} (rows and columns {', '.join(c.q_names)})"),
+            per_point([None if sp is None else sp.K_q.tolist() for sp in points]),
+        )
+        out.add(Output("energy", "energy"), per_point([None if sp is None else sp.energy for sp in points]))
+        out.extend(_formula_stiffness(model, hs))
         if inputs["stress_limit"]:
             last = sols[-1]
-            lim_values, lim_dims, lim_msg = (
+            limit, limit_message = (
                 self._limit(model, hs, inputs, last, solver)
                 if last.ok
-                else ({}, {}, "no stress limit: the last point was not solved")
+                else (Values(), "no stress limit: the last point was not solved")
             )
-            values.update(lim_values)
-            dims.update(lim_dims)
-            units.update({k: result_unit(d) for k, d in lim_dims.items()})
-            message += "; " + lim_msg
+            out.extend(limit)
+            message += "; " + limit_message
         info = SolverInfo(
             "+".join(sorted({s.solver for s in sols if s.solver})) or solver.name,
             sum(s.iterations for s in sols),
             sum(s.seconds for s in sols),
         )
-        res = Result(self.name, status, values, units, dims, info, message, statuses, _model_info(model))
+        res = _hinge_result(self.name, model, status, out, info, message, statuses)
         return res.warn(*_point_warnings(hs, points, inputs.get("sigma", inputs.get("sigma_allow"))))
 
-    def _limit(self, model: Model, hs: cm.HingeSet, inputs: Mapping[str, Any], end: PoseSolution, solver):  # noqa: C901 - bracket, root, then one value family per coordinate kind
+    def _limit(
+        self, model: Model, hs: cm.HingeSet, inputs: Mapping[str, Any], end: PoseSolution, solver: SolverConfig
+    ) -> tuple[Values, str]:
         """The scale λ of the ray home -> end at which the largest stress reaches σ_allow."""
-        c = model.closure
         sigma = inputs["sigma"]
-        by_actuators = bool(given(inputs, c.q_names))
-        t_home, t_end = model.task_of(model.x_home), model.task_of(end.x)
-
-        def pose(lam: float) -> PoseSolution:
-            if by_actuators:
-                return forward_kinematics(model, model.q_home + lam * (end.q - model.q_home), solver)
-            return inverse_kinematics(model, t_home + lam * (t_end - t_home), solver)
+        ray = _Ray(model, end, bool(given(inputs, model.closure.q_names)), solver)
 
         def excess(lam: float) -> float:
-            sol = pose(lam)
+            sol = ray.pose(lam)
             if not sol.ok:
                 raise _OutOfReach(lam, sol)
             sp = cm.static_point(model, hs, sol.x, sol.q, inputs["load"])
@@ -267,46 +321,38 @@ class ActuatorForces(_HingeKind):
 
         s_end = excess(1.0) + sigma
         lam_lin = sigma / s_end if s_end > 0 else None
-        lam_hi = 1.0
         try:
-            s_start = excess(0.0) + sigma
-            if s_start >= sigma:  # no root to bracket: the motion starts at or above the allowable stress
-                raise InputError(
-                    f"the allowable stress {sigma:.6g} Pa is already reached at the start of the motion (home: "
-                    f"largest hinge stress {s_start:.6g} Pa, {s_end:.6g} Pa at its end); give a larger "
-                    "sigma_allow" + (" or a smaller load" if np.any(inputs["load"]) else ""),
-                    path=self._sigma_path(inputs, hs),
-                )
-            while excess(lam_hi) < 0:
-                lam_hi *= 2.0
-                if lam_hi > 1e6:
-                    return {}, {}, "the stresses never reach sigma_allow along this motion"
-            lam = scipy.optimize.brentq(excess, 0.0 if lam_hi == 1.0 else lam_hi / 2, lam_hi, xtol=1e-12, rtol=1e-12)
+            lam = self._root(excess, sigma, s_end, inputs, hs)
         except _OutOfReach as exc:
             return (
-                {},
-                {},
+                Values(),
                 f"the motion leaves the reachable poses (scale {exc.lam:g}: {exc.sol.status.value}) before a hinge "
                 f"reaches sigma_allow",
             )
-        sol = pose(lam)
-        values: dict[str, Any] = {"sigma_allow": sigma, "scale_at_allowable": lam, "scale_at_allowable_linear": lam_lin}
-        dims: dict[str, str] = {"sigma_allow": "stress", "scale_at_allowable": "dimensionless"}
-        dims["scale_at_allowable_linear"] = "dimensionless"
-        for k, i in enumerate(c.task_index):
-            name = c.x[i].name
-            values[f"{name}_at_allowable"] = float(sol.x[i])
-            values[f"{name}_at_allowable_linear"] = float(t_home[k] + lam_lin * (t_end[k] - t_home[k]))
-            dims[f"{name}_at_allowable"] = dims[f"{name}_at_allowable_linear"] = c.x[i].kind
-        for off, target in c.offsets.items():
-            i = c.x_names.index(target)
-            values[f"{off}_at_allowable"] = float(sol.x[i] - model.x_home[i])
-            values[f"{off}_at_allowable_linear"] = values[f"{target}_at_allowable_linear"] - float(model.x_home[i])
-            dims[f"{off}_at_allowable"] = dims[f"{off}_at_allowable_linear"] = c.x[i].kind
-        for j, qn in enumerate(c.q_names):
-            values[f"{qn}_at_allowable"] = float(sol.q[j])
-            dims[f"{qn}_at_allowable"] = c.q[j].kind
-        return values, dims, f"first hinge at sigma_allow = {sigma / 1e6:.6g} MPa at scale {lam:.6g} of the motion"
+        if lam is None:
+            return Values(), "the stresses never reach sigma_allow along this motion"
+        values = _limit_values(model, ray, ray.pose(lam), lam, lam_lin, sigma)
+        return values, f"first hinge at sigma_allow = {sigma / 1e6:.6g} MPa at scale {lam:.6g} of the motion"
+
+    def _root(
+        self, excess: Any, sigma: float, s_end: float, inputs: Mapping[str, Any], hs: cm.HingeSet
+    ) -> float | None:
+        """The root of ``excess`` on the ray: bracketed from [0, 1] by doubling, then Brent's
+        method; None when the stresses never reach σ_allow."""
+        s_start = excess(0.0) + sigma
+        if s_start >= sigma:  # no root to bracket: the motion starts at or above the allowable stress
+            raise InputError(
+                f"the allowable stress {sigma:.6g} Pa is already reached at the start of the motion (home: "
+                f"largest hinge stress {s_start:.6g} Pa, {s_end:.6g} Pa at its end); give a larger "
+                "sigma_allow" + (" or a smaller load" if np.any(inputs["load"]) else ""),
+                path=self._sigma_path(inputs, hs),
+            )
+        lam_hi = 1.0
+        while excess(lam_hi) < 0:
+            lam_hi *= 2.0
+            if lam_hi > 1e6:
+                return None
+        return scipy.optimize.brentq(excess, 0.0 if lam_hi == 1.0 else lam_hi / 2, lam_hi, xtol=1e-12, rtol=1e-12)
 
     @staticmethod
     def _sigma_path(inputs: Mapping[str, Any], hs: cm.HingeSet) -> tuple:
@@ -341,6 +387,42 @@ class _OutOfReach(Exception):
     def __init__(self, lam: float, sol: PoseSolution) -> None:
         super().__init__(f"scale {lam}")
         self.lam, self.sol = lam, sol
+
+
+class _Ray:
+    """The motion from home towards a pose, scaled by λ: by the actuators (forward
+    kinematics) or by the task coordinates (inverse kinematics)."""
+
+    def __init__(self, model: Model, end: PoseSolution, by_actuators: bool, solver: SolverConfig) -> None:
+        self.model, self.end, self.by_actuators, self.solver = model, end, by_actuators, solver
+        self.t_home, self.t_end = model.task_of(model.x_home), model.task_of(end.x)
+
+    def pose(self, lam: float) -> PoseSolution:
+        m = self.model
+        if self.by_actuators:
+            return forward_kinematics(m, m.q_home + lam * (self.end.q - m.q_home), self.solver)
+        return inverse_kinematics(m, self.t_home + lam * (self.t_end - self.t_home), self.solver)
+
+
+def _limit_values(
+    model: Model, ray: _Ray, sol: PoseSolution, lam: float, lam_lin: float | None, sigma: float
+) -> Values:
+    """The pose and actuators where the first hinge reaches σ_allow, and their linear extrapolation."""
+    c = model.closure
+    out = Values().add(Output("sigma_allow", "stress"), sigma)
+    out.add(Output("scale_at_allowable", "dimensionless"), lam)
+    out.add(Output("scale_at_allowable_linear", "dimensionless"), lam_lin)
+    for k, i in enumerate(c.task_index):
+        name, kind = c.x[i].name, c.x[i].kind
+        out.add(Output(f"{name}_at_allowable", kind), float(sol.x[i]))
+        linear = ray.t_home[k] + lam_lin * (ray.t_end[k] - ray.t_home[k])
+        out.add(Output(f"{name}_at_allowable_linear", kind), float(linear))
+    for off, target in c.offsets.items():
+        i = c.x_names.index(target)
+        out.add(Output(f"{off}_at_allowable", c.x[i].kind), float(sol.x[i] - model.x_home[i]))
+        linear = out.values[f"{target}_at_allowable_linear"] - float(model.x_home[i])
+        out.add(Output(f"{off}_at_allowable_linear", c.x[i].kind), linear)
+    return out.add_all((Output(f"{qn}_at_allowable", c.q[j].kind), float(sol.q[j])) for j, qn in enumerate(c.q_names))
 
 
 class PlatformCompliance(_HingeKind):
@@ -379,27 +461,31 @@ class PlatformCompliance(_HingeKind):
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _check_pose_inputs(model, inputs, path, required=False)
 
-    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:  # noqa: C901 - one branch per hinge model and outcome
-        c = model.closure
-        hs: cm.HingeSet = inputs["hinge_set"]
-        f, ka = inputs["load"], inputs["k_actuator"]
+    def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         sol = _commanded_pose(model, inputs, solver)
-        names, dims = _pose_names(model)
-        units = {n: result_unit(dims[n]) for n in names}
-        values = _pose_values(model, [sol], False)
+        out = Values(_pose_outputs(model), _pose_values(model, [sol], False))
         info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
         if not sol.ok:
-            return Result(self.name, sol.status, values, units, dims, info, sol.message, None, _model_info(model))
+            return _hinge_result(self.name, model, sol.status, out, info, sol.message)
         note = inputs.get("fallback", "")
         if inputs["six_axis"] is not None:
-            res = self._run_six_axis(model, inputs, sol, (values, units, dims, info))
+            res = self._run_six_axis(model, inputs, sol, out, info)
             if res is not None:
                 return res
             note = (
                 "; the six-axis hinge model is singular here (a motion of the legs' chains meets no hinge, "
                 "e.g. a leg's spin between two spherical joints), so the default fell back to hinge_axes: kinematic"
             )
-        values["hinge_model"], dims["hinge_model"], units["hinge_model"] = "kinematic", "text", ""
+        return self._run_kinematic(model, inputs, sol, out, info, note)
+
+    def _run_kinematic(
+        self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, out: Values, info: SolverInfo, note: str
+    ) -> Result:
+        """The kinematic hinge model: the output compliance at the pose, the loaded pose by IPOPT."""
+        c = model.closure
+        hs: cm.HingeSet = inputs["hinge_set"]
+        f, ka = inputs["load"], inputs["k_actuator"]
+        out.add(text("hinge_model"), "kinematic")
         sp = cm.static_point(model, hs, sol.x, sol.q)
         try:
             C = cm.output_compliance(sp, ka)
@@ -408,63 +494,44 @@ class PlatformCompliance(_HingeKind):
                 "K_q + K_a is singular: the hinges and actuators leave a motion without stiffness "
                 "(give a positive k_actuator, or more hinges)"
             )
-            return Result(self.name, Status.SINGULAR, values, units, dims, info, msg, None, _model_info(model))
+            return _hinge_result(self.name, model, Status.SINGULAR, out, info, msg)
         lin = C @ f
         loaded = cm.compliant_fk(model, hs, sol.x, sol.q, sp.F, f, ka)
-        xs = ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in c.x)
-        values.update(C=C.tolist(), deflection_linear=lin.tolist())
-        dims.update(C="matrix", deflection_linear="vector")
-        units.update(C=f"rows and columns {xs}; m/N, rad/(N*m) and mixed", deflection_linear=xs)
-        for i, x in enumerate(c.x):
-            values[f"C_{x.name}"] = float(C[i, i])
-            dims[f"C_{x.name}"] = "compliance" if x.kind == "length" else "rotational_compliance"
-            units[f"C_{x.name}"] = "m/N" if x.kind == "length" else "rad/(N*m)"
+        out.extend(_compliance_matrix(c, C, lin)).extend(_diagonal_compliance(c, C))
         status, message = Status.SOLVED, "compliant forward kinematics by IPOPT (" + loaded.message + ")"
         if not np.any(f):
             message = "no load: the output compliance only"
         if loaded.ok:
             d = loaded.x - sol.x
-            values["deflection"] = d.tolist()
-            dims["deflection"] = "vector"
-            units["deflection"] = xs
-            for i, x in enumerate(c.x):
-                values[f"d_{x.name}"] = float(d[i])
-                dims[f"d_{x.name}"] = x.kind
-                units[f"d_{x.name}"] = result_unit(x.kind)
+            out.extend(_deflection_values(c, d))
             spl = cm.static_point(model, hs, loaded.x, loaded.q)
-            sv, sd = _stress_values(hs, [spl], False)
-            values.update({k + "_loaded": v for k, v in sv.items()})
-            dims.update({k + "_loaded": v for k, v in sd.items()})
-            units.update({k + "_loaded": "Pa" for k in sd})
-            values["q_loaded"] = loaded.q.tolist()
-            dims["q_loaded"] = "vector"
-            units["q_loaded"] = ", ".join(f"{q.name} [{result_unit(q.kind)}]" for q in c.q)
+            out.extend(_stress_values(hs, [spl], False, "_loaded"))
+            out.add(vector("q_loaded", _coordinate_list(c.q)), loaded.q.tolist())
         else:
             status = Status.NOT_CONVERGED
         if ka is None:
             message += "; actuators rigidly held: a pseudo-rigid-body model with rigid links does not deflect"
-        message += note
         info = SolverInfo("ipopt", sol.iterations + loaded.iterations, sol.seconds)
-        res = Result(self.name, status, values, units, dims, info, message, None, _model_info(model))
+        res = _hinge_result(self.name, model, status, out, info, message + note)
         if not loaded.ok:
             return res.warn(*validity.hinge_geometry_warnings(hs.hinges))
         res.warn(*_point_warnings(hs, [spl]))
         return res.warn(*validity.linear_range_warnings(d, lin, c.x_names, [x.kind for x in c.x]))
 
-    def _run_six_axis(self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, parts: tuple) -> Result | None:  # noqa: C901 - unloaded, linearized, loaded, then one value family each
-        """The six-axis hinge model: the unloaded equilibrium at the commanded actuators, the
-        output compliance there, and the loaded pose by IPOPT."""
-        values, units, dims, info = parts
+    def _run_six_axis(
+        self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, out: Values, info: SolverInfo
+    ) -> Result | None:
+        """The six-axis hinge model: the unloaded equilibrium at the commanded actuators and the
+        output compliance there (None where it is singular and the model was the default)."""
         c = model.closure
         sm: SixAxisModel = inputs["six_axis"]
         f, ka = inputs["load"], inputs["k_actuator"]
-        xs = ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in c.x)
         try:
             z0 = sm.start(sol.x, sol.q)
             ok, z_u, lam_u, it_u = sm.newton(z0, np.zeros(c.nx), sol.q, None, None)
             if not ok:
                 msg = "six-axis hinge model: no unloaded equilibrium at the commanded actuators (Newton on the KKT)"
-                return Result(self.name, Status.NOT_CONVERGED, values, units, dims, info, msg, None, _model_info(model))
+                return _hinge_result(self.name, model, Status.NOT_CONVERGED, out, info, msg)
             Fc = sm.actuator_reactions(z_u, lam_u, np.zeros(c.nx))
             C = sm.compliance(z_u, lam_u, ka, None if ka is None else Fc)
         except np.linalg.LinAlgError:
@@ -475,60 +542,75 @@ class PlatformCompliance(_HingeKind):
                 "no actuator (e.g. a leg's spin between two spherical joints; give a positive k_actuator, more "
                 "hinges, or hinge_axes: kinematic)"
             )
-            return Result(self.name, Status.SINGULAR, values, units, dims, info, msg, None, _model_info(model))
-        values.update(C=C.tolist(), deflection_linear=(C @ f).tolist(), hinge_model="all")
-        dims.update(C="matrix", deflection_linear="vector", hinge_model="text")
-        units.update(C=f"rows and columns {xs}; m/N, rad/(N*m) and mixed", deflection_linear=xs, hinge_model="")
-        for i, x in enumerate(c.x):
-            values[f"C_{x.name}"] = float(C[i, i])
-            dims[f"C_{x.name}"] = "compliance" if x.kind == "length" else "rotational_compliance"
-            units[f"C_{x.name}"] = "m/N" if x.kind == "length" else "rad/(N*m)"
-        unloaded = sm.stresses(z_u)
-        values["stress_max_unloaded"] = max((v for v in unloaded.values() if v is not None), default=None)
-        dims["stress_max_unloaded"], units["stress_max_unloaded"] = "stress", "Pa"
-        six = ", ".join(sm.six_axis_hinges) or "none"
-        note = f"six-axis hinges: {six}; {sm.chains.note}"
+            return _hinge_result(self.name, model, Status.SINGULAR, out, info, msg)
+        out.extend(_compliance_matrix(c, C, C @ f)).add(text("hinge_model"), "all")
+        out.extend(_diagonal_compliance(c, C))
+        out.add(Output("stress_max_unloaded", "stress"), _largest(sm.stresses(z_u)))
+        note = f"six-axis hinges: {', '.join(sm.six_axis_hinges) or 'none'}; {sm.chains.note}"
         if not np.any(f):
             info = SolverInfo("newton-kkt", sol.iterations + it_u, sol.seconds)
-            msg = f"no load: the output compliance only ({note})"
-            res = Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+            res = _hinge_result(
+                self.name, model, Status.SOLVED, out, info, f"no load: the output compliance only ({note})"
+            )
             return res.warn(*_six_axis_warnings(sm, [z_u]))
+        return self._six_axis_loaded(model, inputs, sol, out, (z_u, Fc, C, it_u), note)
+
+    def _six_axis_loaded(
+        self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, out: Values, unloaded: tuple, note: str
+    ) -> Result:
+        """The six-axis model's loaded pose by IPOPT, from the unloaded equilibrium."""
+        c = model.closure
+        sm: SixAxisModel = inputs["six_axis"]
+        f, ka = inputs["load"], inputs["k_actuator"]
+        z_u, Fc, C, it_u = unloaded
         ok, z_l, lam_l, it_l, st = sm.ipopt(z_u, f, sol.q, ka, None if ka is None else Fc)
         info = SolverInfo("ipopt", sol.iterations + it_u + it_l, sol.seconds)
         if not ok:
             msg = f"six-axis compliant forward kinematics by IPOPT did not converge ({st})"
-            return Result(self.name, Status.NOT_CONVERGED, values, units, dims, info, msg, None, _model_info(model))
+            return _hinge_result(self.name, model, Status.NOT_CONVERGED, out, info, msg)
         d = z_l[: c.nx] - z_u[: c.nx]
-        values["deflection"] = d.tolist()
-        dims["deflection"], units["deflection"] = "vector", xs
-        for i, x in enumerate(c.x):
-            values[f"d_{x.name}"] = float(d[i])
-            dims[f"d_{x.name}"] = x.kind
-            units[f"d_{x.name}"] = result_unit(x.kind)
-        q_l = z_l[c.nx : c.nx + c.nq]
-        values["q_loaded"] = q_l.tolist()
-        dims["q_loaded"] = "vector"
-        units["q_loaded"] = ", ".join(f"{q.name} [{result_unit(q.kind)}]" for q in c.q)
-        loaded = sm.stresses(z_l)
-        values["stress_max_loaded"] = max((v for v in loaded.values() if v is not None), default=None)
-        dims["stress_max_loaded"], units["stress_max_loaded"] = "stress", "Pa"
+        out.extend(_deflection_values(c, d))
+        out.add(vector("q_loaded", _coordinate_list(c.q)), z_l[c.nx : c.nx + c.nq].tolist())
+        out.add(Output("stress_max_loaded", "stress"), _largest(sm.stresses(z_l)))
         if ka is None:
             F = sm.actuator_reactions(z_l, lam_l, f)
-            for j, q in enumerate(c.q):
-                values[f"F{j + 1}_loaded"] = float(F[j])
-                dims[f"F{j + 1}_loaded"] = "force" if q.kind == "length" else "moment"
-                units[f"F{j + 1}_loaded"] = "N" if q.kind == "length" else "N*m"
+            out.add_all((_force_output(f"F{j + 1}_loaded", q), float(F[j])) for j, q in enumerate(c.q))
         msg = f"compliant forward kinematics by IPOPT ({st}, {it_l} iterations); {note}"
-        res = Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+        res = _hinge_result(self.name, model, Status.SOLVED, out, info, msg)
         res.warn(*_six_axis_warnings(sm, [z_l]))
         return res.warn(*validity.linear_range_warnings(d, C @ f, c.x_names, [x.kind for x in c.x]))
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
         c = model.closure
-        names = _pose_names(model)[0] + ["C", "deflection_linear", "deflection", "q_loaded", "stress_max_loaded"]
-        names += [f"C_{x.name}" for x in c.x] + [f"d_{x.name}" for x in c.x]
-        names += ["hinge_model", "stress_max_unloaded"] + [f"F{j + 1}_loaded" for j in range(c.nq)]
-        return names
+        xs, qs = _coordinate_list(c.x), _coordinate_list(c.q)
+        return [
+            *_pose_outputs(model),
+            _compliance_output(c),
+            vector("deflection_linear", xs),
+            vector("deflection", xs),
+            vector("q_loaded", qs),
+            Output("stress_max_loaded", "stress"),
+            *(_diagonal_output(x) for x in c.x),
+            *(Output(f"d_{x.name}", x.kind) for x in c.x),
+            text("hinge_model"),
+            Output("stress_max_unloaded", "stress"),
+            *(_force_output(f"F{j + 1}_loaded", q) for j, q in enumerate(c.q)),
+        ]
+
+
+#: how many frequencies equal each mode's own
+MULTIPLICITY = vector("multiplicity", "per mode: how many frequencies equal its own (1: a simple frequency)")
+
+
+def _mode_outputs(c: Any) -> list[Output]:
+    """M, K and the mode shapes, in the actuator and the pose coordinates."""
+    qs = ", ".join(c.q_names)
+    return [
+        matrix("M", f"{result_unit('mass')} or {result_unit('inertia')} (generalized coordinates {qs})"),
+        matrix("K", f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"),
+        matrix("modes_q", f"rows: modes; columns {qs} (M-normalized, canonical in the pose coordinates)"),
+        matrix("modes_x", f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)"),
+    ]
 
 
 def _six_axis_warnings(sm: SixAxisModel, zs: list[np.ndarray]) -> list:
@@ -605,53 +687,30 @@ class NaturalFrequencies(_HingeKind):
         c = model.closure
         hs: cm.HingeSet = inputs["hinge_set"]
         sol = _commanded_pose(model, inputs, solver)
-        names, dims = _pose_names(model)
-        units = {n: result_unit(dims[n]) for n in names}
-        values = _pose_values(model, [sol], False)
+        out = Values(_pose_outputs(model), _pose_values(model, [sol], False))
         info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
         if not sol.ok:
-            return Result(self.name, sol.status, values, units, dims, info, sol.message, None, _model_info(model))
+            return _hinge_result(self.name, model, sol.status, out, info, sol.message)
         sp = cm.static_point(model, hs, sol.x, sol.q)
         M = sp.J.T @ np.diag(inputs["M_x"]) @ sp.J + np.diag(inputs["M_q"])
         K = 0.5 * (sp.K_q + sp.K_q.T)
         try:  # canonical modes: the same on every BLAS kernel (docs/site/guide/compliance.md)
             lam, modes, clusters = canonical_eigh(K, M, T=sp.J)  # read in the pose coordinates
         except np.linalg.LinAlgError:
-            return Result(
-                self.name,
-                Status.SINGULAR,
-                values,
-                units,
-                dims,
-                info,
-                "the mass matrix J^T M_x J + M_q is singular: give masses that move every actuated direction",
-                None,
-                _model_info(model),
-            )
+            msg = "the mass matrix J^T M_x J + M_q is singular: give masses that move every actuated direction"
+            return _hinge_result(self.name, model, Status.SINGULAR, out, info, msg)
         freq = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
-        for k in range(c.nq):
-            values[f"f{k + 1}"] = float(freq[k])
-            dims[f"f{k + 1}"] = "frequency"
-            units[f"f{k + 1}"] = "Hz"
-        shapes = (sp.J @ modes).T
-        values.update(M=M.tolist(), K=K.tolist(), modes_q=modes.T.tolist(), modes_x=shapes.tolist())
-        values["multiplicity"] = multiplicities(clusters)
-        dims.update(M="matrix", K="matrix", modes_q="matrix", modes_x="matrix", multiplicity="vector")
-        units.update(
-            M=f"kg or kg*m^2 (generalized coordinates {', '.join(c.q_names)})",
-            K="N/m or N*m/rad",
-            modes_q=f"rows: modes; columns {', '.join(c.q_names)} (M-normalized, canonical in the pose coordinates)",
-            modes_x=f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)",
-            multiplicity="per mode: how many frequencies equal its own (1: a simple frequency)",
-        )
+        out.add_all((Output(f"f{k + 1}", "frequency"), float(freq[k])) for k in range(c.nq))
+        out.add_all(zip(_mode_outputs(c), (M.tolist(), K.tolist(), modes.T.tolist(), (sp.J @ modes).T.tolist())))
+        out.add(MULTIPLICITY, multiplicities(clusters))
         msg = "frequencies from |K_q - (2 pi f)^2 M| = 0 at the pose"
         repeated = [idx for idx in clusters if len(idx) > 1]
         if repeated:
             msg += "; " + "; ".join(degenerate_note(idx) for idx in repeated)
-        res = Result(self.name, Status.SOLVED, values, units, dims, info, msg, None, _model_info(model))
+        res = _hinge_result(self.name, model, Status.SOLVED, out, info, msg)
         return res.warn(*_point_warnings(hs, [sp]))
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
         c = model.closure
-        names = _pose_names(model)[0] + [f"f{k + 1}" for k in range(c.nq)]
-        return names + ["M", "K", "modes_q", "modes_x", "multiplicity"]
+        frequencies = [Output(f"f{k + 1}", "frequency") for k in range(c.nq)]
+        return [*_pose_outputs(model), *frequencies, *_mode_outputs(c), MULTIPLICITY]

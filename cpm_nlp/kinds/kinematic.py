@@ -32,7 +32,7 @@ from ..core.kind import (
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
 from ..core.model import Model
 from ..core.options import Option
-from ..core.outputs import Output, declared_result, output_names, outputs_of
+from ..core.outputs import Output, declared_result, outputs_of
 from ..core.progress import track
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.schema import Record
@@ -198,10 +198,10 @@ class ForwardKinematics(ProblemKind):
             sols = [forward_kinematics(model, q, solver, guess) for q in track(qs, "forward kinematics")]
         return _result(self.name, model, sols, batch, solver)
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
         # the values of ``assembly_modes: all`` (:func:`mode_value_names`) are not listed: they
         # would become columns (and change the fingerprint) of every forward_kinematics sweep
-        return _pose_names(model)[0]
+        return _pose_outputs(model)
 
 
 def _guess_option(model: Model) -> Record:
@@ -396,8 +396,8 @@ class InverseKinematics(ProblemKind):
             sols = [inverse_kinematics(model, t, solver, inputs["method"]) for t in track(ts, "inverse kinematics")]
         return _result(self.name, model, sols, batch, solver)
 
-    def output_names(self, model: Model) -> list[str]:
-        return _pose_names(model)[0]
+    def outputs(self, model: Model) -> list[Output]:
+        return _pose_outputs(model)
 
 
 class Jacobian(ProblemKind):
@@ -468,8 +468,8 @@ class Jacobian(ProblemKind):
             res.warn(*filter(None, [near_singular_warning(extra["cond"], "J_task, homogenized", "cond")]))
         return res
 
-    def output_names(self, model: Model) -> list[str]:
-        return output_names(_pose_outputs(model) + _jacobian_outputs(model.closure))
+    def outputs(self, model: Model) -> list[Output]:
+        return _pose_outputs(model) + _jacobian_outputs(model.closure)
 
 
 def _jacobian_outputs(c: Any) -> list[Output]:
@@ -516,11 +516,13 @@ class JointRequirements(ProblemKind):
             )
         return res
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
+        """The pose, then the range of each family of joints (actuators, dependent pose
+        coordinates, passive joints) and of its deviation from home
+        (:func:`~cpm_nlp.analysis.requirements.joint_requirements`)."""
         c = model.closure
-        fams = sorted(
-            {q.group for q in c.q} | {c.x[i].group for i in c.dep_index} | {p.group for p in c.passive_coords}
-        )
-        ranges = [f"{f}_{e}" for f in fams for e in ("min", "max")]
-        ranges += [f"d{f}_{e}" for f in fams for e in ("min", "max")]
-        return _pose_names(model)[0] + ranges
+        dims = {co.group: co.kind for co in (*c.q, *(c.x[i] for i in c.dep_index), *c.passive_coords)}
+        fams = sorted(dims)
+        ranges = [Output(f"{f}_{e}", dims[f]) for f in fams for e in ("min", "max")]
+        ranges += [Output(f"d{f}_{e}", dims[f]) for f in fams for e in ("min", "max")]
+        return _pose_outputs(model) + ranges

@@ -25,11 +25,10 @@ from ..core.mechanism import Part
 from ..core.model import Model
 from ..core.multistart import start_options
 from ..core.options import Option
+from ..core.outputs import Output, declared_result, output_names, outputs_of, size
 from ..core.result import Result, SolverInfo, Status
 from ..core.schema import Either, ListOf, Record
 from ..core.solver import SolverConfig
-from ..core.units import si_unit
-from .workspace import _volume_dimension
 
 
 class SynthesisFormulation(ProblemKind, Part):
@@ -184,9 +183,8 @@ class CuboidSynthesis(SynthesisFormulation):
             samples_per_edge=inputs["samples_per_edge"],
             check_per_edge=inputs["check_per_edge"],
         )
-        names = self.output_names(model, inputs)
-        values: dict[str, Any] = dict.fromkeys(names)
-        dims = self._dims(model, inputs)
+        outputs = self._outputs(model, inputs)
+        values: dict[str, Any] = dict.fromkeys(output_names(outputs))
         c = model.closure
         if rep.found:
             values.update({n: rep.parameters[n] for n in inputs["design"]})
@@ -204,42 +202,43 @@ class CuboidSynthesis(SynthesisFormulation):
             )
         values.update(starts=rep.starts, starts_converged=rep.converged, starts_agreed=rep.agreed)
         status = Status.SOLVED if rep.found else Status.INFEASIBLE if rep.infeasible else Status.NOT_CONVERGED
-        units = {k: si_unit(v) for k, v in dims.items()}
-        units["volume"] = _volume_dimension(model)[1]
-        return Result(
+        return declared_result(
             "synthesis",
             status,
+            outputs,
             values,
-            units,
-            dims,
-            SolverInfo("ipopt", rep.iterations, rep.seconds),
-            rep.message,
-            None,
-            {"type": model.name, **dict(model.parameters)},
+            solver=SolverInfo("ipopt", rep.iterations, rep.seconds),
+            message=rep.message,
+            model={"type": model.name, **dict(model.parameters)},
         )
 
-    def _dims(self, model: Model, inputs: Mapping[str, Any] | None) -> dict[str, str]:
+    def _outputs(self, model: Model, inputs: Mapping[str, Any] | None) -> list[Output]:
+        """The design parameters, the box, its volume and check, the multi-start's counts."""
         c = model.closure
-        dims = {n: _dim(model, n) for n in (inputs["design"] if inputs else c.parameters)}
+        out = outputs_of({n: _dim(model, n) for n in (inputs["design"] if inputs else c.parameters)}, named=False)
         for i in c.task_index:
-            dims[f"{c.x[i].name}_min"] = dims[f"{c.x[i].name}_max"] = c.x[i].kind
-        dims["volume"] = _volume_dimension(model)[0]
-        dims.update(
-            footprint="dimensionless",
-            objective="dimensionless",
-            check_points="dimensionless",
-            check_outside="dimensionless",
-            check_margin="si",
-            check_binding="text",
-            shrink="dimensionless",
-            starts="dimensionless",
-            starts_converged="dimensionless",
-            starts_agreed="dimensionless",
+            out += [Output(f"{c.x[i].name}_min", c.x[i].kind), Output(f"{c.x[i].name}_max", c.x[i].kind)]
+        out.append(size("volume", (c.x[i].kind for i in c.task_index)))
+        counts = ("starts", "starts_converged", "starts_agreed")
+        return out + outputs_of(
+            {
+                "footprint": "dimensionless",
+                "objective": "dimensionless",
+                "check_points": "dimensionless",
+                "check_outside": "dimensionless",
+                "check_margin": "si",
+                "check_binding": "text",
+                "shrink": "dimensionless",
+                **dict.fromkeys(counts, "dimensionless"),
+            },
+            named=False,
         )
-        return dims
+
+    def outputs(self, model: Model) -> list[Output]:
+        return self._outputs(model, None)
 
     def output_names(self, model: Model, inputs: Mapping[str, Any] | None = None) -> list[str]:
-        return list(self._dims(model, inputs))
+        return output_names(self._outputs(model, inputs))
 
 
 def formulation(model: Model) -> SynthesisFormulation | None:
@@ -282,6 +281,9 @@ class Synthesis(ProblemKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         require_ipopt(solver, self.name)
         return formulation(model).run(model, inputs, solver)
+
+    def outputs(self, model: Model) -> list[Output]:
+        return formulation(model).outputs(model)
 
     def output_names(self, model: Model) -> list[str]:
         return formulation(model).output_names(model)

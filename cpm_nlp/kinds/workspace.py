@@ -37,9 +37,10 @@ from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import Model
 from ..core.multistart import start_options
 from ..core.options import Option
+from ..core.outputs import Output, declared_result, outputs_of, size
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
-from ..core.units import si_unit, size_dimension
+from ..core.units import size_dimension
 from .hinge_inputs import stress_limit_option
 from .kinematic import _model_info
 
@@ -93,8 +94,16 @@ class PaperMembership(Part):
             raise MechanismDeclarationError(f"paper_membership must be callable, got {self.test!r:.60}")
 
 
-def _unit(dim: str) -> str:
-    return "SI unit of the binding quantity" if dim == "si" else si_unit(dim)
+#: the unit of a margin: that of whichever quantity binds (a length, an angle, a stress ...)
+BINDING_UNIT = "SI unit of the binding quantity"
+
+
+def _declared(model: Model, dims: Mapping[str, str]) -> list[Output]:
+    """The outputs of the workspace kinds by their dimensions: no unit for what has none, a
+    margin's of the binding quantity, a task box's size by its sides."""
+    kinds = [model.closure.x[i].kind for i in model.closure.task_index]
+    special = {"si": lambda o: Output(o.name, "si", unit=BINDING_UNIT), "task volume": lambda o: size(o.name, kinds)}
+    return [special.get(o.dimension, lambda o: o)(o) for o in outputs_of(dims, named=False)]
 
 
 def _region_options(model: Model) -> list[Option]:
@@ -214,7 +223,7 @@ class InscribedCuboid(ProblemKind):
             refinements=inputs["refinements"],
             region=_region(inputs, model, ("inputs",)),
         )
-        vdim, vunit = _volume_dimension(model)
+        vdim = _volume_dimension(model)[0]
         values: dict[str, Any] = {}
         dims: dict[str, str] = {}
         for k, t in enumerate(c.task):
@@ -271,17 +280,16 @@ class InscribedCuboid(ProblemKind):
             )
             if values.get("certificate"):
                 message += f"; {values['certificate']}"
-        units = {k: (vunit if d == "task volume" else _unit(d)) for k, d in dims.items()}
-        return Result(
+        undeclared = [k for k in values if k not in dims]  # a mechanism's values of no box: dimension not said
+        outputs = _declared(model, dims) + [Output(k, "unknown", unit="") for k in undeclared]
+        return declared_result(
             self.name,
             status,
+            outputs,
             values,
-            units,
-            dims,
-            SolverInfo("ipopt", res.iterations, res.seconds),
-            message,
-            None,
-            _model_info(model),
+            solver=SolverInfo("ipopt", res.iterations, res.seconds),
+            message=message,
+            model=_model_info(model),
         )
 
 
@@ -315,14 +323,19 @@ class Workspace(ProblemKind):
         if have:
             broadcast([inputs[t] for t in task], task, path)
 
-    def output_names(self, model: Model) -> list[str]:
-        task = list(model.closure.task)
-        return (
-            ["inside", "status", "margin", "binding", "inside_paper", "count_inside", "count_undecided"]
-            + [f"cloud_{t}" for t in task]
-            + ["cloud_count", "cloud_undecided", "volume_estimate", "volume_estimate_error", "volume_estimate_upper"]
-            + [f"{t}_range" for t in task]
+    def outputs(self, model: Model) -> list[Output]:
+        """Membership of the given points (inside, status, margin, binding, the paper's own
+        test where the mechanism has one), then the cloud, its volume estimate and region."""
+        c = model.closure
+        task = [c.x[i] for i in c.task_index]
+        dims = dict.fromkeys(("inside", "status"), "text") | {"margin": "si", "binding": "text", "inside_paper": "text"}
+        dims |= dict.fromkeys(("count_inside", "count_undecided"), "dimensionless")
+        dims |= {f"cloud_{x.name}": x.kind for x in task}
+        dims |= dict.fromkeys(("cloud_count", "cloud_undecided"), "dimensionless")
+        dims |= dict.fromkeys(
+            ("volume_estimate", "volume_estimate_error", "volume_estimate_upper"), _volume_dimension(model)[0]
         )
+        return _declared(model, dims | {f"{x.name}_range": x.kind for x in task})
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         model = inputs.get("stress_limit") or model
@@ -382,8 +395,12 @@ class Workspace(ProblemKind):
                 f"{mem.count_undecided} of {len(mem.status)} given points undecided (no pose on the designated "
                 "branch found from any start)"
             )
-        vunit = _volume_dimension(model)[1]
-        units = {k: (vunit if d == "task volume" else _unit(d)) for k, d in dims.items()}
-        return Result(
-            self.name, status, values, units, dims, SolverInfo(solver.name), message, None, _model_info(model)
+        return declared_result(
+            self.name,
+            status,
+            _declared(model, dims),
+            values,
+            solver=SolverInfo(solver.name),
+            message=message,
+            model=_model_info(model),
         )

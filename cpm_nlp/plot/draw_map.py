@@ -5,6 +5,7 @@ on scattered points of any domain, e.g. the RPR (s, t) triangle (RPR paper, Fig.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -45,7 +46,147 @@ def _slivers(x: np.ndarray, y: np.ndarray, corners: np.ndarray, factor: float = 
     return longest > factor * np.median(edges)
 
 
-def design_map_figure(  # noqa: C901 - one branch per optional layer of the map
+@dataclass
+class _Layers:
+    """What the layers of one design map share: the axes, the points in display units, which
+    solved (``good``), which lie outside the design space (``away``), the region, the domain
+    and the colour scale."""
+
+    ax: Any
+    X: np.ndarray
+    Y: np.ndarray
+    Z: np.ndarray
+    good: np.ndarray
+    away: np.ndarray
+    region: np.ndarray | None
+    poly: np.ndarray | None
+    norm: Any
+    levels: Any
+
+
+def _colour_scale(zpos: np.ndarray) -> tuple[Any, Any]:
+    """The colour norm and contour levels: logarithmic for values over decades, else linear."""
+    if zpos.min() > 0 and zpos.max() / zpos.min() > 1000:  # values over decades: a log scale shows them all
+        from matplotlib.colors import LogNorm
+
+        return LogNorm(zpos.min(), zpos.max()), np.geomspace(zpos.min(), zpos.max(), 9)[1:-1]
+    return None, 8
+
+
+def _grid_layer(m: _Layers, grid: tuple, fx: float, fy: float) -> Any:
+    """Points on a full grid: cells, contour lines, the region's outline."""
+    ux, uy, ix, iy = grid
+    cells = np.full((len(uy), len(ux)), np.nan)
+    cells[iy[m.good], ix[m.good]] = m.Z[m.good]
+    masked = np.ma.masked_invalid(cells)
+    mappable = m.ax.pcolormesh(
+        cell_edges(ux * fx), cell_edges(uy * fy), masked, cmap="viridis", shading="flat", norm=m.norm
+    )
+    if np.count_nonzero(np.isfinite(cells)) >= 4 and np.nanmax(cells) > np.nanmin(cells):
+        cs = m.ax.contour(ux * fx, uy * fy, masked, levels=m.levels, colors="k", linewidths=0.6, alpha=0.7)
+        m.ax.clabel(cs, fontsize="x-small", fmt="%.3g")
+    if m.region is not None and m.region.any():
+        mask = np.zeros_like(cells)
+        mask[iy, ix] = m.region.astype(float)
+        m.ax.contour(ux * fx, uy * fy, mask, levels=[0.5], colors="tab:red", linewidths=2)
+    return mappable
+
+
+def _triangulated(m: _Layers) -> Any:
+    """Scattered points: a triangulation (points outside the design space stay out of it, its
+    hull is then the domain's, if convex; points that did not solve make holes)."""
+    from matplotlib.path import Path as MplPath
+    from matplotlib.tri import Triangulation
+
+    use = ~m.away
+    X, Y = m.X[use], m.Y[use]
+    tri = Triangulation(X, Y)
+    corners = tri.triangles
+    bad = ~m.good[use][corners].all(axis=1)
+    bad |= _slivers(X, Y, corners)
+    if m.poly is not None:
+        centroids = np.c_[X[corners].mean(axis=1), Y[corners].mean(axis=1)]
+        bad |= ~MplPath(m.poly).contains_points(centroids, radius=1e-9)
+    tri.set_mask(bad)
+    if bad.all():
+        raise ValueError("every triangle has a point that did not solve")
+    Zf = np.where(m.good, m.Z, np.nanmean(m.Z[m.good]))[use]
+    mappable = m.ax.tripcolor(tri, Zf, cmap="viridis", shading="gouraud", norm=m.norm)
+    if np.ptp(m.Z[m.good]) > 0:
+        cs = m.ax.tricontour(tri, Zf, levels=m.levels, colors="k", linewidths=0.6, alpha=0.7)
+        m.ax.clabel(cs, fontsize="x-small", fmt="%.3g")
+    if m.region is not None and m.region[use].any():
+        m.ax.tricontour(tri, m.region[use].astype(float), levels=[0.5], colors="tab:red", linewidths=2)
+    return mappable
+
+
+def _scattered_layer(m: _Layers) -> Any:
+    """Scattered points: triangulated, else (too few or collinear points) the points coloured."""
+    good = m.good
+    try:
+        mappable = _triangulated(m)
+    except (ValueError, RuntimeError):  # too few or collinear points: colour the points themselves
+        return m.ax.scatter(m.X[good], m.Y[good], c=m.Z[good], cmap="viridis", s=30, norm=m.norm)
+    if good.sum() <= 2000:
+        m.ax.plot(m.X[good], m.Y[good], ".", color="k", ms=1.5, alpha=0.5)
+    return mappable
+
+
+def _point_layers(m: _Layers, region_label: str) -> None:
+    """The region's legend entry, the points outside the design space and those not solved,
+    the domain's outline."""
+    ax, X, Y = m.ax, m.X, m.Y
+    if m.region is not None and m.region.any():
+        ax.plot([], [], color="tab:red", lw=2, label=region_label)
+    away = m.away
+    if away.any():  # few: dotted; many (a grid around the domain): the blank says it
+        few = away.sum() <= 400
+        ax.plot(
+            *((X[away], Y[away]) if few else ([], [])),
+            "." if few else "s",
+            color="0.8",
+            ms=2 if few else 6,
+            label=f"outside the design space ({int(away.sum())}{'' if few else ', blank'})",
+        )
+    failed = ~m.good & ~away
+    if failed.any():
+        ax.plot(X[failed], Y[failed], "x", color="0.45", ms=5, label=f"not solved ({int(failed.sum())})")
+    if m.poly is not None:
+        closed = np.vstack([m.poly, m.poly[:1]])
+        ax.plot(closed[:, 0], closed[:, 1], "--", color="k", lw=1.2, label="design domain")
+
+
+def _marks(m: _Layers, marks: Sequence, best: str | None, fx: float, fy: float, unit: str) -> None:
+    """The reference designs, and the best point (``best``: "max" or "min")."""
+    ax = m.ax
+    styles = ({"marker": "o", "mfc": "white"}, {"marker": "D", "mfc": "tab:orange"}, {"marker": "s", "mfc": "tab:cyan"})
+    for (mx, my, label), style in zip(marks, styles):
+        if mx is not None and my is not None:
+            ax.plot(mx * fx, my * fy, ls="none", mec="k", ms=9, mew=1.5, label=label, **style)
+    if best not in ("max", "min"):
+        return
+    X, Y, Z = m.X, m.Y, m.Z
+    idx = np.flatnonzero(m.good)
+    k = idx[np.argmax(Z[idx])] if best == "max" else idx[np.argmin(Z[idx])]
+    ax.plot(
+        X[k], Y[k], "*", color="tab:red", ms=16, mec="k", label=f"{best} {value_text(Z[k])} {unit_text(unit)}".strip()
+    )
+    ax.annotate(f"({X[k]:.4g}, {Y[k]:.4g})", (X[k], Y[k]), textcoords="offset points", xytext=(8, 8), fontsize="small")
+
+
+def _solved(x: np.ndarray, y: np.ndarray, z: np.ndarray, ok: Any, name: str) -> np.ndarray:
+    """Which points have a value (finite, and ``ok`` where given); bad input: none."""
+    if not (len(x) == len(y) == len(z)):
+        raise InputError(f"x, y and the value must have one entry per point (got {len(x)}, {len(y)}, {len(z)})")
+    good = np.isfinite(z) & np.isfinite(x) & np.isfinite(y)
+    if ok is not None:
+        good &= np.asarray(ok, dtype=bool).ravel()
+    if not good.any():
+        raise InputError(f"no point has a value of {name} to plot (no point solved)")
+    return good
+
+
+def design_map_figure(
     x: Any,
     y: Any,
     z: Any,
@@ -73,126 +214,38 @@ def design_map_figure(  # noqa: C901 - one branch per optional layer of the map
     that point; ``marks``: (x, y, label) of reference designs.
     """
     Figure = figure_class()
-    from matplotlib.path import Path as MplPath
-    from matplotlib.tri import Triangulation
-
     x = np.asarray(x, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
     z = as_floats(np.asarray(z, dtype=object).ravel())
-    if not (len(x) == len(y) == len(z)):
-        raise InputError(f"x, y and the value must have one entry per point (got {len(x)}, {len(y)}, {len(z)})")
-    good = np.isfinite(z) & np.isfinite(x) & np.isfinite(y)
-    if ok is not None:
-        good &= np.asarray(ok, dtype=bool).ravel()
-    if not good.any():
-        raise InputError(f"no point has a value of {names[2]} to plot (no point solved)")
+    good = _solved(x, y, z, ok, names[2])
     away = np.zeros(len(x), bool) if outside is None else np.asarray(outside, dtype=bool).ravel() & ~good
     (fx, ux_), (fy, uy_), (fz, uz_) = (
         display_unit(dimensions[0], x[np.isfinite(x)]),
         display_unit(dimensions[1], y[np.isfinite(y)]),
         display_unit(dimensions[2], z[good]),
     )
-    X, Y, Z = x * fx, y * fy, z * fz
-    poly = None if domain is None else np.asarray(domain, dtype=float).reshape(-1, 2) * [fx, fy]
-    inside_region = None if region is None else np.array([bool(v) for v in np.asarray(region, dtype=object).ravel()])
     fig = Figure(figsize=(8, 6.5), layout="constrained")
     ax = fig.add_subplot(1, 1, 1)
-    grid = _grid_index(x, y)
-    mappable = None
-    levels: Any = 8
-    norm = None
-    zpos = Z[good]
-    if zpos.min() > 0 and zpos.max() / zpos.min() > 1000:  # values over decades: a log scale shows them all
-        from matplotlib.colors import LogNorm
-
-        norm = LogNorm(zpos.min(), zpos.max())
-        levels = np.geomspace(zpos.min(), zpos.max(), 9)[1:-1]
-    if grid is not None:
-        ux, uy, ix, iy = grid
-        cells = np.full((len(uy), len(ux)), np.nan)
-        cells[iy[good], ix[good]] = Z[good]
-        masked = np.ma.masked_invalid(cells)
-        mappable = ax.pcolormesh(
-            cell_edges(ux * fx), cell_edges(uy * fy), masked, cmap="viridis", shading="flat", norm=norm
-        )
-        if np.count_nonzero(np.isfinite(cells)) >= 4 and np.nanmax(cells) > np.nanmin(cells):
-            cs = ax.contour(ux * fx, uy * fy, masked, levels=levels, colors="k", linewidths=0.6, alpha=0.7)
-            ax.clabel(cs, fontsize="x-small", fmt="%.3g")
-        if inside_region is not None and inside_region.any():
-            mask = np.zeros_like(cells)
-            mask[iy, ix] = inside_region.astype(float)
-            ax.contour(ux * fx, uy * fy, mask, levels=[0.5], colors="tab:red", linewidths=2)
-    else:
-        try:
-            # points outside the design space stay out of the triangulation (its hull is then the
-            # domain's, if convex); points that did not solve make holes
-            use = ~away
-            tri = Triangulation(X[use], Y[use])
-            corners = tri.triangles
-            bad = ~good[use][corners].all(axis=1)
-            bad |= _slivers(X[use], Y[use], corners)
-            if poly is not None:
-                centroids = np.c_[X[use][corners].mean(axis=1), Y[use][corners].mean(axis=1)]
-                bad |= ~MplPath(poly).contains_points(centroids, radius=1e-9)
-            tri.set_mask(bad)
-            if bad.all():
-                raise ValueError("every triangle has a point that did not solve")
-            Zf = np.where(good, Z, np.nanmean(Z[good]))[use]
-            mappable = ax.tripcolor(tri, Zf, cmap="viridis", shading="gouraud", norm=norm)
-            if np.ptp(Z[good]) > 0:
-                cs = ax.tricontour(tri, Zf, levels=levels, colors="k", linewidths=0.6, alpha=0.7)
-                ax.clabel(cs, fontsize="x-small", fmt="%.3g")
-            if inside_region is not None and inside_region[use].any():
-                ax.tricontour(tri, inside_region[use].astype(float), levels=[0.5], colors="tab:red", linewidths=2)
-        except (ValueError, RuntimeError):  # too few or collinear points: colour the points themselves
-            mappable = None
-        if mappable is None:
-            mappable = ax.scatter(X[good], Y[good], c=Z[good], cmap="viridis", s=30, norm=norm)
-        elif good.sum() <= 2000:
-            ax.plot(X[good], Y[good], ".", color="k", ms=1.5, alpha=0.5)
-    fig.colorbar(
-        mappable,
-        ax=ax,
-        pad=0.01,
-        fraction=0.05,
-        label=axis_label(names[2], uz_) + (", log scale" if norm is not None else ""),
+    Z = z * fz
+    norm, levels = _colour_scale(Z[good])
+    m = _Layers(
+        ax,
+        x * fx,
+        y * fy,
+        Z,
+        good,
+        away,
+        None if region is None else np.array([bool(v) for v in np.asarray(region, dtype=object).ravel()]),
+        None if domain is None else np.asarray(domain, dtype=float).reshape(-1, 2) * [fx, fy],
+        norm,
+        levels,
     )
-    if inside_region is not None and inside_region.any():
-        ax.plot([], [], color="tab:red", lw=2, label=region_label)
-    if away.any():  # few: dotted; many (a grid around the domain): the blank says it
-        shown = (X[away], Y[away]) if away.sum() <= 400 else ([], [])
-        ax.plot(
-            *shown,
-            "s" if away.sum() > 400 else ".",
-            color="0.8",
-            ms=2 if away.sum() <= 400 else 6,
-            label=f"outside the design space ({int(away.sum())}{'' if away.sum() <= 400 else ', blank'})",
-        )
-    failed = ~good & ~away
-    if failed.any():
-        ax.plot(X[failed], Y[failed], "x", color="0.45", ms=5, label=f"not solved ({int(failed.sum())})")
-    if poly is not None:
-        closed = np.vstack([poly, poly[:1]])
-        ax.plot(closed[:, 0], closed[:, 1], "--", color="k", lw=1.2, label="design domain")
-    styles = ({"marker": "o", "mfc": "white"}, {"marker": "D", "mfc": "tab:orange"}, {"marker": "s", "mfc": "tab:cyan"})
-    for (mx, my, label), style in zip(marks, styles):
-        if mx is not None and my is not None:
-            ax.plot(mx * fx, my * fy, ls="none", mec="k", ms=9, mew=1.5, label=label, **style)
-    if best in ("max", "min"):
-        idx = np.flatnonzero(good)
-        k = idx[np.argmax(Z[idx])] if best == "max" else idx[np.argmin(Z[idx])]
-        ax.plot(
-            X[k],
-            Y[k],
-            "*",
-            color="tab:red",
-            ms=16,
-            mec="k",
-            label=f"{best} {value_text(Z[k])} {unit_text(uz_)}".strip(),
-        )
-        ax.annotate(
-            f"({X[k]:.4g}, {Y[k]:.4g})", (X[k], Y[k]), textcoords="offset points", xytext=(8, 8), fontsize="small"
-        )
+    grid = _grid_index(x, y)
+    mappable = _grid_layer(m, grid, fx, fy) if grid is not None else _scattered_layer(m)
+    label = axis_label(names[2], uz_) + (", log scale" if norm is not None else "")
+    fig.colorbar(mappable, ax=ax, pad=0.01, fraction=0.05, label=label)
+    _point_layers(m, region_label)
+    _marks(m, marks, best, fx, fy, uz_)
     ax.set_xlabel(axis_label(names[0], ux_))
     ax.set_ylabel(axis_label(names[1], uy_))
     handles = ax.get_legend_handles_labels()[0]

@@ -43,7 +43,42 @@ class Panel:
     points: Sequence[tuple[float, float, str]] = ()
 
 
-def panels_figure(  # noqa: C901 - one branch per optional layer of a panel
+def _draw_panel(ax: Any, panel: Panel, xs: np.ndarray, fx: float, xlabel: str, markers: bool) -> int:
+    """One panel: its curves and published points, labels, legend and title; how many of
+    its curves and point sets have a value to draw."""
+    ys_all = [as_floats(v) for v in panel.series.values()]
+    both = np.concatenate(ys_all) if ys_all else np.array([])
+    fy, uy = display_unit(panel.dimension, both)
+    drawn = 0
+    for label, ys in zip(panel.series, ys_all):
+        if len(ys) != len(xs):
+            raise InputError(f"{label}: expected {len(xs)} values (one per point), got {len(ys)}")
+        ax.plot(xs * fx, ys * fy, marker="o" if markers else None, ms=3, lw=1.2, label=pretty(label))
+        drawn += int(np.isfinite(ys).any())
+    if panel.points:
+        px_, py_ = np.array([(p[0], p[1]) for p in panel.points]).T
+        ax.plot(px_ * fx, py_ * fy, "D", ms=7, mfc="none", mec="tab:red", mew=1.5, label=panel.points[0][2])
+        drawn += 1
+    ax.set_ylabel(axis_label(panel.name, uy))
+    ax.set_xlabel(xlabel)
+    ax.grid(True, alpha=0.3)
+    entries = len(panel.series) + bool(panel.points)
+    if entries > 1:
+        ax.legend(fontsize="x-small", ncol=min(3, entries))
+    text = _panel_title(panel, both[np.isfinite(both)] * fy, uy)
+    if text:
+        ax.set_title(wrap(text, int(4.2 * 9)), fontsize="small")
+    return drawn
+
+
+def _panel_title(panel: Panel, finite: np.ndarray, unit: str) -> str:
+    """The panel's title, with the range of its values where it asks for it."""
+    if not (panel.annotate_range and finite.size):
+        return panel.title
+    return (panel.title + "\n" if panel.title else "") + f"{finite.min():.3g} … {finite.max():.3g} {unit}".strip()
+
+
+def panels_figure(
     x: Any,
     panels: Sequence[Panel],
     *,
@@ -66,33 +101,10 @@ def panels_figure(  # noqa: C901 - one branch per optional layer of a panel
     nrows = math.ceil(n / ncols)
     width = max(4.2 * ncols, 6.5)
     fig = Figure(figsize=(width, 3.3 * nrows + 0.5 + 0.25 * title.count("\n")), layout="constrained")
+    xlabel = axis_label(xname, ux) if xdimension else xname
     drawn = 0
     for k, panel in enumerate(panels):
-        ax = fig.add_subplot(nrows, ncols, k + 1)
-        ys_all = [as_floats(v) for v in panel.series.values()]
-        both = np.concatenate(ys_all) if ys_all else np.array([])
-        fy, uy = display_unit(panel.dimension, both)
-        for label, ys in zip(panel.series, ys_all):
-            if len(ys) != len(xs):
-                raise InputError(f"{label}: expected {len(xs)} values (one per point), got {len(ys)}")
-            ax.plot(xs * fx, ys * fy, marker="o" if markers else None, ms=3, lw=1.2, label=pretty(label))
-            drawn += int(np.isfinite(ys).any())
-        if panel.points:
-            label = panel.points[0][2]
-            px_, py_ = np.array([(p[0], p[1]) for p in panel.points]).T
-            ax.plot(px_ * fx, py_ * fy, "D", ms=7, mfc="none", mec="tab:red", mew=1.5, label=label)
-            drawn += 1
-        ax.set_ylabel(axis_label(panel.name, uy))
-        ax.set_xlabel(axis_label(xname, ux) if xdimension else xname)
-        ax.grid(True, alpha=0.3)
-        if len(panel.series) + bool(panel.points) > 1:
-            ax.legend(fontsize="x-small", ncol=min(3, len(panel.series) + bool(panel.points)))
-        finite = both[np.isfinite(both)] * fy
-        text = panel.title
-        if panel.annotate_range and finite.size:
-            text = (text + "\n" if text else "") + f"{finite.min():.3g} … {finite.max():.3g} {uy}".strip()
-        if text:
-            ax.set_title(wrap(text, int(4.2 * 9)), fontsize="small")
+        drawn += _draw_panel(fig.add_subplot(nrows, ncols, k + 1), panel, xs, fx, xlabel, markers)
     if not drawn:
         raise InputError("no point has a value to plot (no point solved)")
     if title:

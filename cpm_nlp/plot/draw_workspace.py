@@ -83,7 +83,139 @@ def _box_sizes(lo: np.ndarray, hi: np.ndarray, scales: Sequence[tuple[float, str
     return " × ".join(f"{number(d)} {u}".rstrip() for d, (_, u) in zip(hi - lo, scales))
 
 
-def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxes, boundary slices)
+@dataclass
+class _Scene:
+    """What the 3-D view and the projections of one workspace figure share, in display units:
+    the points ``P``, the factor ``f`` of each axis, the scales and labels, the cuboid ``B``,
+    the other boxes (SI), the hull's points (SI), the slices with their lines, and every
+    point drawn (``both``, SI)."""
+
+    P: np.ndarray
+    f: np.ndarray
+    size: float
+    scales: list
+    labels: list[str]
+    names: Sequence[str]
+    B: np.ndarray | None
+    others: list
+    hull_pts: np.ndarray | None
+    lines_by_slice: list
+    both: np.ndarray
+
+
+def _slice_frame(sl: BoundarySlice) -> np.ndarray:
+    """The four corners of a slice's extent, in 3-D (its plane at ``sl.at``)."""
+    i, j = sl.axes
+    grid = np.zeros((4, 3))
+    grid[:, i] = [min(sl.x), max(sl.x)] * 2
+    grid[:, j] = [min(sl.y), max(sl.y), max(sl.y), min(sl.y)]
+    grid[:, 3 - i - j] = sl.at
+    return grid
+
+
+def _hull_3d(ax: Any, sc: _Scene) -> None:
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from scipy.spatial import ConvexHull
+
+    H = sc.hull_pts * sc.f
+    faces = ConvexHull(H).simplices
+    ax.add_collection3d(Poly3DCollection([H[fc] for fc in faces], facecolor="tab:blue", edgecolor="none", alpha=0.15))
+    ax.scatter(H[:, 0], H[:, 1], H[:, 2], color="tab:blue", s=12)
+    ax.plot([], [], color="tab:blue", lw=6, alpha=0.3, label=f"workspace: hull of {len(H)} vertices")
+
+
+def _slices_3d(ax: Any, sc: _Scene, label: str) -> None:
+    """The boundary slices' lines in their planes (one legend entry for all)."""
+    drawn = False
+    for sl, lines in sc.lines_by_slice:
+        i, j = sl.axes
+        k = 3 - i - j
+        for line in lines:
+            xyz = np.zeros((len(line), 3))
+            xyz[:, i], xyz[:, j], xyz[:, k] = line[:, 0], line[:, 1], sl.at
+            xyz = xyz * sc.f
+            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label=None if drawn else "_b")
+            drawn = True
+    if drawn:
+        ax.plot([], [], color="k", lw=1.2, label=label)
+
+
+def _boxes_3d(ax: Any, sc: _Scene, cuboid_label: str) -> None:
+    """The cuboid (shaded) and the other boxes (dashed edges), each with its sizes in the legend."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    if sc.B is not None:
+        lo, hi = sc.B.min(axis=0), sc.B.max(axis=0)
+        corners = box_corners(lo, hi)
+        ax.add_collection3d(
+            Poly3DCollection([corners[fc] for fc in _BOX_FACES], facecolor="tab:red", edgecolor="darkred", alpha=0.25)
+        )
+        ax.plot([], [], color="tab:red", lw=6, alpha=0.4, label=f"{cuboid_label} ({_box_sizes(lo, hi, sc.scales)})")
+    for (olo, ohi, olabel), colour in zip(sc.others, OTHER_BOXES):
+        lo, hi = np.minimum(olo, ohi) * sc.f, np.maximum(olo, ohi) * sc.f
+        corners = box_corners(lo, hi)
+        for a, b in BOX_EDGES:
+            ax.plot(*corners[[a, b]].T, color=colour, lw=1.8, ls="--")
+        ax.plot([], [], color=colour, lw=1.8, ls="--", label=f"{olabel} ({_box_sizes(lo, hi, sc.scales)})")
+
+
+def _hull_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
+    from scipy.spatial import ConvexHull
+
+    H2 = (sc.hull_pts * sc.f)[:, [i, j]]
+    try:
+        loop = H2[ConvexHull(H2).vertices]
+        a2.fill(loop[:, 0], loop[:, 1], color="tab:blue", alpha=0.15)
+        a2.plot(*np.vstack([loop, loop[:1]]).T, color="tab:blue", lw=1)
+    except (ValueError, RuntimeError):  # a flat projection: the points alone
+        a2.plot(H2[:, 0], H2[:, 1], "o", color="tab:blue")
+
+
+def _slices_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
+    """The slices in the plane of this projection, titled by where they cut."""
+    f = sc.f
+    for sl, lines in sc.lines_by_slice:
+        if set(sl.axes) != {i, j}:
+            continue
+        swap = sl.axes != (i, j)
+        for line in lines:
+            u, v = (line[:, 1], line[:, 0]) if swap else (line[:, 0], line[:, 1])
+            a2.plot(u * f[i], v * f[j], color="k", lw=1.2)
+        k = 3 - i - j
+        at = sl.at * f[k]
+        at = 0.0 if abs(at) < 1e-9 * max(np.ptp(sc.both[:, k] * f[k]), 1e-300) else at
+        a2.set_title(f"boundary at {pretty(sc.names[k])} = {number(at)} {sc.scales[k][1]}".rstrip(), fontsize="small")
+
+
+def _boxes_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
+    from matplotlib.patches import Rectangle
+
+    if sc.B is not None:
+        lo, hi = sc.B.min(axis=0), sc.B.max(axis=0)
+        a2.add_patch(Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor="tab:red", lw=2))
+    for (olo, ohi, _), colour in zip(sc.others, OTHER_BOXES):
+        lo, hi = np.minimum(olo, ohi) * sc.f, np.maximum(olo, ohi) * sc.f
+        a2.add_patch(
+            Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor=colour, lw=1.8, ls="--")
+        )
+
+
+def _projection(a2: Any, sc: _Scene, i: int, j: int) -> None:
+    """The projection on the plane of axes i, j: points, hull, slices, boxes."""
+    P = sc.P
+    if len(P):
+        a2.scatter(P[:, i], P[:, j], s=sc.size, color="tab:blue", alpha=0.3, lw=0)
+    if sc.hull_pts is not None:
+        _hull_2d(a2, sc, i, j)
+    _slices_2d(a2, sc, i, j)
+    _boxes_2d(a2, sc, i, j)
+    a2.set_xlabel(sc.labels[i])
+    a2.set_ylabel(sc.labels[j])
+    a2.grid(True, alpha=0.3)
+    a2.autoscale_view()
+
+
+def workspace_figure(
     points: Any,
     *,
     cuboid: tuple[Sequence[float], Sequence[float]] | None = None,
@@ -104,9 +236,6 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
     drawn in the projection of that plane and in 3-D) and the convex ``hull``
     of given points (K x 3, SI; e.g. the vertices of an actuator workspace)."""
     Figure = figure_class()
-    from matplotlib.patches import Rectangle
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
     if not len(pts) and cuboid is None and hull is None:
@@ -115,14 +244,7 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
     others = [(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float), label) for lo, hi, label in boxes]
     hull_pts = None if hull is None else np.asarray(hull, dtype=float).reshape(-1, 3)
     parts = [pts] + ([] if box is None else [box]) + [np.vstack([lo, hi]) for lo, hi, _ in others]
-    parts += [] if hull_pts is None else [hull_pts]
-    for sl in slices:
-        i, j = sl.axes
-        grid = np.zeros((4, 3))
-        grid[:, i] = [min(sl.x), max(sl.x)] * 2
-        grid[:, j] = [min(sl.y), max(sl.y), max(sl.y), min(sl.y)]
-        grid[:, 3 - i - j] = sl.at
-        parts.append(grid)
+    parts += ([] if hull_pts is None else [hull_pts]) + [_slice_frame(sl) for sl in slices]
     both = np.vstack(parts)
     # one unit per dimension, so that three lengths are read on one scale
     scales = [
@@ -130,95 +252,37 @@ def workspace_figure(  # noqa: C901 - one branch per optional layer (cloud, boxe
     ]
     f = np.array([s[0] for s in scales])
     P = pts * f
-    labels = [axis_label(n, s[1]) for n, s in zip(names, scales)]
+    sc = _Scene(
+        P,
+        f,
+        float(np.clip(3000 / max(len(P), 1), 2, 25)),
+        scales,
+        [axis_label(n, s[1]) for n, s in zip(names, scales)],
+        names,
+        None if box is None else box * f,
+        others,
+        hull_pts,
+        [(sl, slice_lines(sl)) for sl in slices],
+        both,
+    )
     fig = Figure(figsize=(11, 9), layout="constrained")
     ax = fig.add_subplot(2, 2, 1, projection="3d")
-    size = float(np.clip(3000 / max(len(P), 1), 2, 25))
     if len(P):
-        ax.scatter(
-            P[:, 0], P[:, 1], P[:, 2], s=size, c=P[:, 2], cmap="viridis", alpha=0.5, label=f"{points_label} ({len(P)})"
-        )
-    ax.set_xlabel(labels[0])
-    ax.set_ylabel(labels[1])
-    ax.set_zlabel(labels[2])
+        label = f"{points_label} ({len(P)})"
+        ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=sc.size, c=P[:, 2], cmap="viridis", alpha=0.5, label=label)
+    ax.set_xlabel(sc.labels[0])
+    ax.set_ylabel(sc.labels[1])
+    ax.set_zlabel(sc.labels[2])
     few_ticks(ax, True)
     if hull_pts is not None:
-        from scipy.spatial import ConvexHull
-
-        H = hull_pts * f
-        faces = ConvexHull(H).simplices
-        ax.add_collection3d(
-            Poly3DCollection([H[fc] for fc in faces], facecolor="tab:blue", edgecolor="none", alpha=0.15)
-        )
-        ax.scatter(H[:, 0], H[:, 1], H[:, 2], color="tab:blue", s=12)
-        ax.plot([], [], color="tab:blue", lw=6, alpha=0.3, label=f"workspace: hull of {len(H)} vertices")
-    lines_by_slice = [(sl, slice_lines(sl)) for sl in slices]
-    drawn_boundary = False
-    for sl, lines in lines_by_slice:
-        i, j = sl.axes
-        k = 3 - i - j
-        for line in lines:
-            xyz = np.zeros((len(line), 3))
-            xyz[:, i], xyz[:, j], xyz[:, k] = line[:, 0], line[:, 1], sl.at
-            xyz = xyz * f
-            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label=None if drawn_boundary else "_b")
-            drawn_boundary = True
-    if drawn_boundary:
-        ax.plot([], [], color="k", lw=1.2, label=slices_label)
-    B = None
-    if box is not None:
-        B = box * f
-        lo, hi = B.min(axis=0), B.max(axis=0)
-        corners = box_corners(lo, hi)
-        ax.add_collection3d(
-            Poly3DCollection([corners[fc] for fc in _BOX_FACES], facecolor="tab:red", edgecolor="darkred", alpha=0.25)
-        )
-        ax.plot([], [], color="tab:red", lw=6, alpha=0.4, label=f"{cuboid_label} ({_box_sizes(lo, hi, scales)})")
-    for (olo, ohi, olabel), colour in zip(others, OTHER_BOXES):
-        lo, hi = np.minimum(olo, ohi) * f, np.maximum(olo, ohi) * f
-        corners = box_corners(lo, hi)
-        for a, b in BOX_EDGES:
-            ax.plot(*corners[[a, b]].T, color=colour, lw=1.8, ls="--")
-        ax.plot([], [], color=colour, lw=1.8, ls="--", label=f"{olabel} ({_box_sizes(lo, hi, scales)})")
+        _hull_3d(ax, sc)
+    _slices_3d(ax, sc, slices_label)
+    _boxes_3d(ax, sc, cuboid_label)
     handles = [h for h, lab in zip(*ax.get_legend_handles_labels()) if not lab.startswith("_")]
     if handles:
         fig.legend(handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize="small")
     for n, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
-        a2 = fig.add_subplot(2, 2, n + 2)
-        if len(P):
-            a2.scatter(P[:, i], P[:, j], s=size, color="tab:blue", alpha=0.3, lw=0)
-        if hull_pts is not None:
-            from scipy.spatial import ConvexHull
-
-            H2 = (hull_pts * f)[:, [i, j]]
-            try:
-                loop = H2[ConvexHull(H2).vertices]
-                a2.fill(loop[:, 0], loop[:, 1], color="tab:blue", alpha=0.15)
-                a2.plot(*np.vstack([loop, loop[:1]]).T, color="tab:blue", lw=1)
-            except (ValueError, RuntimeError):  # a flat projection: the points alone
-                a2.plot(H2[:, 0], H2[:, 1], "o", color="tab:blue")
-        for sl, lines in lines_by_slice:
-            if set(sl.axes) == {i, j}:
-                swap = sl.axes != (i, j)
-                for line in lines:
-                    u, v = (line[:, 1], line[:, 0]) if swap else (line[:, 0], line[:, 1])
-                    a2.plot(u * f[i], v * f[j], color="k", lw=1.2)
-                k = 3 - i - j
-                at = sl.at * f[k]
-                at = 0.0 if abs(at) < 1e-9 * max(np.ptp(both[:, k] * f[k]), 1e-300) else at
-                a2.set_title(f"boundary at {pretty(names[k])} = {number(at)} {scales[k][1]}".rstrip(), fontsize="small")
-        if B is not None:
-            lo, hi = B.min(axis=0), B.max(axis=0)
-            a2.add_patch(Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor="tab:red", lw=2))
-        for (olo, ohi, _), colour in zip(others, OTHER_BOXES):
-            lo, hi = np.minimum(olo, ohi) * f, np.maximum(olo, ohi) * f
-            a2.add_patch(
-                Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor=colour, lw=1.8, ls="--")
-            )
-        a2.set_xlabel(labels[i])
-        a2.set_ylabel(labels[j])
-        a2.grid(True, alpha=0.3)
-        a2.autoscale_view()
+        _projection(fig.add_subplot(2, 2, n + 2), sc, i, j)
     if title:
         fig.suptitle(title)
     return fig

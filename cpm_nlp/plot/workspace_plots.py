@@ -31,48 +31,74 @@ from .style import as_floats
 # -- workspace ------------------------------------------------------------------------------------
 
 
-def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901 - one branch per source of points
+def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
     """A point cloud with its cuboid (see the module's naming conventions)."""
     workspace_figure = workspace_html if options.interactive else workspace_figure_png
     v = data.values
     title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
-    if data.problem == "actuator_workspace" and len(result_closure(data).task) == 2:  # its points are x, y
-        return _planar_workspace_plot(data, options, result_closure(data))
-    if data.problem == "actuator_workspace" and isinstance(v.get("points"), list):  # task coordinates
+    if data.problem == "actuator_workspace":
         closure = result_closure(data)
-        task = list(closure.task)
-        lo, hi = [v.get(f"{t}_min") for t in task], [v.get(f"{t}_max") for t in task]
-        box = (lo, hi) if all(isinstance(b, (int, float)) for b in lo + hi) else None
-        # no hull: the faces between the corners' images are curved (the grid's images lie outside
-        # the corners' hull), and the images themselves show the shape
-        return workspace_figure(
-            np.asarray(v["points"], dtype=float),
-            cuboid=box,
-            names=task,
-            dimensions=[closure.x[i].kind for i in closure.task_index],
-            title=title,
-            points_label="images of the stroke grid",
-            cuboid_label="bounding box",
-        )
+        if len(closure.task) == 2:  # its points are x, y
+            return _planar_workspace_plot(data, options, closure)
+        if isinstance(v.get("points"), list):  # task coordinates
+            return _stroke_images_plot(data, closure, workspace_figure, title)
     if v.get("points") is not None:
-        pts = np.asarray(v["points"], dtype=float)
-        if pts.ndim != 2 or pts.shape[1] != 3:
-            raise NotApplicable(f"'points' must be a list of [x, y, z], got shape {pts.shape}")
-        lower, upper = v.get("cuboid_lower"), v.get("cuboid_upper")
-        cuboid = (lower, upper) if lower is not None and upper is not None else None
-        dim = dimension_of(data, "points") or "length"
-        names = v.get("point_names") or ("x", "y", "z")
-        return workspace_figure(pts, cuboid=cuboid, names=names, dimensions=(dim,) * 3, title=title)
+        return _given_points_plot(data, workspace_figure, title)
     closure = result_closure(data)
     task = list(closure.task)
     if len(task) == 2:
         return _planar_workspace_plot(data, options, closure)
     if len(task) != 3:
         raise NotApplicable(f"a workspace cloud needs 2 or 3 task coordinates; {closure.name} has {len(task)}")
-    kinds = [closure.x[i].kind for i in closure.task_index]
-    cuboid = None
+    return _task_workspace_plot(data, closure, workspace_figure, title)
+
+
+def _stroke_images_plot(data: ResultData, closure: Any, workspace_figure: Any, title: str) -> Any:
+    """An actuator workspace's images of the stroke grid, in the task coordinates, in its bounding box."""
+    v = data.values
+    task = list(closure.task)
+    lo, hi = [v.get(f"{t}_min") for t in task], [v.get(f"{t}_max") for t in task]
+    box = (lo, hi) if all(isinstance(b, (int, float)) for b in lo + hi) else None
+    # no hull: the faces between the corners' images are curved (the grid's images lie outside
+    # the corners' hull), and the images themselves show the shape
+    return workspace_figure(
+        np.asarray(v["points"], dtype=float),
+        cuboid=box,
+        names=task,
+        dimensions=[closure.x[i].kind for i in closure.task_index],
+        title=title,
+        points_label="images of the stroke grid",
+        cuboid_label="bounding box",
+    )
+
+
+def _given_points_plot(data: ResultData, workspace_figure: Any, title: str) -> Any:
+    """A result's own ``points`` [x, y, z] with its ``cuboid_lower`` … ``cuboid_upper``."""
+    v = data.values
+    pts = np.asarray(v["points"], dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise NotApplicable(f"'points' must be a list of [x, y, z], got shape {pts.shape}")
+    lower, upper = v.get("cuboid_lower"), v.get("cuboid_upper")
+    cuboid = (lower, upper) if lower is not None and upper is not None else None
+    dim = dimension_of(data, "points") or "length"
+    names = v.get("point_names") or ("x", "y", "z")
+    return workspace_figure(pts, cuboid=cuboid, names=names, dimensions=(dim,) * 3, title=title)
+
+
+def _task_box(v: Any, task: list[str]) -> tuple | None:
+    """The box ``<t>_min`` … ``<t>_max`` of the task coordinates, where every bound is a number."""
     if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
-        cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
+        return [v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task]
+    return None
+
+
+def _task_workspace_plot(data: ResultData, closure: Any, workspace_figure: Any, title: str) -> Any:
+    """Three task coordinates: the workspace kind's cloud (with the boundary where the model is
+    at hand), an inscribed cuboid (with the workspace around it), else a batch of solved poses."""
+    v = data.values
+    task = list(closure.task)
+    kinds = [closure.x[i].kind for i in closure.task_index]
+    cuboid = _task_box(v, task)
     if data.problem == "inscribed_cuboid":
         box_label = "maximal inscribed cuboid"
     else:
@@ -85,41 +111,9 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
         pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
         label = "reachable points (seeded sample)"
         if data.live is not None and all(isinstance(v.get(f"{t}_range"), list) for t in task):
-            lo = np.array([v[f"{t}_range"][0] for t in task], dtype=float)
-            hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
-            centre = np.clip(data.live.task_of(data.live.x_home), lo, hi)
-            slices = _boundary_slices(data.live, lo, hi, centre)
-            if data.live.closure.ik is not None:  # membership is cheap: each vertex bisected onto the boundary
-                slices = [replace(sl, lines=_refined_boundary(data.live, sl, centre)) for sl in slices]
-            return workspace_figure(
-                pts,
-                names=task,
-                dimensions=kinds,
-                title=title,
-                points_label=label,
-                slices=slices,
-                slices_label="workspace boundary (slices through the home pose)",
-            )
+            return _cloud_with_boundary(data, pts, task, kinds, workspace_figure, title)
     elif cuboid is not None:  # inscribed_cuboid: the workspace around it from the model, if at hand
-        pts, label, slices = np.zeros((0, 3)), "", ()
-        boxes = _paper_boxes(data)
-        if data.live is not None and data.problem == "inscribed_cuboid":
-            pts, slices = _workspace_around(data.live, cuboid)
-            label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
-        elif data.problem == "inscribed_cuboid":
-            title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
-        return workspace_figure(
-            pts,
-            cuboid=cuboid,
-            names=task,
-            dimensions=kinds,
-            title=title,
-            points_label=label,
-            cuboid_label=box_label,
-            boxes=boxes,
-            slices=slices,
-            hull=hull,
-        )
+        return _cuboid_plot(data, cuboid, (task, kinds, box_label, hull), workspace_figure, title)
     else:  # a batch of poses, one sweep point per pose
         names = [pose_name(data, closure, t) for t in task]
         require_lists(data, names, "a workspace cloud")
@@ -130,6 +124,51 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:  # noqa: C901
         task, label = names, "solved poses"
     return workspace_figure(
         pts, cuboid=cuboid, names=task, dimensions=kinds, title=title, points_label=label, cuboid_label=box_label
+    )
+
+
+def _cloud_with_boundary(
+    data: ResultData, pts: np.ndarray, task: list[str], kinds: list[str], workspace_figure: Any, title: str
+) -> Any:
+    """The workspace kind's cloud with the boundary in the planes through the home pose."""
+    v = data.values
+    lo = np.array([v[f"{t}_range"][0] for t in task], dtype=float)
+    hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
+    centre = np.clip(data.live.task_of(data.live.x_home), lo, hi)
+    slices = _boundary_slices(data.live, lo, hi, centre)
+    if data.live.closure.ik is not None:  # membership is cheap: each vertex bisected onto the boundary
+        slices = [replace(sl, lines=_refined_boundary(data.live, sl, centre)) for sl in slices]
+    return workspace_figure(
+        pts,
+        names=task,
+        dimensions=kinds,
+        title=title,
+        points_label="reachable points (seeded sample)",
+        slices=slices,
+        slices_label="workspace boundary (slices through the home pose)",
+    )
+
+
+def _cuboid_plot(data: ResultData, cuboid: tuple, axes: tuple, workspace_figure: Any, title: str) -> Any:
+    """A cuboid (and the paper's box), with the workspace around it where the model is at hand."""
+    task, kinds, box_label, hull = axes
+    pts, label, slices = np.zeros((0, 3)), "", ()
+    if data.live is not None and data.problem == "inscribed_cuboid":
+        pts, slices = _workspace_around(data.live, cuboid)
+        label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+    elif data.problem == "inscribed_cuboid":
+        title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
+    return workspace_figure(
+        pts,
+        cuboid=cuboid,
+        names=task,
+        dimensions=kinds,
+        title=title,
+        points_label=label,
+        cuboid_label=box_label,
+        boxes=_paper_boxes(data),
+        slices=slices,
+        hull=hull,
     )
 
 
@@ -281,7 +320,7 @@ def _stroke_edges(data: ResultData, closure: Any) -> list[np.ndarray]:
     return [T[ok]] if ok.sum() > 1 else []
 
 
-def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any) -> Any:  # noqa: C901 - one branch per kind
+def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any) -> Any:
     """A planar workspace (two task coordinates, e.g. the five-bar's x, y) in its plane:
     the points, the rectangle (inscribed_cuboid) or the bounding box (actuator_workspace),
     and the boundary: the zero level of the membership margin (workspace,
@@ -293,71 +332,97 @@ def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any)
     task = list(closure.task)
     kinds = [closure.x[i].kind for i in closure.task_index]
     title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
-    cuboid = None
-    if all(isinstance(v.get(f"{t}_min"), (int, float)) and isinstance(v.get(f"{t}_max"), (int, float)) for t in task):
-        cuboid = ([v[f"{t}_min"] for t in task], [v[f"{t}_max"] for t in task])
+    cuboid = _task_box(v, task)
     common = {"names": task, "dimensions": kinds, "title": title}
     if data.problem == "actuator_workspace":
-        pts = np.asarray(v["points"], dtype=float) if isinstance(v.get("points"), list) else np.zeros((0, 2))
-        corners = np.asarray(v["vertices"], dtype=float) if isinstance(v.get("vertices"), list) else None
-        partial = bool(v.get("n_not_assembled"))  # the stroke edges' image is not the boundary then
-        edges = [] if partial else _stroke_edges(data, closure)
-        note = STROKE_BOUNDARY if edges else "no boundary: give inputs.points: true or plot with solve --plot"
-        if partial:
-            note = "no boundary drawn: part of the stroke box does not assemble (images of the grid points that do)"
-        return workspace_figure_2d(
-            pts,
-            cuboid=cuboid,
-            cuboid_label="bounding box",
-            points_label="images of the stroke grid",
-            outline=edges,
-            corners=corners,
-            note=note,
-            **common,
-        )
-    note = MEMBERSHIP_BOUNDARY.format(g=PLANAR_GRID)
+        return _planar_strokes_plot(data, closure, cuboid, common)
     if all(value_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
-        pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
-        slices: list[BoundarySlice] = []
-        if data.live is not None and all(isinstance(v.get(f"{t}_range"), list) for t in task):
-            lo = np.array([v[f"{t}_range"][0] for t in task], dtype=float)
-            hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
-            slices = _boundary_slices(data.live, lo, hi, (lo + hi) / 2, PLANAR_GRID)
-        return workspace_figure_2d(
-            pts,
-            points_label="reachable points (seeded sample)",
-            outline=[line for sl in slices for line in _refined_boundary(data.live, sl, (lo + hi) / 2)],
-            note=note if slices else "no boundary: plot with solve --plot (the model at hand)",
-            **common,
-        )
+        return _planar_cloud_plot(data, task, common)
     if cuboid is not None:  # inscribed_cuboid (or synthesis): the workspace around it, if the model is at hand
-        pts, slices, label = np.zeros((0, 2)), [], ""
-        if data.live is not None:
-            lo, hi = (np.asarray(c, dtype=float) for c in cuboid)
-            centre = (lo + hi) / 2
-            for probed in (probe_region(data.live, centre=centre), probe_region(data.live)):
-                if probed is not None:  # the box, the region probed from its centre and from home
-                    lo, hi = np.minimum(lo, probed[0]), np.maximum(hi, probed[1])
-            pad = 0.1 * (hi - lo)
-            lo, hi = lo - pad, hi + pad
-            pts = sample_workspace(data.live, CLOUD_SAMPLE, 0, (lo, hi))[0]
-            slices = _boundary_slices(data.live, lo, hi, centre, PLANAR_GRID)
-            label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
-        else:
-            title += "\n(the rectangle alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
-        common["title"] = title
-        return workspace_figure_2d(
-            pts,
-            cuboid=cuboid,
-            cuboid_label="maximal inscribed rectangle",
-            points_label=label,
-            outline=[line for sl in slices for line in _refined_boundary(data.live, sl, centre)],
-            note=note if slices else "",
-            **common,
-        )
+        return _planar_rectangle_plot(data, cuboid, common)
     names = [pose_name(data, closure, t) for t in task]  # a batch of poses
     require_lists(data, names, "a workspace plot")
     pts = np.array([as_floats(v[n]) for n in names]).T
     if data.ok is not None:
         pts = pts[data.ok]
     return workspace_figure_2d(pts, points_label="solved poses", **common)
+
+
+def _planar_strokes_plot(data: ResultData, closure: Any, cuboid: tuple | None, common: dict) -> Any:
+    """A planar actuator workspace: the images of the stroke grid, its bounding box, the
+    image of the stroke square's edges (unless part of the box does not assemble)."""
+    v = data.values
+    pts = np.asarray(v["points"], dtype=float) if isinstance(v.get("points"), list) else np.zeros((0, 2))
+    corners = np.asarray(v["vertices"], dtype=float) if isinstance(v.get("vertices"), list) else None
+    partial = bool(v.get("n_not_assembled"))  # the stroke edges' image is not the boundary then
+    edges = [] if partial else _stroke_edges(data, closure)
+    note = STROKE_BOUNDARY if edges else "no boundary: give inputs.points: true or plot with solve --plot"
+    if partial:
+        note = "no boundary drawn: part of the stroke box does not assemble (images of the grid points that do)"
+    return workspace_figure_2d(
+        pts,
+        cuboid=cuboid,
+        cuboid_label="bounding box",
+        points_label="images of the stroke grid",
+        outline=edges,
+        corners=corners,
+        note=note,
+        **common,
+    )
+
+
+#: the note of a planar cloud without its model at hand (no boundary is traced)
+NO_MODEL_NOTE = "no boundary: plot with solve --plot (the model at hand)"
+
+
+def _planar_cloud_plot(data: ResultData, task: list[str], common: dict) -> Any:
+    """The workspace kind's cloud in its plane, with the boundary where the model is at hand."""
+    v = data.values
+    pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
+    outline: list[np.ndarray] = []
+    slices: list[BoundarySlice] = []
+    if data.live is not None and all(isinstance(v.get(f"{t}_range"), list) for t in task):
+        lo = np.array([v[f"{t}_range"][0] for t in task], dtype=float)
+        hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
+        slices = _boundary_slices(data.live, lo, hi, (lo + hi) / 2, PLANAR_GRID)
+        outline = [line for sl in slices for line in _refined_boundary(data.live, sl, (lo + hi) / 2)]
+    return workspace_figure_2d(
+        pts,
+        points_label="reachable points (seeded sample)",
+        outline=outline,
+        note=MEMBERSHIP_BOUNDARY.format(g=PLANAR_GRID) if slices else NO_MODEL_NOTE,
+        **common,
+    )
+
+
+def _planar_rectangle_plot(data: ResultData, cuboid: tuple, common: dict) -> Any:
+    """An inscribed rectangle, with the workspace around it where the model is at hand."""
+    pts, outline, label = np.zeros((0, 2)), [], ""
+    slices: list[BoundarySlice] = []
+    if data.live is not None:
+        lo, hi = (np.asarray(c, dtype=float) for c in cuboid)
+        centre = (lo + hi) / 2
+        for probed in (probe_region(data.live, centre=centre), probe_region(data.live)):
+            if probed is not None:  # the box, the region probed from its centre and from home
+                lo, hi = np.minimum(lo, probed[0]), np.maximum(hi, probed[1])
+        pad = 0.1 * (hi - lo)
+        lo, hi = lo - pad, hi + pad
+        pts = sample_workspace(data.live, CLOUD_SAMPLE, 0, (lo, hi))[0]
+        slices = _boundary_slices(data.live, lo, hi, centre, PLANAR_GRID)
+        outline = [line for sl in slices for line in _refined_boundary(data.live, sl, centre)]
+        label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+    else:
+        common = {
+            **common,
+            "title": common["title"]
+            + "\n(the rectangle alone: `cpm-nlp solve FILE --plot` draws the workspace around it)",
+        }
+    return workspace_figure_2d(
+        pts,
+        cuboid=cuboid,
+        cuboid_label="maximal inscribed rectangle",
+        points_label=label,
+        outline=outline,
+        note=MEMBERSHIP_BOUNDARY.format(g=PLANAR_GRID) if slices else "",
+        **common,
+    )

@@ -55,6 +55,32 @@ class InputRow:
 
 
 @dataclass(frozen=True)
+class ValueRow:
+    """One value a kind declares (:class:`~cpm_nlp.core.outputs.Output`): name, the unit a
+    result writes for it (SI, or what a matrix's rows and columns are), dimension, and what it
+    is where that is not the value itself ("pz relative to home": an offset)."""
+
+    name: str
+    unit: str
+    dimension: str
+    meaning: str
+
+
+def _value_rows(kind: ProblemKind, model: Model, names: tuple[str, ...]) -> tuple[ValueRow, ...]:
+    """The kind's declared outputs as rows; none where it declares only their names."""
+    try:
+        outputs = kind.outputs(model)
+    except NotImplementedError:
+        return ()
+    if tuple(o.name for o in outputs) != names:  # a kind that adds names to those it declares
+        return ()
+    return tuple(
+        ValueRow(o.name, o.si, o.dimension, f"{o.refers_to} relative to home" if o.role == "reference" else "")
+        for o in outputs
+    )
+
+
+@dataclass(frozen=True)
 class KindDescription:
     """A kind described for one mechanism; ``unsupported`` is the reason it does not apply
     (then ``inputs`` and ``values`` are empty)."""
@@ -67,6 +93,8 @@ class KindDescription:
     unsupported: str | None
     inputs: tuple[InputRow, ...]
     values: tuple[str, ...]
+    #: the values with their units and dimensions, where the kind declares them (empty: names only)
+    outputs: tuple[ValueRow, ...] = ()
 
 
 def _mechanism_section(mech: Mechanism) -> tuple[dict[str, Any], str]:
@@ -212,7 +240,8 @@ def describe_kind(
     except Exception as exc:
         raise PluginError(f"problem kind {kind.name!r} ({origin}): describing its inputs failed: {exc}") from exc
     rows = tuple(_row(o) for o in options)
-    return KindDescription(kind.name, kind.description, origin, mechanism, source, None, rows, values)
+    outputs = _value_rows(kind, model, values)
+    return KindDescription(kind.name, kind.description, origin, mechanism, source, None, rows, values, outputs)
 
 
 def kind_text(desc: KindDescription) -> str:
@@ -232,7 +261,11 @@ def kind_text(desc: KindDescription) -> str:
             lines.append(f"{pad}{row.name:<{width}} [{row.unit}] {row.default}".rstrip())
             lines.append(f"{pad}{'':<{width}} {row.meaning}")
     lines.append("values:")
-    lines.append("  " + (", ".join(desc.values) if desc.values else "(none)"))
+    for row in desc.outputs:
+        what = f"; {row.meaning}" if row.meaning else ""
+        lines.append(f"  {row.name:<14} [{row.unit}] {row.dimension}{what}")
+    if not desc.outputs:
+        lines.append("  " + (", ".join(desc.values) if desc.values else "(none)"))
     return "\n".join(lines) + "\n"
 
 
@@ -298,6 +331,12 @@ def kind_markdown(desc: KindDescription, level: int = 3, nested: _Nested | None 
         out += _table(rows)
     else:
         out.append("No inputs.")
+    if desc.outputs:
+        out += ["", "| value | unit | dimension | what |", "| --- | --- | --- | --- |"]
+        out += [
+            f"| `{_cell(r.name)}` | {_cell(r.unit)} | {_cell(r.dimension)} | {_cell(r.meaning)} |" for r in desc.outputs
+        ]
+        return "\n".join(out + [""])
     out += ["", "Values: " + (", ".join(f"`{v}`" for v in desc.values) if desc.values else "none") + ".", ""]
     return "\n".join(out)
 

@@ -27,11 +27,11 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import InputError, suggest, unknown_key_error
-from ..core.finite import check_numbers, finite_status
+from ..core.finite import check_numbers
 from ..core.kind import ProblemKind
 from ..core.model import Model
 from ..core.origin import Origin
-from ..core.result import Result
+from ..core.result import Result, finite_status
 from ..core.solver import SolverConfig
 from ..io.datafile import data_file_of, merge_data_file
 from ..io.inputs import display_name, input_dir
@@ -82,29 +82,11 @@ def problem_from_dict(data: Any, *, file: str | None = None, base_dir: Path | No
         raise exc.at(file=file) from None
 
 
-def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Problem:  # noqa: C901 - one step per section of the file
-    if not isinstance(data, dict):
-        kind = "an empty file" if data is None else f"{type(data).__name__} {data!r}"[:80]
-        raise InputError(f"expected a mapping with keys {', '.join(TOP_LEVEL)}; got {kind}")
-    check_numbers(data)  # no inf, NaN or 1500-digit integer anywhere, before anything is built
-    for key in data:
-        if key not in TOP_LEVEL:
-            raise unknown_key_error(str(key), TOP_LEVEL, (), "top-level key")
-    if data.get("problem") is None:
-        raise InputError("missing required key 'problem' (the problem kind, e.g. forward_kinematics)")
+def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Problem:
+    """One step per section of the file, in the order its messages are given."""
+    _check_top_level(data)
     kind = problem_kind(data["problem"])
-    mech = data.get("mechanism")
-    if not isinstance(mech, Mapping):
-        raise InputError(
-            "expected a mapping with keys type, parameters, limits"
-            + ("" if mech is not None else " (the key is missing)"),
-            path=("mechanism",),
-        )
-    for key in mech:
-        if key not in SECTION_KEYS:
-            raise unknown_key_error(str(key), SECTION_KEYS, ("mechanism",), "mechanism key")
-    model = section_model(mech, base_dir)
-    origin = section_origin(mech, base_dir, model)
+    model, origin = _mechanism_section(data.get("mechanism"), base_dir)
     reason = kind.supports(model)
     if reason:
         raise InputError(
@@ -128,6 +110,35 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
     if data.get("sweep") is not None:
         sweep = parse_sweep(data["sweep"], data, kind, model, base_dir)
     return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data, sweep, origin)
+
+
+def _check_top_level(data: Any) -> None:
+    """A mapping of the top-level keys, with finite numbers only and a problem kind."""
+    if not isinstance(data, dict):
+        kind = "an empty file" if data is None else f"{type(data).__name__} {data!r}"[:80]
+        raise InputError(f"expected a mapping with keys {', '.join(TOP_LEVEL)}; got {kind}")
+    check_numbers(data)  # no inf, NaN or 1500-digit integer anywhere, before anything is built
+    for key in data:
+        if key not in TOP_LEVEL:
+            raise unknown_key_error(str(key), TOP_LEVEL, (), "top-level key")
+    if data.get("problem") is None:
+        raise InputError("missing required key 'problem' (the problem kind, e.g. forward_kinematics)")
+
+
+def _mechanism_section(mech: Any, base_dir: Path | None) -> tuple[Model, Origin | None]:
+    """The model of the ``mechanism`` section, and where its mechanism comes from."""
+    if not isinstance(mech, Mapping):
+        raise InputError(
+            "expected a mapping with keys type, parameters, limits"
+            + ("" if mech is not None else " (the key is missing)"),
+            path=("mechanism",),
+        )
+    for key in mech:
+        if key not in SECTION_KEYS:
+            raise unknown_key_error(str(key), SECTION_KEYS, ("mechanism",), "mechanism key")
+    model = section_model(mech, base_dir)
+    origin = section_origin(mech, base_dir, model)
+    return model, origin
 
 
 def _check_reproduced_values(raw: Any, spec: Any, names: list[str]) -> None:
@@ -191,6 +202,5 @@ def solve(problem: Problem) -> Result:
         result.origin = problem.origin
     result = finite_status(result)  # a NaN or an inf is a failed status, never an answer
     if problem.outputs is not None:
-        keep = set(problem.outputs)
-        result.values = {k: v for k, v in result.values.items() if k in keep}
+        result.keep(problem.outputs)
     return result

@@ -39,7 +39,7 @@ def parse_override(text: str) -> tuple[list[str | int], Any]:
     return parts, value
 
 
-def apply_overrides(data: Any, overrides: Sequence[str]) -> dict[str, Any]:  # noqa: C901 - one message per way a dotted key can miss
+def apply_overrides(data: Any, overrides: Sequence[str]) -> dict[str, Any]:
     """Apply ``--set`` overrides (like Hydra) to a parsed problem file.
 
     Keys are dotted paths; integers or ``[i]`` index lists; under
@@ -57,31 +57,46 @@ def apply_overrides(data: Any, overrides: Sequence[str]) -> dict[str, Any]:  # n
             parts = parts[:2] + [".".join(str(p) for p in parts[2:])]
         if len(parts) > 1 and parts[0] == "solver" and isinstance(data.get("solver"), str):
             data["solver"] = {"preset": data["solver"]}  # a preset name, now refined
-        node: Any = data
-        for depth, part in enumerate(parts[:-1]):
-            where = tuple(parts[: depth + 1])
-            if isinstance(node, list):
-                if not isinstance(part, int) or not -len(node) <= part < len(node):
-                    raise InputError(
-                        f"--set {text}: no list element {part!r} at {format_key_path(where[:-1])}", path=("--set",)
-                    )
-                node = node[part]
-                continue
-            if not isinstance(node, dict):
-                raise InputError(f"--set {text}: {format_key_path(where[:-1])} is not a mapping", path=("--set",))
-            if part not in node or node[part] is None:
-                node[part] = {}
-            node = node[part]
-        last = parts[-1]
-        if isinstance(node, list):
-            if not isinstance(last, int) or not -len(node) <= last < len(node):
-                raise InputError(f"--set {text}: no list element {last!r}", path=("--set",))
-            node[last] = value
-        elif isinstance(node, dict):
-            node[last] = value
-        else:
-            raise InputError(f"--set {text}: {format_key_path(parts[:-1])} is not a mapping", path=("--set",))
+        node = _parent_node(data, parts, text)
+        _set_last(node, parts, value, text)
     return data
+
+
+def _parent_node(data: dict, parts: list[str | int], text: str) -> Any:
+    """The list or mapping that holds the last key of ``parts``; missing mappings are created."""
+    node: Any = data
+    for depth, part in enumerate(parts[:-1]):
+        where = tuple(parts[: depth + 1])
+        if isinstance(node, list):
+            if not _is_index(part, node):
+                raise InputError(
+                    f"--set {text}: no list element {part!r} at {format_key_path(where[:-1])}", path=("--set",)
+                )
+            node = node[part]
+            continue
+        if not isinstance(node, dict):
+            raise InputError(f"--set {text}: {format_key_path(where[:-1])} is not a mapping", path=("--set",))
+        if part not in node or node[part] is None:
+            node[part] = {}
+        node = node[part]
+    return node
+
+
+def _set_last(node: Any, parts: list[str | int], value: Any, text: str) -> None:
+    last = parts[-1]
+    if isinstance(node, list):
+        if not _is_index(last, node):
+            raise InputError(f"--set {text}: no list element {last!r}", path=("--set",))
+        node[last] = value
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise InputError(f"--set {text}: {format_key_path(parts[:-1])} is not a mapping", path=("--set",))
+
+
+def _is_index(part: str | int, node: list) -> bool:
+    """Whether ``part`` is an index of the list ``node`` (negative ones too)."""
+    return isinstance(part, int) and -len(node) <= part < len(node)
 
 
 def _deep_copy(value: Any) -> Any:

@@ -285,12 +285,33 @@ def _check_tolerance_reason(row: Mapping, fig: PublishedFigure, path: tuple) -> 
         )
 
 
-def _parse_row(row: Any, path: tuple) -> PublishedFigure:  # noqa: C901 - one rule per key of a row
+def _check_row_keys(row: Any, path: tuple) -> None:
     if not isinstance(row, Mapping):
         raise InputError(f"expected a mapping with keys {', '.join(ROW_KEYS)}", path=path)
     for key in row:
         if key not in ROW_KEYS:
             raise unknown_key_error(str(key), ROW_KEYS, path, "row key")
+
+
+def _check_not_computed(row: Mapping, reason: str, path: tuple) -> None:
+    """A figure the model does not compute (``value: null``): a reason, and nothing to compare."""
+    if not reason:
+        raise InputError("a figure the model does not compute (value: null) needs a 'reason'", path=path)
+    for key in ("tolerance", "tolerance_reason", "echoes"):
+        if key in row:
+            raise InputError(f"a figure the model does not compute (value: null) has no {key!r}", path=path)
+
+
+def _check_value_name(value: Any, path: tuple) -> None:
+    """The name of a result value, with list indices: ``s_min``, ``dz[0]``."""
+    if not isinstance(value, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*", value):
+        raise InputError(
+            f"expected the name of a result value, e.g. s_min or dz[0], got {value!r}", path=path + ("value",)
+        )
+
+
+def _parse_row(row: Any, path: tuple) -> PublishedFigure:
+    _check_row_keys(row, path)
     quantity = _text(row, "quantity", path)
     source = _text(row, "source", path)
     reason = _text(row, "reason", path, required=False)
@@ -305,18 +326,11 @@ def _parse_row(row: Any, path: tuple) -> PublishedFigure:  # noqa: C901 - one ru
     value = row.get("value")
     published_raw = row["published"]
     if value is None:
-        if not reason:
-            raise InputError("a figure the model does not compute (value: null) needs a 'reason'", path=path)
-        for key in ("tolerance", "tolerance_reason", "echoes"):
-            if key in row:
-                raise InputError(f"a figure the model does not compute (value: null) has no {key!r}", path=path)
+        _check_not_computed(row, reason, path)
         return PublishedFigure(
             quantity, source, str(published_raw), None, "dimensionless", None, None, None, reason, "differ", category
         )
-    if not isinstance(value, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*", value):
-        raise InputError(
-            f"expected the name of a result value, e.g. s_min or dz[0], got {value!r}", path=path + ("value",)
-        )
+    _check_value_name(value, path)
     published, dim = parse_any_quantity(published_raw, path + ("published",))
     kind, tol = _tolerance(row, dim, path)
     if expect == "differ" and not reason:

@@ -385,7 +385,7 @@ def _threads(client: Any) -> int:
     return max(1, sum(client.nthreads().values()))
 
 
-def _execute(  # noqa: C901 - the scheduling loop with its retry and split rules
+def _execute(
     client: Any,
     job: Job,
     pending: list[int],
@@ -399,64 +399,78 @@ def _execute(  # noqa: C901 - the scheduling loop with its retry and split rules
     or it raised) is split into single points; a single point that fails is
     recorded with status ``error``.  Returns the number of worker threads."""
     distributed = require("distributed", "sweep", "running a sweep")
-    queue = list(reversed(pending))  # pop() from the end = lowest point first
-    threads = _threads(client)
-    per_point = None  # seconds, measured
-    futures: dict[Any, list[int]] = {}
-    done = len(store.done)
-    total = job.spec.size
-    retry: list[list[int]] = []
+    run = _Scheduling(client, job, pending, store, chunk_size)
+    seq = distributed.as_completed([])
+    try:
+        run.submit(seq)
+        last_threads = time.monotonic()
+        for fut in seq:
+            run.collect(fut)
+            if progress is not None:
+                progress(run.done, run.total)
+            if time.monotonic() - last_threads > 2.0:  # clusters grow and shrink
+                run.threads, last_threads = _threads(client), time.monotonic()
+            run.submit(seq)
+    finally:
+        if run.futures:
+            client.cancel(list(run.futures))
+    return run.threads
 
-    def next_chunk() -> list[int]:
-        if retry:
-            return retry.pop()
-        if chunk_size:
-            n = chunk_size
-        elif per_point is None:
+
+class _Scheduling:
+    """The state of the scheduling loop of :func:`_execute`: the points still to submit, the
+    chunks to retry one point at a time, the tasks in flight and the measured time per point."""
+
+    def __init__(self, client: Any, job: Job, pending: list[int], store: Any, chunk_size: int | None) -> None:
+        self.client, self.job, self.store, self.chunk_size = client, job, store, chunk_size
+        self.queue = list(reversed(pending))  # pop() from the end = lowest point first
+        self.threads = _threads(client)
+        self.per_point: float | None = None  # seconds, measured
+        self.futures: dict[Any, list[int]] = {}
+        self.done = len(store.done)
+        self.total = job.spec.size
+        self.retry: list[list[int]] = []
+
+    def next_chunk(self) -> list[int]:
+        if self.retry:
+            return self.retry.pop()
+        queue = self.queue
+        if self.chunk_size:
+            n = self.chunk_size
+        elif self.per_point is None:
             n = 1  # measure first
         else:
-            n = int(TASK_SECONDS / max(per_point, 1e-6))
-            n = min(n, math.ceil(len(queue) / (2 * threads)))  # keep the end balanced
+            n = int(TASK_SECONDS / max(self.per_point, 1e-6))
+            n = min(n, math.ceil(len(queue) / (2 * self.threads)))  # keep the end balanced
         n = max(1, min(n, len(queue)))
         return [queue.pop() for _ in range(n)]
 
-    def submit(seq: Any) -> None:
-        while (queue or retry) and len(futures) < IN_FLIGHT * threads:
-            ids = next_chunk()
-            fut = client.submit(solve_points, job, ids, pure=False)
-            futures[fut] = ids
+    def submit(self, seq: Any) -> None:
+        while (self.queue or self.retry) and len(self.futures) < IN_FLIGHT * self.threads:
+            ids = self.next_chunk()
+            fut = self.client.submit(solve_points, self.job, ids, pure=False)
+            self.futures[fut] = ids
             seq.add(fut)
 
-    seq = distributed.as_completed([])
-    try:
-        submit(seq)
-        last_threads = time.monotonic()
-        for fut in seq:
-            ids = futures.pop(fut)
-            if fut.status == "finished":
-                out = fut.result()
-                store.append(out["records"], out["units"], out["dimensions"])
-                secs = [r["seconds"] for r in out["records"]]
-                mean = sum(secs) / len(secs)
-                per_point = mean if per_point is None else 0.7 * per_point + 0.3 * mean
-                done += len(ids)
-            else:
-                exc = fut.exception() if fut.status == "error" else None
-                if len(ids) > 1:
-                    log.warning("a task of %d points failed (%s); solving them one by one", len(ids), exc)
-                    retry.extend([i] for i in reversed(ids))
-                else:
-                    store.append([_error_record(job, ids[0], exc)], {}, {})
-                    done += 1
-            if progress is not None:
-                progress(done, total)
-            if time.monotonic() - last_threads > 2.0:  # clusters grow and shrink
-                threads, last_threads = _threads(client), time.monotonic()
-            submit(seq)
-    finally:
-        if futures:
-            client.cancel(list(futures))
-    return threads
+    def collect(self, fut: Any) -> None:
+        """A task come back: its records written, or its points split for a retry, or (one
+        point) an ``error`` record."""
+        ids = self.futures.pop(fut)
+        if fut.status == "finished":
+            out = fut.result()
+            self.store.append(out["records"], out["units"], out["dimensions"])
+            secs = [r["seconds"] for r in out["records"]]
+            mean = sum(secs) / len(secs)
+            self.per_point = mean if self.per_point is None else 0.7 * self.per_point + 0.3 * mean
+            self.done += len(ids)
+            return
+        exc = fut.exception() if fut.status == "error" else None
+        if len(ids) > 1:
+            log.warning("a task of %d points failed (%s); solving them one by one", len(ids), exc)
+            self.retry.extend([i] for i in reversed(ids))
+        else:
+            self.store.append([_error_record(self.job, ids[0], exc)], {}, {})
+            self.done += 1
 
 
 def _error_record(job: Job, k: int, exc: BaseException | None) -> dict[str, Any]:

@@ -8,7 +8,7 @@ The package's ``pantograph`` is the mechanism file ``problems/mechanisms/pantogr
 These closures, derived by hand from eq 1-8, were the built-in module
 ``cpm_nlp.mechanisms.pantograph.kinematics`` until issue 21 (item 5) wrote the mechanism once,
 in the file; they stay here as the independent derivation the file is checked against
-(``tests/test_pantograph_written_once.py``, to 1e-12).  Not part of the package: import it
+(``tests/mechanisms/pantograph/test_pantograph_written_once.py``, to 1e-12).  Not part of the package: import it
 from the tests only.  The paper's analyses (limits of eq 31, workspace, cuboid) are the
 package's (``cpm_nlp.mechanisms.pantograph.analysis``): :func:`build` uses its eq 31.
 

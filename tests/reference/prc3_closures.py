@@ -7,7 +7,7 @@ generated from the legs) with the add-on ``cpm_nlp.mechanisms.prc3.addon`` (the 
 the dynamics, the hinge check).  These closures, derived by hand from the paper's equations,
 were the built-in module ``cpm_nlp.mechanisms.prc3.kinematics`` until issue 21 (item 5) wrote
 the mechanism once, in the file; they stay here as the independent derivation the file is
-checked against (``tests/test_prc3_written_once.py``, to 1e-12).  Not part of the package:
+checked against (``tests/mechanisms/prc3/test_prc3_written_once.py``, to 1e-12).  Not part of the package:
 import it from the tests only.
 
 Symbols follow the paper:

@@ -6,7 +6,7 @@ The package's ``prs3`` is the mechanism file ``problems/mechanisms/prs3.yaml`` (
 closures generated from the legs).  These closures, derived by hand from the paper's
 equations, were the built-in module ``cpm_nlp.mechanisms.prs3`` until issue 21 (item 5)
 wrote the mechanism once, in the file; they stay here as the independent derivation the
-file is checked against (``tests/test_prs3_written_once.py``, to 1e-12).  Not part of the
+file is checked against (``tests/mechanisms/prs3/test_prs3_written_once.py``, to 1e-12).  Not part of the
 package: import it from the tests only.
 
 Symbols follow the paper:

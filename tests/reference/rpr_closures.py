@@ -8,7 +8,7 @@ generated from the legs, its passive joints and closed-form IK written in it) wi
 closures, derived by hand from the paper's eq 2-13, were the built-in module
 ``cpm_nlp.mechanisms.rpr.kinematics`` until issue 21 (item 5) wrote the mechanism once, in the
 file; they stay here as the independent derivation the file is checked against
-(``tests/test_rpr_written_once.py``, to 1e-12).  Not part of the package: import it from the
+(``tests/mechanisms/rpr/test_rpr_written_once.py``, to 1e-12).  Not part of the package: import it from the
 tests only.  The screw theory of eq 7-13 (an analysis, not the closures) is the add-on's
 :mod:`cpm_nlp.mechanisms.rpr.screws`.
 

@@ -42,7 +42,7 @@ set when the strokes are the binding limits:
 
 from __future__ import annotations
 
-from ...core.kernels import SINGULAR_CONDITION
+from ...core.pose_checks import SINGULAR_CONDITION
 from .box import WorkspaceReport, box_corners, box_grid, gauss_box, joint_box, reachable_workspace
 from .cuboid import (
     ADDED_PER_ROUND,

@@ -10,6 +10,7 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -428,7 +429,113 @@ def cuboid_formulation(formulation: str | CuboidFormulation) -> CuboidFormulatio
     return FORMULATIONS[formulation]
 
 
-def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
+def _seeds(
+    model: Model, config: SolverConfig, region: tuple, starts: int, seed: int, cloud: int
+) -> tuple[list, Membership]:
+    """The start points (home where it is inside, then points of a seeded cloud of the
+    region that are inside), and the cloud's membership."""
+    lo_r, hi_r = region
+    rng = np.random.default_rng(seed)
+    home_t = model.task_of(model.x_home)
+    T = lo_r + (hi_r - lo_r) * rng.random((cloud, lo_r.size))
+    cloud_mem = membership(model, T, config)
+    members = T[cloud_mem.inside]
+    seeds = []
+    if membership(model, home_t[None, :], config).inside[0]:
+        seeds.append(home_t)
+    seeds += list(members[rng.permutation(len(members))[: max(starts - len(seeds), 0)]])
+    return seeds[:starts], cloud_mem
+
+
+def _run_starts(engine: Any, boxes: list) -> tuple[list, int]:
+    """Each start's NLP solve (converged, z, status, iterations), and the iterations summed:
+    the first start alone, the others together where the engine can (one block-separable
+    NLP, see cuboid_ik.SlotNLP), else, or if that fails, one by one."""
+    runs: list = [(False, None, "no pose at the start", 0) if box is None else None for box in boxes]
+    pending = [k for k, box in enumerate(boxes) if box is not None]
+    iterations = 0
+    joint = None
+    if len(pending) > 2 and hasattr(engine, "start_all"):
+        k0 = pending.pop(0)
+        runs[k0] = engine.start(*boxes[k0])
+        iterations += runs[k0][3]
+        joint, iters = engine.start_all([boxes[k][:2] for k in pending])
+        iterations += iters
+    if joint is not None:
+        for k, run in zip(pending, joint):
+            runs[k] = run
+        return runs, iterations
+    for k in track(pending, "cuboid starts"):
+        runs[k] = engine.start(*boxes[k])
+        iterations += runs[k][3]
+    return runs, iterations
+
+
+def _exchange_rounds(
+    model: Model,
+    engine: Any,
+    z: np.ndarray,
+    frame: tuple,
+    check_per_edge: int | None,
+    config: SolverConfig,
+    rounds: int,
+) -> tuple[np.ndarray, CuboidCheck, int, int]:
+    """The exchange method: while the box fails its dense check, its worst outside points
+    join the NLP's samples and it is solved again (at most ``rounds`` rounds and
+    :data:`EXTRA_SLOTS` points); the last solution, its check, the rounds and iterations."""
+    centre, size = frame
+    d = model.closure.nq
+
+    def checked(z: np.ndarray) -> tuple:
+        lower = centre + size * z[:d]
+        return check_box(model, lower, lower + size * z[d : 2 * d], check_per_edge, config)
+
+    check, S_check, mem = checked(z)
+    done = iterations = 0
+    room = EXTRA_SLOTS
+    while not check.passed and done < rounds and room > 0:
+        out = np.flatnonzero(~mem.inside)
+        worst = out[np.argsort(mem.margin[out])][: min(ADDED_PER_ROUND, room)]
+        room -= len(worst)
+        z_new, ok, status, iters = engine.exchange(z, S_check[worst])
+        iterations += iters
+        done += 1
+        if not ok:
+            log.info("exchange round %d did not converge (%s)", done, status)
+            break
+        z = z_new
+        check, S_check, mem = checked(z)
+    return z, check, done, iterations
+
+
+def shrink_to_pass(
+    model: Model,
+    lower,
+    upper,
+    check_per_edge: int | None,
+    config: SolverConfig,
+    check: CuboidCheck | None = None,
+    steps: int = 30,
+) -> tuple[np.ndarray, np.ndarray, float, CuboidCheck]:
+    """The box shrunk about its centre by the largest factor (bisection, ``steps`` steps)
+    that passes the membership check, with that factor (1: it passes as it is) and its
+    check (``check``: the box's own, when known)."""
+    check = check if check is not None else check_box(model, lower, upper, check_per_edge, config)[0]
+    if check.passed:
+        return lower, upper, 1.0, check
+    mid, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
+    good, bad = 0.0, 1.0
+    for _ in range(steps):
+        f = 0.5 * (good + bad)
+        if check_box(model, mid - f * half, mid + f * half, check_per_edge, config)[0].passed:
+            good = f
+        else:
+            bad = f
+    lower, upper = mid - good * half, mid + good * half
+    return lower, upper, good, check_box(model, lower, upper, check_per_edge, config)[0]
+
+
+def inscribed_cuboid(
     model: Model,
     solver: SolverConfig | None = None,
     *,
@@ -469,16 +576,7 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
             )
     lo_r, hi_r = (np.asarray(v, dtype=float) for v in region)
     centre, size = 0.5 * (lo_r + hi_r), np.maximum(hi_r - lo_r, 1e-12)
-    rng = np.random.default_rng(seed)
-    home_t = model.task_of(model.x_home)
-    T = lo_r + (hi_r - lo_r) * rng.random((cloud, d))
-    cloud_mem = membership(model, T, config)
-    members = T[cloud_mem.inside]
-    seeds = []
-    if membership(model, home_t[None, :], config).inside[0]:
-        seeds.append(home_t)
-    seeds += list(members[rng.permutation(len(members))[: max(starts - len(seeds), 0)]])
-    seeds = seeds[:starts]
+    seeds, cloud_mem = _seeds(model, config, (lo_r, hi_r), starts, seed, cloud)
     if not seeds:
         return CuboidResult(
             False,
@@ -497,31 +595,8 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
         engine = _closed_form_cuboid(model, config, base, centre, size, cloud_mem)
     else:
         engine = _PoseCuboid(model, config, base, centre, size)
-    runs: list = [None] * len(seeds)
-    iterations = 0
     boxes = _start_boxes(model, seeds, engine.S, centre, size, config)
-    pending = []
-    for k, box in enumerate(boxes):
-        if box is None:
-            runs[k] = (False, None, "no pose at the start", 0)
-        else:
-            pending.append(k)
-    # the first start alone; the others together where the engine can (one block-separable
-    # NLP, see cuboid_ik.SlotNLP), else, or if that fails, one by one
-    joint = None
-    if len(pending) > 2 and hasattr(engine, "start_all"):
-        k0 = pending.pop(0)
-        runs[k0] = engine.start(*boxes[k0])
-        iterations += runs[k0][3]
-        joint, iters = engine.start_all([boxes[k][:2] for k in pending])
-        iterations += iters
-    if joint is not None:
-        for k, run in zip(pending, joint):
-            runs[k] = run
-    else:
-        for k in track(pending, "cuboid starts"):
-            runs[k] = engine.start(*boxes[k])
-            iterations += runs[k][3]
+    runs, iterations = _run_starts(engine, boxes)
     volumes = [float(np.prod(size * r[1][d : 2 * d])) if r[0] else None for r in runs]
     ok_vols = [v for v in volumes if v is not None]
     best, agreed = best_and_agreement([-v if v is not None else None for v in volumes])
@@ -537,38 +612,12 @@ def inscribed_cuboid(  # noqa: C901 - the driver: starts, exchange rounds, check
             infeasible=all("Infeasible" in r[2] for r in runs),
         )
     z = runs[best][1]
+    z, check, rounds, iters = _exchange_rounds(model, engine, z, (centre, size), check_per_edge, config, refinements)
+    iterations += iters
     lower = centre + size * z[:d]
-    upper = lower + size * z[d : 2 * d]
-    check, S_check, mem = check_box(model, lower, upper, check_per_edge, config)
-    rounds = 0
-    room = EXTRA_SLOTS
-    while not check.passed and rounds < refinements and room > 0:
-        out = np.flatnonzero(~mem.inside)
-        worst = out[np.argsort(mem.margin[out])][: min(ADDED_PER_ROUND, room)]
-        room -= len(worst)
-        z_new, ok, status, iters = engine.exchange(z, S_check[worst])
-        iterations += iters
-        rounds += 1
-        if not ok:
-            log.info("exchange round %d did not converge (%s)", rounds, status)
-            break
-        z = z_new
-        lower = centre + size * z[:d]
-        upper = lower + size * z[d : 2 * d]
-        check, S_check, mem = check_box(model, lower, upper, check_per_edge, config)
-    shrink = 1.0
-    if not check.passed:  # largest homothetic shrink about the centre that passes the check
-        mid, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
-        good, bad = 0.0, 1.0
-        for _ in range(30):
-            f = 0.5 * (good + bad)
-            if check_box(model, mid - f * half, mid + f * half, check_per_edge, config)[0].passed:
-                good = f
-            else:
-                bad = f
-        shrink = good
-        lower, upper = mid - shrink * half, mid + shrink * half
-        check = check_box(model, lower, upper, check_per_edge, config)[0]
+    lower, upper, shrink, check = shrink_to_pass(
+        model, lower, lower + size * z[d : 2 * d], check_per_edge, config, check
+    )
     if shrink == 0.0:  # a point, not a box: no shrink about the centre passes (a hole or a boundary there)
         return CuboidResult(
             False,

@@ -11,8 +11,8 @@ import casadi as ca
 import numpy as np
 
 from ...core.batch import evaluate_points
-from ...core.kernels import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
 from ...core.model import LoopClosure, Model
+from ...core.pose_checks import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
 from ...core.solver import SolverConfig
 from .exclusion import prove_outside
 from .point_ik import IPOPT_STARTS, ipopt_solve, newton, reduce_angles, start_set

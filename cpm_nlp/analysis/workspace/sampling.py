@@ -24,7 +24,57 @@ PROBE_BISECTIONS = 40
 PROBE_LEVELS = 4
 
 
-def probe_region(  # noqa: C901 - one loop of probe rounds with its stop rules
+def _double(model: Model, solver: SolverConfig | None, t0: np.ndarray, dirs: np.ndarray) -> tuple:
+    """Along each direction, the last doubling step inside and the first outside (1e4 where
+    none is): every step of the doubling tested in one call where :data:`PROBE_LEVELS` > 1."""
+    d = t0.size
+    inside_step = np.zeros(len(dirs))
+    outside_step = np.full(len(dirs), np.nan)
+    steps = [1e-9]
+    while steps[-1] * 2 < 1e4:
+        steps.append(steps[-1] * 2)
+    block = len(steps) if PROBE_LEVELS > 1 else 1
+    for first in range(0, len(steps), block):
+        todo = np.flatnonzero(np.isnan(outside_step))
+        if not todo.size:
+            break
+        s = np.array(steps[first : first + block])
+        pts = t0 + s[None, :, None] * dirs[todo][:, None, :]
+        inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(todo.size, s.size)
+        for row, k in enumerate(todo):
+            out = np.flatnonzero(~inside[row])
+            # the step before the first outside one is inside (none before the first step)
+            last_in = s[-1] if not out.size else (s[out[0] - 1] if out[0] > 0 else inside_step[k])
+            inside_step[k] = last_in
+            outside_step[k] = s[out[0]] if out.size else outside_step[k]
+    return inside_step, np.where(np.isnan(outside_step), 1e4, outside_step)
+
+
+def _bisect_levels(model, solver, t0, dirs, inside_step, outside_step, k: int) -> tuple:
+    """``k`` levels of bisection along every direction in one membership call: the 2^k - 1
+    midpoints those levels could visit, then the path each direction takes through them."""
+    d = t0.size
+    cols = np.arange(len(dirs))
+    nodes = 2**k - 1  # a binary tree: node i has children 2i + 1 (outside) and 2i + 2 (inside)
+    low, high, mid = (np.empty((nodes, len(dirs))) for _ in range(3))
+    low[0], high[0] = inside_step, outside_step
+    for i in range(nodes):
+        mid[i] = 0.5 * (low[i] + high[i])
+        if 2 * i + 2 < nodes:
+            low[2 * i + 1], high[2 * i + 1] = low[i], mid[i]
+            low[2 * i + 2], high[2 * i + 2] = mid[i], high[i]
+    pts = t0 + mid[:, :, None] * dirs[None, :, :]
+    inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(nodes, len(dirs))
+    node = np.zeros(len(dirs), dtype=int)
+    for _ in range(k):
+        ins, m = inside[node, cols], mid[node, cols]
+        inside_step = np.where(ins, m, inside_step)
+        outside_step = np.where(ins, outside_step, m)
+        node = np.where(ins, 2 * node + 2, 2 * node + 1)
+    return inside_step, outside_step
+
+
+def probe_region(
     model: Model, solver: SolverConfig | None = None, centre=None, factor: float = 2.0
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """A box around ``centre`` (default: the home pose) in the task coordinates:
@@ -40,50 +90,12 @@ def probe_region(  # noqa: C901 - one loop of probe rounds with its stop rules
     d = t0.size
     if not membership(model, t0[None, :], solver).inside[0]:
         return None
-    levels = PROBE_LEVELS
     dirs = np.vstack([np.eye(d), -np.eye(d)])
-    cols = np.arange(2 * d)
-    inside_step = np.zeros(2 * d)
-    outside_step = np.full(2 * d, np.nan)
-    steps = [1e-9]
-    while steps[-1] * 2 < 1e4:
-        steps.append(steps[-1] * 2)
-    block = len(steps) if levels > 1 else 1
-    for first in range(0, len(steps), block):  # doubling
-        todo = np.flatnonzero(np.isnan(outside_step))
-        if not todo.size:
-            break
-        s = np.array(steps[first : first + block])
-        pts = t0 + s[None, :, None] * dirs[todo][:, None, :]
-        inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(todo.size, s.size)
-        for row, k in enumerate(todo):
-            out = np.flatnonzero(~inside[row])
-            if out.size:
-                outside_step[k] = s[out[0]]
-                if out[0] > 0:
-                    inside_step[k] = s[out[0] - 1]
-            else:
-                inside_step[k] = s[-1]
-    outside_step = np.where(np.isnan(outside_step), 1e4, outside_step)
+    inside_step, outside_step = _double(model, solver, t0, dirs)
     done = 0
     while done < PROBE_BISECTIONS:  # bisection, k levels per call
-        k = min(levels, PROBE_BISECTIONS - done)
-        nodes = 2**k - 1  # a binary tree: node i has children 2i + 1 (outside) and 2i + 2 (inside)
-        low, high, mid = (np.empty((nodes, 2 * d)) for _ in range(3))
-        low[0], high[0] = inside_step, outside_step
-        for i in range(nodes):
-            mid[i] = 0.5 * (low[i] + high[i])
-            if 2 * i + 2 < nodes:
-                low[2 * i + 1], high[2 * i + 1] = low[i], mid[i]
-                low[2 * i + 2], high[2 * i + 2] = mid[i], high[i]
-        pts = t0 + mid[:, :, None] * dirs[None, :, :]
-        inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(nodes, 2 * d)
-        node = np.zeros(2 * d, dtype=int)
-        for _ in range(k):
-            ins, m = inside[node, cols], mid[node, cols]
-            inside_step = np.where(ins, m, inside_step)
-            outside_step = np.where(ins, outside_step, m)
-            node = np.where(ins, 2 * node + 2, 2 * node + 1)
+        k = min(PROBE_LEVELS, PROBE_BISECTIONS - done)
+        inside_step, outside_step = _bisect_levels(model, solver, t0, dirs, inside_step, outside_step, k)
         done += k
     plus, minus = inside_step[:d], inside_step[d:]
     span = np.maximum(plus + minus, 1e-12)

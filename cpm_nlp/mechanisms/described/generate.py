@@ -571,7 +571,7 @@ class Generator:
                 # the usual P normal to the R: e·vp is e·v).  Same branch decisions as e·vp on the
                 # turned axes, whose e·w was a rounded 0 (|e·w| <= 1e-16): the two differ by at most
                 # |v·w| 1e-16 plus rounding, so their signs agree wherever |e·v| exceeds that
-                # (tests/test_generated_lean.py: 900 legs, 600 within 1e-14..1e-3 L of e·v = 0)
+                # (tests/mechanisms/described/test_generated_lean.py: 900 legs, 600 within 1e-14..1e-3 L of e·v = 0)
                 working = ca.dot(rate, v)
                 if along is not None:
                     e_l, w_l = b.local.get("axis"), elim.local.get("axis")

@@ -49,10 +49,10 @@ from ...core.errors import InputError
 from ...core.model import Model
 from ...core.multistart import AGREEMENT, best_and_agreement, start_options, uniform_starts
 from ...core.options import Option
+from ...core.outputs import Output, declared_result, outputs_of
 from ...core.result import Result, SolverInfo, Status
 from ...core.schema import Record
 from ...core.solver import SolverConfig
-from ...core.units import si_unit
 from ...kinds.synthesis import SynthesisFormulation
 from . import analysis as P
 
@@ -239,8 +239,8 @@ class PantographSynthesis(SynthesisFormulation):
             )
         _material(inputs, path)
 
-    def output_names(self, model: Model) -> list[str]:
-        return list(OUTPUT_DIMS)
+    def outputs(self, model: Model) -> list[Output]:
+        return outputs_of(OUTPUT_DIMS, named=False)
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         t0 = time.perf_counter()
@@ -371,17 +371,14 @@ class PantographSynthesis(SynthesisFormulation):
 
     def _result(self, status, values, message, iterations, t0, model, material) -> Result:
         dims = {k: OUTPUT_DIMS.get(k, "dimensionless") for k in values}
-        units = {k: si_unit(v) for k, v in dims.items()}
-        return Result(
+        return declared_result(
             "synthesis",
             status,
+            outputs_of(dims, named=False),
             values,
-            units,
-            dims,
-            SolverInfo("ipopt", iterations, time.perf_counter() - t0),
-            message,
-            None,
-            {"type": model.name, "E": material[0], "sigma_all": material[1]},
+            solver=SolverInfo("ipopt", iterations, time.perf_counter() - t0),
+            message=message,
+            model={"type": model.name, "E": material[0], "sigma_all": material[1]},
         )
 
 

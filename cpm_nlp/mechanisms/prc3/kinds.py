@@ -9,6 +9,7 @@ from typing import Any
 from ...core.kind import ProblemKind, actuator_options, broadcast, check_actuator_limits, given
 from ...core.model import Model
 from ...core.options import Option
+from ...core.outputs import Output
 from ...core.result import Result
 from ...core.solver import SolverConfig
 from ...kinds.analysis import closed_form_result
@@ -35,18 +36,27 @@ class Amplifier(ProblemKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         A2 = model.derived["A2"]
         values: dict[str, Any] = {"A1": model.derived["A1"], "A2": A2}
-        dims = {"A1": "dimensionless", "A2": "dimensionless"}
         for k, name in enumerate(model.closure.q_names):
             q = inputs.get(name)
             if q is None:
                 continue
             values[name] = q
             values[f"d{k + 1}"] = [A2 * v for v in q] if isinstance(q, list) else A2 * q  # eq 2
-            dims[name] = dims[f"d{k + 1}"] = "length"
+        declared = {o.name: o for o in self.outputs(model)}
         return closed_form_result(
-            self.name, model, values, dims, message="A1 = L2/L1, A2 = L2 L4/(L1 L3) (eq 1); d = A2 q"
+            self.name,
+            model,
+            values,
+            [declared[n] for n in values],
+            message="A1 = L2/L1, A2 = L2 L4/(L1 L3) (eq 1); d = A2 q",
         )
 
-    def output_names(self, model: Model) -> list[str]:
-        n = len(model.closure.q_names)
-        return ["A1", "A2"] + model.closure.q_names + [f"d{k + 1}" for k in range(n)]
+    def outputs(self, model: Model) -> list[Output]:
+        """The ratios (eq 1), the actuator inputs and the outputs d = A2 q (eq 2), lengths."""
+        q = model.closure.q_names
+        return [
+            Output("A1", "dimensionless"),
+            Output("A2", "dimensionless"),
+            *(Output(n, "length") for n in q),
+            *(Output(f"d{k + 1}", "length") for k in range(len(q))),
+        ]

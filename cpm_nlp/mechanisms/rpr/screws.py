@@ -8,7 +8,7 @@ These are analyses of the paper, beside the mechanism's kinematics, which is its
 bases are written in the paper's own points: A_i (eq 5), B_i = R B_i' + o' (eq 3-4),
 R = Ry(theta) Rx(alpha) (eq 2), o' = (P sin theta, 0, P cos theta); the screw-theory
 Jacobian they give is checked against the AD Jacobian of the file's closures (the kind
-``rpr_screw_jacobian`` reports the difference, ``dJ``; tests/test_rpr_kinematics.py).
+``rpr_screw_jacobian`` reports the difference, ``dJ``; tests/mechanisms/rpr/test_rpr_kinematics.py).
 
 Symbols follow the paper: pose x = (theta, alpha, P), actuators q = (l1, l2, l3) (eq 6),
 parameters p = (r1, r2, P0); legs 1 and 3 are RPU (R at A_i about y, U at B_i about y then

@@ -1,0 +1,158 @@
+"""Embedding API: the model's CasADi Functions in the user's own CasADi code,
+and the compiled batch backend."""
+
+import importlib.util
+import math
+import threading
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import cpm_nlp as cn
+from cpm_nlp.core.compiled import compiler_available
+from cpm_nlp.core.result import Status
+from tests.conftest import PAPER_PRS3, PROBLEMS, ROOT
+from tests.mechanisms.prs3.test_prs3_kinematics import central_difference
+
+NEWTON = cn.SolverConfig(method="newton")
+
+
+@pytest.fixture(scope="module")
+def fns(prs3):
+    return cn.functions(prs3)
+
+
+def test_functions_are_named_with_parameters_built_in(fns, prs3):
+    assert fns.phi.name() == "prs3_phi" and fns.phi.name_in() == ["x", "q"] and fns.phi.name_out() == ["phi"]
+    assert fns.fk.name_in() == ["q", "x0"] and fns.fk.name_out()[0] == "x" and fns.fk.name_out()[-1] == "status"
+    assert fns.ik.name_in() == ["t"] and fns.ik.name_out()[:3] == ["x", "q", "passive"]
+    assert fns.jacobian.name_out() == ["J", "J_inv", "Phi_x", "Phi_q"]
+    np.testing.assert_array_equal(
+        np.asarray(fns.phi(prs3.x_home, prs3.q_home)).ravel(), cn.residual(prs3, prs3.x_home, prs3.q_home)
+    )
+
+
+def test_functions_from_a_problem_file():
+    fns = cn.functions(PROBLEMS / "prs3_forward_kinematics.yaml")
+    assert fns.model.limits["s"] == pytest.approx((-3e-3, 3e-3))
+    out = fns.fk(q=[4e-3, 0, 0], x0=fns.x_home)  # beyond the file's stroke
+    assert cn.status_of(out["status"]) is Status.OUTSIDE_JOINT_LIMITS
+    with pytest.raises(cn.InputError, match="expected a Model or the path of a problem file"):
+        cn.functions(42)
+
+
+def test_fk_derivatives_are_exact(fns, prs3):
+    """AD through the embedded FK (implicit function theorem) equals the model
+    Jacobian J = -Φ_x⁻¹Φ_q and central differences."""
+    q = ca.MX.sym("q", 3)
+    x = fns.fk(q=q, x0=fns.x_home)["x"]
+    dxdq = ca.Function("dxdq", [q], [ca.jacobian(x, q)])
+    q0 = np.array([1e-3, -0.5e-3, 0.8e-3])
+    ad = np.asarray(dxdq(q0))
+    sol = cn.forward_kinematics(prs3, q0, NEWTON)
+    np.testing.assert_allclose(ad, cn.jacobians(prs3, sol.x, sol.q).J, rtol=1e-10, atol=1e-14)
+    fd = central_difference(lambda qq: np.asarray(fns.fk(q=qq, x0=fns.x_home)["x"]).ravel(), q0, 1e-7)
+    np.testing.assert_allclose(ad, fd, atol=1e-6 * np.max(np.abs(ad)))
+
+
+def test_functions_from_several_threads(fns):
+    rng = np.random.default_rng(31)
+    qs = rng.uniform(-2e-3, 2e-3, (40, 3))
+    serial = [np.asarray(fns.fk(q=q, x0=fns.x_home)["x"]).ravel() for q in qs]
+    results = [None] * len(qs)
+
+    def work(lo):
+        for k in range(lo, len(qs), 4):
+            results[k] = np.asarray(fns.fk(q=qs[k], x0=fns.x_home)["x"]).ravel()
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for a, b in zip(results, serial):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_library_prints_nothing(capfd, prs3):
+    cn.forward_kinematics(prs3, [1e-3, 0, 0])
+    cn.forward_kinematics(prs3, [1e-3, 0, 0], NEWTON)
+    cn.batch_forward_kinematics(prs3, [[1e-3, 0, 0]] * 10)
+    cn.functions(prs3).fk(q=[0, 0, 0], x0=prs3.x_home)
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_example_uses_the_fk_in_its_own_optimization():
+    """examples/prs3_fk_in_nlp.py: the largest tilt psi at dz = +2 mm within the
+    Fig. 6-7 joint ranges; the optimum is a pose the toolkit confirms."""
+    spec = importlib.util.spec_from_file_location("prs3_fk_in_nlp", ROOT / "examples" / "prs3_fk_in_nlp.py")
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    r = example.solve()
+    assert r["success"] and r["status"] is Status.SOLVED
+    assert max(abs(r["beta_m"])) == pytest.approx(math.radians(1.9), rel=1e-6)  # the active constraint
+    assert r["psi"] > math.radians(0.2)  # more than the paper's requirement (section 4)
+    np.testing.assert_allclose(r["ik_q"], r["q"], atol=1e-12)
+
+
+# -- compiled backend ----------------------------------------------------------------------
+
+
+@pytest.fixture
+def compiled_cache(tmp_path, monkeypatch):
+    """A fresh cache for this test (the session's may hold libraries already)."""
+    monkeypatch.setenv("CPM_NLP_CACHE", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+@pytest.mark.skipif(not compiler_available(), reason="no C compiler")
+def test_compiled_backend_equals_map(compiled_cache):
+    model = cn.build_model("prs3", PAPER_PRS3, {"s": ["-2 mm", "2 mm"]})
+    rng = np.random.default_rng(32)
+    q = rng.uniform(-2.2e-3, 2.2e-3, (3000, 3))
+    q[::100] = [0.3, -0.3, 0.0]
+    a = cn.batch_forward_kinematics(model, q, backend="map")
+    b = cn.batch_forward_kinematics(model, q, backend="compiled")
+    assert b.backend == "compiled" and a.backend == "map"
+    np.testing.assert_array_equal(a.status, b.status)
+    np.testing.assert_allclose(b.x, a.x, rtol=1e-12, atol=1e-18)
+    for k in ("residual", "round_trip_error", "limit_margin"):
+        np.testing.assert_allclose(b.checks[k], a.checks[k], rtol=1e-12, atol=1e-18)
+    t = np.column_stack([model.derived["pz0"] + q[:, 0], q[:, 1], q[:, 2]])
+    ia = cn.batch_inverse_kinematics(model, t, backend="map")
+    ib = cn.batch_inverse_kinematics(model, t, backend="compiled")
+    np.testing.assert_array_equal(ia.status, ib.status)
+    np.testing.assert_allclose(ib.q, ia.q, rtol=1e-12, atol=1e-18)
+    ja = cn.batch_jacobians(model, ia.x[ia.ok], ia.q[ia.ok], backend="map")
+    jb = cn.batch_jacobians(model, ia.x[ia.ok], ia.q[ia.ok], backend="compiled")
+    np.testing.assert_allclose(jb.J, ja.J, rtol=1e-12, atol=1e-18)
+    # the library is cached by content hash: a second model of the type reuses it
+    libs = sorted(Path(compiled_cache).glob("compiled/*/*.so"))
+    assert sorted(p.name for p in libs) == ["prs3_fk.so", "prs3_ik.so", "prs3_jacobian.so"]
+    other = cn.build_model("prs3", {"b": "40 mm", "L": "100 mm"})
+    assert cn.batch_forward_kinematics(other, q[1:11], backend="compiled").ok.all()
+    assert sorted(Path(compiled_cache).glob("compiled/*/*.so")) == libs
+
+
+def test_a_slow_build_does_not_block_other_entries():
+    """A C compilation in one thread must not stall single solves in others."""
+    from cpm_nlp.core.solver import SolverCache
+
+    cache = SolverCache()
+    started, release = threading.Event(), threading.Event()
+
+    def slow():
+        started.set()
+        release.wait(5)
+        return "slow"
+
+    builder = threading.Thread(target=lambda: cache.memo(("a",), slow))
+    builder.start()
+    assert started.wait(5)
+    assert cache.memo(("b",), lambda: "fast") == "fast"  # returned while "a" is still building
+    release.set()
+    builder.join()
+    assert cache.memo(("a",), lambda: "again") == "slow"
