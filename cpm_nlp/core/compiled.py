@@ -39,7 +39,7 @@ from .model import LoopClosure
 log = logging.getLogger(__name__)
 
 #: flags of the compiled batch path (the export uses the plain -O2 the README shows)
-CFLAGS = ("-O3", "-fPIC", "-shared")
+CFLAGS = ("-O3", "-ffp-contract=off", "-fPIC", "-shared")
 
 
 class CompilerError(CpmError):
