@@ -118,9 +118,10 @@ def test_compiled_backend_equals_map(compiled_cache):
     b = cn.batch_forward_kinematics(model, q, backend="compiled")
     assert b.backend == "compiled" and a.backend == "map"
     np.testing.assert_array_equal(a.status, b.status)
-    np.testing.assert_allclose(b.x, a.x, rtol=1e-12, atol=1e-18)
-    for k in ("residual", "round_trip_error", "limit_margin"):
-        np.testing.assert_allclose(b.checks[k], a.checks[k], rtol=1e-12, atol=1e-18)
+    # the same bits: the C is built without floating-point contraction (compiled.CFLAGS)
+    np.testing.assert_array_equal(b.x, a.x)
+    for k in ("residual", "round_trip_error", "cond1", "limit_margin"):
+        np.testing.assert_array_equal(b.checks[k], a.checks[k])
     t = np.column_stack([model.derived["pz0"] + q[:, 0], q[:, 1], q[:, 2]])
     ia = cn.batch_inverse_kinematics(model, t, backend="map")
     ib = cn.batch_inverse_kinematics(model, t, backend="compiled")
