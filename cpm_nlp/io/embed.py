@@ -29,8 +29,9 @@ go straight to the kernel (:class:`KernelFunction`): the compiled C through
 ctypes where a C compiler is available (built once per machine, as
 ``backend="auto"`` of the solvers), else a CasADi FunctionBuffer, with the
 buffers allocated once per thread -- the same numbers, to the bit, as CasADi's
-own call, returned as numpy (a column vector 1-D, a 1 x 1 output a float64, a
-matrix 2-D).  Called on CasADi types (MX, SX, DM) they are CasADi's own call.
+own call, returned as numpy arrays of the shapes ``np.asarray`` gives the DMs
+((n, 1) for a column vector), a 1 x 1 output as a float64.  Called on CasADi
+types (MX, SX, DM) they are CasADi's own call.
 """
 
 from __future__ import annotations
@@ -92,9 +93,10 @@ class KernelFunction(ca.Function):
     CasADi's virtual machine), one set of buffers per thread.  The numbers are those of
     CasADi's own call to the bit (the compiled C is built without floating-point contraction,
     ``tests/io/test_embed.py`` compares them on many poses and threads); they come back as
-    numpy arrays (copies): a column vector 1-D, a 1 x 1 output a float64, a matrix 2-D
-    (column-major values, as ``np.asarray`` of the DM).  Anything else -- an MX, SX or DM
-    argument, a mixed call, a size CasADi would have to interpret -- is CasADi's own call.
+    numpy arrays (copies) of the shape ``np.asarray`` gives the DM ((n, 1) for a column
+    vector), a 1 x 1 output as a float64 (``int()`` and ``float()`` work as on the DM).
+    Anything else -- an MX, SX or DM argument, a mixed call, a size CasADi would have to
+    interpret -- is CasADi's own call.
     Unpickled, it is a plain :class:`casadi.Function`.
     """
 
@@ -168,10 +170,10 @@ class KernelFunction(ca.Function):
         res = []
         for k, (rows, cols) in zip(self._pick, self._shapes):
             out = outs[k]
-            if cols == 1:
-                res.append(out[0] if rows == 1 else out.copy())
+            if rows == cols == 1:
+                res.append(out[0])  # a float64: int() and float() work as on a 1 x 1 DM
             else:
-                res.append(out.reshape((rows, cols), order="F").copy())
+                res.append(out.reshape((rows, cols), order="F").copy())  # np.asarray(DM)'s shape
         if kwargs or not args:
             return dict(zip(self._names_out, res))
         return res[0] if len(res) == 1 else tuple(res)
