@@ -397,13 +397,6 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
     return closure.solvers.memo(key, build)
 
 
-#: Newton steps of the reduced FK's second try, taken only where the first
-#: :data:`REDUCED_STEPS` did not converge (a CasADi Switch: no cost elsewhere): the number of
-#: steps adapts to the pose.  On the shipped five-bar at +-0.25 rad about home, 8.3 % of the
-#: poses needed a fourth step (benchmarks/bench_batch_speed.py); 8 leaves room for larger moves
-REDUCED_STEPS_MORE = 8
-
-
 def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
     """``<name>_fk: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) ->
     (x, passive, residual, branch_margin, round_trip_error, cond1,
@@ -412,8 +405,9 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
 
     Mechanisms with a closed-form IK: first :func:`reduced_fk_kernel` with
     :data:`REDUCED_STEPS` steps (nq unknowns); where Newton did not converge in
-    them, the reduced kernel again from x0 with :data:`REDUCED_STEPS_MORE` steps
-    (the steps adapt to the pose); a pose neither settles as ``solved`` -- Newton
+    them, the same kernel again from the pose they reached (the guess about it and
+    :data:`REDUCED_STEPS` more steps: the number of steps adapts to the pose, and the
+    C code has the kernel once); a pose neither settles as ``solved`` -- Newton
     did not converge, a check failed, or the conditioning bound is not certified --
     goes to :func:`full_fk_kernel` from x0 (each branch evaluated only where taken:
     CasADi Switches), so every status other than ``solved`` comes from the full
@@ -428,7 +422,6 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
 
     def build() -> Kernel:
         reduced = reduced_fk_kernel(c, config).function
-        more = reduced_fk_kernel(c, config, REDUCED_STEPS_MORE).function
         full = full_fk_kernel(c, config).function
         names = ("x", "passive", *_STATUS_OUTPUTS)
         # outputs: (x, passive, checks..., path, status): status stays last
@@ -448,8 +441,9 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         keep = answer("keep", r_in, 0)
         f = list(full(*ins[:6]))
         fallback = answer("fallback", f, 1)
-        # the second try: more reduced steps from x0; what they do not settle, the full path decides
-        m = list(more(*ins))
+        # the second try: the reduced kernel from the pose the first reached (a non-finite one
+        # settles nothing); what it does not settle, the full path decides from x0
+        m = list(reduced(ins[0], r_in[0], *ins[2:]))
         more_keep = answer("more_keep", m, 0)
         more_switch = ca.Function.if_else(f"{c.name}_fk_more_switch", more_keep, fallback)
         retry = ca.Function(f"{c.name}_fk_retry", ins + r_in, more_switch(m[-1] == solved, *ins, *r_in), *io)

@@ -44,7 +44,7 @@ import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError, suggest
-from ..core.kernels import FK_OUTPUTS, REDUCED_STEPS, REDUCED_STEPS_MORE, Kernel, bake, kernel, newton_options
+from ..core.kernels import FK_OUTPUTS, REDUCED_STEPS, Kernel, bake, kernel, newton_options
 from ..core.model import Coordinate, Model
 from ..core.pose_checks import ROUND_TRIP_FACTOR, SINGULAR_CONDITION, STATUSES, limit_vectors, limited_coordinates
 from ..core.result import STATUS_TEXT
@@ -330,7 +330,7 @@ def manifest(
                 if c.ik is None
                 else f"; first {REDUCED_STEPS} Newton steps on the task coordinates through the closed-form IK, "
                 "from the first-order guess t0 = x0[task] + J_home (q - q_ik(x0[task])) (J_home = dt/dq at home), "
-                f"{REDUCED_STEPS_MORE} from the same guess where {REDUCED_STEPS} did not converge, "
+                f"where they do not converge, the guess about the pose they reached and {REDUCED_STEPS} more, "
                 "falling back to fast_newton on Φ from x0 where they do not settle the pose"
             ),
         },

@@ -528,8 +528,8 @@ def test_pantograph_file_workspace_near_full_reach_agrees_with_the_module():
 
 def test_reduced_steps_adapt_so_few_five_bar_poses_fall_back():
     """Issue 23 (item 4): on the five-bar at +-0.25 rad about home (5000 seeded poses) the
-    3-step reduced Newton leaves more than 5 % unsettled; with the second try of
-    REDUCED_STEPS_MORE steps where the first did not converge, fewer than 5 % go to the full
+    3-step reduced Newton leaves more than 5 % unsettled; with the second try where the first
+    did not converge (the reduced kernel again from the pose it reached), fewer than 5 % go to the full
     Newton (a count, not a timing).  Statuses stay the full path's, the poses the full path's
     and the IK's, and a pose out of reach is still not_converged, answered by the full path."""
     model = cn.build_model("five_bar")
