@@ -272,3 +272,18 @@ def test_direct_fk_keeps_casadi_semantics(fns, prs3):
     assert type(plain) is ca.Function and plain.name_out() == fns.fk.name_out()
     with pytest.raises(cn.InputError, match="unknown backend 'compile'"):
         cn.functions(prs3, backend="compile")
+
+
+def test_direct_fk_without_a_working_compiler_uses_the_virtual_machine(tmp_path, monkeypatch, caplog):
+    """backend "auto" and a compiler that fails: the call on numbers still answers, through a
+    FunctionBuffer, with the same numbers (a warning says so)."""
+    monkeypatch.setenv("CPM_NLP_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("CC", "false")  # a "compiler" that always fails
+    model = cn.build_model("prs3", PAPER_PRS3)
+    fns = cn.functions(model)
+    q = np.array([1e-3, 0.5e-3, -0.3e-3])
+    with caplog.at_level("WARNING", logger="cpm_nlp"):
+        out = fns.fk(q, model.x_home)
+    assert fns.fk.backend_used == "map" and "backend 'auto' uses 'map'" in caplog.text
+    for got, want in zip(out, _casadi_call(fns.fk, q, model.x_home)):
+        np.testing.assert_array_equal(_as_casadi_shape(got, want.shape), want)
