@@ -36,7 +36,9 @@ types (MX, SX, DM) they are CasADi's own call.
 
 from __future__ import annotations
 
+import functools
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -108,11 +110,13 @@ class KernelFunction(ca.Function):
         self._nnz_in = tuple(baked.nnz_in(i) for i in range(baked.n_in()))
         self._defaults = tuple(np.full(n, baked.default_in(i)) for i, n in enumerate(self._nnz_in))
         self._pick = tuple(kern.outputs.index(n) for n in self._names_out)
-        self._shapes = tuple(baked.size_out(i) for i in range(baked.n_out()))
+        shapes = [baked.size_out(i) for i in range(baked.n_out())]
+        self._out = tuple((k, None if shape == (1, 1) else shape) for k, shape in zip(self._pick, shapes))
         dense = [kern.function.sparsity_in(i).is_dense() for i in range(kern.function.n_in())]
         dense += [kern.function.sparsity_out(k).is_dense() for k in self._pick]
         self._direct_ok = all(dense)  # the buffers hold dense values only
         self._lock = threading.Lock()
+        self._local = threading.local()
         self._bound: BoundCall | BoundNative | None = None
         self.backend_used = ""  # "compiled" or "map", once a call on numbers has bound the kernel
 
@@ -136,6 +140,25 @@ class KernelFunction(ca.Function):
                     self.backend_used = used
                 bound = self._bound
         return bound
+
+    def _thread_state(self) -> tuple[list[np.ndarray], list[np.ndarray], Callable[[], int]]:
+        """This thread's (pose input buffers, output buffers, evaluate -> nonzero on failure)."""
+        state = getattr(self._local, "state", None)
+        if state is None:
+            bound = self._direct()
+            buffers = bound.buffers()  # this thread's buffers, bound to the kernel once
+            if isinstance(bound, BoundNative):
+                run: Callable[[], int] = functools.partial(bound.loop.call, *buffers[0])
+            else:
+                buf, evaluate = buffers[0], buffers[1]
+
+                def run() -> int:
+                    evaluate()
+                    return buf.ret()
+
+            # the buffers last: kept alive with the raw addresses the ctypes arguments hold
+            state = self._local.state = (buffers[2], buffers[3], run, buffers)
+        return state[:3]
 
     def _numbers(self, args: tuple, kwargs: dict) -> list[np.ndarray] | None:
         """The per-pose inputs as flat float arrays, or None where CasADi's call must decide."""
@@ -166,14 +189,14 @@ class KernelFunction(ca.Function):
         values = self._numbers(args, kwargs)
         if values is None:
             return super().__call__(*args, **kwargs)
-        outs = self._direct()(*values)
-        res = []
-        for k, (rows, cols) in zip(self._pick, self._shapes):
-            out = outs[k]
-            if rows == cols == 1:
-                res.append(out[0])  # a float64: int() and float() work as on a 1 x 1 DM
-            else:
-                res.append(out.reshape((rows, cols), order="F").copy())  # np.asarray(DM)'s shape
+        pose, outs, run = self._thread_state()
+        for buffer, value in zip(pose, values):
+            buffer[:] = value
+        if run():
+            raise RuntimeError(f"evaluation of {self.name()} failed")
+        # a 1 x 1 output as a float64 (int() and float() work as on a 1 x 1 DM), others a copy in
+        # the shape np.asarray gives the DM
+        res = [outs[k][0] if shape is None else outs[k].reshape(shape, order="F").copy() for k, shape in self._out]
         if kwargs or not args:
             return dict(zip(self._names_out, res))
         return res[0] if len(res) == 1 else tuple(res)
