@@ -123,3 +123,20 @@ def test_peer_benchmark_without_peers(tmp_path, capsys, monkeypatch):
     assert peers["pylinkage"] == {"skipped": "pylinkage is not installed"}
     printed = capsys.readouterr().out
     assert "pin (Pinocchio) is not installed" in printed and "pylinkage is not installed" in printed
+
+
+def test_batch_speed_benchmark_smoke(tmp_path, capsys):
+    """benchmarks/bench_batch_speed.py runs end to end (small sizes; no timing is asserted, only
+    the same bits before and after the flags, and the five-bar fallback share, a count)."""
+    spec = importlib.util.spec_from_file_location("bench_batch_speed", ROOT / "benchmarks" / "bench_batch_speed.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = tmp_path / "bench_batch_speed.json"
+    assert bench.main(["--quick", "--rounds", "1", "-o", str(out)]) == 0
+    data = json.loads(out.read_text())
+    if "kernel" in data:  # a C compiler is there
+        assert data["kernel"]["kernel_before_same_bits_as_vm"] and data["kernel"]["kernel_now_same_bits_as_vm"]
+        assert data["batch"]["statuses"] == {"solved": 2000}
+    assert data["fivebar"]["fallback_share_now"] < 0.05 < data["fivebar"]["fallback_share_3_steps"]
+    assert data["single"]["single_fk_function_us"] > 0 and "load" in data["single"]
+    assert "written:" in capsys.readouterr().out

@@ -330,6 +330,7 @@ def manifest(
                 if c.ik is None
                 else f"; first {REDUCED_STEPS} Newton steps on the task coordinates through the closed-form IK, "
                 "from the first-order guess t0 = x0[task] + J_home (q - q_ik(x0[task])) (J_home = dt/dq at home), "
+                f"where they do not converge, the guess about the pose they reached and {REDUCED_STEPS} more, "
                 "falling back to fast_newton on Φ from x0 where they do not settle the pose"
             ),
         },
