@@ -33,7 +33,8 @@ from .chains import supported as chains_supported
 from .drawing import geometry_of
 from .generate import described_limits, parameter_options
 from .graph import closure_parts, graph_geometry
-from .spec import Description, description_from_dict
+from .read import description_from_dict
+from .spec import Description
 
 log = logging.getLogger(__name__)
 
