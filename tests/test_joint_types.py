@@ -25,7 +25,7 @@ from cpm_nlp.analysis import compliance, hinge_types
 from cpm_nlp.core.chains import JOINT_DOF
 from cpm_nlp.core.joints import JOINT_LETTERS, JOINT_TYPES, joint_type, joint_types
 from cpm_nlp.mechanisms import described
-from cpm_nlp.mechanisms.described import generate, read_joint, spec
+from cpm_nlp.mechanisms.described import builder, generate, motions, read_joint, spec
 from cpm_nlp.plot import draw_mechanism, interactive
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -126,14 +126,14 @@ def test_letters_and_the_drawings():
     }
     drawn = (draw_mechanism.JOINT_MARKER, draw_mechanism.JOINT_NAME, interactive._JOINT_SYMBOL)
     assert set(JOINT_LETTERS) == set(drawn[0]) == set(drawn[1]) == set(drawn[2])
-    assert generate._LETTER == {n: t.letter for n, t in JOINT_TYPES.items()}
+    assert motions.LETTER == {n: t.letter for n, t in JOINT_TYPES.items()}
 
 
 def test_generate_aliases_are_the_table():
-    """The names other modules import from generate.py are the table's."""
-    assert generate.POINT_JOINTS == {"S", "planar_R"}
-    assert generate.SPHERE_JOINTS == {"U", "S", "planar_R"}
-    assert generate.JOINT_DIMS == {
+    """The names other modules import from motions.py are the table's."""
+    assert motions.POINT_JOINTS == {"S", "planar_R"}
+    assert motions.SPHERE_JOINTS == {"U", "S", "planar_R"}
+    assert motions.JOINT_DIMS == {
         "P": "length",
         "planar_P": "length",
         "R": "angle",
@@ -201,7 +201,7 @@ def _file_joints():
         for leg in d.legs:
             for j in leg.joints:
                 for c in j.coordinates:
-                    types[c] = types[generate.family(c)] = j.type
+                    types[c] = types[builder.family(c)] = j.type
         out[f.name] = (d, types)
     return out
 

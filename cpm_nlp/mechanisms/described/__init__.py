@@ -31,8 +31,8 @@ from . import expr as ex
 from .chains import chains_function
 from .chains import supported as chains_supported
 from .drawing import geometry_of
-from .generate import described_limits, parameter_options
 from .graph import closure_parts, graph_geometry
+from .options import described_limits, parameter_options
 from .read import description_from_dict
 from .spec import Description
 

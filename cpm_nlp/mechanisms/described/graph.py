@@ -44,9 +44,13 @@ from ...core.model import Coordinate
 from ...core.options import REQUIRED
 from ...core.screws import vee
 from . import expr as ex
+from .branches import branch_expressions, select_branch
+from .builder import ClosureBuilder, Reported, family
 from .drawing import _polygon
+from .emit import closure_functions
 from .expand import InLeg
-from .generate import JOINT_DIMS, Generator, _Reported, _rot, _xyz_angles, elementary_motions, family
+from .generate import Generator
+from .motions import JOINT_DIMS, elementary_motions, rot, xyz_angles
 from .spec import GROUND_NAMES, Description, Joint
 
 log = logging.getLogger(__name__)
@@ -106,7 +110,7 @@ def _shift(v: ca.SX) -> tuple:
     return ca.SX.eye(3), v
 
 
-class GraphGenerator(Generator):
+class GraphGenerator(ClosureBuilder):
     """Builds the symbolic closure of a bodies-and-joints description (errors carry key paths)."""
 
     def __init__(self, d: Description) -> None:
@@ -133,13 +137,13 @@ class GraphGenerator(Generator):
         if id(leg) not in frames:
             env = dict(self.env)
             if leg.index is not None:
-                self._bind(env, leg.index, ex.Value(ca.SX(float(leg.values[0])), None), leg.path + ("repeat", "index"))
+                self.bind(env, leg.index, ex.Value(ca.SX(float(leg.values[0])), None), leg.path + ("repeat", "index"))
             for name, text in leg.let.items():
-                self._bind(env, name, super().value(text, leg.path + ("let", name), env), leg.path + ("let", name))
+                self.bind(env, name, super().value(text, leg.path + ("let", name), env), leg.path + ("let", name))
             turn = ca.SX.eye(3)
             if leg.rotate is not None:
                 angle = super().scalar(leg.rotate, leg.path + ("repeat", "rotate"), env, "angle")
-                turn = _rot(leg.rotate_axis, angle)
+                turn = rot(leg.rotate_axis, angle)
             frames[id(leg)] = (env, turn)
         return frames[id(leg)]
 
@@ -241,7 +245,7 @@ class GraphGenerator(Generator):
             if kind == "U" and not j.axes:
                 raise InputError("a U joint needs its two 'axes' (the first on the proximal body)", path=j.path)
             if kind == "S" and j.axes:
-                self._independent_axes(g.axes, j.path + ("axes",))
+                self.independent_axes(g.axes, j.path + ("axes",))
             dof = JOINT_TYPES[kind].dof
             if j.coordinates and len(j.coordinates) != dof:
                 raise InputError(
@@ -379,7 +383,7 @@ class GraphGenerator(Generator):
                 what = "its actuator's joint" if actuated is not None else "a tree coordinate"
                 coord = Coordinate(name, dim, f"{j.type} joint {g.name} ({g.a} - {g.b}), {what}", fam)
                 # a flexure's limits are a deflection about the joint's value in the drawing
-                limit = None if actuated is not None else self._flexure_range(g, dim, home)  # type: ignore[arg-type]
+                limit = None if actuated is not None else self.flexure_range(g, dim, home)  # type: ignore[arg-type]
                 self.extra.append((coord, sym, home, limit, j.path))
                 g.values.append(sym - home)
                 if actuated is not None:
@@ -395,7 +399,7 @@ class GraphGenerator(Generator):
         T = _shift(g.pa)
         motions = elementary_motions(g) if g.type != "distance" else []  # type: ignore[arg-type]
         for (kind, axis), value in zip(motions, g.values):
-            T = _compose(T, (ca.SX.eye(3), value * axis) if kind == "P" else (_rot(axis, value), ca.SX.zeros(3)))
+            T = _compose(T, (ca.SX.eye(3), value * axis) if kind == "P" else (rot(axis, value), ca.SX.zeros(3)))
         return _compose(T, _shift(-g.pb))
 
     def poses(self) -> None:
@@ -490,19 +494,19 @@ class GraphGenerator(Generator):
             vals = [ca.dot(g.axis, d)]
         elif g.type == "U":
             F = ca.horzcat(g.axes[0], g.axes[1], ca.cross(g.axes[0], g.axes[1]))
-            vals = _xyz_angles(F.T @ M @ F)[:2]
+            vals = xyz_angles(F.T @ M @ F)[:2]
         else:  # S
             F = ca.horzcat(*g.axes) if g.axes else ca.SX.eye(3)
-            vals = _xyz_angles(F.T @ M @ F)
+            vals = xyz_angles(F.T @ M @ F)
         for k, (name, v) in enumerate(zip(j.coordinates, vals)):
             dim = JOINT_DIMS.get(g.type, "angle") if not (g.type == "C" and k == 1) else "length"
             home = self.scalar(j.home[k], j.path + ("home", k), self.env, dim) if k < len(j.home) else 0
             desc = f"{j.type} joint {g.name} ({g.a} - {g.b}), closing loop {g.loop}"
             self.reported.append(
-                _Reported(
+                Reported(
                     Coordinate(name, dim, desc, j.limit or family(name)),
                     home + v,
-                    self._flexure_range(g, dim, home),  # type: ignore[arg-type]
+                    self.flexure_range(g, dim, home),  # type: ignore[arg-type]
                     j.path,
                 )
             )
@@ -603,26 +607,26 @@ class GraphGenerator(Generator):
                 coord = Coordinate(
                     f"{name}_{'xyz'[k]}", "length", desc or f"{'xyz'[k]} of {body}.{point}", f"{name}_{'xyz'[k]}"
                 )
-                self.reported.append(_Reported(coord, w[k], None, ("outputs", name)))
+                self.reported.append(Reported(coord, w[k], None, ("outputs", name)))
         full = dict(self.xenv)
         for c, s in zip(self.q_coords, self.q_syms):
-            self._bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("joints", c.name))
+            self.bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("joints", c.name))
         for k, name in enumerate(self.x_names):
             if name not in full:
                 full[name] = ex.Value(self.x[k], ex.DIMENSION_OF[self.x_coords[k].kind])
-        added = self.branch_expressions(full)
+        added = branch_expressions(self, full)
         for qty in d.passive:
             v = self.value(qty.value, ("passive", qty.name), full, qty.dimension)
             dim = qty.dimension or ("length" if v.dim and v.dim[0] else "angle")
             self.reported.append(
-                _Reported(
+                Reported(
                     Coordinate(qty.name, dim, qty.description, qty.family or family(qty.name)),
                     v.sx,
                     None,
                     ("passive", qty.name),
                 )
             )
-        self._unique_names()
+        self.unique_names()
         self.assembler = Assembler(self, q, span)
         keep = self.assembler.select_rows()
         if self.assembler.info.mobility != len(self.q_coords):
@@ -654,9 +658,9 @@ class GraphGenerator(Generator):
                 )
         if not self.normal_form:
             self.graph_indicators(q)
-        self.select_branch(added)
+        select_branch(self, added)
         self.check_task_count()
-        fns = self.functions(q)
+        fns = closure_functions(self, q)
         fns["assemble"] = self.assembler
         if self.normal_form:
             # every closure equation: the loop rows, then Φ's own rows (actuation, platform).  The

@@ -20,8 +20,9 @@ from ...core.joints import JOINT_TYPES
 from ...core.model import Model
 from ...core.options import REQUIRED
 from ...core.units import format_quantity
+from .builder import family
 from .expand import GROUND, PLATFORM, expand_legs, expansion_gap
-from .generate import Generator, family
+from .generate import Generator
 from .graph import closure_parts
 from .spec import Description, Joint
 
