@@ -30,8 +30,8 @@ from ...io.yamlfile import load_yaml_text, parse_yaml, read_yaml
 from . import expr as ex
 from .chains import chains_function
 from .chains import supported as chains_supported
-from .drawing import geometry_of
-from .graph import closure_parts, graph_geometry
+from .closure import closure_parts
+from .drawing import geometry_of, graph_geometry
 from .options import described_limits, parameter_options
 from .read import description_from_dict
 from .spec import Description

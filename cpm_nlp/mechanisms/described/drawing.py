@@ -1,4 +1,5 @@
-"""The drawing of a mechanism described by its legs (the ``geometry`` capability).
+"""The drawing of a mechanism described by its legs, or by its bodies and joints (the
+``geometry`` capability).
 
 The generator locates every joint of every leg at a pose symbolically (the
 ``drawing_points`` function of x, q, p): the joints of the proximal chain moved
@@ -16,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ...core.joints import JOINT_TYPES
 from ...core.mechanism import Drawing
 
 #: (leg name, [(joint letter, actuated, the link after it changes length)])
@@ -120,3 +122,63 @@ def fixed_links(layout: Layout) -> list[tuple[str, str]]:
             if not legjoints[n][2]:
                 out.append((f"{leg}_{n + 1}", f"{leg}_{n + 2}"))
     return out
+
+
+def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any], Drawing]:
+    """The ``geometry`` capability of a graph (``gen``: its :class:`~.graph.GraphGenerator`; ``fn``:
+    its ``drawing_points`` of (x, q, p), ``layout`` the body and name of each point): every body's
+    points, each body a segment (two points) or a face (three or more); the ground as the base,
+    the platform body as the platform."""
+    d = gen.d
+    ground, platform = gen.ground, gen.platform_body
+    actuated = {g.b if not g.reversed else g.a for g in gen.gjoints if g.tree and g.spec.actuated is not None}
+    named = [(g, g.spec.at if isinstance(g.spec.at, str) and g.spec.at.isidentifier() else g.name) for g in gen.gjoints]
+    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type not in ("distance", "pose")}
+    ends = [(g.spec.at, g.spec.to) for g in gen.gjoints if g.type == "distance"]
+
+    def rods(pts: dict) -> list[tuple[str, str, str]]:
+        return [(a, b, "leg") for a, b in ends if isinstance(a, str) and isinstance(b, str) and a in pts and b in pts]
+
+    def geometry(model: Any, x: Any, q: Any) -> Drawing:
+        V = np.asarray(
+            fn(np.asarray(x, dtype=float), np.asarray(q, dtype=float), np.asarray(model.p, dtype=float)), dtype=float
+        )
+        pts: dict[str, np.ndarray] = {}
+        of_body: dict[str, list[str]] = {}
+        for k, (body, name) in enumerate(layout):
+            if name not in pts:
+                pts[name] = V[:, k].copy()
+            of_body.setdefault(body, []).append(name)
+        if platform != ground:  # the platform point (none when the pose is the joints' alone)
+            pts["P" if "P" not in pts else "P0"] = V[:, -1].copy()
+        span = float(np.ptp(np.array(list(pts.values())), axis=0).max()) or 1.0
+        segments, faces = [], []
+        for body in [b.name for b in d.bodies]:
+            names = list(dict.fromkeys(of_body.get(body, [])))
+            part = (
+                "base"
+                if body == ground
+                else "platform"
+                if body == platform
+                else "actuator"
+                if body in actuated
+                else "link"
+            )
+            ring = _polygon(pts, names, 1e-9 * span)
+            if len(ring) >= 3:
+                faces.append((part, tuple(ring)))
+            elif len(ring) == 2:
+                segments.append((ring[0], ring[1], part))
+        segments += rods(pts)
+        note = "bodies as straight links (two points) or polygons (three or more) through their points"
+        if d.platform.planar:
+            note += "; a planar mechanism, drawn in its plane z = 0"
+        return Drawing(
+            points=pts,
+            segments=tuple(segments),
+            faces=tuple(faces),
+            joints={n: letter for n, letter in letters.items() if n in pts},
+            note=note,
+        )
+
+    return geometry

@@ -21,9 +21,9 @@ from ...core.model import Model
 from ...core.options import REQUIRED
 from ...core.units import format_quantity
 from .builder import family
+from .closure import closure_parts
 from .expand import GROUND, PLATFORM, expand_legs, expansion_gap
 from .generate import Generator
-from .graph import closure_parts
 from .spec import Description, Joint
 
 
