@@ -51,6 +51,7 @@ with bodies; it would be the slower closure.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import casadi as ca
@@ -85,6 +86,25 @@ from .motions import (
 from .spec import Joint, Leg
 
 
+@dataclass
+class _Link:
+    """An eliminated link c -> B of a leg: the joint at c, the proximal chain before it and its motion
+    Rm, c and B - c at the pose (v), the link at the reference configuration (u0) and moved (u = Rm
+    u0), and in the leg's own frame its vector, the joint's axis and the link's length r."""
+
+    leg: Leg
+    elim: ResolvedJoint
+    before: list[ResolvedJoint]
+    Rm: ca.SX
+    c: ca.SX
+    u0: ca.SX
+    u: ca.SX
+    v: ca.SX
+    u0_l: ca.SX
+    axis_l: ca.SX | None
+    r: ca.SX
+
+
 class Generator(ClosureBuilder):
     """Builds the symbolic closure of a legs description, each leg's passive joints eliminated
     (errors carry key paths)."""
@@ -103,18 +123,30 @@ class Generator(ClosureBuilder):
         self.leg_joints.append((leg, joints))
         self.close(leg, joints, turn if leg.rotate is not None else None)
 
-    def resolve(self, j: Joint, env: Mapping[str, ex.Value], turn: ca.SX) -> ResolvedJoint:  # noqa: C901 - one rule per joint part
+    def resolve(self, j: Joint, env: Mapping[str, ex.Value], turn: ca.SX) -> ResolvedJoint:
+        """A joint of a leg resolved in the leg's environment (turn: the leg's rotation)."""
         out = ResolvedJoint(j)
+        self._check_type(j)
+        self._resolve_points(out, env, turn)
+        self._resolve_axes(out, env, turn)
+        self._resolve_values(out, env)
+        return out
+
+    def _check_type(self, j: Joint) -> None:
+        """The mechanism's plane takes the joint's type."""
         planar = self.d.platform.planar
-        kind = JOINT_TYPES[j.type]
         allowed = joint_types(planar)
         if j.type not in allowed:
-            other = kind.twin
+            other = JOINT_TYPES[j.type].twin
             raise InputError(
                 f"a {'planar' if planar else 'spatial'} mechanism takes {', '.join(allowed)} joints, got {j.type}",
                 path=j.path + ("type",),
                 suggestions=[other] if other else (),
             )
+
+    def _resolve_points(self, out: ResolvedJoint, env: Mapping[str, ex.Value], turn: ca.SX) -> None:
+        """Its location ``at``; a distance joint's ``to`` and the rod's given ``length``."""
+        j = out.spec
         if j.at is None:
             raise InputError(f"a {j.type} joint needs its location 'at'", path=j.path)
         out.local["at"] = self.vector(j.at, j.path + ("at",), env, "length")
@@ -136,6 +168,11 @@ class Generator(ClosureBuilder):
                 f"only a distance joint has 'length' (a {j.type} joint's links are drawn by their joints)",
                 path=j.path + ("length",),
             )
+
+    def _resolve_axes(self, out: ResolvedJoint, env: Mapping[str, ex.Value], turn: ca.SX) -> None:
+        """Its unit axis (given, or z) and axes, turned with the leg and in the leg's own frame."""
+        j = out.spec
+        kind = JOINT_TYPES[j.type]
         if kind.axis == "given":
             if j.axis is None:
                 raise InputError(f"a {j.type} joint needs its 'axis'", path=j.path)
@@ -159,10 +196,15 @@ class Generator(ClosureBuilder):
             raise InputError(f"a {j.type} joint needs its {need} 'axes'", path=j.path)
         if need == 3 and j.axes:
             self.independent_axes(out.axes, j.path + ("axes",))
-        dof = kind.dof
-        if j.coordinates and len(j.coordinates) != dof:
+
+    def _resolve_values(self, out: ResolvedJoint, env: Mapping[str, ex.Value]) -> None:
+        """Its coordinates (one per degree of freedom); its actuator's displacement, or its home values."""
+        j = out.spec
+        kind = JOINT_TYPES[j.type]
+        if j.coordinates and len(j.coordinates) != kind.dof:
             raise InputError(
-                f"a {j.type} joint has {dof} coordinate(s), got {len(j.coordinates)}", path=j.path + ("coordinates",)
+                f"a {j.type} joint has {kind.dof} coordinate(s), got {len(j.coordinates)}",
+                path=j.path + ("coordinates",),
             )
         if j.actuated is not None:
             out.value = self.actuator(j, env)
@@ -172,33 +214,11 @@ class Generator(ClosureBuilder):
                 self.scalar(h, j.path + ("home", k), env, dims[k] if k < len(dims) else None)
                 for k, h in enumerate(j.home)
             ]
-        return out
 
-    def close(self, leg: Leg, joints: list[ResolvedJoint], turn: ca.SX | None = None) -> None:  # noqa: C901 - one branch per leg ending
+    def close(self, leg: Leg, joints: list[ResolvedJoint], turn: ca.SX | None = None) -> None:
         """The leg's closure rows, indicators and reported joint values (turn: a repeated leg's turn)."""
         last = joints[-1]
-        rod = None  # a distance joint's given length
-        if last.type == "distance":
-            tip, elim = (
-                last.to,
-                ResolvedJoint(Joint("S", path=last.spec.path), at=last.at, local={"at": last.local["at"]}),
-            )
-            tip_l = last.local["to"]
-            rod = last.length
-            before = joints[:-1]
-        elif last.type in POINT_JOINTS and (last.type == "S") != self.d.platform.planar:
-            tip, tip_l = last.at, last.local["at"]
-            before = joints[:-1]
-            elim = None
-            if before and before[-1].value is None and before[-1].type in ("R", "C", *SPHERE_JOINTS):
-                elim = before.pop()
-        else:
-            want = "planar_R" if self.d.platform.planar else "S"
-            raise InputError(
-                f"leg {leg.name}: it must reach the platform through a point joint ({want}) or a distance joint; "
-                f"its last joint is {last.type}",
-                path=last.spec.path + ("type",),
-            )
+        tip, tip_l, rod, before, elim = self._ending(leg, joints)
         slide = None
         if elim is None and before and before[-1].type in ("P", "planar_P") and len(before) >= 2:
             if before[-2].value is None and before[-2].type in SPHERE_JOINTS | {"R"}:
@@ -210,86 +230,127 @@ class Generator(ClosureBuilder):
         B = self.platform_point(tip)
         self.draw_leg(leg, last, before, elim, slide, Rm, tm, B)
         R_rel = self.R @ self.R_home.T
-        rows = 2 if self.d.platform.planar else 3
         if elim is None:
             v = B - (Rm @ tip + tm)
-            for k in range(rows):
+            for k in range(2 if self.d.platform.planar else 3):
                 self.rows.append((v[k], f"leg {leg.name}: point {'xyz'[k]}"))
             self.report_tip(last, Rm, R_rel, leg.name)
             return
         c = Rm @ elim.at + tm
         u0 = tip - elim.at
-        u = Rm @ u0
-        v = B - c
         # the link's constants in the leg's frame (the same for every copy of a repeated leg)
-        u0_l, axis_l = tip_l - elim.local["at"], elim.local.get("axis")
-        r = ca.norm_2(u0_l)
-        Rb = Rm
+        u0_l = tip_l - elim.local["at"]
+        link = _Link(leg, elim, before, Rm, c, u0, Rm @ u0, B - c, u0_l, elim.local.get("axis"), ca.norm_2(u0_l))
         if slide is not None:
-            if slide.value is None:
-                raise InputError(
-                    f"leg {leg.name}: a passive P between two point joints constrains nothing", path=slide.spec.path
-                )
-            self.requirements.append(
-                (
-                    ca.norm_2(ca.cross(slide.axis, u0)) / r,
-                    "the P joint's axis is not along the leg (c -> B)",
-                    slide.spec.path,
-                )
-            )
-            # squared (polynomial in the pose): Newton from far starts converges far more often than on
-            # |v| - length; near a solution it is (length / r)(|v| - length)
-            self.rows.append(((ca.dot(v, v) - (r + slide.value) ** 2) / (2 * r), f"leg {leg.name}: length"))
-            self.indicator((r + slide.value) / r, leg, slide, "the leg's length over its reference length")
-            self.indicator(ca.dot(u, v) / (r * ca.norm_2(v)), leg, elim, COSINE)
-            if elim.type == "R":  # R-P-S: the leg also stays in the plane normal to the R axis
-                w = Rm @ elim.axis
-                self.rows.append((ca.dot(v, w) - ca.dot(u0_l, axis_l), f"leg {leg.name}: plane of the R joint"))
-                theta = ca.atan2(ca.dot(w, ca.cross(u, v)), ca.dot(u, v))
-                self.report(elim, [theta], leg.name)
-                Rb = rot(w, theta) @ Rm
-            else:
-                Rb = self.report_sphere(elim, Rm, u0, v, leg)
-        elif elim.type == "R":
-            w = Rm @ elim.axis
-            h = ca.dot(u0_l, axis_l)
-            up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
-            self.rows.append((ca.dot(v, w) - h, f"leg {leg.name}: plane of the R joint"))
-            self.rows.append(
-                ((ca.dot(v, v) - ca.dot(u0_l, u0_l)) / (2 * r), f"leg {leg.name}: radius about the R joint")
-            )
-            self.eliminated(leg, elim, before, c, v, 2, w)
-            if turn is not None and is_identity(Rm):
-                # a turned leg whose proximal chain only slides: its angle and its link's rotation in
-                # the leg's own frame (v_l = turnᵀ v), where the file's axes are (0, 1, 0) and the
-                # like -- the rotation about w_l keeps a U or S axis along w_l exactly, and the tip's
-                # angles need no turned constant (:meth:`report_tip`)
-                v_l, w_l = turn.T @ v, axis_l
-                # w·(up × vp) = v·(w × u) and up·vp = u·v - (u·w)(v·w), with u·w = h
-                theta = ca.atan2(ca.dot(v_l, ca.cross(w_l, u0_l)), ca.dot(u0_l, v_l) - h * ca.dot(v_l, w_l))
-                self.report(elim, [theta], leg.name)
-                self.report_tip(last, rot(w_l, theta), R_rel, leg.name, turn)
-                return
-            theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
-            self.report(elim, [theta], leg.name)
-            Rb = rot(w, theta) @ Rm
-        elif elim.type == "C":
-            w = Rm @ elim.axis
-            up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
-            rp = ca.norm_2(u0_l - ca.dot(u0_l, axis_l) * axis_l)
-            self.rows.append(((ca.dot(vp, vp) - rp**2) / (2 * rp), f"leg {leg.name}: cylinder of the C joint"))
-            self.eliminated(leg, elim, before, c, v, 1, w)
-            theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
-            self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0_l, axis_l)], leg.name)
-            Rb = rot(w, theta) @ Rm
+            Rb, tip_turn = self._close_slide(link, slide), None
         else:
-            if rod is None:
-                self.rows.append(((ca.dot(v, v) - ca.dot(u0_l, u0_l)) / (2 * r), f"leg {leg.name}: distance"))
-            else:  # its given length: the drawing need not close (the reference is assembled)
-                self.rows.append(((ca.dot(v, v) - rod**2) / (2 * rod), f"leg {leg.name}: distance"))
-            self.eliminated(leg, elim, before, c, v, 1)
-            Rb = self.report_sphere(elim, Rm, u0, v, leg)
-        self.report_tip(last, Rb, R_rel, leg.name)
+            close = {"R": self._close_revolute, "C": self._close_cylinder}.get(elim.type, self._close_sphere)
+            Rb, tip_turn = close(link, rod, turn)
+        self.report_tip(last, Rb, R_rel, leg.name, tip_turn)
+
+    def _ending(self, leg: Leg, joints: list[ResolvedJoint]) -> tuple:
+        """How the leg reaches the platform: (the platform point B0, in the leg's frame too, a
+        distance joint's given length, the joints before it, the joint whose link is eliminated --
+        the point joint before a distance joint, else the R, C or point joint before the last one,
+        when passive)."""
+        last = joints[-1]
+        before = joints[:-1]
+        if last.type == "distance":
+            elim = ResolvedJoint(Joint("S", path=last.spec.path), at=last.at, local={"at": last.local["at"]})
+            return last.to, last.local["to"], last.length, before, elim
+        if last.type in POINT_JOINTS and (last.type == "S") != self.d.platform.planar:
+            elim = None
+            if before and before[-1].value is None and before[-1].type in ("R", "C", *SPHERE_JOINTS):
+                elim = before.pop()
+            return last.at, last.local["at"], None, before, elim
+        want = "planar_R" if self.d.platform.planar else "S"
+        raise InputError(
+            f"leg {leg.name}: it must reach the platform through a point joint ({want}) or a distance joint; "
+            f"its last joint is {last.type}",
+            path=last.spec.path + ("type",),
+        )
+
+    def _close_slide(self, link: _Link, slide: ResolvedJoint) -> ca.SX | None:
+        """A P along the link c -> B between two point joints (or after an R): its length row."""
+        leg, elim, u0, u, v, r = link.leg, link.elim, link.u0, link.u, link.v, link.r
+        if slide.value is None:
+            raise InputError(
+                f"leg {leg.name}: a passive P between two point joints constrains nothing", path=slide.spec.path
+            )
+        self.requirements.append(
+            (
+                ca.norm_2(ca.cross(slide.axis, u0)) / r,
+                "the P joint's axis is not along the leg (c -> B)",
+                slide.spec.path,
+            )
+        )
+        # squared (polynomial in the pose): Newton from far starts converges far more often than on
+        # |v| - length; near a solution it is (length / r)(|v| - length)
+        self.rows.append(((ca.dot(v, v) - (r + slide.value) ** 2) / (2 * r), f"leg {leg.name}: length"))
+        self.indicator((r + slide.value) / r, leg, slide, "the leg's length over its reference length")
+        self.indicator(ca.dot(u, v) / (r * ca.norm_2(v)), leg, elim, COSINE)
+        if elim.type != "R":
+            return self.report_sphere(elim, link.Rm, u0, v, leg)
+        # R-P-S: the leg also stays in the plane normal to the R axis
+        w = link.Rm @ elim.axis
+        self.rows.append((ca.dot(v, w) - ca.dot(link.u0_l, link.axis_l), f"leg {leg.name}: plane of the R joint"))
+        theta = ca.atan2(ca.dot(w, ca.cross(u, v)), ca.dot(u, v))
+        self.report(elim, [theta], leg.name)
+        return rot(w, theta) @ link.Rm
+
+    def _close_revolute(self, link: _Link, _rod: ca.SX | None, turn: ca.SX | None) -> tuple:
+        """An R at c: B stays on a circle about its axis (axial offset, radius)."""
+        leg, elim, Rm, u, v, u0_l, axis_l, r = (
+            link.leg,
+            link.elim,
+            link.Rm,
+            link.u,
+            link.v,
+            link.u0_l,
+            link.axis_l,
+            link.r,
+        )
+        w = Rm @ elim.axis
+        h = ca.dot(u0_l, axis_l)
+        up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
+        self.rows.append((ca.dot(v, w) - h, f"leg {leg.name}: plane of the R joint"))
+        self.rows.append(((ca.dot(v, v) - ca.dot(u0_l, u0_l)) / (2 * r), f"leg {leg.name}: radius about the R joint"))
+        self.eliminated(leg, elim, link.before, link.c, v, 2, w)
+        if turn is not None and is_identity(Rm):
+            # a turned leg whose proximal chain only slides: its angle and its link's rotation in
+            # the leg's own frame (v_l = turnᵀ v), where the file's axes are (0, 1, 0) and the
+            # like -- the rotation about w_l keeps a U or S axis along w_l exactly, and the tip's
+            # angles need no turned constant (:meth:`report_tip`)
+            v_l, w_l = turn.T @ v, axis_l
+            # w·(up × vp) = v·(w × u) and up·vp = u·v - (u·w)(v·w), with u·w = h
+            theta = ca.atan2(ca.dot(v_l, ca.cross(w_l, u0_l)), ca.dot(u0_l, v_l) - h * ca.dot(v_l, w_l))
+            self.report(elim, [theta], leg.name)
+            return rot(w_l, theta), turn
+        theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
+        self.report(elim, [theta], leg.name)
+        return rot(w, theta) @ Rm, None
+
+    def _close_cylinder(self, link: _Link, _rod: ca.SX | None, _turn: ca.SX | None) -> tuple:
+        """A C at c: B stays on a cylinder about its axis."""
+        leg, elim, Rm, u, v, u0_l, axis_l = link.leg, link.elim, link.Rm, link.u, link.v, link.u0_l, link.axis_l
+        w = Rm @ elim.axis
+        up, vp = u - ca.dot(u, w) * w, v - ca.dot(v, w) * w
+        rp = ca.norm_2(u0_l - ca.dot(u0_l, axis_l) * axis_l)
+        self.rows.append(((ca.dot(vp, vp) - rp**2) / (2 * rp), f"leg {leg.name}: cylinder of the C joint"))
+        self.eliminated(leg, elim, link.before, link.c, v, 1, w)
+        theta = ca.atan2(ca.dot(w, ca.cross(up, vp)), ca.dot(up, vp))
+        self.report(elim, [theta, ca.dot(v, w) - ca.dot(u0_l, axis_l)], leg.name)
+        return rot(w, theta) @ Rm, None
+
+    def _close_sphere(self, link: _Link, rod: ca.SX | None, _turn: ca.SX | None) -> tuple:
+        """A U, S or planar R at c (or a distance joint): B stays on a sphere (circle) about c."""
+        leg, v, u0_l, r = link.leg, link.v, link.u0_l, link.r
+        if rod is None:
+            self.rows.append(((ca.dot(v, v) - ca.dot(u0_l, u0_l)) / (2 * r), f"leg {leg.name}: distance"))
+        else:  # its given length: the drawing need not close (the reference is assembled)
+            self.rows.append(((ca.dot(v, v) - rod**2) / (2 * rod), f"leg {leg.name}: distance"))
+        self.eliminated(leg, link.elim, link.before, link.c, v, 1)
+        return self.report_sphere(link.elim, link.Rm, link.u0, v, leg), None
 
     def indicator(self, value: ca.SX | None, leg: Leg, j: ResolvedJoint, what: str) -> None:
         """A generated branch indicator, named after its leg and joint (``a1.U1``: leg a1, its
@@ -480,36 +541,54 @@ class Generator(ClosureBuilder):
         self.report(last, xyz_angles(F.T @ Rb.T @ R_rel @ F), leg_name)
 
     # -- the whole closure -----------------------------------------------------------------------
-    def build(self) -> dict[str, Any]:  # noqa: C901 - one step per section of the description
-        d = self.d
+    def build(self) -> dict[str, Any]:
+        """The closure: the platform, each leg's rows (its passive joints eliminated), the declared
+        actuators and closures, the reported values, the branch indicators, the functions."""
         self.platform()
-        for leg in d.legs:
+        for leg in self.d.legs:
             self.leg(leg)
-        for name, (dim, home) in d.actuators.items():
+        self.declared_actuators()
+        q = ca.vertcat(*self.q_syms)
+        full = dict(self.xenv)
+        for c, s in zip(self.q_coords, self.q_syms):
+            self.bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("actuators", c.name))
+        for k, text in enumerate(self.d.closures):
+            self.rows.append((self.scalar(text, ("closures", k), full), f"closures[{k}]"))
+        added = branch_expressions(self, full)
+        families = list(dict.fromkeys(r.coord.group for r in self.reported))
+        self.reported.sort(key=lambda r: families.index(r.coord.group))  # alpha1..3, beta1..3, as the papers list them
+        self.report_passive(full)
+        self.add_unknowns()
+        self.unique_names()
+        self.check_mobility()
+        elimination_indicators(self, q)
+        aspect(self, q)
+        select_branch(self, added)
+        self.check_task_count()
+        return closure_functions(self, q)
+
+    def declared_actuators(self) -> None:
+        """The ``actuators`` section's (for closures written as expressions), after the joints'."""
+        for name, (dim, home) in self.d.actuators.items():
             if name not in [c.name for c in self.q_coords]:
                 self.q_coords.append(Coordinate(name, dim, "actuator", family(name)))
                 self.q_syms.append(ca.SX.sym(name))
                 self.q_home.append(self.scalar(home, ("actuators", name, "home"), self.env, dim))
         if not self.q_coords:
             raise InputError("no actuators: mark joints 'actuated: name' (or declare 'actuators')", path=("legs",))
-        q = ca.vertcat(*self.q_syms)
-        full = dict(self.xenv)
-        for c, s in zip(self.q_coords, self.q_syms):
-            self.bind(full, c.name, ex.Value(s, ex.DIMENSION_OF[c.kind]), ("actuators", c.name))
-        for k, text in enumerate(d.closures):
-            self.rows.append((self.scalar(text, ("closures", k), full), f"closures[{k}]"))
-        added = branch_expressions(self, full)
-        families = list(dict.fromkeys(r.coord.group for r in self.reported))
-        self.reported.sort(key=lambda r: families.index(r.coord.group))  # alpha1..3, beta1..3, as the papers list them
-        for qty in d.passive:
+
+    def report_passive(self, full: dict[str, ex.Value]) -> None:
+        """The ``passive`` section's values, reported beside the joints'."""
+        for qty in self.d.passive:
             v = self.value(qty.value, ("passive", qty.name), full, qty.dimension)
             dim = qty.dimension or dim_name(v.dim)
             fam = qty.family or family(qty.name)
             self.reported.append(
                 Reported(Coordinate(qty.name, dim, qty.description, fam), v.sx, None, ("passive", qty.name))
             )
-        self.add_unknowns()
-        self.unique_names()
+
+    def check_mobility(self) -> None:
+        """As many equations as pose coordinates."""
         nx, nrows = len(self.x_names), len(self.rows)
         if nrows != nx:
             what = "over" if nrows > nx else "under"
@@ -519,11 +598,6 @@ class Generator(ClosureBuilder):
                 path=("platform", "coordinates"),
                 hint="declare the coordinates the structure fixes under platform.fixed, or add legs",
             )
-        elimination_indicators(self, q)
-        aspect(self, q)
-        select_branch(self, added)
-        self.check_task_count()
-        return closure_functions(self, q)
 
 
 __all__ = ["Generator"]
