@@ -6,6 +6,7 @@ generated ones."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import casadi as ca
 
@@ -142,3 +143,36 @@ def aspect(gen: ClosureBuilder, q: ca.SX) -> None:
     phi = ca.vertcat(*[r[0] for r in gen.rows])
     value = aspect_indicator(phi, gen.x, q, gen.R, gen.x_home, ca.vertcat(*gen.q_home))
     gen.branch.append((value, ASPECT, ASPECT_DESCRIPTION))
+
+
+def graph_indicators(gen: Any, q: ca.SX) -> None:
+    """A graph's indicators (``gen``: its :class:`~.graph.GraphGenerator`): one indicator per
+    diagonal block of Φ_x (block-triangular form) that holds loop rows: the sign of the block's
+    determinant is the assembly mode of the loops it holds; it is taken as the reference
+    configuration's, and scaled by the determinant's size at the drawing."""
+    phi = ca.vertcat(*[r[0] for r in gen.rows])
+    J = ca.jacobian(phi, gen.x)
+    if ca.sprank(J.sparsity()) < J.size1():
+        return
+    nb, rowperm, colperm, rowblock, colblock, *_ = J.sparsity().btf()
+    nloop = sum(1 for r in gen.rows if r[1].startswith("loop "))
+    xq = ca.vertcat(gen.x, q)
+    draw = ca.vertcat(gen.x_home, *gen.q_home)
+    for k in range(nb):
+        rows = rowperm[rowblock[k] : rowblock[k + 1]]
+        cols = colperm[colblock[k] : colblock[k + 1]]
+        loops = sorted({int(gen.rows[r][1].split()[1]) for r in rows if r < nloop})
+        if not loops or len(cols) > ASPECT_MAX_NX:
+            continue
+        d = twist_determinant(phi[rows], ca.vertcat(*[gen.x[c] for c in cols]), None)
+        sign = gen.assembler.reference_sign(d)
+        scale = ca.fmax(ca.fabs(ca.substitute(d, xq, draw)), 1e-300)
+        name = "loop" + "_".join(str(n) for n in loops)
+        taken, base, m = {b[1] for b in gen.branch}, name, 2
+        while name in taken:  # another block of the same loops (the 3-PRC's platform closes two)
+            name, m = f"{base}_block{m}", m + 1
+        what = (
+            f"assembly mode of loop{'s' if len(loops) > 1 else ''} {', '.join(map(str, loops))}: det of "
+            f"{'their' if len(loops) > 1 else 'its'} block of Φ_x, signed as at the reference configuration"
+        )
+        gen.branch.append((sign * d / scale, name, what))

@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
 from ...core.joints import JOINT_TYPES
@@ -182,3 +183,38 @@ def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any],
         )
 
     return geometry
+
+
+def graph_drawing_points(gen: Any, q: Any) -> tuple[Any, list]:
+    """A graph's drawing (``gen``: its :class:`~.graph.GraphGenerator`): every body's points at
+    the pose (x, q, p), and what to draw: the layout."""
+    # a point name on several bodies is one drawn point where a joint keeps them together
+    # (R, U, S, planar R at that point); across a P or C joint, or unjoined, a point of its own
+    root: dict[tuple, tuple] = {}
+
+    def find(k: tuple) -> tuple:
+        while root.get(k, k) != k:
+            k = root[k]
+        return k
+
+    for g in gen.gjoints:
+        at = g.spec.at
+        if isinstance(at, str) and g.type in ("R", "U", "S", "planar_R"):
+            root[find((g.b, at))] = find((g.a, at))
+    drawn: dict[tuple, str] = {}
+    cols, layout = [], []
+    for body in gen.d.bodies:
+        for name, p in gen.body_points[body.name].items():
+            key = find((body.name, name))
+            if key not in drawn:
+                drawn[key] = name + "'" * sum(1 for k in drawn if k[1] == name)
+            cols.append(gen.world(body.name, p))
+            layout.append((body.name, drawn[key]))
+    for g in gen.gjoints:
+        if (isinstance(g.spec.at, str) and g.spec.at.isidentifier()) or g.type == "pose":
+            continue
+        cols.append(gen.world(g.a, g.pa))
+        layout.append((g.a, g.name))
+    cols.append(gen.P)
+    fn = ca.Function("drawing_points", [gen.x, q, gen.p], [ca.horzcat(*cols)], ["x", "q", "p"], ["points"])
+    return fn, layout

@@ -32,7 +32,6 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from ...core.aspect import ASPECT_MAX_NX, twist_determinant
 from ...core.errors import InputError, suggest
 from ...core.joints import JOINT_TYPES, joint_types
 from ...core.model import Coordinate
@@ -40,8 +39,9 @@ from ...core.options import REQUIRED
 from ...core.screws import vee
 from . import expr as ex
 from .assembly import Assembler
-from .branches import branch_expressions, select_branch
+from .branches import branch_expressions, graph_indicators, select_branch
 from .builder import ClosureBuilder, Reported, family
+from .drawing import graph_drawing_points
 from .emit import closure_functions
 from .expand import InLeg
 from .graph_rows import Cut, axis_normals, cut_rows, cut_values
@@ -440,7 +440,7 @@ class GraphGenerator(ClosureBuilder):
         self.select_rows(scale)
         self.check_rows()
         if not self.normal_form:
-            self.graph_indicators(q)
+            graph_indicators(self, q)
         select_branch(self, added)
         self.check_task_count()
         fns = self.graph_functions(q)
@@ -542,39 +542,8 @@ class GraphGenerator(ClosureBuilder):
             act = self.actuation()
             e = ca.vertcat(*[row[0] for row in self.loop_rows], *[r[0] for r in act + self.platform_rows])
             fns["loops"] = ca.Function("loops", [self.x, q, self.p], [e], ["x", "q", "p"], ["r"])
-        fns["graph_drawing"] = self.drawing_function(q)
+        fns["graph_drawing"] = graph_drawing_points(self, q)
         return fns
-
-    def graph_indicators(self, q: ca.SX) -> None:
-        """One indicator per diagonal block of Φ_x (block-triangular form) that holds loop rows: the
-        sign of the block's determinant is the assembly mode of the loops it holds; it is taken as
-        the reference configuration's, and scaled by the determinant's size at the drawing."""
-        phi = ca.vertcat(*[r[0] for r in self.rows])
-        J = ca.jacobian(phi, self.x)
-        if ca.sprank(J.sparsity()) < J.size1():
-            return
-        nb, rowperm, colperm, rowblock, colblock, *_ = J.sparsity().btf()
-        nloop = sum(1 for r in self.rows if r[1].startswith("loop "))
-        xq = ca.vertcat(self.x, q)
-        draw = ca.vertcat(self.x_home, *self.q_home)
-        for k in range(nb):
-            rows = rowperm[rowblock[k] : rowblock[k + 1]]
-            cols = colperm[colblock[k] : colblock[k + 1]]
-            loops = sorted({int(self.rows[r][1].split()[1]) for r in rows if r < nloop})
-            if not loops or len(cols) > ASPECT_MAX_NX:
-                continue
-            d = twist_determinant(phi[rows], ca.vertcat(*[self.x[c] for c in cols]), None)
-            sign = self.assembler.reference_sign(d)
-            scale = ca.fmax(ca.fabs(ca.substitute(d, xq, draw)), 1e-300)
-            name = "loop" + "_".join(str(n) for n in loops)
-            taken, base, m = {b[1] for b in self.branch}, name, 2
-            while name in taken:  # another block of the same loops (the 3-PRC's platform closes two)
-                name, m = f"{base}_block{m}", m + 1
-            what = (
-                f"assembly mode of loop{'s' if len(loops) > 1 else ''} {', '.join(map(str, loops))}: det of "
-                f"{'their' if len(loops) > 1 else 'its'} block of Φ_x, signed as at the reference configuration"
-            )
-            self.branch.append((sign * d / scale, name, what))
 
     def limit_options(self) -> tuple:
         """As the legs', less the families of the actuated joints' own coordinates (their actuators' limits hold)."""
@@ -601,40 +570,6 @@ class GraphGenerator(ClosureBuilder):
         xt = ca.vertcat(*[self.x[k] for k in tree])
         g = ca.jacobian(r, xt).T @ r / scale
         return [(g[k], f"loops, normal equation of {self.x_names[tree[k]]}") for k in range(len(tree))]
-
-    # -- drawing ---------------------------------------------------------------------------
-    def drawing_function(self, q: ca.SX) -> tuple[ca.Function, list]:
-        """Every body's points at the pose (x, q, p), and what to draw: the layout."""
-        # a point name on several bodies is one drawn point where a joint keeps them together
-        # (R, U, S, planar R at that point); across a P or C joint, or unjoined, a point of its own
-        root: dict[tuple, tuple] = {}
-
-        def find(k: tuple) -> tuple:
-            while root.get(k, k) != k:
-                k = root[k]
-            return k
-
-        for g in self.gjoints:
-            at = g.spec.at
-            if isinstance(at, str) and g.type in ("R", "U", "S", "planar_R"):
-                root[find((g.b, at))] = find((g.a, at))
-        drawn: dict[tuple, str] = {}
-        cols, layout = [], []
-        for body in self.d.bodies:
-            for name, p in self.body_points[body.name].items():
-                key = find((body.name, name))
-                if key not in drawn:
-                    drawn[key] = name + "'" * sum(1 for k in drawn if k[1] == name)
-                cols.append(self.world(body.name, p))
-                layout.append((body.name, drawn[key]))
-        for g in self.gjoints:
-            if (isinstance(g.spec.at, str) and g.spec.at.isidentifier()) or g.type == "pose":
-                continue
-            cols.append(self.world(g.a, g.pa))
-            layout.append((g.a, g.name))
-        cols.append(self.P)
-        fn = ca.Function("drawing_points", [self.x, q, self.p], [ca.horzcat(*cols)], ["x", "q", "p"], ["points"])
-        return fn, layout
 
 
 def parameter_defaults(d: Description) -> np.ndarray:
