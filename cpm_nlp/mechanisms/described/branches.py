@@ -34,7 +34,7 @@ WORKING_P = "working mode: e·(B - c) of the P joint before it (axis e) and the 
 
 
 def elimination_indicators(gen: ClosureBuilder, q: ca.SX) -> None:
-    """The indicator of each eliminated link (recorded by :meth:`eliminated`), a mode invariant.
+    """The indicator of each eliminated link (recorded by :meth:`.generate.Generator.eliminated`), a mode invariant.
 
     If the link's rows make a diagonal block of Φ_x (block-triangular form, Dulmage-Mendelsohn)
     holding no other elimination, the link closes a sub-chain of its own (a four-bar's coupler

@@ -45,7 +45,7 @@ def assembled_from_drawing(d: Description) -> bool:
 
 
 class LegsAssembler:
-    """The reference configuration of a legs file from a rough drawing: the :class:`Assembler` of
+    """The reference configuration of a legs file from a rough drawing: the :class:`.assembly.Assembler` of
     the graph its legs expand into (:func:`.expand.expand_legs`; Gauss-Newton on its loops with the
     actuators at their drawn values), its pose coordinates read by name into the legs' (the
     platform's, then each proximal chain's passive joints')."""

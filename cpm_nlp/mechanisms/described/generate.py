@@ -22,7 +22,7 @@ The eliminated joints' values (the passive joint angles) are recovered from
 the chain afterwards, and each elimination gives a branch indicator, an
 invariant of a mode (it changes sign only at a singularity of the sub-chain
 it separates, never because a link turned far), positive at the reference
-configuration (:meth:`Generator.elimination_indicators`):
+configuration (:func:`.branches.elimination_indicators`):
 
 * the link closes a sub-chain of its own (its rows make a diagonal block of
   Φ_x in block-triangular form with no other elimination: a four-bar's
@@ -354,7 +354,7 @@ class Generator(ClosureBuilder):
 
     def indicator(self, value: ca.SX | None, leg: Leg, j: ResolvedJoint, what: str) -> None:
         """A generated branch indicator, named after its leg and joint (``a1.U1``: leg a1, its
-        first joint, a U); value None: filled in by :meth:`elimination_indicators`."""
+        first joint, a U); value None: filled in by :func:`.branches.elimination_indicators`."""
         n = j.spec.path[-1] + 1 if j.spec.path and isinstance(j.spec.path[-1], int) else 0
         name = f"{leg.name}.{JOINT_TYPES[j.type].letter}{n}"
         self.branch.append((value, name, f"leg {leg.name}, joint {n} ({j.type}): {what}"))
@@ -373,7 +373,7 @@ class Generator(ClosureBuilder):
         normal to the axis ``along`` of an eliminated R or C, else v) and its working-mode expression:
         the closure's rate with respect to the joint before it, w·((c - a) × vp) for a revolute (axis
         w at a), e·vp for a P along e (None: no joint before it, or one with several motions).  The
-        indicator itself is chosen once Φ_x is known (:meth:`elimination_indicators`)."""
+        indicator itself is chosen once Φ_x is known (:func:`.branches.elimination_indicators`)."""
         vp = v if along is None else v - ca.dot(v, along) * along
         working, what = None, ""
         if before and JOINT_TYPES[before[-1].type].dof == 1:

@@ -9,16 +9,18 @@ The formulation (relative coordinates with cut joints, as multibody codes write 
   a ``distance`` joint is a rod, never a tree edge), places every body by the product of the
   exponentials of the tree joints' displacements from the drawing.  A tree joint brings its point
   on the distal body onto its point on the proximal one, so a rough drawing (the two points apart)
-  costs nothing.
+  costs nothing (:mod:`.graph_tree`).
 * Each joint left out of the tree closes one loop (the fundamental cycles of the tree: a cycle
   basis).  Its rows say that the two bodies' relative motion is one the joint allows: a point joint
   (S; planar R) keeps its two points together, an R also keeps the axes parallel, a P keeps the
-  relative rotation and the offset along the axis, a distance joint the rod's length.
+  relative rotation and the offset along the axis, a distance joint the rod's length
+  (:mod:`.graph_rows`).
 * Mobility is the number of tree coordinates less the rank of the loops' Jacobian at the reference
   configuration (so an overconstrained linkage such as the Bennett linkage loads); the rows are
-  kept that are independent there, in file order.  Grübler-Kutzbach is counted beside it.
+  kept that are independent there, in file order.  Grübler-Kutzbach is counted beside it
+  (:mod:`.mobility`).
 * The reference configuration is assembled from the drawing: a Gauss-Newton solve on the loops
-  with the actuators at their ``home`` values, for any parameter values (:class:`Assembler`).
+  with the actuators at their ``home`` values, for any parameter values (:class:`.assembly.Assembler`).
 * The pose coordinates are the platform's (``platform.body``, ``platform.point``): rows that say
   the platform coordinates locate that body, then the passive tree coordinates.
 
