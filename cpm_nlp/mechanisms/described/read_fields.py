@@ -5,7 +5,7 @@ keys), a list, a name, free text, a dimension, the type name, a size limit.  Eac
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+from collections.abc import Hashable, Mapping
 from typing import Any
 
 from ...core.errors import InputError, suggest, unknown_key_error
@@ -96,7 +96,7 @@ def check_size(count: int, limit: int, what: str, path: tuple) -> None:
 def check_known(items: Any, known: Mapping | list, path: tuple, what: str = "coordinate") -> None:
     """Each (key, name) of ``items`` names one of ``known`` (the error at ``path`` + its key)."""
     for key, name in items:
-        if name not in known:
+        if not isinstance(name, Hashable) or name not in known:
             raise InputError(
                 f"unknown {what} {name!r}; declared: {', '.join(known)}",
                 path=path + (key,),

@@ -5,7 +5,7 @@ file's."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Hashable, Mapping
 from typing import Any
 
 from ...core.errors import InputError, suggest
@@ -72,7 +72,7 @@ def _named_points(raw: list, path: tuple, points: dict[str, Expr]) -> dict[str, 
     """A list of the drawing's point names: each the global point."""
     own = {}
     for k, n in enumerate(raw):
-        if n not in points:
+        if not isinstance(n, Hashable) or n not in points:
             raise InputError(
                 f"unknown point {n!r}; the drawing's points: {', '.join(points) or 'none (declare them under points)'}",
                 path=path + (k,),

@@ -3,7 +3,7 @@ rotation, task, fixed coordinates, home pose, bounds and offsets."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Hashable, Mapping
 from typing import Any
 
 from ...core.errors import InputError
@@ -39,8 +39,10 @@ def read_platform(raw: Any, path: tuple, graph: bool = False) -> Platform:
             raise InputError(f"missing key {key!r} ({PLATFORM_KEYS[key]})", path=path)
     rotation = _rotation(raw.get("rotation") or [], path + ("rotation",))
     task = as_list(raw["task"], path + ("task",), "a list of coordinate names")
-    if not graph:
-        check_known(enumerate(task), coords, path + ("task",))
+    # a graph's task may name a joint coordinate (checked when it is built): here, a name at least
+    check_known(
+        ((k, t) for k, t in enumerate(task) if not graph or not isinstance(t, Hashable)), coords, path + ("task",)
+    )
     fixed = as_mapping(raw.get("fixed") or {}, path + ("fixed",), "name -> value")
     home = as_mapping(raw.get("home") or {}, path + ("home",), "name -> value")
     bounds = {
@@ -87,6 +89,6 @@ def _offsets(raw: Any, path: tuple, coords: dict, fixed: dict) -> dict[str, str]
     offsets = as_mapping(raw, path, "name -> coordinate")
     for name, target in offsets.items():
         as_name(name, path + (name,), "an offset name")
-        if target not in coords or target in fixed:
+        if not isinstance(target, Hashable) or target not in coords or target in fixed:
             raise InputError(f"expected a pose coordinate, got {target!r}", path=path + (name,))
     return offsets
