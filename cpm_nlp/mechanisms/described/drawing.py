@@ -20,6 +20,7 @@ import numpy as np
 
 from ...core.joints import JOINT_TYPES
 from ...core.mechanism import Drawing
+from .motions import LETTER, ResolvedJoint, chain_motion
 
 #: (leg name, [(joint letter, actuated, the link after it changes length)])
 Layout = Sequence[tuple[str, Sequence[tuple[str, bool, bool]]]]
@@ -218,3 +219,39 @@ def graph_drawing_points(gen: Any, q: Any) -> tuple[Any, list]:
     cols.append(gen.P)
     fn = ca.Function("drawing_points", [gen.x, q, gen.p], [ca.horzcat(*cols)], ["x", "q", "p"], ["points"])
     return fn, layout
+
+
+def leg_points(
+    last: ResolvedJoint,
+    before: list[ResolvedJoint],
+    elim: ResolvedJoint | None,
+    slide: ResolvedJoint | None,
+    Rm: ca.SX,
+    tm: ca.SX,
+    B: ca.SX,
+    planar: bool,
+) -> list[tuple[str, ca.SX, bool, bool]]:
+    """A leg's joints located at the pose x (with q, p), for the drawing: the proximal
+    chain's joints moved by the joints before them, the eliminated joint by the whole
+    proximal chain, a P along the leg at its reference distance from there, the last
+    joint where the platform puts it."""
+    out: list[tuple[str, ca.SX, bool, bool]] = []
+    Rk, tk = ca.SX.eye(3), ca.SX.zeros(3)
+    for j in before:
+        out.append((LETTER[j.type], Rk @ j.at + tk, j.value is not None and j.spec.actuated is not None, False))
+        Rj, tj = chain_motion([j])
+        Rk, tk = Rk @ Rj, Rk @ tj + tk
+    if elim is not None:
+        c = Rm @ elim.at + tm
+        letter = "R" if planar and last.type == "distance" else LETTER[elim.type]
+        out.append((letter, c, False, elim.type == "C"))
+        if slide is not None:
+            reach = ca.norm_2(slide.at - elim.at)
+            out.append(
+                (LETTER[slide.type], c + reach * (B - c) / ca.norm_2(B - c), slide.spec.actuated is not None, True)
+            )
+    tip = "R" if planar and last.type == "distance" else LETTER[last.type]
+    out.append((tip, B, False, False))
+    # a segment after a P (or C) joint changes length: mark the joints that slide
+    out = [(t, v, act, slides or t in ("P", "C")) for t, v, act, slides in out]
+    return out

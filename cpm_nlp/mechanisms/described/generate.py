@@ -71,13 +71,14 @@ from .branches import (
     select_branch,
 )
 from .builder import ClosureBuilder, Reported, dim_name, family
+from .drawing import leg_points
 from .emit import closure_functions
 from .motions import (
     BASE_AXES,
-    LETTER,
     POINT_JOINTS,
     SPHERE_JOINTS,
     ResolvedJoint,
+    chain_motion,
     elementary_motions,
     is_identity,
     rot,
@@ -226,9 +227,9 @@ class Generator(ClosureBuilder):
         for k, j in enumerate(before):
             if j.value is None:
                 self.unknowns(j, leg, k)
-        Rm, tm = self.chain(before)
+        Rm, tm = chain_motion(before)
         B = self.platform_point(tip)
-        self.draw_leg(leg, last, before, elim, slide, Rm, tm, B)
+        self.drawn.append((leg.name, leg_points(last, before, elim, slide, Rm, tm, B, self.d.platform.planar)))
         R_rel = self.R @ self.R_home.T
         if elim is None:
             v = B - (Rm @ tip + tm)
@@ -378,7 +379,7 @@ class Generator(ClosureBuilder):
         working, what = None, ""
         if before and JOINT_TYPES[before[-1].type].dof == 1:
             b = before[-1]
-            Rk, tk = self.chain(before[:-1])  # the joint before, moved by the joints before it
+            Rk, tk = chain_motion(before[:-1])  # the joint before, moved by the joints before it
             if JOINT_TYPES[b.type].motion[0][0] == "R":
                 rate = ca.cross(Rk @ b.axis, c - (Rk @ b.at + tk))
                 what = WORKING_PLANAR if self.d.platform.planar else WORKING_R
@@ -400,57 +401,6 @@ class Generator(ClosureBuilder):
         rows = list(range(len(self.rows) - nrows, len(self.rows)))
         self.pending.append((len(self.branch), rows, working, what))
         self.indicator(None, leg, elim, "")
-
-    def draw_leg(
-        self,
-        leg: Leg,
-        last: ResolvedJoint,
-        before: list[ResolvedJoint],
-        elim: ResolvedJoint | None,
-        slide: ResolvedJoint | None,
-        Rm: ca.SX,
-        tm: ca.SX,
-        B: ca.SX,
-    ) -> None:
-        """The leg's joints located at the pose x (with q, p), for the drawing: the proximal
-        chain's joints moved by the joints before them, the eliminated joint by the whole
-        proximal chain, a P along the leg at its reference distance from there, the last
-        joint where the platform puts it."""
-        planar = self.d.platform.planar
-        out: list[tuple[str, ca.SX, bool, bool]] = []
-        Rk, tk = ca.SX.eye(3), ca.SX.zeros(3)
-        for j in before:
-            out.append((LETTER[j.type], Rk @ j.at + tk, j.value is not None and j.spec.actuated is not None, False))
-            Rj, tj = self.chain([j])
-            Rk, tk = Rk @ Rj, Rk @ tj + tk
-        if elim is not None:
-            c = Rm @ elim.at + tm
-            letter = "R" if planar and last.type == "distance" else LETTER[elim.type]
-            out.append((letter, c, False, elim.type == "C"))
-            if slide is not None:
-                reach = ca.norm_2(slide.at - elim.at)
-                out.append(
-                    (LETTER[slide.type], c + reach * (B - c) / ca.norm_2(B - c), slide.spec.actuated is not None, True)
-                )
-        tip = "R" if planar and last.type == "distance" else LETTER[last.type]
-        out.append((tip, B, False, False))
-        # a segment after a P (or C) joint changes length: mark the joints that slide
-        out = [(t, v, act, slides or t in ("P", "C")) for t, v, act, slides in out]
-        self.drawn.append((leg.name, out))
-
-    def chain(self, joints: list[ResolvedJoint]) -> tuple[ca.SX, ca.SX]:
-        """The motion y -> Rm y + tm of the proximal chain's last body (product of exponentials)."""
-        Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
-        for j in joints:
-            motions = j.motions or [(JOINT_TYPES[j.type].motion[0][0], j.axis, j.value)]
-            for kind, axis, value in motions:
-                if kind == "P":
-                    Rk, tk = ca.SX.eye(3), value * axis
-                else:  # a rotation about the axis through j.at
-                    Rk = rot(axis, value)
-                    tk = j.at - Rk @ j.at
-                Rm, tm = Rm @ Rk, Rm @ tk + tm
-        return Rm, tm
 
     def unknowns(self, j: ResolvedJoint, leg: Leg, k: int) -> None:
         """A passive joint of the proximal chain: its values become pose unknowns (dependent coordinates)."""

@@ -80,3 +80,18 @@ def elementary_motions(j: ResolvedJoint) -> list[tuple[str, Any]]:
     t = JOINT_TYPES[j.type]
     axes = j.axes or [BASE_AXES[a] for a in t.default_axes]
     return [(kind, j.axis if source == "axis" else axes[source]) for kind, source in t.motion]
+
+
+def chain_motion(joints: list[ResolvedJoint]) -> tuple[ca.SX, ca.SX]:
+    """The motion y -> Rm y + tm of the proximal chain's last body (product of exponentials)."""
+    Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
+    for j in joints:
+        motions = j.motions or [(JOINT_TYPES[j.type].motion[0][0], j.axis, j.value)]
+        for kind, axis, value in motions:
+            if kind == "P":
+                Rk, tk = ca.SX.eye(3), value * axis
+            else:  # a rotation about the axis through j.at
+                Rk = rot(axis, value)
+                tk = j.at - Rk @ j.at
+            Rm, tm = Rm @ Rk, Rm @ tk + tm
+    return Rm, tm
