@@ -25,6 +25,9 @@ from .spec import Description, Joint, Leg
 
 @dataclass
 class Reported:
+    """A reported joint value (not a pose coordinate): its coordinate, its expression of (x, q, p),
+    its default limits and the key path of what declares it."""
+
     coord: Coordinate
     value: ca.SX
     limit: tuple | None = None
@@ -170,7 +173,7 @@ class ClosureBuilder:
             can = ", ".join(n for n, t in JOINT_TYPES.items() if t.actuable)
             raise InputError(f"a {j.type} joint cannot be actuated ({can} can)", path=j.path + ("actuated",))
         fam = j.limit or family(name)
-        self.q_coords.append(Coordinate(name, dim, f"actuator of the {j.type} joint at {where_of(j.path)}", fam))
+        self.q_coords.append(Coordinate(name, dim, f"actuator of the {j.type} joint at {format_key_path(j.path)}", fam))
         sym = ca.SX.sym(name)
         self.q_syms.append(sym)
         home = j.home[0] if j.home else 0
@@ -263,9 +266,8 @@ class ClosureBuilder:
             name = r.coord.name
             if name in seen:
                 path = r.path + ("coordinates",) if r.path and r.path[0] != "passive" else r.path
-                also = (
-                    "by every copy of this repeated leg" if seen[name] == r.path else f"also at {where_of(seen[name])}"
-                )
+                where = format_key_path(seen[name])
+                also = "by every copy of this repeated leg" if seen[name] == r.path else f"also at {where}"
                 raise InputError(
                     f"the coordinate name {name!r} is declared twice ({also}); give each joint value its own "
                     "name (in a repeated leg, with its index: e.g. 'alpha{i}')",
@@ -309,11 +311,8 @@ class ClosureBuilder:
         return tuple(seen.values())
 
 
-def where_of(path: tuple) -> str:
-    return format_key_path(path)
-
-
 def dim_name(dim: ex.Dim) -> str:
+    """The dimension a value's (length, angle) exponents name: length, angle or dimensionless."""
     if dim is None or dim[0] == 0:
         return "angle" if dim is not None and dim[1] else "dimensionless"
     return "length"
