@@ -348,13 +348,19 @@ class _Evaluator:
         if len(node.args) != nargs:
             raise self.fail(node, f"{name}() takes {nargs} argument(s), got {len(node.args)}")
         args = [self.eval(a) for a in node.args]
+        self._check_sizes(node, name, args, vector)
+        dim = rule(name, args, self.col(node))
+        return self.finite(node, Value(impl(*[a.sx for a in args]), dim), args, name)
+
+    def _check_sizes(self, node: ast.Call, name: str, args: list[Value], vector: bool) -> None:
+        """A function of scalars takes scalars; cross() vectors of 3, dot() two of one size."""
         for a, arg in zip(node.args, args):
             if vector and arg.size != 3 and name == "cross":
                 raise self.fail(a, "cross() takes vectors of 3 elements")
             if not vector and arg.size != 1:
                 raise self.fail(a, f"{name}() takes scalars; got a vector of {arg.size}")
-        dim = rule(name, args, self.col(node))
-        return self.finite(node, Value(impl(*[a.sx for a in args]), dim), args, name)
+        if name == "dot" and args[0].size != args[1].size:
+            raise self.fail(node, f"dot() takes two vectors of one size, got {args[0].size} and {args[1].size}")
 
     def _select(self, node: ast.Call) -> Value:
         """select(i, a, b, ...): the i-th (from 1) of the values, i a plain number known when the file is read."""

@@ -248,6 +248,9 @@ def _quantity(name: str, raw: Any, path: tuple) -> Quantity:
         raise InputError("missing key 'value' (an expression)", path=path)
     dim = None if raw.get("dimension") is None else as_dimension(raw["dimension"], path + ("dimension",))
     fam = raw.get("family") or ""
+    if not isinstance(fam, str):
+        what = f"expected a joint-limit family (a name such as 'alpha'), got {fam!r:.60}"
+        raise InputError(what, path=path + ("family",))
     return Quantity(name, raw["value"], dim, as_text(raw.get("description"), path + ("description",)), fam)
 
 
