@@ -7,7 +7,7 @@ sections have modules of their own: :mod:`.read_platform`, :mod:`.read_legs`,
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Hashable, Mapping
 from typing import Any
 
 from ...analysis.compliance import HINGE_KEYS
@@ -248,7 +248,7 @@ def _quantity(name: str, raw: Any, path: tuple) -> Quantity:
         raise InputError("missing key 'value' (an expression)", path=path)
     dim = None if raw.get("dimension") is None else as_dimension(raw["dimension"], path + ("dimension",))
     fam = raw.get("family") or ""
-    if not isinstance(fam, str):
+    if not isinstance(fam, Hashable):  # a family names an option (a key)
         what = f"expected a joint-limit family (a name such as 'alpha'), got {fam!r:.60}"
         raise InputError(what, path=path + ("family",))
     return Quantity(name, raw["value"], dim, as_text(raw.get("description"), path + ("description",)), fam)
