@@ -144,9 +144,10 @@ class Assembler:
         x0, _q0, _span = (np.asarray(v, dtype=float).ravel() for v in self.draw(self.defaults))
         Jx = np.asarray(self.F(x0, _q0, self.defaults)[1], dtype=float)
         cols = gen.tree_columns()
-        J = Jx[: self.nloop][:, cols]
-        # the rank where the drawing has a value (a parameter can put a point out of reach: NaN)
-        free = len(cols) - int(np.linalg.matrix_rank(J)) if np.all(np.isfinite(J)) else len(gen.q_coords)
+        try:
+            free = len(cols) - int(np.linalg.matrix_rank(Jx[: self.nloop][:, cols]))
+        except np.linalg.LinAlgError:  # no rank: the drawing has no value (a point out of reach: NaN)
+            free = len(gen.q_coords)
         if free < len(gen.q_coords):  # the actuators lock the loops against each other
             return InputError(
                 f"wrong mobility: at the drawing the loops leave {free} degree(s) of freedom, and "
