@@ -56,7 +56,7 @@ from .atomic import check_output_path
 WHAT = ("fk", "ik", "jacobian")
 
 #: a mechanism name usable in C identifiers and file names (described mechanisms are checked when read:
-#: cpm_nlp.mechanisms.described.spec.MAX_TYPE_NAME); anything else is refused before a file is written
+#: cpm_nlp.mechanisms.described.read_fields.MAX_TYPE_NAME); anything else is refused before a file is written
 SAFE_NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9])*")
 MAX_NAME = 64
 FORMATS = ("casadi", "c")
