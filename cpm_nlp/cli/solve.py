@@ -23,10 +23,12 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
 
     check_output_path(args.output, [args.file])
     check_plot_args(args, [args.file, args.output])
+    # small dense algebra only: BLAS threads cost more than they give (core/blas.py); first,
+    # so that the cap is the libraries' environment, set before numpy loads them
+    blas.cap_process()
     with progress.reporting(progress_bars(args)):
         with solver_output(args):
             problem = load_problem(args.file, args.set or [])
-        blas.cap_process()  # small dense algebra only: BLAS threads cost more than they give (core/blas.py)
         with solver_output(args, problem.solver):
             result = solve(problem)
     # the result first: a plot that cannot be drawn never takes it away
