@@ -18,14 +18,14 @@ if TYPE_CHECKING:
 
 
 def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
+    # small dense algebra only: BLAS threads cost more than they give (core/blas.py); first,
+    # so that the cap is the libraries' environment, set before numpy loads them
+    blas.cap_process()
     from ..mechanisms.registry import mechanism_type
     from ..problems.file import load_problem, solve
 
     check_output_path(args.output, [args.file])
     check_plot_args(args, [args.file, args.output])
-    # small dense algebra only: BLAS threads cost more than they give (core/blas.py); first,
-    # so that the cap is the libraries' environment, set before numpy loads them
-    blas.cap_process()
     with progress.reporting(progress_bars(args)):
         with solver_output(args):
             problem = load_problem(args.file, args.set or [])
