@@ -176,60 +176,75 @@ def bench_cuboid(repeats: int) -> dict:
     return {"pantograph_cuboid": entry}
 
 
-#: start-up commands, in a fresh process each (argv after the interpreter)
+#: one BLAS thread, as ``cpm-nlp solve`` sets it before numpy loads (core/blas.py)
+CAPPED = {"OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "BLIS_NUM_THREADS": "1"}
+LIBS = "import numpy, casadi, yaml"
+
+#: start-up commands, in a fresh process each: (argv after the interpreter, environment added)
 STARTUP = {
-    "python_isolated": ["-I", "-S", "-c", "pass"],
-    "python_bare": ["-c", "pass"],
-    "python_numpy": ["-c", "import numpy"],
-    "python_casadi": ["-c", "import casadi"],
-    "python_numpy_casadi_yaml": ["-c", "import numpy, casadi, yaml"],
-    "help": ["-m", "cpm_nlp", "--help"],
-    "plot_help": ["-m", "cpm_nlp", "plot", "--help"],
-    "solve_prs3_fk": ["-m", "cpm_nlp", "solve", "problems/prs3_forward_kinematics.yaml"],
+    "python_isolated": (["-I", "-S", "-c", "pass"], {}),
+    "python_bare": (["-c", "pass"], {}),
+    "python_numpy": (["-c", "import numpy"], {}),
+    "python_casadi": (["-c", "import casadi"], {}),
+    "python_numpy_casadi_yaml": (["-c", LIBS], {}),
+    # what the solve cannot avoid, as the solve loads it: one BLAS thread, no teardown at exit
+    "python_numpy_casadi_yaml_capped": (["-c", f"{LIBS}, os; os._exit(0)"], CAPPED),
+    "help": (["-m", "cpm_nlp", "--help"], {}),
+    "plot_help": (["-m", "cpm_nlp", "plot", "--help"], {}),
+    "solve_prs3_fk": (["-m", "cpm_nlp", "solve", "problems/prs3_forward_kinematics.yaml"], {}),
 }
 
 
 def _child(argv: list[str], env: dict) -> tuple[float, float]:
-    """(CPU seconds, user + sys, wall seconds) of one run of the interpreter with ``argv``."""
+    """(CPU seconds, user + sys, wall seconds) of one run of the interpreter with ``argv``
+    (in the checkout named by ``env["PYTHONPATH"]``)."""
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, *argv], cwd=ROOT, capture_output=True, check=True, env=env)
+    cwd = env["PYTHONPATH"].split(os.pathsep)[0]
+    subprocess.run([sys.executable, *argv], cwd=cwd, capture_output=True, check=True, env=env)
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime, wall
 
 
-def bench_startup(repeats: int) -> dict:
-    """Start-up CPU time of the CLI beside its baselines, interleaved (issue 23)."""
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH", "")]))
-    for argv in STARTUP.values():  # warm-up: bytecode written, files in the page cache
-        _child(argv, env)
-    cpu: dict = {k: [] for k in STARTUP}
-    wall: dict = {k: [] for k in STARTUP}
+def bench_startup(repeats: int, before_checkout: str | None = None) -> dict:
+    """Start-up CPU time of the CLI beside its baselines, interleaved (issue 23);
+    ``before_checkout``: another checkout (e.g. ``git archive`` of the commit before a
+    change) whose ``--help`` and solve run in the same interleaving (``*_before``)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONPATH")}
+    env["PYTHONPATH"] = str(ROOT)
+    runs = dict(STARTUP)
+    if before_checkout:
+        other = {"PYTHONPATH": str(Path(before_checkout).resolve())}
+        runs["help_before"] = (STARTUP["help"][0], other)
+        runs["solve_prs3_fk_before"] = (STARTUP["solve_prs3_fk"][0], other)
+    for argv, extra in runs.values():  # warm-up: bytecode written, files in the page cache
+        _child(argv, {**env, **extra})
+    cpu: dict = {k: [] for k in runs}
+    wall: dict = {k: [] for k in runs}
     before = load()
     for _ in range(repeats):
-        for k, argv in STARTUP.items():
-            c, w = _child(argv, env)
+        for k, (argv, extra) in runs.items():
+            c, w = _child(argv, {**env, **extra})
             cpu[k].append(c)
             wall[k].append(w)
     after = load()
     med = {k: statistics.median(v) for k, v in cpu.items()}
     out: dict = {}
-    for k in STARTUP:
+    for k in runs:
         out[k] = {
             "cpu": med[k],
             "cpu_min": min(cpu[k]),
             "wall": statistics.median(wall[k]),
             "unit": "s",
-            "command": "python " + " ".join(STARTUP[k]),
+            "command": " ".join([*(f"{n}={v}" for n, v in runs[k][1].items()), "python", *runs[k][0]]),
             "load_before": before,
             "load_after": after,
         }
-    libs, bare = med["python_numpy_casadi_yaml"], med["python_bare"]
+    libs, bare = med["python_numpy_casadi_yaml_capped"], med["python_bare"]
     for name, base, base_name in (
         ("help", bare, "python -c pass"),
-        ("solve_prs3_fk", libs, "python -c 'import numpy, casadi, yaml'"),
+        ("solve_prs3_fk", libs, "python -c 'import numpy, casadi, yaml' (one BLAS thread, no teardown)"),
     ):
         entry = out[name]
         target = TARGETS[name]
@@ -253,6 +268,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="few repeats (a smoke run, not a measurement)")
     parser.add_argument("--startup", action="store_true", help="only the start-up figures (issue 23)")
+    parser.add_argument("--before", metavar="DIR", help="start-up: also run --help and the solve from this checkout")
     parser.add_argument("-o", "--output", default=None, help="JSON file (default: issue15.json, startup.json)")
     args = parser.parse_args(argv)
     args.output = args.output or str(Path(__file__).parent / ("startup.json" if args.startup else "issue15.json"))
@@ -263,7 +279,7 @@ def main(argv: list[str] | None = None) -> int:
         "quick": args.quick,
         **({} if args.startup else bench_certify(n)),
         **({} if args.startup else bench_cuboid(n)),
-        **bench_startup(n if args.quick else 9),
+        **bench_startup(n if args.quick else 9, args.before),
     }
     for name, e in results.items():
         if isinstance(e, dict) and "cpu" in e:
