@@ -23,7 +23,9 @@ Measurements
                       fastest way to evaluate them from Python)
   single_fk_newton    one cn.forward_kinematics(model, q, newton) call (µs, median)
   single_fk_ipopt     one cn.forward_kinematics(model, q) call (IPOPT)
-  single_fk_function  one call of cn.functions(model).fk (the embedding Function)
+  single_fk_function  one call of cn.functions(model).fk on numpy arrays (the embedding
+                      Function's direct call into the compiled kernel, issue 23)
+  single_fk_function_casadi  the same call on DMs (CasADi's own call, as every call was before)
   casadi_trivial_call one call of a CasADi Function y = x from Python (the floor of the above)
   reproduce           `cpm-nlp reproduce`, end to end in a fresh process (s)
   memory_1m           batch FK of 1,000,000 poses in a fresh process: peak RSS (MB)
@@ -241,6 +243,8 @@ def bench_single(model: cn.Model, quick: bool) -> dict:
     out["single_fk_newton_path"] = cn.forward_kinematics(model, q, newton).path
     noted(out, "single_fk_ipopt", 1e6 * median_call(lambda: cn.forward_kinematics(model, q), max(50, n // 10)))
     noted(out, "single_fk_function", 1e6 * median_call(lambda: fns.fk(q, model.x_home), n))
+    qd, xd = ca.DM(q), ca.DM(model.x_home)
+    noted(out, "single_fk_function_casadi", 1e6 * median_call(lambda: fns.fk(qd, xd), n))
     noted(out, "casadi_trivial_call", 1e6 * median_call(lambda: trivial(1.0), n))
     return out
 
@@ -339,6 +343,7 @@ UNITS = {
     "single_fk_newton": "µs",
     "single_fk_ipopt": "µs",
     "single_fk_function": "µs",
+    "single_fk_function_casadi": "µs",
     "reproduce": "s",
     "memory_1m": "MB peak RSS",
     "memory_1m_seconds": "s",

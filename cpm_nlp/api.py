@@ -48,18 +48,23 @@ from .problems.registry import kind_names, problem_kind
 from .problems.reproduce import Comparison, reproduce
 
 
-def functions(source: Model | str | os.PathLike, solver: SolverConfig | None = None) -> ModelFunctions:
+def functions(
+    source: Model | str | os.PathLike, solver: SolverConfig | None = None, *, backend: str = "auto"
+) -> ModelFunctions:
     """The CasADi Functions of a model, or of the mechanism of a problem file.
 
     source: a :class:`Model` (e.g. from :func:`cpm_nlp.build_model`) or the
     path of a problem file (its mechanism, and its solver unless ``solver`` is given).
     solver: tolerance and Newton options (abstol, abstolStep, max_iter) built
     into fk and ik (default: ``SolverConfig("newton")``).
+    backend: what evaluates fk, ik and jacobian called on numbers ("auto": the compiled C
+    where a C compiler is available; "compiled"; "map": CasADi's virtual machine); on
+    CasADi symbols they are CasADi Functions whatever the backend.
     """
     if isinstance(source, (str, os.PathLike)):
         problem = load_problem(source)
-        return model_functions(problem.model, solver or problem.solver)
-    return model_functions(source, solver)
+        return model_functions(problem.model, solver or problem.solver, backend=backend)
+    return model_functions(source, solver, backend=backend)
 
 
 def describe_mechanism(description: Description, *, register: bool = True) -> Mechanism:

@@ -65,6 +65,7 @@ from ..core.batch import batch_forward_kinematics, evaluate
 from ..core.errors import InputError
 from ..core.kinematics import PoseSolution, assess, forward_kinematics, passive_joints
 from ..core.model import Model
+from ..core.multistart import DEFAULT_STARTS as DEFAULT_STARTS  # the default starts of a search (defined there)
 from ..core.pose_checks import ROUND_TRIP_FACTOR, STATUSES
 from ..core.result import Status
 from ..core.solver import SolverConfig
@@ -385,9 +386,6 @@ DAMPED_STEPS = 30
 #: steps 91 % of the starts converge (measured with its home lifted 1 m) and every mode's basin holds at least
 #: 0.06 % of them (benchmarks/bench_assembly_modes.py)
 STEP_LIMIT = 1.0
-#: starts of a search: all 40 modes of Dietmaier's platform with probability 0.999 (estimated
-#: from the basins of 100 000 starts; benchmarks/bench_assembly_modes.py measures it over seeds)
-DEFAULT_STARTS = 12000
 
 
 def search_solver(config: SolverConfig) -> SolverConfig:

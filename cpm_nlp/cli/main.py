@@ -8,10 +8,11 @@ Exit status (:mod:`cpm_nlp.cli.exits`): 0 solved, 1 a solve that did not succeed
 says why), 2 bad input (one message naming the file, the key path and what was expected), 70
 an internal error (a bug: please report it).
 
-Start-up is kept short on purpose: this module and the subcommand modules import only the
-standard library and the light :mod:`cpm_nlp.core.errors`; each subcommand and renderer
-imports what it needs when it runs (units, numpy, CasADi, the problem kinds, Matplotlib,
-Dask), so ``cpm-nlp --help`` loads none of them.
+Start-up is kept short on purpose (issue 23): this module imports only argparse and a few
+standard modules; a subcommand's module is imported when that subcommand runs
+(:class:`_Command`), and each subcommand and renderer imports what it needs when it runs
+(units, numpy, CasADi, the problem kinds, Matplotlib, Dask), so ``cpm-nlp --help`` loads
+none of them, nor any subcommand module.
 """
 
 from __future__ import annotations
@@ -24,19 +25,8 @@ import signal
 import sys
 from collections.abc import Callable, Sequence
 
-from ..core.errors import CpmError, InputError
 from ..core.version import __version__
-from ..io.inputs import inputs_scope
-from .bars import close_bars
-from .describe import cmd_describe
-from .examples import cmd_examples
 from .exits import EXIT_BROKEN_PIPE, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_OK
-from .export import cmd_export
-from .plot import cmd_plot
-from .reproduce import cmd_reproduce
-from .solve import cmd_check, cmd_solve
-from .sweep import cmd_sweep
-from .urdf import cmd_import
 
 TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
 if TYPE_CHECKING:
@@ -71,7 +61,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="write the result as JSON to FILE (atomically)")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit status tells")
     _add_plot_arguments(p, "--plot")
-    p.set_defaults(func=cmd_solve)
+    p.set_defaults(func=_Command("solve", "cmd_solve"))
 
     p = sub.add_parser(
         "sweep",
@@ -97,7 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--overwrite", action="store_true", help="discard RESULTS and start again instead of resuming")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
     _add_plot_arguments(p, "--plot")
-    p.set_defaults(func=cmd_sweep)
+    p.set_defaults(func=_Command("sweep", "cmd_sweep"))
 
     p = sub.add_parser(
         "plot",
@@ -110,18 +100,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--x", metavar="NAME", help="map: parameter (or value) on the horizontal axis")
     p.add_argument("--y", metavar="NAME", help="map: parameter (or value) on the vertical axis")
     _add_plot_arguments(p, None)
-    p.set_defaults(func=cmd_plot)
+    p.set_defaults(func=_Command("plot", "cmd_plot"))
 
     p = sub.add_parser("check", help="validate a problem file without solving it")
     p.add_argument("file")
     p.add_argument("--set", action="append", metavar="KEY=VALUE")
-    p.set_defaults(func=cmd_check)
+    p.set_defaults(func=_Command("solve", "cmd_check"))
 
     p = sub.add_parser("reproduce", help="solve every problem file that reproduces a published figure")
     p.add_argument("paths", nargs="*", help="problem files or directories (default: problems/)")
     p.add_argument("--json", action="store_true", help="print the table as JSON")
     p.add_argument("-o", "--output", metavar="FILE", help="write the table as JSON to FILE")
-    p.set_defaults(func=cmd_reproduce)
+    p.set_defaults(func=_Command("reproduce", "cmd_reproduce"))
 
     p = sub.add_parser(
         "export",
@@ -134,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", default="casadi", help="casadi (.casadi files) or c (source + header)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (created if missing)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file")
-    p.set_defaults(func=cmd_export)
+    p.set_defaults(func=_Command("export", "cmd_export"))
 
     p = sub.add_parser(
         "examples",
@@ -144,7 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("dir", metavar="DIR", help="directory to copy into (created if missing)")
     p.add_argument("--force", action="store_true", help="overwrite files of the same name")
-    p.set_defaults(func=cmd_examples)
+    p.set_defaults(func=_Command("examples", "cmd_examples"))
 
     p = sub.add_parser(
         "describe", help="list mechanisms and problem kinds, or describe one (a mechanism file: load, check, describe)"
@@ -158,7 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--plot", metavar="FIGURE", help="with a mechanism file: also draw its body graph (.png, .svg, .pdf)"
     )
-    p.set_defaults(func=cmd_describe)
+    p.set_defaults(func=_Command("describe", "cmd_describe"))
 
     p = sub.add_parser(
         "import",
@@ -177,8 +167,22 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--task", metavar="X,Y", help="the task coordinates (default: by the number of actuators)")
     p.add_argument("--spatial", action="store_true", help="write a spatial file even if the mechanism is planar")
-    p.set_defaults(func=cmd_import)
+    p.set_defaults(func=_Command("urdf", "cmd_import"))
     return parser
+
+
+class _Command:
+    """The handler of a subcommand, ``cpm_nlp.cli.<module>.<name>``, imported only when that
+    subcommand runs: the parser (and ``--help``) loads no subcommand module."""
+
+    def __init__(self, module: str, name: str) -> None:
+        self.module = module
+        self.name = name
+
+    def resolve(self) -> Callable[[argparse.Namespace, TextIO], int]:
+        import importlib
+
+        return getattr(importlib.import_module(f".{self.module}", __package__), self.name)
 
 
 class _Deferred(str):
@@ -202,6 +206,7 @@ class _PlotTypesFormatter(argparse.HelpFormatter):
 def _plot_types_text(width: int) -> str:
     import textwrap
 
+    from ..core.errors import CpmError
     from ..plot.registry import plot_type_names, plot_types
 
     try:
@@ -257,9 +262,13 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
     root = logging.getLogger("cpm_nlp")
     root.addHandler(handler)
     root.setLevel(logging.WARNING - 10 * min(args.verbose, 2))
-    func: Callable[[argparse.Namespace, TextIO], int] = args.func
+    from ..core.errors import CpmError, InputError
+    from ..io.inputs import inputs_scope
+    from .bars import close_bars
+
     args.err = err
     try:
+        func = args.func.resolve()
         with inputs_scope():
             return func(args, out)
     except InputError as exc:
@@ -342,7 +351,29 @@ def main_entry() -> None:
             with contextlib.suppress(Exception):
                 stream.flush()
         os._exit(code)
-    sys.exit(code)
+    _exit_without_teardown(code)
+
+
+def _exit_without_teardown(code: int) -> None:
+    """Exit with ``code`` once the command is done, without tearing the interpreter down.
+
+    Tearing down the modules and the objects of a solve (CasADi's graphs and solvers, the
+    numpy and CasADi extension modules) took 30 to 90 ms of CPU, a quarter of a whole
+    ``cpm-nlp solve`` (issue 23, start-up), to free memory the process returns at once.
+    What an exit must do is still done: the ``atexit`` functions run (logging's flush, a
+    coverage run's save), stdout and stderr are flushed; every output file was written
+    and closed by the command.  Where a thread of ours is still alive (a sweep's cluster),
+    the ordinary exit joins it."""
+    import atexit
+    import threading
+
+    if threading.active_count() > 1:
+        sys.exit(code)
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":  # pragma: no cover

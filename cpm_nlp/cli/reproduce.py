@@ -73,12 +73,12 @@ def render_reproduce_summary(summary: dict[str, Any]) -> str:
 
 
 def cmd_reproduce(args: argparse.Namespace, out: TextIO) -> int:
+    blas.cap_process()  # first: before numpy loads its BLAS, the cap is its environment (core/blas.py)
     from ..core.result import jsonable
     from ..problems.published import summarize
     from ..problems.reproduce import reproduce
 
     check_output_path(args.output, args.paths)
-    blas.cap_process()
     with solver_output(args):
         rows = reproduce(args.paths or None)
     summary = summarize(rows)

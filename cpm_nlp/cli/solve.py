@@ -18,6 +18,9 @@ if TYPE_CHECKING:
 
 
 def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
+    # small dense algebra only: BLAS threads cost more than they give (core/blas.py); first,
+    # so that the cap is the libraries' environment, set before numpy loads them
+    blas.cap_process()
     from ..mechanisms.registry import mechanism_type
     from ..problems.file import load_problem, solve
 
@@ -26,7 +29,6 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     with progress.reporting(progress_bars(args)):
         with solver_output(args):
             problem = load_problem(args.file, args.set or [])
-        blas.cap_process()  # small dense algebra only: BLAS threads cost more than they give (core/blas.py)
         with solver_output(args, problem.solver):
             result = solve(problem)
     # the result first: a plot that cannot be drawn never takes it away

@@ -41,7 +41,7 @@ import numpy as np
 
 from . import progress
 from .compiled import BACKENDS as BACKENDS  # noqa: F401 - re-exported
-from .compiled import NativeLoop, backend_function, native_loop
+from .compiled import NativeLoop, backend_function, cache_key, native_loop, packed_outputs
 from .errors import InputError
 from .fast_calls import fast
 from .kernels import PATHS, Kernel, fk_kernel, ik_kernel, jacobian_kernel, shared_values
@@ -264,8 +264,17 @@ def _broadcast_rows(values, n: int, n_cols: int, name: str) -> np.ndarray:
 
 def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Function | NativeLoop, str]:
     """The kernel's CasADi Function ("map") or the compiled library's loop over poses ("compiled")."""
-    fn, used = backend_function(model.closure, kern, backend)
-    return (native_loop(model.closure, kern), used) if used == "compiled" else (fn, used)
+    c = model.closure
+
+    def resolve() -> tuple[ca.Function | NativeLoop, str]:
+        fn, used = backend_function(c, kern, backend)
+        return (native_loop(c, kern), used) if used == "compiled" else (fn, used)
+
+    if backend not in BACKENDS:  # the error, with its suggestion, is backend_function's
+        return resolve()
+    # one look-up per call (keyed on the cache's environment: a changed CPM_NLP_CACHE means
+    # other libraries), instead of the paths of compiled.cache_dir() built twice per call
+    return c.solvers.memo(("batch_backend", backend, *cache_key()) + kern.key, resolve)
 
 
 def _run_chunks(run: Callable[[int], int], starts: list[int], chunk: int, n: int, threads: int, what: str) -> list[int]:
@@ -335,17 +344,17 @@ def evaluate(
     per_pose = [a for a in args if a.ndim == 2]
     n = per_pose[0].shape[0] if per_pose else 1
     nnz_out = function.nnz_out if native else [function.nnz_out(k) for k in range(function.n_out())]
-    outs = [np.empty((n, m)) for m in nnz_out]
+    outs = packed_outputs(n, nnz_out) if native else [np.empty((n, m)) for m in nnz_out]
     if n == 0:
         return outs
     threads = default_threads() if threads is None else max(1, int(threads))
     chunk = max(1, min(int(chunk), -(-n // threads)))
     starts = list(range(0, n, chunk))
     if native:
-        args = [np.ascontiguousarray(a, dtype=float) for a in args]
+        where = function.addresses([np.ascontiguousarray(a, dtype=float) for a in args], outs)
 
         def run(start: int) -> int:
-            return function.run(start, min(start + chunk, n), args, outs)
+            return function.run_at(start, min(start + chunk, n), where)
 
     else:
         maps: dict[int, tuple[ca.Function, list[np.ndarray | None]]] = {}

@@ -8,7 +8,11 @@ compliance took 20-28 ms per pose against 1.1 ms with one BLAS thread
 
 * :func:`cap_process` -- one BLAS thread for the whole process: the CLI and the
   sweep's worker processes call it (they run nothing but small algebra; parallel
-  work is CasADi's thread pool and Dask's processes, not BLAS).
+  work is CasADi's thread pool and Dask's processes, not BLAS).  Called before
+  any BLAS library is loaded (``cpm-nlp solve`` calls it first), it only sets the
+  libraries' environment variables (:data:`BLAS_THREAD_VARIABLES`), which they
+  read when they load: threadpoolctl is not imported and costs nothing (issue 23,
+  start-up); processes started from this one inherit the cap.
 * :func:`small_algebra` -- the same for a block of library code, for a program that
   calls the library (its own BLAS threads are restored after); cheap when the
   process is already capped; :func:`one_blas_thread` decorates a function with it.
@@ -22,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import os
 import sys
 import threading
 from collections.abc import Callable, Iterator
@@ -29,7 +34,12 @@ from typing import Any, TypeVar
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-_STATE: dict[str, Any] = {"controller": None, "seen": None, "capped": False}
+#: the environment variables that set the threads of a BLAS library when it loads (OpenBLAS,
+#: Intel MKL, BLIS, Apple's vecLib)
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
+
+#: "by_environment": capped before any BLAS library was loaded (each reads its variable)
+_STATE: dict[str, Any] = {"controller": None, "seen": None, "capped": False, "by_environment": False}
 _LOCK = threading.Lock()
 #: the modules that load a BLAS library (numpy's, and scipy's own)
 _BLAS_MODULES = ("numpy", "scipy.linalg")
@@ -52,9 +62,17 @@ def _controller() -> Any:
 
 
 def cap_process() -> None:
-    """One BLAS thread from now on, in this process, for the libraries loaded so far
-    (nothing is imported here: a solve that needs no scipy loads none; a library
-    loaded later is capped by the next :func:`small_algebra`)."""
+    """One BLAS thread from now on, in this process.  Before any BLAS library is loaded:
+    their environment variables, read when each loads (nothing imported).  Else, for the
+    libraries loaded so far, through threadpoolctl (a solve that needs no scipy loads
+    none; a library loaded later is capped by the next :func:`small_algebra`)."""
+    if _STATE["by_environment"]:
+        return
+    if not _loaded():
+        for name in BLAS_THREAD_VARIABLES:
+            os.environ[name] = "1"
+        _STATE["by_environment"] = _STATE["capped"] = True
+        return
     _controller().limit(limits=1, user_api="blas")
     _STATE["capped"] = True
 
@@ -63,7 +81,7 @@ def cap_process() -> None:
 def small_algebra() -> Iterator[None]:
     """One BLAS thread within the block (a no-op where :func:`cap_process` ran)."""
     if _STATE["capped"]:
-        if _STATE["seen"] != _loaded():
+        if not _STATE["by_environment"] and _STATE["seen"] != _loaded():
             cap_process()
         yield
         return

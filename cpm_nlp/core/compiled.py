@@ -38,8 +38,15 @@ from .model import LoopClosure
 
 log = logging.getLogger(__name__)
 
-#: flags of the compiled batch path (the export uses the plain -O2 the README shows)
-CFLAGS = ("-O3", "-fPIC", "-shared")
+#: flags of the compiled batch path (the export uses the plain -O2 the README shows).
+#: -ffp-contract=off: no fused multiply-add, so the C gives CasADi's virtual machine's numbers
+#: to the bit on every machine (gcc contracts by default where the target has FMA, e.g. aarch64).
+#: -fvisibility=hidden with GCC_HASCLASSVISIBILITY (CasADi's CASADI_SYMBOL_EXPORT then marks
+#: the library's entry points visible): CasADi's helpers (casadi_sq, casadi_fabs, casadi_fmin,
+#: casadi_fmax, ...) are otherwise exported, so every use is a call through the PLT that gcc
+#: may not inline -- about 600 of them in the 3-PRS FK; hidden, they inline: 22-30 % less CPU
+#: per pose, the same bits (benchmarks/bench_batch_speed.py)
+CFLAGS = ("-O3", "-ffp-contract=off", "-fvisibility=hidden", "-DGCC_HASCLASSVISIBILITY", "-fPIC", "-shared")
 
 
 class CompilerError(CpmError):
@@ -57,6 +64,14 @@ def cache_dir() -> Path:
         return Path(os.environ.get("LOCALAPPDATA", Path.home())) / "cpm_nlp" / "Cache"
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "cpm_nlp"
+
+
+def cache_key() -> tuple[str | None, ...]:
+    """The environment that decides :func:`cache_dir` (``CPM_NLP_CACHE``, ``XDG_CACHE_HOME``,
+    ``HOME``, ``LOCALAPPDATA``), as a key of the per-process memos: a changed variable (a test's
+    fresh cache) means other libraries, and no path is built on every call."""
+    env = os.environ
+    return (env.get("CPM_NLP_CACHE"), env.get("XDG_CACHE_HOME"), env.get("HOME"), env.get("LOCALAPPDATA"))
 
 
 def find_compiler() -> list[str] | None:
@@ -142,18 +157,57 @@ class NativeLoop:
     def run(self, start: int, stop: int, inputs: list[np.ndarray], outputs: list[np.ndarray]) -> int:
         """Poses start..stop-1.  inputs: (N, nnz) C-contiguous per-pose arrays or
         1-D shared values; outputs: (N, nnz_out) C-contiguous arrays."""
-        ins = (ctypes.c_void_p * self.n_in)()
-        in_step = (ctypes.c_long * self.n_in)()
-        for k, a in enumerate(inputs):
-            step = a.shape[1] if a.ndim == 2 else 0
-            ins[k] = a.ctypes.data + 8 * start * step
-            in_step[k] = step
-        outs = (ctypes.c_void_p * self.n_out)()
-        out_step = (ctypes.c_long * self.n_out)()
-        for k, a in enumerate(outputs):
-            outs[k] = a.ctypes.data + 8 * start * a.shape[1]
-            out_step[k] = a.shape[1]
+        return self.run_at(start, stop, self.addresses(inputs, outputs))
+
+    @staticmethod
+    def addresses(inputs: list[np.ndarray], outputs: list[np.ndarray]) -> tuple:
+        """Where the arrays of :meth:`run` are: (addresses, steps, number of inputs, buffer to
+        keep alive), inputs then outputs, each address that of row 0 and its step the row length
+        (0 for a shared 1-D input).  The shared inputs are copied into one buffer, and outputs
+        made by :func:`packed_outputs` are located through their one buffer: one address
+        look-up each (numpy's ``.ctypes.data`` costs about 1.4 µs, 17 of them were a third of
+        the fixed cost of a call)."""
+        shared = [a for a in inputs if a.ndim != 2]
+        block = np.concatenate(shared) if shared else np.empty(0)
+        base, at = block.ctypes.data, 0
+        addr: list[int] = []
+        for a in inputs:
+            if a.ndim == 2:
+                addr.append(a.ctypes.data)
+            else:
+                addr.append(base + 8 * at)
+                at += a.size
+        owner = outputs[0].base if outputs else None
+        if isinstance(owner, np.ndarray) and owner.size == sum(o.size for o in outputs):
+            start, at = owner.ctypes.data, 0
+            for o in outputs:  # pieces of one buffer, in order (packed_outputs)
+                addr.append(start + 8 * at)
+                at += o.size
+        else:
+            addr.extend(o.ctypes.data for o in outputs)
+        steps = [a.shape[1] if a.ndim == 2 else 0 for a in inputs] + [o.shape[1] for o in outputs]
+        return addr, steps, len(inputs), block
+
+    def run_at(self, start: int, stop: int, where: tuple) -> int:
+        """Poses start..stop-1 of the arrays located by :meth:`addresses`."""
+        addr, steps, n_in, _block = where
+        moved = [a + 8 * start * s for a, s in zip(addr, steps)]
+        ins = (ctypes.c_void_p * self.n_in)(*moved[:n_in])
+        in_step = (ctypes.c_long * self.n_in)(*steps[:n_in])
+        outs = (ctypes.c_void_p * self.n_out)(*moved[n_in:])
+        out_step = (ctypes.c_long * self.n_out)(*steps[n_in:])
         return int(self.call(stop - start, ins, in_step, outs, out_step))
+
+
+def packed_outputs(n: int, widths: list[int]) -> list[np.ndarray]:
+    """(n, width) C-contiguous arrays, the consecutive pieces of one buffer (located at once
+    by :meth:`NativeLoop.addresses`)."""
+    block = np.empty(n * sum(widths))
+    out, at = [], 0
+    for w in widths:
+        out.append(block[at : at + n * w].reshape(n, w))
+        at += n * w
+    return out
 
 
 class BoundNative(BoundCall):
@@ -277,7 +331,7 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
                 return "map"
             return "compiled"
 
-        if closure.solvers.memo(("auto_backend", str(cache_dir())) + kern.key, decide) == "compiled":
+        if closure.solvers.memo(("auto_backend", *cache_key()) + kern.key, decide) == "compiled":
             return compiled_function(closure, kern), "compiled"
     return kern.function, "map"
 
@@ -294,19 +348,19 @@ def _library(closure: LoopClosure, kern: Kernel) -> Path:
     def build() -> Path:
         return build_library(_source(closure, kern), kern.name)
 
-    return closure.solvers.memo(("library", str(cache_dir())) + kern.key, build)
+    return closure.solvers.memo(("library", *cache_key()) + kern.key, build)
 
 
 def compiled_function(closure: LoopClosure, kern: Kernel) -> ca.Function:
     """The kernel's compiled twin (same inputs and outputs), built or loaded once per process."""
     return closure.solvers.memo(
-        ("compiled", str(cache_dir())) + kern.key, lambda: ca.external(kern.name, str(_library(closure, kern)))
+        ("compiled", *cache_key()) + kern.key, lambda: ca.external(kern.name, str(_library(closure, kern)))
     )
 
 
 def native_loop(closure: LoopClosure, kern: Kernel) -> NativeLoop:
     """The compiled kernel's loop over poses (:func:`batch_loop_source`), loaded once per process."""
     return closure.solvers.memo(
-        ("native_loop", str(cache_dir())) + kern.key,
+        ("native_loop", *cache_key()) + kern.key,
         lambda: NativeLoop(_library(closure, kern), kern.name, compiled_function(closure, kern)),
     )

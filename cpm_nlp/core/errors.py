@@ -12,7 +12,6 @@ Two kinds of failure are kept apart on purpose:
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterable, Sequence
 
 KeyPath = tuple  # tuple[str | int, ...]
@@ -31,6 +30,8 @@ def format_key_path(path: Sequence[str | int]) -> str:
 
 def suggest(word: str, candidates: Iterable[str], n: int = 3) -> list[str]:
     """Close matches of ``word`` among ``candidates`` (for "did you mean")."""
+    import difflib  # only where a name is wrong: a run that goes well never loads it (issue 23, start-up)
+
     candidates = [str(c) for c in candidates]
     lowered = {c.lower(): c for c in candidates}
     w = str(word).lower()

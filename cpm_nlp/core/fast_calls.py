@@ -94,6 +94,11 @@ class BoundCall:
             state = self._local.state = [buf, evaluate, pose, outs, [False] * len(pose)]
         return state
 
+    def buffers(self) -> list:
+        """This thread's state, built once: the evaluation (a FunctionBuffer and its evaluate,
+        or the compiled loop's ctypes arguments), the inputs, the pose inputs, the outputs."""
+        return self._state()
+
     def _fill(self, state: list, pose: Sequence[Any]) -> None:
         arrays, is_default = state[2], state[4]
         for k, value in enumerate(pose):

@@ -1,5 +1,5 @@
 """The joint types of mechanism files: one table, read by the file reader
-(:mod:`cpm_nlp.mechanisms.described.spec`), the generator of loop closures
+(:mod:`cpm_nlp.mechanisms.described.read_joint`), the generator of loop closures
 (:mod:`~cpm_nlp.mechanisms.described.generate`), the legs' serial chains
 (:mod:`cpm_nlp.core.chains`) and the ``describe`` text.
 

@@ -403,11 +403,14 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
     limit_margin, status[, path])``: the FK of every path in cpm_nlp (single
     Newton solves, batches, the embedding Functions, exported code).
 
-    Mechanisms with a closed-form IK: first :func:`reduced_fk_kernel` (nq
-    unknowns); a pose it does not settle as ``solved`` -- Newton did not
-    converge, a check failed, or the conditioning bound is not certified --
-    goes to :func:`full_fk_kernel` from x0 (only that branch is evaluated: a
-    CasADi Switch), so every status other than ``solved`` comes from the full
+    Mechanisms with a closed-form IK: first :func:`reduced_fk_kernel` with
+    :data:`REDUCED_STEPS` steps (nq unknowns); where Newton did not converge in
+    them, the same kernel again from the pose they reached (the guess about it and
+    :data:`REDUCED_STEPS` more steps: the number of steps adapts to the pose, and the
+    C code has the kernel once); a pose neither settles as ``solved`` -- Newton
+    did not converge, a check failed, or the conditioning bound is not certified --
+    goes to :func:`full_fk_kernel` from x0 (each branch evaluated only where taken:
+    CasADi Switches), so every status other than ``solved`` comes from the full
     path exactly as it did before the reduced one existed.  ``path`` says
     which one answered (0 reduced, 1 full; :data:`PATHS`).  Mechanisms without
     a closed-form IK: :func:`full_fk_kernel` alone (no ``path`` output).
@@ -420,26 +423,36 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
     def build() -> Kernel:
         reduced = reduced_fk_kernel(c, config).function
         full = full_fk_kernel(c, config).function
-        q, x0 = ca.MX.sym("q", c.nq), ca.MX.sym("x0", c.nx)
-        shared = _shared_symbols(c) + [ca.MX.sym("J_home", c.nq, c.nq), ca.MX.sym("Phi_x_home_inv", c.nx, c.nx)]
-        r = reduced(q, x0, *shared)
         names = ("x", "passive", *_STATUS_OUTPUTS)
-        # the Switch's branches share one signature: (q, x0, p, lower, upper, tol, reduced outputs)
-        in_names = ["q", "x0", *SHARED_INPUTS][: 2 + len(shared[:4])]
-        ins = [ca.MX.sym(n, s.sparsity()) for n, s in zip(in_names, [q, x0, *shared[:4]])]
-        r_names = [f"reduced_{n}" for n in names]
-        r_in = [ca.MX.sym(n, reduced.sparsity_out(k)) for k, n in enumerate(r_names)]
         # outputs: (x, passive, checks..., path, status): status stays last
         out_names = [*names[:-1], "path", "status"]
+        in_names = ["q", "x0", *REDUCED_SHARED_INPUTS]
+        ins = [ca.MX.sym(n, reduced.sparsity_in(k)) for k, n in enumerate(in_names)]
+        # every branch of the Switches takes (q, x0, shared..., the reduced outputs): one signature
+        r_names = [f"reduced_{n}" for n in names]
+        r_in = [ca.MX.sym(n, reduced.sparsity_out(k)) for k, n in enumerate(r_names)]
         # names from the lists, not the symbols: a symbol of size 0 (no passive joints) is a constant
         io = (in_names + r_names, out_names)
-        keep = ca.Function(f"{c.name}_fk_keep", ins + r_in, r_in[:-1] + [ca.MX(0), r_in[-1]], *io)
-        f = list(full(*ins))
-        fallback = ca.Function(f"{c.name}_fk_fallback", ins + r_in, f[:-1] + [ca.MX(1), f[-1]], *io)
-        switch = ca.Function.if_else(f"{c.name}_fk_switch", keep, fallback)
-        settled = r[-1] == code_of(Status.SOLVED)
-        outs = switch(settled, q, x0, *shared[:4], *r)
-        fn = ca.Function(f"{c.name}_fk", [q, x0, *shared], list(outs), ["q", "x0", *REDUCED_SHARED_INPUTS], out_names)
+        solved, not_converged = code_of(Status.SOLVED), code_of(Status.NOT_CONVERGED)
+
+        def answer(name: str, outs: list, path: int) -> ca.Function:
+            return ca.Function(f"{c.name}_fk_{name}", ins + r_in, outs[:-1] + [ca.MX(path), outs[-1]], *io)
+
+        keep = answer("keep", r_in, 0)
+        f = list(full(*ins[:6]))
+        fallback = answer("fallback", f, 1)
+        # the second try: the reduced kernel from the pose the first reached (a non-finite one
+        # settles nothing); what it does not settle, the full path decides from x0
+        m = list(reduced(ins[0], r_in[0], *ins[2:]))
+        more_keep = answer("more_keep", m, 0)
+        more_switch = ca.Function.if_else(f"{c.name}_fk_more_switch", more_keep, fallback)
+        retry = ca.Function(f"{c.name}_fk_retry", ins + r_in, more_switch(m[-1] == solved, *ins, *r_in), *io)
+        rest = ca.Function.if_else(f"{c.name}_fk_rest", retry, fallback)
+        rest_fn = ca.Function(f"{c.name}_fk_unsettled", ins + r_in, rest(r_in[-1] == not_converged, *ins, *r_in), *io)
+        switch = ca.Function.if_else(f"{c.name}_fk_switch", keep, rest_fn)
+        r = reduced(*ins)
+        outs = switch(r[-1] == solved, *ins, *r)
+        fn = ca.Function(f"{c.name}_fk", ins, list(outs), in_names, out_names)
         return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS)
 
     key = ("fk_kernel", _options_key(opts))

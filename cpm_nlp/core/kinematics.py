@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .compiled import BoundNative, backend_function, native_loop
 from .errors import InputError
 from .fast_calls import BoundCall, fast
 from .kernels import PATHS, batch_newton_supported, fk_kernel, shared_values
@@ -41,6 +40,10 @@ from .pose_checks import (
 from .pose_checks import SINGULAR_CONDITION as SINGULAR_CONDITION  # noqa: F401
 from .result import Status
 from .solver import SolverConfig
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from .compiled import BoundNative
 
 log = logging.getLogger(__name__)
 
@@ -221,6 +224,8 @@ def _bound_fk(model: Model, config: SolverConfig, backend: str) -> tuple[BoundCa
     cache = model.__dict__.setdefault("_bound_kernels", {})
     hit = cache.get(key)
     if hit is None:
+        from .compiled import BoundNative, backend_function, native_loop  # the Newton path only (issue 23, start-up)
+
         kern = fk_kernel(model.closure, config)
         fn, used = backend_function(model.closure, kern, backend)
         shared = shared_values(kern, model, config.tolerance)

@@ -17,6 +17,13 @@ from .options import Option
 #: two objectives agree when they differ by at most this, relative to the best
 AGREEMENT = 1e-4
 
+#: starts of an assembly-mode search (:func:`cpm_nlp.analysis.assembly.assembly_modes`, the
+#: ``mode_starts`` of a forward_kinematics problem): all 40 modes of Dietmaier's platform with
+#: probability 0.999 (estimated from the basins of 100 000 starts; benchmarks/bench_assembly_modes.py
+#: measures it over seeds).  Here, not in the search's module, so that the kind declaring
+#: the option does not import the search (issue 23, start-up)
+DEFAULT_STARTS = 12000
+
 
 def uniform_starts(lower, upper, count: int, seed: int, first=None) -> np.ndarray:
     """``count`` points in the box [lower, upper] (count, n): ``first`` (clipped

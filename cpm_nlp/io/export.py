@@ -56,7 +56,7 @@ from .atomic import check_output_path
 WHAT = ("fk", "ik", "jacobian")
 
 #: a mechanism name usable in C identifiers and file names (described mechanisms are checked when read:
-#: cpm_nlp.mechanisms.described.spec.MAX_TYPE_NAME); anything else is refused before a file is written
+#: cpm_nlp.mechanisms.described.read_fields.MAX_TYPE_NAME); anything else is refused before a file is written
 SAFE_NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9])*")
 MAX_NAME = 64
 FORMATS = ("casadi", "c")
@@ -330,6 +330,7 @@ def manifest(
                 if c.ik is None
                 else f"; first {REDUCED_STEPS} Newton steps on the task coordinates through the closed-form IK, "
                 "from the first-order guess t0 = x0[task] + J_home (q - q_ik(x0[task])) (J_home = dt/dq at home), "
+                f"where they do not converge, the guess about the pose they reached and {REDUCED_STEPS} more, "
                 "falling back to fast_newton on Φ from x0 where they do not settle the pose"
             ),
         },

@@ -12,11 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.assembly import DEFAULT_STARTS, AssemblyModes, assembly_modes
-from ..analysis.mode_certificate import ModeCertificate, certify_modes
-from ..analysis.requirements import joint_requirements
 from ..analysis.validity import NEAR_SINGULAR_CONDITION, near_singular_warning
-from ..core.batch import batch_forward_kinematics, batch_inverse_kinematics
 from ..core.errors import InputError
 from ..core.kernels import batch_newton_supported
 from ..core.kind import (
@@ -31,6 +27,7 @@ from ..core.kind import (
 )
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics, jacobians
 from ..core.model import Model
+from ..core.multistart import DEFAULT_STARTS
 from ..core.options import Option
 from ..core.outputs import Output, declared_result, outputs_of
 from ..core.progress import track
@@ -38,6 +35,13 @@ from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
+
+# the assembly-mode search, its certificate, the batches and the joint requirements are
+# imported where they run: a single FK solve loads none of them (issue 23, start-up)
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ..analysis.assembly import AssemblyModes
+    from ..analysis.mode_certificate import ModeCertificate
 
 
 def _pose_names(model: Model) -> tuple[list[str], dict[str, str]]:
@@ -187,12 +191,17 @@ class ForwardKinematics(ProblemKind):
         qs, batch = broadcast([inputs[n] for n in names], names, ("inputs",))
         guess = inputs.get("guess")
         if inputs.get("assembly_modes") == "all":
+            from ..analysis.assembly import assembly_modes
+            from ..analysis.mode_certificate import certify_modes
+
             found = assembly_modes(
                 model, qs[0], solver, starts=inputs["mode_starts"], seed=inputs["mode_seed"], guess=guess
             )
             cert = certify_modes(model, found) if inputs.get("mode_certificate") else None
             return _modes_result(self.name, model, found, solver, cert)
         if batch and batch_newton_supported(solver):  # one vectorized Newton over every point
+            from ..core.batch import batch_forward_kinematics
+
             sols = batch_forward_kinematics(model, qs, solver, guess).solutions()
         else:
             sols = [forward_kinematics(model, q, solver, guess) for q in track(qs, "forward kinematics")]
@@ -391,6 +400,8 @@ class InverseKinematics(ProblemKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         ts, batch = broadcast(task_values(inputs, model, ("inputs",)), list(model.closure.task), ("inputs",))
         if batch and model.closure.ik is not None and inputs["method"] != "solve":  # closed form, vectorized
+            from ..core.batch import batch_inverse_kinematics
+
             sols = batch_inverse_kinematics(model, ts, solver).solutions()
         else:
             sols = [inverse_kinematics(model, t, solver, inputs["method"]) for t in track(ts, "inverse kinematics")]
@@ -507,6 +518,8 @@ class JointRequirements(ProblemKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         c = model.closure
         grid = [v if isinstance(v, list) else [v] for v in task_values(inputs, model, ("inputs",))]
+        from ..analysis.requirements import joint_requirements
+
         rep = joint_requirements(model, grid, solver)
         sols = rep.solutions
         res = _result(self.name, model, sols, True, solver, rep.ranges, outputs_of(rep.range_dimensions))

@@ -26,7 +26,6 @@ import logging
 import re
 import threading
 from collections.abc import Mapping
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -103,9 +102,21 @@ class _Registry:
         self.version = 0
 
     def _discover(self) -> dict[str, tuple[str, Origin]]:
+        """Every name: the built-in ones, the shipped mechanism files (by file name, none
+        read), then the plugins' entry points (a name already taken is the shipped one)."""
         if self._specs is None:
+            from importlib import metadata  # only here: a shipped name never reads the entry points
+
             specs = _builtin_specs()
             builtin_files = {target for target, _origin in specs.values()}
+            for path in described.shipped_files():
+                if f"file:{path}" in builtin_files:  # a built-in's file (its name is the built-in's)
+                    continue
+                spec = _shipped_spec(path.stem)
+                if spec is None or path.stem in specs:
+                    log.warning("mechanism file %s ignored: its file name is no valid name, or it is taken", path)
+                    continue
+                specs[path.stem] = spec
             for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
                 detail = ep.value + (f", package {ep.dist.name}" if ep.dist else "")
                 origin = Origin("plugin", ep.name, detail=detail)
@@ -115,14 +126,6 @@ class _Registry:
                     )
                     continue
                 specs[ep.name] = (ep.value, origin)
-            for path in described.shipped_files():
-                if f"file:{path}" in builtin_files:  # a built-in's file (its name is the built-in's)
-                    continue
-                name = _file_mechanism_name(path)
-                if name is None or name in specs:
-                    log.warning("mechanism file %s ignored: no valid name, or the name is taken", path)
-                    continue
-                specs[name] = (f"file:{path}", Origin("file", name, path=str(path)))
             self._specs = specs
         return self._specs
 
@@ -171,10 +174,15 @@ class _Registry:
             self.version += 1
 
     def _spec(self, name: str) -> tuple[str, Origin] | None:
-        """The (target, origin) of ``name``: a built-in's without discovering the plugins and
-        reading the shipped files (nothing registered yet, so no spec can differ from it)."""
-        if self._specs is None and name in BUILTIN.keys() | BUILTIN_FILES.keys():
-            return _builtin_specs()[name]
+        """The (target, origin) of ``name``.  Before anything is registered, a built-in's or a
+        shipped mechanism file's is found by its name alone (issue 23): no other shipped file
+        is read and no plugin is discovered (a plugin never takes a shipped name)."""
+        if self._specs is None:
+            if name in BUILTIN.keys() | BUILTIN_FILES.keys():
+                return _builtin_specs()[name]
+            shipped = _shipped_spec(name)
+            if shipped is not None:
+                return shipped
         return self._discover().get(name)
 
     def get(self, name: str) -> Mechanism:
@@ -252,13 +260,16 @@ def _build_closure(mech: Mechanism) -> LoopClosure:
 _UNEXPECTED = re.compile(r"unexpected keyword argument '(\w+)'")
 
 
-def _file_mechanism_name(path: Any) -> str | None:
-    try:
-        data = described.read_yaml(path)
-    except CpmError:
+def _shipped_spec(name: Any) -> tuple[str, Origin] | None:
+    """The (target, origin) of the shipped mechanism file ``<name>.yaml`` (a shipped file is
+    named by its file name, which its ``name`` must repeat), None if there is none; nothing
+    is read.  Only an identifier is looked up: never a path out of the shipped directory."""
+    if not isinstance(name, str) or not name.isidentifier() or name in BUILTIN_FILES:
         return None
-    name = data.get("name") if isinstance(data, Mapping) else None
-    return name if isinstance(name, str) and name.isidentifier() else None
+    path = described.SHIPPED_DIR / f"{name}.yaml"
+    if not path.is_file():
+        return None
+    return f"file:{path}", Origin("file", name, path=str(path))
 
 
 def _load(name: str, target: str, origin: Origin) -> Mechanism:
@@ -293,6 +304,11 @@ def _load(name: str, target: str, origin: Origin) -> Mechanism:
 def _load_file(name: str, path: str, origin: Origin) -> Mechanism:
     """A mechanism file; a built-in one with its add-on (:data:`ADDONS`), if it has one."""
     mech = described.load_file(path)
+    if mech.name != name:  # a shipped file is found by its file name: the two must agree
+        raise PluginError(
+            f"mechanism file {path} declares the name {mech.name!r}, but its file name says {name!r}; "
+            "the two must agree"
+        )
     if origin.kind == "built-in" and name in ADDONS:
         mech = described.with_same_text(with_addon(mech, _addon(name, ADDONS[name])), mech)
     return mech

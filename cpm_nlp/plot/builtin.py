@@ -1,5 +1,7 @@
 """The built-in plot types: one declaration each, in the order ``--help`` lists them.
 
+Each function is named, not imported (:class:`~cpm_nlp.plot.plot_type.Deferred`): listing the
+plot types imports no plot module (issue 23, start-up).
 A mechanism adds the plots of its own paper through its add-on
 (:attr:`cpm_nlp.core.mechanism.Addon.plots`), a third-party package through the
 entry-point group ``cpm_nlp.plots`` (:mod:`cpm_nlp.plot.registry`).
@@ -7,39 +9,71 @@ entry-point group ``cpm_nlp.plots`` (:mod:`cpm_nlp.plot.registry`).
 
 from __future__ import annotations
 
-from .comparison_plots import comparison_plot, matrices_plot
-from .compliance_plots import dynamics_plot, ellipsoid_plot, forces_plot, modes_plot
-from .curve_plots import io_plot, requirements_plot
-from .mechanism_plots import design_plot, jacobian_plot, mechanism_plot
-from .plot_type import PlotType
-from .sweep_plots import lines_plot, map_plot
-from .workspace_plots import workspace_plot
+from .plot_type import Deferred, PlotType
+
+
+def _in(module: str, function: str) -> Deferred:
+    """The plot function ``function`` of ``cpm_nlp.plot.<module>``, imported when drawn."""
+    return Deferred(f"cpm_nlp.plot.{module}:{function}")
+
 
 BUILTIN = (
     PlotType(
         "workspace",
-        workspace_plot,
+        _in("workspace_plots", "workspace_plot"),
         "a point cloud of the workspace with its cuboid and boundary (a planar one in its plane)",
         interactive=True,
     ),
-    PlotType("map", map_plot, "a value over two swept parameters, or over the grids of a kind's map_axes"),
-    PlotType("lines", lines_plot, "values of a one-parameter sweep against the parameter"),
     PlotType(
-        "requirements", requirements_plot, "joint requirements over the studied poses (actuators, passive joints)"
+        "map",
+        _in("sweep_plots", "map_plot"),
+        "a value over two swept parameters, or over the grids of a kind's map_axes",
     ),
-    PlotType("io", io_plot, "outputs against the input that varies over a batch (FK, IK)"),
-    PlotType("mechanism", mechanism_plot, "the mechanism at the result's pose, home faintly", interactive=True),
-    PlotType("design", design_plot, "a synthesised design drawn at home, the file's design faintly", interactive=True),
+    PlotType("lines", _in("sweep_plots", "lines_plot"), "values of a one-parameter sweep against the parameter"),
+    PlotType(
+        "requirements",
+        _in("curve_plots", "requirements_plot"),
+        "joint requirements over the studied poses (actuators, passive joints)",
+    ),
+    PlotType("io", _in("curve_plots", "io_plot"), "outputs against the input that varies over a batch (FK, IK)"),
+    PlotType(
+        "mechanism",
+        _in("mechanism_plots", "mechanism_plot"),
+        "the mechanism at the result's pose, home faintly",
+        interactive=True,
+    ),
+    PlotType(
+        "design",
+        _in("mechanism_plots", "design_plot"),
+        "a synthesised design drawn at home, the file's design faintly",
+        interactive=True,
+    ),
     PlotType(
         "jacobian",
-        jacobian_plot,
+        _in("mechanism_plots", "jacobian_plot"),
         "the mechanism at the pose beside cond and manipulability over a workspace slice",
         interactive=True,
     ),
-    PlotType("comparison", comparison_plot, "values computed here beside their references (paper, reference design)"),
-    PlotType("matrices", matrices_plot, "every matrix of the result as an annotated heat map"),
-    PlotType("dynamics", dynamics_plot, "natural frequencies and mode shapes from M and K, beside printed values"),
-    PlotType("forces", forces_plot, "actuator forces and hinge stresses along a motion"),
-    PlotType("ellipsoid", ellipsoid_plot, "the compliance ellipsoid of the platform, on the mechanism"),
-    PlotType("modes", modes_plot, "mode shapes as arrows on the mechanism, one panel per mode"),
+    PlotType(
+        "comparison",
+        _in("comparison_plots", "comparison_plot"),
+        "values computed here beside their references (paper, reference design)",
+    ),
+    PlotType(
+        "matrices", _in("comparison_plots", "matrices_plot"), "every matrix of the result as an annotated heat map"
+    ),
+    PlotType(
+        "dynamics",
+        _in("compliance_plots", "dynamics_plot"),
+        "natural frequencies and mode shapes from M and K, beside printed values",
+    ),
+    PlotType("forces", _in("compliance_plots", "forces_plot"), "actuator forces and hinge stresses along a motion"),
+    PlotType(
+        "ellipsoid",
+        _in("compliance_plots", "ellipsoid_plot"),
+        "the compliance ellipsoid of the platform, on the mechanism",
+    ),
+    PlotType(
+        "modes", _in("compliance_plots", "modes_plot"), "mode shapes as arrows on the mechanism, one panel per mode"
+    ),
 )

@@ -5,6 +5,7 @@ a plugin)."""
 
 from __future__ import annotations
 
+import importlib
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -18,6 +19,32 @@ NAME = re.compile(r"[a-z][a-z0-9_]*")
 
 class PlotDeclarationError(InputError):
     """A plot type declared wrongly (the message names where it was declared)."""
+
+
+class Deferred:
+    """A plot function named ``"module:attribute"``, imported when the plot is first drawn:
+    declaring and listing plot types (``cpm-nlp plot --help``) imports no plot module, nor
+    Matplotlib (issue 23, start-up)."""
+
+    def __init__(self, target: str) -> None:
+        module, _, attr = target.partition(":")
+        if not module or not attr:
+            raise PlotDeclarationError(f"expected a plot function as 'module:attribute', got {target!r}")
+        self.target = target
+        self._function: Callable[[Any, Any], Any] | None = None
+
+    def resolve(self) -> Callable[[Any, Any], Any]:
+        """The function itself (imported on first use)."""
+        if self._function is None:
+            module, _, attr = self.target.partition(":")
+            self._function = getattr(importlib.import_module(module), attr)
+        return self._function
+
+    def __call__(self, data: Any, options: Any) -> Any:
+        return self.resolve()(data, options)
+
+    def __repr__(self) -> str:
+        return f"Deferred({self.target!r})"
 
 
 @dataclass(frozen=True)

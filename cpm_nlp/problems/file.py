@@ -38,11 +38,9 @@ from ..io.inputs import display_name, input_dir
 from ..mechanisms.provenance import section_origin
 from ..mechanisms.registry import SECTION_KEYS, section_model
 from .overrides import apply_overrides
-from .published import parse_reproduce
 from .reader import read_yaml
 from .registry import problem_kind
 from .solver_section import parse_solver
-from .sweep_section import parse_sweep
 
 TOP_LEVEL = {
     "problem": "the problem kind",
@@ -103,11 +101,15 @@ def _problem_from_dict(data: Any, file: str | None, base_dir: Path | None) -> Pr
     if not isinstance(description, str):
         raise InputError(f"expected free text, got {description!r}", path=("description",))
     reproduce = None
-    if data.get("reproduce") is not None:
+    if data.get("reproduce") is not None:  # the sections a file may lack are parsed by modules loaded for them
+        from .published import parse_reproduce
+
         reproduce = parse_reproduce(data["reproduce"], ("reproduce",))
         _check_reproduced_values(data["reproduce"], reproduce, outputs or kind.output_names(model))
     sweep = None
     if data.get("sweep") is not None:
+        from .sweep_section import parse_sweep
+
         sweep = parse_sweep(data["sweep"], data, kind, model, base_dir)
     return Problem(kind, model, inputs, solver, outputs, reproduce, file, description, data, sweep, origin)
 

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import importlib
 import threading
-from importlib import metadata
 from typing import Any
 
 from ..core.errors import CpmError, InputError, suggest
@@ -85,6 +84,8 @@ def _collect() -> dict[str, tuple[type[ProblemKind], str]]:
         mech = mechanism_type(mname)
         for name, cls in mech.kinds.items():
             _add(table, name, cls, f"mechanism {mname!r} ({mech.origin})")
+    from importlib import metadata  # only here: a generic kind (problem_kind) never reads the entry points
+
     for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
         origin = f"plugin {ep.name!r} ({ep.value})"
         try:

@@ -153,13 +153,35 @@ def test_library_does_not_print(capfd):
 
 
 def test_start_up_loads_only_what_the_command_needs():
-    """`import cpm_nlp` and `cpm-nlp --help` load neither numpy nor CasADi; a solve of a
-    file with plain units loads neither pint, scipy, matplotlib, Dask nor pyarrow
-    (issue 15: start-up time)."""
+    """`import cpm_nlp` and `cpm-nlp --help` load neither numpy, CasADi, YAML, the mechanisms
+    nor a subcommand's module; a solve of a file with plain units loads neither pint, scipy,
+    matplotlib, Dask nor pyarrow, and a single FK solve none of what it does not run: the
+    assembly-mode search, batches, the compiled backend, the plot layer, threadpoolctl (the
+    BLAS cap is set before numpy loads), the entry points of plugins, difflib (issues 15 and 23:
+    start-up time; benchmarks/bench_issue15.py measures it)."""
     heavy = ("numpy", "casadi", "pint", "scipy", "matplotlib", "dask", "distributed", "pyarrow")
-    report = f"print('loaded:' + ','.join(m for m in {heavy!r} if m in sys.modules))"
+    ours = (
+        "yaml",
+        "threadpoolctl",
+        "importlib.metadata",
+        "difflib",
+        "cpm_nlp.mechanisms.registry",
+        "cpm_nlp.cli.solve",
+        "cpm_nlp.cli.describe",
+        "cpm_nlp.cli.sweep",
+        "cpm_nlp.plot",
+        "cpm_nlp.analysis.assembly",
+        "cpm_nlp.analysis.mode_certificate",
+        "cpm_nlp.analysis.workspace",
+        "cpm_nlp.analysis.requirements",
+        "cpm_nlp.core.batch",
+        "cpm_nlp.core.compiled",
+        "cpm_nlp.problems.published",
+        "cpm_nlp.problems.sweep_section",
+    )
 
-    def loaded(body: str) -> set[str]:
+    def loaded(body: str, watched: tuple = heavy + ours) -> set[str]:
+        report = f"print('loaded:' + ','.join(m for m in {watched!r} if m in sys.modules))"
         argv = [sys.executable, "-c", f"import sys, io; {body}; {report}"]
         out = subprocess.run(argv, capture_output=True, text=True, check=True, cwd=ROOT).stdout
         line = [ln for ln in out.splitlines() if ln.startswith("loaded:")][-1]
@@ -167,9 +189,13 @@ def test_start_up_loads_only_what_the_command_needs():
 
     assert loaded("import cpm_nlp") == set()
     assert loaded("from cpm_nlp.cli.main import main; main(['--help'], out=io.StringIO())") == set()
+    # the plot types listed under `solve --help` import no plot module, nor Matplotlib
+    plot_modules = ("matplotlib", "cpm_nlp.plot.workspace_plots", "cpm_nlp.plot.draw_panels", "cpm_nlp.cli.solve")
+    listed = loaded("from cpm_nlp.cli.main import main; main(['solve', '--help'], out=io.StringIO())", plot_modules)
+    assert listed == set()
     fk = "problems/prs3_forward_kinematics.yaml"
     solve = f"from cpm_nlp.cli.main import main; assert main(['solve', '{fk}'], out=io.StringIO()) == 0"
-    assert loaded(solve) == {"numpy", "casadi"}
+    assert loaded(solve) == {"numpy", "casadi", "yaml", "cpm_nlp.mechanisms.registry", "cpm_nlp.cli.solve"}
     # the lazy API still answers every public name
     import cpm_nlp
 

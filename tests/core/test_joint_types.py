@@ -25,7 +25,7 @@ from cpm_nlp.analysis import compliance, hinge_types
 from cpm_nlp.core.chains import JOINT_DOF
 from cpm_nlp.core.joints import JOINT_LETTERS, JOINT_TYPES, joint_type, joint_types
 from cpm_nlp.mechanisms import described
-from cpm_nlp.mechanisms.described import generate, spec
+from cpm_nlp.mechanisms.described import builder, generate, motions, read_joint, spec
 from cpm_nlp.plot import draw_mechanism, interactive
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -126,14 +126,14 @@ def test_letters_and_the_drawings():
     }
     drawn = (draw_mechanism.JOINT_MARKER, draw_mechanism.JOINT_NAME, interactive._JOINT_SYMBOL)
     assert set(JOINT_LETTERS) == set(drawn[0]) == set(drawn[1]) == set(drawn[2])
-    assert generate._LETTER == {n: t.letter for n, t in JOINT_TYPES.items()}
+    assert motions.LETTER == {n: t.letter for n, t in JOINT_TYPES.items()}
 
 
 def test_generate_aliases_are_the_table():
-    """The names other modules import from generate.py are the table's."""
-    assert generate.POINT_JOINTS == {"S", "planar_R"}
-    assert generate.SPHERE_JOINTS == {"U", "S", "planar_R"}
-    assert generate.JOINT_DIMS == {
+    """The names other modules import from motions.py are the table's."""
+    assert motions.POINT_JOINTS == {"S", "planar_R"}
+    assert motions.SPHERE_JOINTS == {"U", "S", "planar_R"}
+    assert motions.JOINT_DIMS == {
         "P": "length",
         "planar_P": "length",
         "R": "angle",
@@ -145,10 +145,10 @@ def test_generate_aliases_are_the_table():
 
 def test_the_reader_accepts_exactly_the_table():
     for name in JOINT_TYPES:
-        assert spec._joint({"type": name, "at": [0, 0, 0]}, ("legs", 0, "joints", 0), {}).type == name
+        assert read_joint.read_joint({"type": name, "at": [0, 0, 0]}, ("legs", 0, "joints", 0), {}).type == name
     for bad, near in (("planar_r", "planar_R"), ("distanse", "distance"), ("r", "R"), ("sphere", None)):
         with pytest.raises(cn.InputError) as info:
-            spec._joint({"type": bad, "at": [0, 0, 0]}, ("legs", 0, "joints", 1), {})
+            read_joint.read_joint({"type": bad, "at": [0, 0, 0]}, ("legs", 0, "joints", 1), {})
         msg = str(info.value)
         assert "legs[0].joints[1].type" in msg and "expected one of: " + ", ".join(JOINT_TYPES) in msg, msg
         if near:
@@ -156,7 +156,7 @@ def test_the_reader_accepts_exactly_the_table():
     for bad in (None, ["R"], 3):  # missing or not a name
         with pytest.raises(cn.InputError, match="unknown joint type"):
             joint_type(bad, ("type",))
-    assert "one of " + ", ".join(JOINT_TYPES) == spec.JOINT_KEYS["type"]
+    assert "one of " + ", ".join(JOINT_TYPES) == read_joint.JOINT_KEYS["type"]
 
 
 def test_the_generator_takes_the_planar_or_the_spatial_types(tmp_path):
@@ -201,7 +201,7 @@ def _file_joints():
         for leg in d.legs:
             for j in leg.joints:
                 for c in j.coordinates:
-                    types[c] = types[generate.family(c)] = j.type
+                    types[c] = types[builder.family(c)] = j.type
         out[f.name] = (d, types)
     return out
 

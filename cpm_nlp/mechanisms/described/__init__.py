@@ -31,10 +31,11 @@ from ...io.yamlfile import load_yaml_text, parse_yaml, read_yaml
 from . import expr as ex
 from .chains import chains_function
 from .chains import supported as chains_supported
-from .drawing import geometry_of
-from .generate import described_limits, parameter_options
-from .graph import closure_parts, graph_geometry
-from .spec import Description, description_from_dict
+from .closure import closure_parts
+from .drawing import geometry_of, graph_geometry
+from .options import described_limits, parameter_options
+from .read import description_from_dict
+from .spec import Description
 
 log = logging.getLogger(__name__)
 

@@ -15,7 +15,8 @@ import casadi as ca
 import numpy as np
 
 from ...core.chains import JOINT_DOF, ChainJoint, Chains, LegChain
-from .generate import Generator, elementary_motions
+from .generate import Generator
+from .motions import elementary_motions
 
 
 def supported(gen: Generator) -> bool:

@@ -1,4 +1,5 @@
-"""The drawing of a mechanism described by its legs (the ``geometry`` capability).
+"""The drawing of a mechanism described by its legs, or by its bodies and joints (the
+``geometry`` capability).
 
 The generator locates every joint of every leg at a pose symbolically (the
 ``drawing_points`` function of x, q, p): the joints of the proximal chain moved
@@ -14,9 +15,12 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
+from ...core.joints import JOINT_TYPES
 from ...core.mechanism import Drawing
+from .motions import LETTER, ResolvedJoint, chain_motion
 
 #: (leg name, [(joint letter, actuated, the link after it changes length)])
 Layout = Sequence[tuple[str, Sequence[tuple[str, bool, bool]]]]
@@ -119,4 +123,135 @@ def fixed_links(layout: Layout) -> list[tuple[str, str]]:
         for n in range(len(legjoints) - 1):
             if not legjoints[n][2]:
                 out.append((f"{leg}_{n + 1}", f"{leg}_{n + 2}"))
+    return out
+
+
+def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any], Drawing]:
+    """The ``geometry`` capability of a graph (``gen``: its :class:`~.graph.GraphGenerator`; ``fn``:
+    its ``drawing_points`` of (x, q, p), ``layout`` the body and name of each point): every body's
+    points, each body a segment (two points) or a face (three or more); the ground as the base,
+    the platform body as the platform."""
+    d = gen.d
+    ground, platform = gen.ground, gen.platform_body
+    actuated = {g.b if not g.reversed else g.a for g in gen.gjoints if g.tree and g.spec.actuated is not None}
+    named = [(g, g.spec.at if isinstance(g.spec.at, str) and g.spec.at.isidentifier() else g.name) for g in gen.gjoints]
+    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type not in ("distance", "pose")}
+    ends = [(g.spec.at, g.spec.to) for g in gen.gjoints if g.type == "distance"]
+
+    def rods(pts: dict) -> list[tuple[str, str, str]]:
+        return [(a, b, "leg") for a, b in ends if isinstance(a, str) and isinstance(b, str) and a in pts and b in pts]
+
+    def geometry(model: Any, x: Any, q: Any) -> Drawing:
+        V = np.asarray(
+            fn(np.asarray(x, dtype=float), np.asarray(q, dtype=float), np.asarray(model.p, dtype=float)), dtype=float
+        )
+        pts: dict[str, np.ndarray] = {}
+        of_body: dict[str, list[str]] = {}
+        for k, (body, name) in enumerate(layout):
+            if name not in pts:
+                pts[name] = V[:, k].copy()
+            of_body.setdefault(body, []).append(name)
+        if platform != ground:  # the platform point (none when the pose is the joints' alone)
+            pts["P" if "P" not in pts else "P0"] = V[:, -1].copy()
+        span = float(np.ptp(np.array(list(pts.values())), axis=0).max()) or 1.0
+        segments, faces = [], []
+        for body in [b.name for b in d.bodies]:
+            names = list(dict.fromkeys(of_body.get(body, [])))
+            part = (
+                "base"
+                if body == ground
+                else "platform"
+                if body == platform
+                else "actuator"
+                if body in actuated
+                else "link"
+            )
+            ring = _polygon(pts, names, 1e-9 * span)
+            if len(ring) >= 3:
+                faces.append((part, tuple(ring)))
+            elif len(ring) == 2:
+                segments.append((ring[0], ring[1], part))
+        segments += rods(pts)
+        note = "bodies as straight links (two points) or polygons (three or more) through their points"
+        if d.platform.planar:
+            note += "; a planar mechanism, drawn in its plane z = 0"
+        return Drawing(
+            points=pts,
+            segments=tuple(segments),
+            faces=tuple(faces),
+            joints={n: letter for n, letter in letters.items() if n in pts},
+            note=note,
+        )
+
+    return geometry
+
+
+def graph_drawing_points(gen: Any, q: Any) -> tuple[Any, list]:
+    """A graph's drawing (``gen``: its :class:`~.graph.GraphGenerator`): every body's points at
+    the pose (x, q, p), and what to draw: the layout."""
+    # a point name on several bodies is one drawn point where a joint keeps them together
+    # (R, U, S, planar R at that point); across a P or C joint, or unjoined, a point of its own
+    root: dict[tuple, tuple] = {}
+
+    def find(k: tuple) -> tuple:
+        while root.get(k, k) != k:
+            k = root[k]
+        return k
+
+    for g in gen.gjoints:
+        at = g.spec.at
+        if isinstance(at, str) and g.type in ("R", "U", "S", "planar_R"):
+            root[find((g.b, at))] = find((g.a, at))
+    drawn: dict[tuple, str] = {}
+    cols, layout = [], []
+    for body in gen.d.bodies:
+        for name, p in gen.body_points[body.name].items():
+            key = find((body.name, name))
+            if key not in drawn:
+                drawn[key] = name + "'" * sum(1 for k in drawn if k[1] == name)
+            cols.append(gen.world(body.name, p))
+            layout.append((body.name, drawn[key]))
+    for g in gen.gjoints:
+        if (isinstance(g.spec.at, str) and g.spec.at.isidentifier()) or g.type == "pose":
+            continue
+        cols.append(gen.world(g.a, g.pa))
+        layout.append((g.a, g.name))
+    cols.append(gen.P)
+    fn = ca.Function("drawing_points", [gen.x, q, gen.p], [ca.horzcat(*cols)], ["x", "q", "p"], ["points"])
+    return fn, layout
+
+
+def leg_points(
+    last: ResolvedJoint,
+    before: list[ResolvedJoint],
+    elim: ResolvedJoint | None,
+    slide: ResolvedJoint | None,
+    Rm: ca.SX,
+    tm: ca.SX,
+    B: ca.SX,
+    planar: bool,
+) -> list[tuple[str, ca.SX, bool, bool]]:
+    """A leg's joints located at the pose x (with q, p), for the drawing: the proximal
+    chain's joints moved by the joints before them, the eliminated joint by the whole
+    proximal chain, a P along the leg at its reference distance from there, the last
+    joint where the platform puts it."""
+    out: list[tuple[str, ca.SX, bool, bool]] = []
+    Rk, tk = ca.SX.eye(3), ca.SX.zeros(3)
+    for j in before:
+        out.append((LETTER[j.type], Rk @ j.at + tk, j.value is not None and j.spec.actuated is not None, False))
+        Rj, tj = chain_motion([j])
+        Rk, tk = Rk @ Rj, Rk @ tj + tk
+    if elim is not None:
+        c = Rm @ elim.at + tm
+        letter = "R" if planar and last.type == "distance" else LETTER[elim.type]
+        out.append((letter, c, False, elim.type == "C"))
+        if slide is not None:
+            reach = ca.norm_2(slide.at - elim.at)
+            out.append(
+                (LETTER[slide.type], c + reach * (B - c) / ca.norm_2(B - c), slide.spec.actuated is not None, True)
+            )
+    tip = "R" if planar and last.type == "distance" else LETTER[last.type]
+    out.append((tip, B, False, False))
+    # a segment after a P (or C) joint changes length: mark the joints that slide
+    out = [(t, v, act, slides or t in ("P", "C")) for t, v, act, slides in out]
     return out

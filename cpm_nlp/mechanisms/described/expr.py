@@ -261,40 +261,48 @@ class _Evaluator:
             return v
         raise self.fail(node, f"the operator {_construct(node.op)} is not allowed")
 
-    def _BinOp(self, node: ast.BinOp) -> Value:  # noqa: C901 - one branch per operator
+    def _BinOp(self, node: ast.BinOp) -> Value:
         a, b = self.eval(node.left), self.eval(node.right)
-        op = node.op
-        if isinstance(op, (ast.Add, ast.Sub)):
-            word = "add" if isinstance(op, ast.Add) else "subtract"
-            if not compatible(a.dim, b.dim):
-                known = [v for v in (a, b) if v.dim == NUMBER and bool(v.sx.is_constant())]
-                hint = f"; {unit_hint(a.dim if a.dim != NUMBER else b.dim)}" if known else ""
-                raise self.fail(node, f"cannot {word} {describe(a.dim)} and {describe(b.dim)}{hint}")
-            if a.size != b.size and 1 not in (a.size, b.size):
-                raise self.fail(node, f"vectors of sizes {a.size} and {b.size} do not add")
-            # an angle plus a plain number (pi/2) is an angle
-            dim = a.dim if dimensioned(a.dim) or b.dim is None else b.dim
-            word = "+" if isinstance(op, ast.Add) else "-"
-            return self.finite(node, Value(a.sx + b.sx if word == "+" else a.sx - b.sx, dim), [a, b], word)
-        if isinstance(op, (ast.Mult, ast.Div)):
-            if a.size > 1 and b.size > 1:
-                raise self.fail(node, "a product of two vectors: use dot() or cross()")
-            if isinstance(op, ast.Div) and b.size > 1:
-                raise self.fail(node, "division by a vector")
-            if isinstance(op, ast.Mult):
-                return self.finite(node, Value(a.sx * b.sx, _mul(a.dim, b.dim)), [a, b], "*")
-            return self.finite(node, Value(a.sx / b.sx, _mul(a.dim, b.dim, -1.0)), [a, b], "/")
-        if isinstance(op, ast.Pow):
-            if not (isinstance(node.right, ast.Constant) or _is_negated_constant(node.right)):
-                raise self.fail(node.right, "an exponent must be a plain number")
-            e = float(ca.DM(b.sx))
-            if b.dim is not None and b.dim != NUMBER:
-                raise self.fail(node.right, "an exponent must be a plain number")
-            dim = None if a.dim is None else (a.dim[0] * e, a.dim[1] * e)
-            if a.size > 1:
-                raise self.fail(node, "a power of a vector")
-            return self.finite(node, Value(a.sx**e, dim), [a, b], "^")
-        raise self.fail(node, f"the operator {_construct(op)} is not allowed (use + - * / ^)")
+        rule = _BINARY.get(type(node.op))
+        if rule is None:
+            raise self.fail(node, f"the operator {_construct(node.op)} is not allowed (use + - * / ^)")
+        return rule(self, node, a, b)
+
+    def _add(self, node: ast.BinOp, a: Value, b: Value) -> Value:
+        """a + b or a - b: the same dimension (an angle plus a plain number is an angle), the same size or a scalar."""
+        add = isinstance(node.op, ast.Add)
+        if not compatible(a.dim, b.dim):
+            known = [v for v in (a, b) if v.dim == NUMBER and bool(v.sx.is_constant())]
+            hint = f"; {unit_hint(a.dim if a.dim != NUMBER else b.dim)}" if known else ""
+            raise self.fail(
+                node, f"cannot {'add' if add else 'subtract'} {describe(a.dim)} and {describe(b.dim)}{hint}"
+            )
+        if a.size != b.size and 1 not in (a.size, b.size):
+            raise self.fail(node, f"vectors of sizes {a.size} and {b.size} do not add")
+        dim = a.dim if dimensioned(a.dim) or b.dim is None else b.dim
+        return self.finite(node, Value(a.sx + b.sx if add else a.sx - b.sx, dim), [a, b], "+" if add else "-")
+
+    def _multiply(self, node: ast.BinOp, a: Value, b: Value) -> Value:
+        """a * b or a / b: at most one vector, never a divisor."""
+        if a.size > 1 and b.size > 1:
+            raise self.fail(node, "a product of two vectors: use dot() or cross()")
+        if isinstance(node.op, ast.Div) and b.size > 1:
+            raise self.fail(node, "division by a vector")
+        if isinstance(node.op, ast.Mult):
+            return self.finite(node, Value(a.sx * b.sx, _mul(a.dim, b.dim)), [a, b], "*")
+        return self.finite(node, Value(a.sx / b.sx, _mul(a.dim, b.dim, -1.0)), [a, b], "/")
+
+    def _power(self, node: ast.BinOp, a: Value, b: Value) -> Value:
+        """a ^ e: e a plain number, a a scalar."""
+        if not (isinstance(node.right, ast.Constant) or _is_negated_constant(node.right)):
+            raise self.fail(node.right, "an exponent must be a plain number")
+        e = float(ca.DM(b.sx))
+        if b.dim is not None and b.dim != NUMBER:
+            raise self.fail(node.right, "an exponent must be a plain number")
+        dim = None if a.dim is None else (a.dim[0] * e, a.dim[1] * e)
+        if a.size > 1:
+            raise self.fail(node, "a power of a vector")
+        return self.finite(node, Value(a.sx**e, dim), [a, b], "^")
 
     def _List(self, node: ast.List | ast.Tuple) -> Value:
         if not node.elts:
@@ -340,13 +348,19 @@ class _Evaluator:
         if len(node.args) != nargs:
             raise self.fail(node, f"{name}() takes {nargs} argument(s), got {len(node.args)}")
         args = [self.eval(a) for a in node.args]
+        self._check_sizes(node, name, args, vector)
+        dim = rule(name, args, self.col(node))
+        return self.finite(node, Value(impl(*[a.sx for a in args]), dim), args, name)
+
+    def _check_sizes(self, node: ast.Call, name: str, args: list[Value], vector: bool) -> None:
+        """A function of scalars takes scalars; cross() vectors of 3, dot() two of one size."""
         for a, arg in zip(node.args, args):
             if vector and arg.size != 3 and name == "cross":
                 raise self.fail(a, "cross() takes vectors of 3 elements")
             if not vector and arg.size != 1:
                 raise self.fail(a, f"{name}() takes scalars; got a vector of {arg.size}")
-        dim = rule(name, args, self.col(node))
-        return self.finite(node, Value(impl(*[a.sx for a in args]), dim), args, name)
+        if name == "dot" and args[0].size != args[1].size:
+            raise self.fail(node, f"dot() takes two vectors of one size, got {args[0].size} and {args[1].size}")
 
     def _select(self, node: ast.Call) -> Value:
         """select(i, a, b, ...): the i-th (from 1) of the values, i a plain number known when the file is read."""
@@ -359,6 +373,16 @@ class _Evaluator:
         if not k.is_integer() or not 1 <= k <= len(node.args) - 1:
             raise self.fail(node.args[0], f"select() index {k:g} is not in 1..{len(node.args) - 1}")
         return self.eval(node.args[int(k)])
+
+
+#: the binary operators an expression may use, each with its rule (dimensions, sizes)
+_BINARY: dict[type, Callable[[_Evaluator, ast.BinOp, Value, Value], Value]] = {
+    ast.Add: _Evaluator._add,
+    ast.Sub: _Evaluator._add,
+    ast.Mult: _Evaluator._multiply,
+    ast.Div: _Evaluator._multiply,
+    ast.Pow: _Evaluator._power,
+}
 
 
 def _adapts(v: Value) -> bool:
@@ -383,30 +407,36 @@ def _text(e: ca.SX) -> str:
     return "NaN" if math.isnan(x) else "-inf" if x < 0 else "inf"
 
 
-def _why(what: str, args: list[Value]) -> str:  # noqa: C901 - one reason per operation
+def _why(what: str, args: list[Value]) -> str:
     """Which operation made a number that is not finite, and why."""
     x = [_number(a) for a in args]
-    if what == "/":
-        return "division by zero" if x[1] == 0 else "the quotient overflows"
-    if what == "^":
-        if x[0] == 0 and x[1] is not None and x[1] < 0:
-            return "zero to a negative power"
-        if x[0] is not None and x[0] < 0 and x[1] is not None and not float(x[1]).is_integer():
-            return "a negative number to a fractional power"
-        return "the power overflows"
-    if what == "sqrt":
-        return "sqrt of a negative number"
-    if what == "log":
-        return "log of zero" if x[0] == 0 else "log of a negative number"
-    if what in ("asin", "acos"):
-        return f"{what} of a number outside [-1, 1]"
-    if what == "exp":
-        return "exp overflows (its argument is above about 709)"
-    if what == "unit":
-        return "unit() of a zero vector"
+    reason = _REASONS.get(what)
+    if reason is not None:
+        return reason(x)
     if what in ("+", "-", "*"):
         return f"'{what}' overflows"
     return f"{what}() gives a number that is not finite"
+
+
+def _power_reason(x: list[float | None]) -> str:
+    if x[0] == 0 and x[1] is not None and x[1] < 0:
+        return "zero to a negative power"
+    if x[0] is not None and x[0] < 0 and x[1] is not None and not float(x[1]).is_integer():
+        return "a negative number to a fractional power"
+    return "the power overflows"
+
+
+#: why an operation's value is not finite, from its arguments' values (None: not known)
+_REASONS: dict[str, Callable[[list[float | None]], str]] = {
+    "/": lambda x: "division by zero" if x[1] == 0 else "the quotient overflows",
+    "^": _power_reason,
+    "sqrt": lambda _x: "sqrt of a negative number",
+    "log": lambda x: "log of zero" if x[0] == 0 else "log of a negative number",
+    "asin": lambda _x: "asin of a number outside [-1, 1]",
+    "acos": lambda _x: "acos of a number outside [-1, 1]",
+    "exp": lambda _x: "exp overflows (its argument is above about 709)",
+    "unit": lambda _x: "unit() of a zero vector",
+}
 
 
 def _is_negated_constant(node: ast.AST) -> bool:

@@ -20,9 +20,10 @@ from ...core.joints import JOINT_TYPES
 from ...core.model import Model
 from ...core.options import REQUIRED
 from ...core.units import format_quantity
+from .builder import family
+from .closure import closure_parts
 from .expand import GROUND, PLATFORM, expand_legs, expansion_gap
-from .generate import Generator, family
-from .graph import closure_parts
+from .generate import Generator
 from .spec import Description, Joint
 
 
@@ -76,26 +77,11 @@ def _joint_line(k: int, spec: Joint, resolved: Any, gen: Generator, model: Model
     return "  ".join(parts)
 
 
-def summary_text(d: Description, model: Model | None, source: str) -> str:  # noqa: C901 - one section after another
+def summary_text(d: Description, model: Model | None, source: str) -> str:
     """The text of ``cpm-nlp describe FILE`` after the mechanism's parameters and limits."""
     gen, fns = closure_parts(d)
-    lines: list[str] = []
     where = f"values at the reference configuration of {source}" if model is not None else source
-    lines.append(f"({where})")
-    if d.derived:
-        lines.append("derived values:")
-        for q, (name, _sx, dim) in zip(d.derived, gen.derived):
-            shown = ""
-            if model is not None:
-                value = model.derived.get(name)
-                if isinstance(value, list):
-                    shown = "[" + ", ".join(format_quantity(v, dim, 5) for v in value) + "]"
-                elif value is not None:
-                    shown = format_quantity(float(value), dim, 6)
-            text = q.value if isinstance(q.value, str) else str(q.value)
-            lines.append(f"  {name:<8} = {shown or text}  ({dim}{'' if not shown else ': ' + text})")
-            if q.description:
-                lines.append(f"  {'':<8}   {q.description}")
+    lines = [f"({where})"] + _derived_lines(d, gen, model)
     if d.is_graph:
         lines += graph_lines(gen, model)
         return "\n".join(lines) + "\n"
@@ -105,8 +91,39 @@ def summary_text(d: Description, model: Model | None, source: str) -> str:  # no
         lines += graph_lines(expanded, model, branch=False)
     else:
         lines.append(f"(no bodies-and-joints view: {why})")
+    lines += _leg_lines(d, gen, model)
+    lines += _closure_lines(fns["row_names"])
+    lines += _legs_mobility_lines(d, gen, model, source, len(fns["row_names"]))
+    if gen.branch:
+        lines.append("branch indicators: " + ", ".join(fns["branch_names"]))
+    return "\n".join(lines) + "\n"
+
+
+def _derived_lines(d: Description, gen: Any, model: Model | None) -> list[str]:
+    """The derived values (with the model's values when there is one)."""
+    if not d.derived:
+        return []
+    lines = ["derived values:"]
+    for q, (name, _sx, dim) in zip(d.derived, gen.derived):
+        shown = _derived_value(model, name, dim)
+        text = q.value if isinstance(q.value, str) else str(q.value)
+        lines.append(f"  {name:<8} = {shown or text}  ({dim}{'' if not shown else ': ' + text})")
+        if q.description:
+            lines.append(f"  {'':<8}   {q.description}")
+    return lines
+
+
+def _derived_value(model: Model | None, name: str, dim: str) -> str:
+    value = None if model is None else model.derived.get(name)
+    if isinstance(value, list):
+        return "[" + ", ".join(format_quantity(v, dim, 5) for v in value) + "]"
+    return "" if value is None else format_quantity(float(value), dim, 6)
+
+
+def _leg_lines(d: Description, gen: Generator, model: Model | None) -> list[str]:
+    """Each leg: the bodies it runs through and its joints."""
     hinges = _hinges_of(d)
-    lines.append("legs (the shorthand; joints base -> platform, at the reference configuration):")
+    lines = ["legs (the shorthand; joints base -> platform, at the reference configuration):"]
     if not gen.leg_joints:
         lines.append("  (none: the loops are written as closures)")
     for leg, joints in gen.leg_joints:
@@ -119,42 +136,52 @@ def summary_text(d: Description, model: Model | None, source: str) -> str:  # no
         lines.append(f"  leg {leg.name}: " + " -> ".join(bodies))
         for k, (spec, resolved) in enumerate(zip(leg.joints, joints)):
             lines.append("    " + _joint_line(k, spec, resolved, gen, model, hinges))
-    lines.append("closures (generated from the legs by elimination, one group per leg: what the solvers use):")
+    return lines
+
+
+def _closure_lines(row_names: list[str]) -> list[str]:
+    """The generated closures, one group per leg."""
+    lines = ["closures (generated from the legs by elimination, one group per leg: what the solvers use):"]
     groups: dict[str, list[str]] = {}
-    for name in fns["row_names"]:
+    for name in row_names:
         head, _, what = name.partition(": ")
         groups.setdefault(head if what else "closures (expressions)", []).append(what or name)
     for head, rows in groups.items():
         lines.append(f"  {head}: {len(rows)} equation(s): " + "; ".join(rows))
-    nx, nq, rows = len(gen.x_names), len(gen.q_coords), len(fns["row_names"])
+    return lines
+
+
+def _legs_mobility_lines(d: Description, gen: Generator, model: Model | None, source: str, rows: int) -> list[str]:
+    """The actuators, pose coordinates and, with a model, the ranks at the reference configuration."""
+    nx, nq = len(gen.x_names), len(gen.q_coords)
     task = list(d.platform.task)
     dependent = [n for n in gen.x_names if n not in task]
-    lines.append("mobility:")
-    lines.append(f"  actuators ({nq}): " + ", ".join(c.name for c in gen.q_coords))
     also = "; dependent " + ", ".join(dependent) if dependent else ""
-    lines.append(f"  pose coordinates ({nx}): task " + ", ".join(task) + also)
+    lines = [
+        "mobility:",
+        f"  actuators ({nq}): " + ", ".join(c.name for c in gen.q_coords),
+        f"  pose coordinates ({nx}): task " + ", ".join(task) + also,
+    ]
     if d.platform.fixed:
         lines.append("  fixed by the structure: " + ", ".join(d.platform.fixed))
     if model is None:
         lines.append(f"  {rows} equation(s) for {nx} pose coordinate(s); rank not checked (no model: {source})")
-    else:
-        c = model.closure
-        jx = np.asarray(c.phi_x(model.x_home, model.q_home, model.p), dtype=float)
-        jq = np.asarray(c.phi_q(model.x_home, model.q_home, model.p), dtype=float)
-        rank_x = int(np.linalg.matrix_rank(jx))
-        rank = int(np.linalg.matrix_rank(np.hstack([jx, jq])))
-        dof = nx + nq - rank
-        lines.append(
-            f"  {rows} equation(s) for {nx} pose coordinate(s); at the reference configuration rank Φ_x = "
-            f"{rank_x}, rank [Φ_x Φ_q] = {rank}: {dof} degree(s) of freedom"
-            + (" (the actuators fix the pose)" if rank_x == nx and dof == nq else "")
-        )
-    if gen.branch:
-        lines.append("branch indicators: " + ", ".join(fns["branch_names"]))
-    return "\n".join(lines) + "\n"
+        return lines
+    c = model.closure
+    jx = np.asarray(c.phi_x(model.x_home, model.q_home, model.p), dtype=float)
+    jq = np.asarray(c.phi_q(model.x_home, model.q_home, model.p), dtype=float)
+    rank_x = int(np.linalg.matrix_rank(jx))
+    rank = int(np.linalg.matrix_rank(np.hstack([jx, jq])))
+    dof = nx + nq - rank
+    lines.append(
+        f"  {rows} equation(s) for {nx} pose coordinate(s); at the reference configuration rank Φ_x = "
+        f"{rank_x}, rank [Φ_x Φ_q] = {rank}: {dof} degree(s) of freedom"
+        + (" (the actuators fix the pose)" if rank_x == nx and dof == nq else "")
+    )
+    return lines
 
 
-def graph_lines(gen: Any, model: Model | None, branch: bool = True) -> list[str]:  # noqa: C901 - one section after another
+def graph_lines(gen: Any, model: Model | None, branch: bool = True) -> list[str]:
     """``describe`` of a bodies-and-joints file: bodies, joints (in the spanning tree or closing a
     loop), the loops, mobility by rank beside Grübler-Kutzbach, and the assembly of the reference
     configuration (``branch``: and the branch indicators)."""
@@ -163,10 +190,25 @@ def graph_lines(gen: Any, model: Model | None, branch: bool = True) -> list[str]
     for body in gen.d.bodies:
         what = f"  -- {body.description}" if body.description else ""
         lines.append(f"  {body.name:<10} points: {', '.join(body.points) or '-'}{what}")
+    lines += _graph_joint_lines(gen)
+    counts: dict[int, int] = {}
+    for _r, _name, loop in gen.loop_rows:
+        counts[loop] = counts.get(loop, 0) + 1
+    lines.append("loops (a cycle basis: one per joint outside the spanning tree):")
+    for number, joint, bodies in info.loops:
+        lines.append(f"  loop {number}, closed by {joint}: {' - '.join(bodies)}  ({counts.get(number, 0)} equation(s))")
+    lines += _graph_mobility_lines(gen, counts)
+    lines.append(_assembly_line(gen, model))
+    if gen.branch and branch:
+        lines.append("branch indicators: " + ", ".join(b[1] for b in gen.branch))
+    return lines
+
+
+def _graph_joint_lines(gen: Any) -> list[str]:
+    """Each joint of the graph: its type, bodies, point, role (tree or the loop it closes), coordinates."""
+    info = gen.info
     ntree = sum(1 for j in info.joints if j[5])
-    lines.append(
-        f"joints ({len(info.joints)}; {ntree} in the spanning tree, {len(info.joints) - ntree} closing a loop):"
-    )
+    lines = [f"joints ({len(info.joints)}; {ntree} in the spanning tree, {len(info.joints) - ntree} closing a loop):"]
     for g, (name, kind, a, b, actuated, tree, loop) in zip(gen.gjoints, info.joints):
         at = g.spec.at if isinstance(g.spec.at, str) else "its coordinates" if kind == "pose" else "(a point)"
         role = "tree" if tree else f"closes loop {loop}"
@@ -176,18 +218,18 @@ def graph_lines(gen: Any, model: Model | None, branch: bool = True) -> list[str]
         if not tree and g.spec.coordinates:
             coords = "coordinates: " + ", ".join(g.spec.coordinates)
         lines.append(f"  {name:<6} {kind:<9} {a} -> {b} at {at}  {role}" + (f"  {coords}" if coords else ""))
-    lines.append("loops (a cycle basis: one per joint outside the spanning tree):")
-    counts: dict[int, int] = {}
-    for _r, _name, loop in gen.loop_rows:
-        counts[loop] = counts.get(loop, 0) + 1
-    for number, joint, bodies in info.loops:
-        lines.append(f"  loop {number}, closed by {joint}: {' - '.join(bodies)}  ({counts.get(number, 0)} equation(s))")
+    return lines
+
+
+def _graph_mobility_lines(gen: Any, counts: dict[int, int]) -> list[str]:
+    """Mobility by rank beside Grübler-Kutzbach, the rows that repeat others, the pose coordinates."""
+    info = gen.info
     nq = len(gen.q_coords)
-    lines.append("mobility:")
-    lines.append(
+    lines = [
+        "mobility:",
         f"  rank of the loops' Jacobian at the reference configuration: {info.mobility} degree(s) of freedom; "
-        f"Grübler-Kutzbach: {info.gruebler}; actuated: {nq} ({', '.join(c.name for c in gen.q_coords)})"
-    )
+        f"Grübler-Kutzbach: {info.gruebler}; actuated: {nq} ({', '.join(c.name for c in gen.q_coords)})",
+    ]
     if info.dropped:
         by_loop: dict[int, int] = {}
         for loop, _name in info.dropped:
@@ -204,22 +246,21 @@ def graph_lines(gen: Any, model: Model | None, branch: bool = True) -> list[str]
     task = list(gen.d.platform.task)
     dependent = [n for n in gen.x_names if n not in task]
     lines.append(f"  pose coordinates ({len(gen.x_names)}): task {', '.join(task)}; dependent {', '.join(dependent)}")
+    return lines
+
+
+def _assembly_line(gen: Any, model: Model | None) -> str:
+    """How the reference configuration assembles from the drawing (the model's parameters, else the defaults)."""
     p = np.asarray(model.p, dtype=float) if model is not None else gen.p_default
     _x, _q, status = gen.assembler.solve(p)
     move_name, move = status["largest_move"]
-    lines.append(
-        "reference configuration: "
-        + (
-            f"assembled from the drawing in {status['steps']} Gauss-Newton step(s): residual "
-            f"{status['residual_at_drawing']:.3g} at the drawing, {status['residual']:.3g} assembled (SI); "
-            f"largest move {move_name} by {move:.4g}"
-            if status["assembled"]
-            else f"does not assemble from the drawing: residual {status['residual']:.3g} in {status['worst_row']}"
-        )
+    return "reference configuration: " + (
+        f"assembled from the drawing in {status['steps']} Gauss-Newton step(s): residual "
+        f"{status['residual_at_drawing']:.3g} at the drawing, {status['residual']:.3g} assembled (SI); "
+        f"largest move {move_name} by {move:.4g}"
+        if status["assembled"]
+        else f"does not assemble from the drawing: residual {status['residual']:.3g} in {status['worst_row']}"
     )
-    if gen.branch and branch:
-        lines.append("branch indicators: " + ", ".join(b[1] for b in gen.branch))
-    return lines
 
 
 def _expanded_graph(d: Description, model: Model | None) -> tuple[Any, str]:

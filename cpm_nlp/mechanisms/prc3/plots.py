@@ -10,13 +10,20 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from ...plot.draw_panels import Panel, panels_figure
 from ...plot.plot_type import PlotType
-from ...plot.results import NotApplicable, PlotOptions, ResultData
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ...plot.results import PlotOptions, ResultData
 
 
 def amplifier_plot(data: ResultData, _options: PlotOptions) -> Any:
     """Output against input of the lever amplifier, d = A2 q (prc3 paper, eq 1-2)."""
+    # the drawing modules are imported when a plot is drawn: listing the plot types
+    # (``cpm-nlp plot --help``) imports this declaration only (issue 23, start-up)
+    from ...plot.draw_panels import Panel, panels_figure
+    from ...plot.results import NotApplicable
+
     v = data.values
     pairs = [(k, "d" + k[1:]) for k in v if re.fullmatch(r"q\d+", k) and isinstance(v[k], list)]
     pairs = [(a, b) for a, b in pairs if isinstance(v.get(b), list)]

@@ -9,19 +9,26 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
-from ...plot.draw_mechanism import Arrow, mechanism_figure
-from ...plot.interactive import mechanism_html
 from ...plot.plot_type import PlotType
-from ...plot.pose import geometry_of, model_for
-from ...plot.results import NotApplicable, PlotOptions, ResultData
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from ...plot.results import PlotOptions, ResultData
 
 
 def twists_plot(data: ResultData, options: PlotOptions) -> Any:
     """The displacement twists of the platform, one per actuator, as arrows on the
     mechanism at the pose: the rotation (ω) and the translation (v) of the
     reference point, each scaled to the drawing (RPR paper, eq 45)."""
+    # numpy and the drawing modules are imported when a plot is drawn: listing the plot
+    # types (``cpm-nlp plot --help``) imports this declaration only (issue 23, start-up)
+    import numpy as np
+
+    from ...plot.draw_mechanism import Arrow, mechanism_figure
+    from ...plot.interactive import mechanism_html
+    from ...plot.pose import geometry_of, model_for
+    from ...plot.results import NotApplicable
+
     T = data.values.get("T")
     if not isinstance(T, list) or len(T) != 6:
         raise NotApplicable("a twists plot needs the 6 x n twist matrix T")

@@ -82,7 +82,7 @@ def test_drawing_at_home_and_at_another_pose(name):
 
 
 def _layout(model):
-    from cpm_nlp.mechanisms.described.graph import closure_parts
+    from cpm_nlp.mechanisms.described.closure import closure_parts
 
     _gen, fns = closure_parts(described.read_description(FILES[model.name]))
     return fns["drawing_legs"]

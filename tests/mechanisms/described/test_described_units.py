@@ -429,3 +429,30 @@ def test_describe_plot_bad_arguments_are_exit_2(tmp_path, cli, args, words):
     for w in words:
         assert w in run.err, run.err
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    "file, where, value, message",
+    [
+        (MECH / "five_bar.yaml", ("platform", "task", 0), [1, 2], "platform.task[0]: unknown coordinate [1, 2]"),
+        (MECH / "prs3.yaml", ("platform", "offsets", "dz"), {"q": 1}, "expected a pose coordinate, got {'q': 1}"),
+        (ROOT / "tests/data/graph/fourbar.yaml", ("platform", "task", 0), [[1]], "unknown coordinate [[1]]"),
+        (ROOT / "tests/data/graph/fourbar.yaml", ("bodies", "crank", 1), [1], "bodies.crank[1]: unknown point [1]"),
+        (MECH / "rpr.yaml", ("passive", "theta_a11", "family"), [1], "family: expected a joint-limit family"),
+        (MECH / "prs3.yaml", ("ik", "let", "AB1"), [1, 2], "dot() takes two vectors of one size, got 3 and 2"),
+        # a = 7 m puts the coupler's drawn point out of reach (the square root of a negative number)
+        (ROOT / "tests/data/graph/fourbar.yaml", ("parameters", "a", "default"), 7, "does not assemble"),
+    ],
+)
+def test_a_list_where_a_name_belongs_is_an_input_error(file, where, value, message):
+    """A list or mapping where the file names a coordinate, a point or a limit family, a vector
+    of the wrong size in dot(), a drawing with no value: one message at its key path (each was a
+    traceback: a TypeError from a lookup, a CasADi assertion, numpy's SVD of NaN)."""
+    data = yaml.safe_load(file.read_text())
+    node = data
+    for key in where[:-1]:
+        node = node[key]
+    node[where[-1]] = value
+    with pytest.raises(cn.InputError) as info:
+        described.from_dict(data, file="f.yaml")
+    assert message in str(info.value), str(info.value)

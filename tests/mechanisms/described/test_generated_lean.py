@@ -23,7 +23,7 @@ import pytest
 
 import cpm_nlp as cn
 from cpm_nlp.core import kernels
-from cpm_nlp.mechanisms.described.generate import _rot
+from cpm_nlp.mechanisms.described.motions import rot
 from tests.reference import prc3_closures, prs3_closures, rpr_closures
 
 PRS3 = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
@@ -42,7 +42,7 @@ def test_rotation_is_rodrigues_and_elementary_about_a_base_axis():
         angle = rng.uniform(-math.pi, math.pi)
         K = _skew(k)
         expected = np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K  # Rodrigues, numpy
-        got = np.array(ca.DM(ca.substitute(_rot(ca.DM(k), t), t, angle)))
+        got = np.array(ca.DM(ca.substitute(rot(ca.DM(k), t), t, angle)))
         np.testing.assert_allclose(got, expected, rtol=0, atol=1e-15)
     for angle in (2.0, -2.9, 0.3):  # |angle| > 60 deg: 1 - (1 - cos) would not be cos to the bit
         c, s = math.cos(angle), math.sin(angle)
@@ -52,7 +52,7 @@ def test_rotation_is_rodrigues_and_elementary_about_a_base_axis():
             "z": [[c, -s, 0], [s, c, 0], [0, 0, 1]],
         }
         for axis, M in elementary.items():
-            got = np.array(ca.DM(ca.substitute(_rot(axis, t), t, angle)))
+            got = np.array(ca.DM(ca.substitute(rot(axis, t), t, angle)))
             assert got.tolist() == np.array(M, dtype=float).tolist(), axis
 
 

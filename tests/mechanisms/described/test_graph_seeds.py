@@ -27,7 +27,7 @@ import cpm_nlp as cn
 from cpm_nlp.core.result import Status
 from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import load_file
-from cpm_nlp.mechanisms.described.graph import closure_parts
+from cpm_nlp.mechanisms.described.closure import closure_parts
 from tests.reference import pantograph_closures, prs3_closures, rpr_closures
 
 CORPUS = Path(__file__).resolve().parents[2] / "corpus"

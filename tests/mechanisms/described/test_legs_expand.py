@@ -23,9 +23,9 @@ from cpm_nlp.core.result import Status
 from cpm_nlp.io.yamlfile import read_yaml
 from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import load_file, read_description
+from cpm_nlp.mechanisms.described.closure import closure_parts
 from cpm_nlp.mechanisms.described.expand import expand_legs, expansion_gap
-from cpm_nlp.mechanisms.described.graph import closure_parts
-from cpm_nlp.mechanisms.described.spec import description_from_dict
+from cpm_nlp.mechanisms.described.read import description_from_dict
 
 ROOT = Path(__file__).resolve().parents[3]
 LEGS_FILES = sorted(
