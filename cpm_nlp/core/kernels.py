@@ -429,8 +429,9 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
     the closure's closed-form FK (``fk_closed``, x0 unused), one flat SX graph, with the same
     inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
 
-    ``status`` is ``solved`` only where the closed form assembles the pose (disc >= 0, finite)
-    and every check passes on (x, q): residual of Φ, branch, IK round trip, limits, and the
+    ``status`` is ``solved`` only where the closed form assembles the pose (disc >= 0, finite),
+    the guess x0 lies on the pose's side of det Φ_x = 0 (else the root Newton seeks from x0 is
+    another assembly: Newton answers), and every check passes on (x, q): residual of Φ, branch, IK round trip, limits, and the
     conditioning with a margin of 2 on the singularity threshold (``cond1`` the certified bound
     of :func:`cond1_bound` where there is a closed-form IK, else the exact one).  Any other
     status means "not settled here": Newton decides.
@@ -454,7 +455,11 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
         chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
         singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))  # margin 2 over the screen
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
-        assembled = ca.logic_and(disc >= 0, all_finite(x))
+        # the guess and the pose on the same side of det Φ_x = 0 (a dyad: of the line through the
+        # circles' centres, which separates its two assemblies): the root Newton is after from x0,
+        # so a search from guesses in another assembly (analysis.assembly) still finds that one
+        same_side = ca.det(c.phi_x(x0, q, p)) * ca.det(c.phi_x(x, q, p)) > 0
+        assembled = ca.logic_and(ca.logic_and(disc >= 0, all_finite(x)), same_side)
         status = _first(ca.logic_not(assembled), Status.NOT_CONVERGED, status)
         names = ["x", "passive", *_STATUS_OUTPUTS]
         outs = [x] + [ca.densify(chk[n]) for n in names[1:-1]]

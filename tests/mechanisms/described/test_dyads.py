@@ -137,3 +137,27 @@ def test_kernel_outputs_and_path_names(five_bar):
     assert kern.name == "five_bar_fk"
     assert kern.outputs[-2:] == ("path", "status") and PATHS[2] == "closed"
     assert list(kern.function.name_in()) == ["q", "x0", *kern.shared_inputs]
+
+
+def test_a_guess_in_the_other_assembly_is_left_to_newton(five_bar):
+    """From a guess across the centres' line (the mirror assembly, as the assembly-mode search
+    starts), the FK is Newton's from that guess -- same status and pose as before the closed
+    form -- not the file's assembly, so the other mode is still found."""
+    m, c = five_bar, five_bar.closure
+    q = _poses(m, 30, seed=3)
+    mirrors = []
+    for qi in q:
+        xi = np.asarray(c.fk_closed(qi, m.p)[0]).ravel()
+        c1 = np.array([-0.05 + 0.1 * np.cos(qi[0]), 0.1 * np.sin(qi[0])])
+        c2 = np.array([0.05 + 0.1 * np.cos(qi[1]), 0.1 * np.sin(qi[1])])
+        e = (c2 - c1) / np.linalg.norm(c2 - c1)
+        mirrors.append(2 * (c1 + np.dot(xi - c1, e) * e) - xi)
+    x0 = np.array(mirrors) + 1e-4  # near the other assembly, not on it
+    got = cn.batch_forward_kinematics(m, q, guess=x0)
+    kern = _newton_fk_kernel(c, NEWTON, "five_bar_fk_newton_reference")
+    out = dict(zip(kern.outputs, evaluate(kern.function, [q, x0, *shared_values(kern, m, NEWTON.tolerance)])))
+    ref = _finish("forward_kinematics", m, out, q, NEWTON.tolerance, "map", 1, 0.0, "fast_newton")
+    assert got.statuses == ref.statuses and Status.SOLVED not in got.statuses
+    assert all(got.path(i) != "closed" for i in range(len(got)))
+    np.testing.assert_allclose(got.raw_joints[:, :2], ref.raw_joints[:, :2], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got.raw_joints[:, :2], np.array(mirrors), rtol=0, atol=1e-12)
