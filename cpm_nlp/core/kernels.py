@@ -426,15 +426,15 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
 def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
     """``<name>_fk_closed: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) -> (x, passive,
     residual, branch_margin, round_trip_error, cond1, limit_margin[, path], status)``: the pose from
-    the closure's closed-form FK (``fk_closed``, x0 unused), one flat SX graph, with the same
+    the closure's closed-form FK (``fk_closed``; x0 only picks the side), one flat SX graph, with the same
     inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
 
     ``status`` is ``solved`` only where the closed form assembles the pose (disc >= 0, finite),
     the guess x0 lies on the pose's side of det Φ_x = 0 (else the root Newton seeks from x0 is
-    another assembly: Newton answers), and every check passes on (x, q): residual of Φ, branch, IK round trip, limits, and the
-    conditioning with a margin of 2 on the singularity threshold (``cond1`` the certified bound
-    of :func:`cond1_bound` where there is a closed-form IK, else the exact one).  Any other
-    status means "not settled here": Newton decides.
+    another assembly: Newton answers), and every check passes on (x, q): residual of Φ, branch,
+    IK round trip, limits, and the conditioning with a margin of 2 on the singularity threshold
+    (``cond1`` the certified bound of :func:`cond1_bound` where there is a closed-form IK, else
+    the exact one).  Any other status means "not settled here": Newton decides.
     """
     opts = newton_options(config)
 
