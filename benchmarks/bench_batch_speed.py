@@ -19,6 +19,12 @@ Measurements
                       the 3-step reduced Newton does not settle (what fell back to the full
                       Newton before the adaptive steps) and that the FK's full path answers now
                       (target < 5 %); CPU µs per pose of the reduced-only and full-only kernels
+  fivebar closed form the five-bar's FK kernel before the closed-form dyad (the Newton FK: reduced,
+                      then full) and now (closed form first, every check, Newton where it does
+                      not settle), the closed-form kernel alone (with every check) and the
+                      circle-circle intersection alone (no check), CPU µs per pose of the
+                      compiled C (1 thread), interleaved; the share the closed form answers; and
+                      the whole batch call per pose (target <= 0.1 µs, item 5)
   single_fk_function  one call of cn.functions(model).fk on numpy arrays (target <= 10 µs), and
                       on DMs (CasADi's own call, the path every call took before)
 """
@@ -39,8 +45,25 @@ import numpy as np
 
 import cpm_nlp as cn
 from cpm_nlp.core.batch import evaluate
-from cpm_nlp.core.compiled import CFLAGS, NativeLoop, _source, build_library, compiled_function, compiler_available
-from cpm_nlp.core.kernels import fk_kernel, full_fk_kernel, reduced_fk_kernel, shared_values
+from cpm_nlp.core.compiled import (
+    CFLAGS,
+    NativeLoop,
+    _source,
+    batch_loop_source,
+    build_library,
+    compiled_function,
+    compiler_available,
+    generate_source,
+)
+from cpm_nlp.core.kernels import (
+    PATHS,
+    _newton_fk_kernel,
+    closed_fk_kernel,
+    fk_kernel,
+    full_fk_kernel,
+    reduced_fk_kernel,
+    shared_values,
+)
 
 PAPER = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}
 STROKE = 2.3e-3  # m, the actuator range of prs3-ruiz.md Fig. 6
@@ -138,14 +161,40 @@ def bench_fivebar(n: int, rounds: int) -> dict:
     backend = "compiled" if compiler_available() else "map"
     res = cn.batch_forward_kinematics(model, q, backend=backend)
     out["fallback_share_now"] = float(np.mean(res.path_codes == 1))
+    out["closed_share"] = float(np.mean(res.path_codes == PATHS.index("closed")))
     out["statuses"] = res.counts()
     out["backend"] = backend
     if backend == "compiled":
         full = full_fk_kernel(c, NEWTON)
-        for tag, kern in (("reduced_3_steps", reduced), ("full", full), ("fk", fk_kernel(c, NEWTON))):
+        kernels = {
+            "reduced_3_steps": reduced,
+            "full": full,
+            "newton_before_closed": _newton_fk_kernel(c, NEWTON, "five_bar_fk_newton_paths"),
+            "fk": fk_kernel(c, NEWTON),
+            "closed_only": closed_fk_kernel(c, NEWTON),
+        }
+        calls = {}
+        for tag, kern in kernels.items():
             fn = NativeLoop(build_library(_source(c, kern), kern.name), kern.name, compiled_function(c, kern))
             args = [q, model.x_home, *shared_values(kern, model, NEWTON.tolerance)]
-            out[f"kernel_{tag}_us_per_pose"] = cpu_per_item(lambda fn=fn, args=args: evaluate(fn, args, 1), n, rounds)
+            calls[tag] = lambda fn=fn, args=args: evaluate(fn, args, 1)
+        # the circle-circle intersection alone (this model's numbers built in, no checks): what
+        # pylinkage's dyad computes
+        q_sym = ca.SX.sym("q", c.nq)
+        bare = ca.Function("five_bar_fk_closed_bare", [q_sym], list(c.fk_closed(q_sym, model.p)), ["q"], ["x", "disc"])
+        source = generate_source(bare, bare.name()) + batch_loop_source(bare, bare.name())
+        bare_loop = NativeLoop(build_library(source, bare.name()), bare.name(), bare)
+        calls["closed_form_alone"] = lambda: evaluate(bare_loop, [q], 1)
+        best = dict.fromkeys(calls, float("inf"))
+        for _ in range(rounds):  # interleaved: every kernel sees the same load
+            for tag, call in calls.items():
+                best[tag] = min(best[tag], cpu_per_item(call, n, 1))
+        for tag, value in best.items():
+            out[f"kernel_{tag}_us_per_pose"] = value
+        out["closed_speedup_vs_newton"] = best["newton_before_closed"] / best["fk"]
+        one_thread = lambda: cn.batch_forward_kinematics(model, q, backend="compiled", threads=1)  # noqa: E731
+        one_thread()
+        out["fivebar_batch_us_per_pose"] = cpu_per_item(one_thread, n, rounds)
     out["load"] = load()
     return out
 
@@ -167,6 +216,9 @@ def bench_single(model: cn.Model, n: int) -> dict:
 TARGETS = {
     "batch_cpu_us_per_pose_2_thread": ("<=", 1.0),
     "fallback_share_now": ("<", 0.05),
+    "kernel_fk_us_per_pose": ("<=", 0.1),
+    "kernel_closed_form_alone_us_per_pose": ("<=", 0.1),
+    "fivebar_batch_us_per_pose": ("<=", 0.1),
     "single_fk_function_us": ("<=", 10.0),
 }
 

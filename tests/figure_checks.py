@@ -16,7 +16,8 @@ def assert_png_drawn(path, min_ink=0.03):
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     rgb = imread(path)[..., :3]
     ink = (rgb < 0.9).any(axis=-1).mean()
-    colours = len(np.unique((rgb * 15).round().reshape(-1, 3), axis=0))
+    q = (rgb * 15).round().astype(np.int64)  # 16 levels per channel: one integer per colour,
+    colours = len(np.unique((q[..., 0] * 16 + q[..., 1]) * 16 + q[..., 2]))  # not unique rows (40x slower)
     assert ink > min_ink and rgb.std() > 0.05 and colours > 8, (ink, rgb.std(), colours)
     return rgb
 

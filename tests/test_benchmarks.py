@@ -138,5 +138,6 @@ def test_batch_speed_benchmark_smoke(tmp_path, capsys):
         assert data["kernel"]["kernel_before_same_bits_as_vm"] and data["kernel"]["kernel_now_same_bits_as_vm"]
         assert data["batch"]["statuses"] == {"solved": 2000}
     assert data["fivebar"]["fallback_share_now"] < 0.05 < data["fivebar"]["fallback_share_3_steps"]
+    assert data["fivebar"]["closed_share"] == 1.0  # every five-bar pose by the closed-form dyad (a count)
     assert data["single"]["single_fk_function_us"] > 0 and "load" in data["single"]
     assert "written:" in capsys.readouterr().out

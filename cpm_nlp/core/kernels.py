@@ -114,8 +114,9 @@ class Kernel:
 SHARED_INPUTS = ("p", "lower", "upper", "tol")
 #: shared inputs of the FK through the closed-form IK: also the model's linearization at home
 REDUCED_SHARED_INPUTS = SHARED_INPUTS + ("J_home", "Phi_x_home_inv")
-#: ``path`` output of the FK kernel: which formulation answered
-PATHS = ("reduced", "full")
+#: ``path`` output of the FK kernel: which formulation answered ("closed": the closed-form FK of a
+#: dyad, :func:`closed_fk_kernel`)
+PATHS = ("reduced", "full", "closed")
 #: outputs of the FK as embedded (:func:`cpm_nlp.io.embed.functions`) and exported: without ``path``
 FK_OUTPUTS = ("x", "passive", "residual", "branch_margin", "round_trip_error", "cond1", "limit_margin", "status")
 _STATUS_OUTPUTS = ("residual", "branch_margin", "round_trip_error", "cond1", "limit_margin", "status")
@@ -398,10 +399,86 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
 
 
 def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
-    """``<name>_fk: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) ->
+    """``<name>_fk``: the FK of every path in cpm_nlp (single Newton solves, batches, the
+    embedding Functions, exported code).
+
+    A closure with a closed-form FK (``fk_closed``: a planar RRR dyad): first
+    :func:`closed_fk_kernel`; a pose it does not settle as ``solved`` goes to the Newton FK
+    below from x0 (a CasADi Switch), so every status other than ``solved`` is Newton's,
+    exactly as without the closed form; ``path`` 2 ("closed") says it answered.  Others: the
+    Newton FK (:func:`_newton_fk_kernel`).
+    """
+    c = closure
+    if c.fk_closed is None:
+        return _newton_fk_kernel(c, config, f"{c.name}_fk")
+    opts = newton_options(config)
+
+    def build() -> Kernel:
+        newton = _newton_fk_kernel(c, config, f"{c.name}_fk_newton_paths" if c.ik is not None else f"{c.name}_fk")
+        first = closed_fk_kernel(c, config).function
+        fn = _settled_or(first, newton.function, f"{c.name}_fk", newton.outputs)
+        return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
+
+    key = ("fk_kernel_closed", _options_key(opts))
+    return c.solvers.memo(key, build)
+
+
+def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
+    """``<name>_fk_closed: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) -> (x, passive,
+    residual, branch_margin, round_trip_error, cond1, limit_margin[, path], status)``: the pose from
+    the closure's closed-form FK (``fk_closed``; x0 only picks the side), one flat SX graph, with the same
+    inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
+
+    ``status`` is ``solved`` only where the closed form assembles the pose (disc >= 0, finite),
+    the guess x0 lies on the pose's side of det Φ_x = 0 (else the root Newton seeks from x0 is
+    another assembly: Newton answers), and every check passes on (x, q): residual of Φ, branch,
+    IK round trip, limits, and the conditioning with a margin of 2 on the singularity threshold
+    (``cond1`` the certified bound of :func:`cond1_bound` where there is a closed-form IK, else
+    the exact one).  Any other status means "not settled here": Newton decides.
+    """
+    opts = newton_options(config)
+
+    def build() -> Kernel:
+        c = closure
+        if c.fk_closed is None:  # pragma: no cover - guarded by fk_kernel
+            raise ValueError(f"{c.name} has no closed-form FK")
+        nl = n_joints(c)
+        q, x0, p = ca.SX.sym("q", c.nq), ca.SX.sym("x0", c.nx), ca.SX.sym("p", c.np)
+        lower, upper, tol = ca.SX.sym("lower", nl), ca.SX.sym("upper", nl), ca.SX.sym("tol")
+        ins, shared_names = [q, x0, p, lower, upper, tol], SHARED_INPUTS
+        b = None
+        if c.ik is not None:
+            jac_home = ca.SX.sym("J_home", c.nq, c.nq)
+            b = ca.SX.sym("Phi_x_home_inv", c.nx, c.nx)
+            ins, shared_names = ins + [jac_home, b], REDUCED_SHARED_INPUTS
+        x, disc = c.fk_closed(q, p)
+        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
+        singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))  # margin 2 over the screen
+        status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
+        # the guess and the pose on the same side of det Φ_x = 0 (a dyad: of the line through the
+        # circles' centres, which separates its two assemblies): the root Newton is after from x0,
+        # so a search from guesses in another assembly (analysis.assembly) still finds that one
+        same_side = ca.det(c.phi_x(x0, q, p)) * ca.det(c.phi_x(x, q, p)) > 0
+        assembled = ca.logic_and(ca.logic_and(disc >= 0, all_finite(x)), same_side)
+        status = _first(ca.logic_not(assembled), Status.NOT_CONVERGED, status)
+        names = ["x", "passive", *_STATUS_OUTPUTS]
+        outs = [x] + [ca.densify(chk[n]) for n in names[1:-1]]
+        if c.ik is not None:  # the Newton FK's outputs: path before status
+            names.insert(-1, "path")
+            outs.append(ca.SX(PATHS.index("closed")))
+        outs = ca.cse(outs + [status])
+        fn = ca.Function(f"{c.name}_fk_closed", ins, outs, ["q", "x0", *shared_names], names)
+        return Kernel(fn, "fk", ("q", "x0"), tuple(names), key, shared_names)
+
+    key = ("closed_fk_kernel", _options_key(opts))
+    return closure.solvers.memo(key, build)
+
+
+def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: str) -> Kernel:
+    """``name: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) ->
     (x, passive, residual, branch_margin, round_trip_error, cond1,
-    limit_margin, status[, path])``: the FK of every path in cpm_nlp (single
-    Newton solves, batches, the embedding Functions, exported code).
+    limit_margin[, path], status)``: the Newton FK -- :func:`fk_kernel` itself for a
+    closure without a closed-form FK, its fallback for the others.
 
     Mechanisms with a closed-form IK: first :func:`reduced_fk_kernel` with
     :data:`REDUCED_STEPS` steps (nq unknowns); where Newton did not converge in
@@ -452,10 +529,10 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         switch = ca.Function.if_else(f"{c.name}_fk_switch", keep, rest_fn)
         r = reduced(*ins)
         outs = switch(r[-1] == solved, *ins, *r)
-        fn = ca.Function(f"{c.name}_fk", ins, list(outs), in_names, out_names)
+        fn = ca.Function(name, ins, list(outs), in_names, out_names)
         return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS)
 
-    key = ("fk_kernel", _options_key(opts))
+    key = ("fk_kernel", _options_key(opts), name)
     return c.solvers.memo(key, build)
 
 

@@ -91,6 +91,11 @@ class LoopClosure:
         optional ``("frame", [x, p], [R, position])``: the platform's rotation
         matrix (3 x 3) and position (3); assembly modes are told apart on it
         (not on angles, which alias).
+    fk_closed:
+        optional closed-form FK of the whole closure, ``("fk_closed", [q, p], [x, disc])``
+        (a planar RRR dyad: :mod:`cpm_nlp.mechanisms.described.dyads`); ``disc < 0`` where it
+        cannot assemble the pose.  The FK kernel tries it first and keeps it only where the pose
+        checks pass (:func:`cpm_nlp.core.kernels.fk_kernel`).
     """
 
     def __init__(
@@ -114,8 +119,10 @@ class LoopClosure:
         branch_descriptions: Sequence[str] = (),
         frame: ca.Function | None = None,
         loops: ca.Function | None = None,
+        fk_closed: ca.Function | None = None,
     ) -> None:
         self.name = name
+        self.fk_closed = fk_closed
         #: every closure equation (m >= nx rows), when phi holds a square combination of them (an
         #: overconstrained linkage's normal equations): a pose is checked against these too, and the
         #: closure's conditioning is that of their Jacobian (:attr:`cond_matrix`); None: phi's own

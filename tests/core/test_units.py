@@ -86,6 +86,24 @@ def _outcome(text, dim):
         return ("error", str(exc), tuple(exc.suggestions))
 
 
+def _remembered(fn):
+    """fn of one argument, its result or its exception remembered per argument."""
+    seen: dict = {}
+
+    def call(arg):
+        if arg not in seen:
+            try:
+                seen[arg] = (True, fn(arg))
+            except Exception as exc:  # noqa: BLE001 - pint raises several types; re-raised below
+                seen[arg] = (False, exc)
+        ok, value = seen[arg]
+        if not ok:
+            raise value.with_traceback(None)
+        return value
+
+    return call
+
+
 def test_fast_path_agrees_with_pint_over_many_strings(monkeypatch):
     """Numbers in every form the parser admits (and some it does not) times the fast
     units, near misses, other spellings and units of other dimensions, for every
@@ -103,6 +121,13 @@ def test_fast_path_agrees_with_pint_over_many_strings(monkeypatch):
         for u in units:
             strings += [f"{n} {u}", f"  {n}{u} "]
     assert len(strings) > 1000
+    # pint's parsing of a unit text and its factor to root units are pure functions of their
+    # argument: remembered here (results and refusals alike) so that the ~50 000 comparisons do
+    # not parse the same few dozen units again each time (the test's time, issue 23); every
+    # string still goes through parse_quantity on both paths
+    reg = U._ureg()
+    monkeypatch.setattr(reg, "parse_units", _remembered(reg.parse_units))
+    monkeypatch.setattr(U, "_root", _remembered(U._root))
     fast = {(s, d): _outcome(s, d) for s in strings for d in U.DIMENSIONS}
     monkeypatch.setattr(U, "FAST_UNITS", {})  # pint alone
     slow = {(s, d): _outcome(s, d) for s in strings for d in U.DIMENSIONS}

@@ -203,29 +203,19 @@ int main(void) {
 
 @pytest.fixture(scope="module")
 def c_build(exported, fns, tmp_path_factory):
-    """The exported C compiled twice: a shared library, and a program with the source linked in."""
+    """The exported C compiled once (C99, position-independent) and linked twice: a shared
+    library, and a program with the source's object linked in."""
     folder = exported[0] / "c"
     build = tmp_path_factory.mktemp("cbuild")
+    obj = build / "prs3_kinematics.o"
+    cc = [GCC, "-O2", "-std=c99", "-fPIC"]
+    subprocess.run([*cc, "-c", str(folder / "prs3_kinematics.c"), "-o", str(obj)], check=True)
     lib = build / "libprs3_kinematics.so"
-    subprocess.run([GCC, "-O2", "-shared", "-fPIC", str(folder / "prs3_kinematics.c"), "-o", str(lib)], check=True)
+    subprocess.run([GCC, "-shared", str(obj), "-o", str(lib)], check=True)
     home = "{" + ", ".join(repr(float(v)) for v in fns.x_home) + "}"
     (build / "driver.c").write_text(C_DRIVER.replace("HOME", home))
     exe = build / "driver"
-    subprocess.run(
-        [
-            GCC,
-            "-O2",
-            "-std=c99",
-            "-I",
-            str(folder),
-            str(build / "driver.c"),
-            str(folder / "prs3_kinematics.c"),
-            "-lm",
-            "-o",
-            str(exe),
-        ],
-        check=True,
-    )
+    subprocess.run([*cc, "-I", str(folder), str(build / "driver.c"), str(obj), "-lm", "-o", str(exe)], check=True)
     return lib, exe
 
 

@@ -393,6 +393,10 @@ def test_cli_refuses_to_overwrite_an_input(cli, tmp_path):
 # -- the imported files load, and their kinematics is the linkage's -------------------------------
 
 NEWTON = cn.SolverConfig("newton")
+#: FK of the imported models on CasADi's virtual machine: each import is a closure of its own,
+#: whose kernel would be compiled for a few poses (most of these tests' time, issue 23); the
+#: backends' agreement is tests/core/test_batch.py's
+MAP = "map"
 
 
 def _model(tmp_path, text: str):
@@ -409,7 +413,7 @@ def test_imported_five_bar_forward_kinematics_is_the_closed_form(tmp_path, q):
     URDF's (mot1, mot2 turn about +x, the plane's normal)."""
     model = _model(tmp_path, import_urdf(FIVE, FIVE_SIDE).text)
     assert model.closure.nq == 2 and list(model.closure.x_names[:2]) == ["x", "y"]
-    fk = cn.forward_kinematics(model, list(q), NEWTON)
+    fk = cn.forward_kinematics(model, list(q), NEWTON, backend=MAP)
     assert fk.status == Status.SOLVED, fk.message
     np.testing.assert_allclose(fk.x[:2], five_bar_drawing(*q)["P"], rtol=0, atol=1e-9)
     ik = cn.inverse_kinematics(model, list(fk.x[:2]))  # FK against IK: the actuators come back
@@ -436,7 +440,7 @@ def test_imported_four_bar_forward_kinematics_is_the_closed_form(tmp_path, q):
     model = _model(tmp_path, import_urdf(FOUR, FOUR_SIDE, platform="tracer").text)
     hand, drawn = four_bar_drawing(q), four_bar_drawing()
     assert abs(hand["th4"] - drawn["th4"]) < 1.0  # inside the rocker's URDF limit [-1, 1]
-    fk = cn.forward_kinematics(model, [q], NEWTON)
+    fk = cn.forward_kinematics(model, [q], NEWTON, backend=MAP)
     assert fk.status == Status.SOLVED, fk.message
     x = dict(zip(model.closure.x_names, fk.x))
     np.testing.assert_allclose([x["x"], x["y"]], hand["T"], rtol=0, atol=1e-9)
@@ -450,7 +454,7 @@ def test_imported_four_bar_as_a_spatial_file(tmp_path):
     text = import_urdf(FOUR, FOUR_SIDE, platform="tracer", planar=False, task=["phi"]).text
     model = _model(tmp_path, text)
     for q in (0.5, -0.7):
-        fk = cn.forward_kinematics(model, [q], NEWTON)
+        fk = cn.forward_kinematics(model, [q], NEWTON, backend=MAP)
         assert fk.status == Status.SOLVED, fk.message
         x = dict(zip(model.closure.x_names, fk.x))
         hand, drawn = four_bar_drawing(q), four_bar_drawing()
@@ -505,7 +509,7 @@ def test_imported_slider_crank_prismatic_joint(tmp_path):
 def test_imported_slider_crank_forward_kinematics(tmp_path, q):
     """FK of the slider's x is a cos(th) + sqrt(b^2 - (a sin(th))^2), th = 30 deg + q (by hand), to 1e-9 m."""
     model = _model(tmp_path, _slider_crank(tmp_path).text)
-    fk = cn.forward_kinematics(model, [q], NEWTON)
+    fk = cn.forward_kinematics(model, [q], NEWTON, backend=MAP)
     th = SC_TH0 + q
     s = SC_A * math.cos(th) + math.sqrt(SC_B**2 - (SC_A * math.sin(th)) ** 2)
     assert fk.status == Status.SOLVED, fk.message
@@ -528,7 +532,7 @@ def test_sidecar_joint_types(tmp_path):
     assert (rod["at"], rod["to"]) == ("P_rocker_pivot", "P_coupler_end")
     assert rod["length"] == pytest.approx(FOUR_C, abs=1e-15)
     assert any("'rocker' is a rod between joint 'rocker_pivot'" in n for n in imported.notes)
-    fk = cn.forward_kinematics(_model(tmp_path, imported.text), [0.5], NEWTON)  # still the four-bar
+    fk = cn.forward_kinematics(_model(tmp_path, imported.text), [0.5], NEWTON, backend=MAP)  # still the four-bar
     assert fk.status == Status.SOLVED, fk.message
     np.testing.assert_allclose(fk.x[:2], four_bar_drawing(0.5)["T"], rtol=0, atol=1e-9)
     side.write_text(Path(FOUR_SIDE).read_text() + "joint_name: [coupler_pin]\njoint_type: [UJOINT_ZX]\n")
@@ -617,7 +621,7 @@ def test_imported_delta_rods_and_forward_kinematics(tmp_path):
     np.testing.assert_allclose(point(data, "platform", "P_effector"), delta_platform((0, 0, 0)), rtol=0, atol=1e-15)
     model = _model(tmp_path, imported.text)
     for q in ((0.0, 0.0, 0.0), (0.2, -0.1, 0.3), (-0.3, 0.25, 0.1)):
-        fk = cn.forward_kinematics(model, list(q), NEWTON)
+        fk = cn.forward_kinematics(model, list(q), NEWTON, backend=MAP)
         assert fk.status == Status.SOLVED, fk.message
         x = dict(zip(model.closure.x_names, fk.x))
         np.testing.assert_allclose([x["x"], x["y"], x["z"]], delta_platform(q), rtol=0, atol=1e-9)
@@ -643,7 +647,7 @@ def test_a_passive_joint_as_the_task(tmp_path):
     """--task rocker_pivot: the four-bar's output angle (Freudenstein's), its change from the
     drawing th4(q) - th4(0) by hand, to 1e-9 rad."""
     model = _model(tmp_path, import_urdf(FOUR, FOUR_SIDE, platform="tracer", task=["rocker_pivot"]).text)
-    fk = cn.forward_kinematics(model, [0.5], NEWTON)
+    fk = cn.forward_kinematics(model, [0.5], NEWTON, backend=MAP)
     assert fk.status == Status.SOLVED, fk.message
     x = dict(zip(model.closure.x_names, fk.x))
     assert x["rocker_pivot"] == pytest.approx(four_bar_drawing(0.5)["th4"] - four_bar_drawing()["th4"], abs=1e-9)
@@ -670,7 +674,7 @@ def test_an_open_drawing_is_closed_at_import(tmp_path):
     assert joints["rocker_pivot"]["home"] == pytest.approx(-0.3, abs=1e-12)
     assert "home" not in joints["crank"] and "home" not in joints["coupler_pin"]
     model = _model(tmp_path, imported.text)
-    fk = cn.forward_kinematics(model, [0.5], NEWTON)
+    fk = cn.forward_kinematics(model, [0.5], NEWTON, backend=MAP)
     assert fk.status == Status.SOLVED, fk.message
     x = dict(zip(model.closure.x_names, fk.x))
     turn = four_bar_drawing(0.5)["th4"] - hand["th4"]

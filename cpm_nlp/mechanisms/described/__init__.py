@@ -159,6 +159,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         branch_descriptions=fns["branch_descriptions"],
         frame=fns["frame"],
         loops=fns.get("loops"),
+        fk_closed=fns.get("fk_closed"),
     )
     if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
         check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))

@@ -33,6 +33,7 @@ def closure_parts(d: Description) -> tuple[ClosureBuilder, dict[str, Any]]:
     fns = g.build()
     if assembled_from_drawing(d):
         fns["assemble"] = LegsAssembler(d, g)
+        fns["fk_closed"] = None  # its branch sign would be the drawing's, not the assembled reference's
     return g, fns
 
 

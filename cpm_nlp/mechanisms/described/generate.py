@@ -72,6 +72,7 @@ from .branches import (
 )
 from .builder import ClosureBuilder, Reported, dim_name, family
 from .drawing import leg_points
+from .dyads import closed_form_fk
 from .emit import closure_functions
 from .motions import (
     BASE_AXES,
@@ -84,7 +85,7 @@ from .motions import (
     rot,
     xyz_angles,
 )
-from .spec import Joint, Leg
+from .spec import Description, Joint, Leg
 
 
 @dataclass
@@ -109,6 +110,11 @@ class _Link:
 class Generator(ClosureBuilder):
     """Builds the symbolic closure of a legs description, each leg's passive joints eliminated
     (errors carry key paths)."""
+
+    def __init__(self, d: Description) -> None:
+        super().__init__(d)
+        #: Φ's circle rows (planar): (row, centre c, platform point B, radius), for :mod:`.dyads`
+        self.circles: list[tuple[int, ca.SX, ca.SX, ca.SX]] = []
 
     # -- legs ------------------------------------------------------------------------------
     def leg(self, leg: Leg) -> None:
@@ -350,6 +356,8 @@ class Generator(ClosureBuilder):
             self.rows.append(((ca.dot(v, v) - ca.dot(u0_l, u0_l)) / (2 * r), f"leg {leg.name}: distance"))
         else:  # its given length: the drawing need not close (the reference is assembled)
             self.rows.append(((ca.dot(v, v) - rod**2) / (2 * rod), f"leg {leg.name}: distance"))
+        # a circle |B - c| = radius (planar): a dyad's half, for the closed-form FK (.dyads)
+        self.circles.append((len(self.rows) - 1, link.c, v + link.c, r if rod is None else rod))
         self.eliminated(leg, link.elim, link.before, link.c, v, 1)
         return self.report_sphere(link.elim, link.Rm, link.u0, v, leg), None
 
@@ -515,7 +523,9 @@ class Generator(ClosureBuilder):
         aspect(self, q)
         select_branch(self, added)
         self.check_task_count()
-        return closure_functions(self, q)
+        fns = closure_functions(self, q)
+        fns["fk_closed"] = closed_form_fk(self, q, self.circles) if self.d.platform.planar else None
+        return fns
 
     def declared_actuators(self) -> None:
         """The ``actuators`` section's (for closures written as expressions), after the joints'."""

@@ -34,6 +34,10 @@ LEGS_FILES = sorted(
     if read_description(f).legs
 )
 NEWTON = cn.SolverConfig("newton")
+#: the FK of both closures on CasADi's virtual machine: the comparison is of the closures, and
+#: compiling each file's two kernels took nearly all the time (Dietmaier's 6-6: 23 of 24 s,
+#: issue 23); the backends' agreement is tests/core/test_batch.py's
+MAP = "map"
 TOL = 1e-10
 
 
@@ -94,7 +98,7 @@ def test_expanded_graph_has_the_legs_mobility_and_forward_kinematics(path):
     _close(np.asarray(graph.x_home)[idx], np.asarray(legs.x_home)[: len(idx)], 1e-15)
     _close(graph.q_home, legs.q_home, 1e-15)
     for q in _inputs(legs):
-        a, b = cn.forward_kinematics(legs, q, NEWTON), cn.forward_kinematics(graph, q, NEWTON)
+        a, b = cn.forward_kinematics(legs, q, NEWTON, backend=MAP), cn.forward_kinematics(graph, q, NEWTON, backend=MAP)
         assert a.status == b.status == Status.SOLVED, (a.message, b.message)
         xa, xb = np.asarray(a.x), np.asarray(b.x)
         _close(xb[idx], xa[: len(idx)])
@@ -115,7 +119,7 @@ def test_every_legs_file_maps_its_platform_and_some_passive_values():
     path = ROOT / "problems" / "mechanisms" / "prs3.yaml"
     _d, _e, legs, graph = _models(path)
     q = _inputs(legs, 1)[0]
-    a, b = cn.forward_kinematics(legs, q, NEWTON), cn.forward_kinematics(graph, q, NEWTON)
+    a, b = cn.forward_kinematics(legs, q, NEWTON, backend=MAP), cn.forward_kinematics(graph, q, NEWTON, backend=MAP)
     pa = cn.passive_joints(legs, np.asarray(a.x), q)
     pb = dict(zip(graph.closure.x_names, np.asarray(b.x))) | cn.passive_joints(graph, np.asarray(b.x), q)
     wanted = {f"{f}{i}" for f in ("alpha", "beta_m", "beta_n", "beta_l") for i in (1, 2, 3)}
@@ -127,7 +131,7 @@ def test_every_legs_file_maps_its_platform_and_some_passive_values():
     for k in range(len(q)):
         step = np.zeros(len(q))
         step[k] = h
-        up, down = (cn.forward_kinematics(graph, q + s, NEWTON, guess=b.x) for s in (step, -step))
+        up, down = (cn.forward_kinematics(graph, q + s, NEWTON, guess=b.x, backend=MAP) for s in (step, -step))
         _close((np.asarray(up.x) - np.asarray(down.x)) / (2 * h), J[:, k], 1e-6)
 
 
@@ -230,7 +234,7 @@ def test_a_rough_drawing_is_assembled_for_any_parameter_value():
     a = exact.model(exact.closure(), {}, {}, ())
     b = mech.model(mech.closure(), {}, {}, ())
     for q in _inputs(a):
-        sa, sb = cn.forward_kinematics(a, q, NEWTON), cn.forward_kinematics(b, q, NEWTON)
+        sa, sb = cn.forward_kinematics(a, q, NEWTON, backend=MAP), cn.forward_kinematics(b, q, NEWTON, backend=MAP)
         assert sa.status == sb.status == Status.SOLVED
         _close(sb.x, sa.x, 1e-12)
 
@@ -244,7 +248,8 @@ def test_an_exact_drawing_with_lengths_gives_todays_model():
     a, b = (m.model(m.closure(), {}, {}, ()) for m in (plain, given))
     _close(b.x_home, a.x_home, 1e-12)
     for q in _inputs(a):
-        _close(cn.forward_kinematics(b, q, NEWTON).x, cn.forward_kinematics(a, q, NEWTON).x, 1e-12)
+        xb, xa = (cn.forward_kinematics(m, q, NEWTON, backend=MAP).x for m in (b, a))
+        _close(xb, xa, 1e-12)
 
 
 def test_links_that_cannot_close_are_refused_with_the_loops_residual():
@@ -375,12 +380,12 @@ def test_a_file_with_legs_and_bodies_is_one_graph(tmp_path):
     assert J[names.index("x"), qn.index("q1")] == pytest.approx(-B / A, rel=1e-9)
     for q1, q2, q3 in ([2e-4, 0.0, 0.0], [-1e-4, 1e-4, -2e-4], [3e-4, -1e-4, 1e-4]):
         given = {"q1": q1, "q2": q2, "q3": q3}
-        sol = cn.forward_kinematics(model, [given[n] for n in qn], NEWTON)
+        sol = cn.forward_kinematics(model, [given[n] for n in qn], NEWTON, backend=MAP)
         assert sol.status == Status.SOLVED, sol.message
         x = np.asarray(sol.x)
         theta, d1 = _lever(q1)
         _close([x[names.index("theta")], x[names.index("d1")]], [theta, d1], TOL)
-        stage = cn.forward_kinematics(ref, [d1, q2, q3], NEWTON)
+        stage = cn.forward_kinematics(ref, [d1, q2, q3], NEWTON, backend=MAP)
         assert stage.status == Status.SOLVED
         _close(x[:3], stage.x, TOL)
 
@@ -458,12 +463,12 @@ def test_an_overconstrained_mixed_file_solves_its_platform_through_the_normal_eq
     for q1, q2, q3 in ([2e-4, 0.0, 0.0], [-1e-4, 1e-4, -2e-4], [3e-4, -1e-4, 1e-4]):
         given = {"q1": q1, "q2": q2, "q3": q3}
         q = [given[n] for n in qn]
-        sol = cn.forward_kinematics(model, q, NEWTON)
+        sol = cn.forward_kinematics(model, q, NEWTON, backend=MAP)
         assert sol.status == Status.SOLVED, sol.message
         x = np.asarray(sol.x)
         assert np.max(np.abs(np.asarray(c.loops(x, q, model.p)))) < 1e-12
         theta, d1 = _lever(q1)
         _close([x[names.index("theta")], x[names.index("d1")]], [theta, d1], TOL)
-        stage = cn.forward_kinematics(ref, [d1, q2, q3], NEWTON)
+        stage = cn.forward_kinematics(ref, [d1, q2, q3], NEWTON, backend=MAP)
         assert stage.status == Status.SOLVED
         _close(x[:3], stage.x, TOL)
