@@ -11,9 +11,12 @@ import os
 
 from .analysis.assembly import AssemblyMode, AssemblyModes, assembly_modes
 from .analysis.certify import Certificate, certify_box
+from .analysis.compliance import JointStiffness
+from .analysis.dynamics import DynamicsModel
 from .analysis.requirements import RequirementsReport, joint_requirements
 from .analysis.workspace import CuboidResult, Membership, check_box, inscribed_cuboid, membership, sample_workspace
 from .core.batch import BatchJacobians, BatchResult, batch_forward_kinematics, batch_inverse_kinematics, batch_jacobians
+from .core.chains import LegChains
 from .core.errors import CpmError, InputError
 from .core.kind import ProblemKind
 from .core.kinematics import (
@@ -26,7 +29,7 @@ from .core.kinematics import (
     passive_joints,
     residual,
 )
-from .core.mechanism import CuboidExtras, DynamicsModel, JointStiffness, Mechanism, declare
+from .core.mechanism import Mechanism, Part, declare
 from .core.model import Coordinate, LoopClosure, Model
 from .core.pose_checks import status_of
 from .core.result import Result, ResultWarning, SolverInfo, Status
@@ -34,6 +37,8 @@ from .core.solver import SolverConfig
 from .core.version import __version__
 from .io.embed import ModelFunctions, model_functions
 from .io.export import export_kinematics, load_exported
+from .kinds.synthesis import SynthesisFormulation
+from .kinds.workspace import CuboidExtras, PaperMembership
 from .mechanisms import described as _described
 from .mechanisms.described.spec import ClosedFormIK, Description, Joint, Leg, Parameter, Platform, Quantity
 from .mechanisms.registry import build_model, mechanism_names, mechanism_type, register, unregister
@@ -107,6 +112,10 @@ __all__ = [
     "CuboidResult",
     "DynamicsModel",
     "JointStiffness",
+    "LegChains",
+    "PaperMembership",
+    "Part",
+    "SynthesisFormulation",
     "InputError",
     "JacobianReport",
     "LoopClosure",

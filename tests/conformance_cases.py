@@ -170,7 +170,7 @@ SPRING = 100.0
 def generated_hinges(s: Subject) -> bool:
     """Whether the compliance kinds get generated springs (the mechanism declares no stiffness)."""
     mech = s.model.mechanism
-    return mech is None or mech.stiffness is None
+    return mech is None or mech.part(cn.JointStiffness) is None
 
 
 def _hinges(s: Subject) -> dict[str, Any] | None:
@@ -217,7 +217,7 @@ def inputs_of(s: Subject, kind: str, poses: dict[str, np.ndarray]) -> dict[str, 
         coarse = len(c.task) > 3  # 6-D: 2^6 samples, 3^6 - 1 + 3^6 check points
         return {"starts": 2, "seed": 0, "samples_per_edge": 2 if coarse else 3, "check_per_edge": 3 if coarse else 5}
     if kind == "synthesis":
-        if s.model.mechanism.synthesis is not None:
+        if s.model.mechanism.part(cn.SynthesisFormulation) is not None:
             return None  # the mechanism's own formulation: its shipped example
         name = design_parameter(s)
         v = s.model.parameters[name]
@@ -232,7 +232,7 @@ def inputs_of(s: Subject, kind: str, poses: dict[str, np.ndarray]) -> dict[str, 
     if kind == "natural_frequencies":
         return {**{n: float(q[0, k]) for k, n in enumerate(c.q_names)}, "masses": masses(s), **hinge_in}
     if kind == "dynamics":
-        dm = s.model.mechanism.dynamics
+        dm = s.model.mechanism.part(cn.DynamicsModel)
         return {"material": "Al 7075-T6", **{m: 0.01 for m, _ in dm.masses}}
     return None
 

@@ -287,6 +287,7 @@ CORE_MUTABLE_ALLOWED = {
     "cpm_nlp.core.batch._MAPPED": "LRU cache of mapped CasADi functions (code, not problem data)",
     "cpm_nlp.core.batch._POOLS": "thread pools by worker count, made once per process",
     "cpm_nlp.core.blas._STATE": "the process's BLAS thread controller, set up once",
+    "cpm_nlp.core.solver._BUILT": "each closure's built solvers and kernels (code), weakly keyed by the closure",
 }
 
 
@@ -297,11 +298,12 @@ def _core_mutable_globals() -> dict[str, str]:
     import collections
     import importlib
     import pkgutil
+    import weakref
     from types import MappingProxyType
 
     import cpm_nlp.core as core
 
-    mutable = (dict, list, set, bytearray, collections.deque)
+    mutable = (dict, list, set, bytearray, collections.deque, weakref.WeakKeyDictionary, weakref.WeakValueDictionary)
     seen: set[int] = set()
     found: dict[str, str] = {}
     for info in sorted(pkgutil.walk_packages(core.__path__, "cpm_nlp.core."), key=lambda i: i.name):
@@ -361,7 +363,20 @@ def test_tests_mirror_the_package():
 
 
 #: calls that make a mutable container (a module global made by one is module state)
-_MUTABLE_CALLS = frozenset({"dict", "list", "set", "defaultdict", "OrderedDict", "deque", "bytearray", "Counter"})
+_MUTABLE_CALLS = frozenset(
+    {
+        "dict",
+        "list",
+        "set",
+        "defaultdict",
+        "OrderedDict",
+        "deque",
+        "bytearray",
+        "Counter",
+        "WeakKeyDictionary",
+        "WeakValueDictionary",
+    }
+)
 
 
 def _makes_mutable(node: ast.expr) -> bool:
@@ -415,7 +430,7 @@ def test_the_mutable_state_check_sees_each_form():
     """The check above finds each form of a mutable module global, and passes the read-only ones."""
     src = (
         "A = {}\nB: list = []\nC = {1}\nD = {k: 1 for k in ()}\nE = [x for x in ()]\nF = dict(a=1)\n"
-        "G = collections.defaultdict(list)\nH = set()\n"
+        "G = collections.defaultdict(list)\nH = set()\nI = weakref.WeakKeyDictionary()\n"
         "OK1 = MappingProxyType({})\nOK2 = (1, 2)\nOK3 = frozenset({1})\nOK4 = tuple([1])\n"
     )
     made = {
@@ -423,7 +438,7 @@ def test_the_mutable_state_check_sees_each_form():
         for st in ast.parse(src).body
         if _makes_mutable(st.value)
     }
-    assert made == set("ABCDEFGH")
+    assert made == set("ABCDEFGHI")
 
 
 def test_results_are_built_from_declared_outputs_only():

@@ -46,13 +46,14 @@ import functools
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import Any, ClassVar
 
 import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError, suggest
 from ..core.fast_calls import FastFunction
+from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import LoopClosure, Model
 from ..core.options import Option, validate_mapping
 from ..core.schema import Either, MappingOf, Quantity, Record
@@ -148,6 +149,82 @@ def _type_dims() -> str:
 
 #: hinge name -> hinge, as a problem file's ``inputs.hinges`` and a mechanism's declared hinges take them
 HINGES = hinges_node("hinges by name: name -> {joints, type, k, dimensions, Kt, material}; null removes one")
+
+
+@dataclass(frozen=True, kw_only=True)
+class HingeSpec:
+    """One hinge as declared, parsed by :data:`HINGES` (SI): the typed record a mechanism's
+    hinge is parsed to once, and a problem file's hinge of the same name is merged over key
+    by key (:meth:`over`).  ``keys``: the keys given (a key given as null clears the one below)."""
+
+    joints: str | Mapping[str, str] | None = None
+    type: str | None = None
+    #: as written (one value or axis -> value): its dimension follows the joint it is on
+    #: (N*m/rad on an angle, N/m on a length), known with the closure
+    k: Any = None
+    material: Material | None = None
+    Kt: float | None = None
+    #: the dimensions given (t, r, w, ... of :data:`~cpm_nlp.analysis.hinge_types.DIM_OPTIONS`)
+    dims: Mapping[str, float | None] = field(default_factory=dict)
+    keys: frozenset[str] = frozenset()
+
+    @classmethod
+    def parsed(cls, values: Mapping[str, Any]) -> HingeSpec:
+        """The record of one hinge as :data:`HINGES` parsed it (only the keys given)."""
+        named = {k: values[k] for k in ("joints", "type", "k", "material", "Kt") if k in values}
+        dims = MappingProxyType({d: values[d] for d in DIM_OPTIONS if d in values})
+        return cls(**named, dims=dims, keys=frozenset(values))
+
+    def over(self, base: HingeSpec | None) -> HingeSpec:
+        """This hinge's keys over ``base`` (the mechanism's hinge of the same name)."""
+        if base is None:
+            return self
+        named = {k: getattr(self, k) for k in ("joints", "type", "k", "material", "Kt") if k in self.keys}
+        dims = MappingProxyType({**base.dims, **self.dims})
+        return dataclasses.replace(base, **named, dims=dims, keys=base.keys | self.keys)
+
+
+@dataclass(frozen=True, kw_only=True)
+class JointStiffness(Part):
+    """The compliant joints of a mechanism as its paper gives them (the part ``stiffness``),
+    used by the compliance kinds as defaults that a problem file may override hinge by hinge
+    (``inputs.hinges``).
+
+    hinges: hinge name -> the same mapping a problem file gives under ``inputs.hinges``:
+        ``joints`` (a coordinate or family name of x, q or the passive joints, or a mapping
+        axis -> name with axes bend, bend2, torsion, axial), ``k`` (N*m/rad on angles, N/m on
+        lengths; one value or one per axis), and optionally a flexure ``type`` with its
+        dimensions (see :data:`HINGE_TYPES`) for the stresses and the stiffness of the axes k
+        does not give.  Kept as written (``cpm-nlp describe`` shows it); parsed once, when
+        declared, to :attr:`records`.
+    material: the hinge material, a name of :data:`cpm_nlp.analysis.flexure.MATERIALS`
+        or an inline mapping ``{name, E, nu, density, yield_strength, allowable}``; parsed
+        once to :attr:`parsed_material`.
+    source: where the paper gives them (file, section, table).
+    """
+
+    capability: ClassVar[str] = "stiffness"
+
+    hinges: Mapping[str, Mapping[str, Any]]
+    material: Any = None
+    source: str = ""
+    #: hinge name -> its record (:class:`HingeSpec`), parsed once from ``hinges``
+    records: Mapping[str, HingeSpec] = field(init=False, repr=False, compare=False)
+    #: the material, parsed once (None when not given)
+    parsed_material: Material | None = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.hinges, Mapping) or not all(
+            isinstance(k, str) and isinstance(v, Mapping) for k, v in self.hinges.items()
+        ):
+            raise MechanismDeclarationError(
+                f"stiffness: hinges must map names to hinge mappings, got {self.hinges!r:.60}"
+            )
+        parsed = HINGES.parse(self.hinges, ("stiffness", "hinges"))
+        records = MappingProxyType({g: HingeSpec.parsed(v) for g, v in parsed.items()})
+        object.__setattr__(self, "records", records)
+        mat = None if self.material is None else material(self.material, ("stiffness", "material"))
+        object.__setattr__(self, "parsed_material", mat)
 
 
 def check_geometry(kind: str, d: Mapping[str, float], path: tuple) -> None:
@@ -263,21 +340,21 @@ def _hinge_axes(closure: LoopClosure, joints: Any, path: tuple) -> dict[str, lis
     return axes
 
 
-def _hinge_dims(kind: str | None, spec: Mapping[str, Any], path: tuple) -> dict[str, float]:
+def _hinge_dims(kind: str | None, spec: HingeSpec, path: tuple) -> dict[str, float]:
     """The dimensions of a hinge type (and its Kt), from a parsed hinge."""
     if kind is None:
         return {}
     need = HINGE_TYPES[kind].dims
-    extra = [d for d in DIM_OPTIONS if d not in need and spec.get(d) is not None]
+    extra = [d for d in DIM_OPTIONS if d not in need and spec.dims.get(d) is not None]
     if extra:
         raise InputError(
             f"hinge type {kind} has no dimension {', '.join(extra)} (it takes {', '.join(need)})", path=path
         )
     dims = validate_mapping(
-        {d: spec.get(d) for d in need}, [DIM_OPTIONS[d] for d in need], path, what="hinge dimension"
+        {d: spec.dims.get(d) for d in need}, [DIM_OPTIONS[d] for d in need], path, what="hinge dimension"
     )
     check_geometry(kind, dims, path)
-    dims["Kt"] = 1.0 if spec.get("Kt") is None else float(spec["Kt"])
+    dims["Kt"] = 1.0 if spec.Kt is None else float(spec.Kt)
     return dims
 
 
@@ -302,16 +379,16 @@ def _given_stiffness(raw_k: Any, axes: Mapping[str, Any], path: tuple) -> dict[s
 
 
 def _parse_hinge(
-    closure: LoopClosure, gname: str, spec: Mapping[str, Any], default_material: Material | None, path: tuple
+    closure: LoopClosure, gname: str, spec: HingeSpec, default_material: Material | None, path: tuple
 ) -> list[Hinge]:
-    """The hinges of one parsed hinge entry (:data:`HINGE`): one per member of its joints."""
-    axes = _hinge_axes(closure, spec.get("joints"), path)
+    """The hinges of one parsed hinge entry (:class:`HingeSpec`): one per member of its joints."""
+    axes = _hinge_axes(closure, spec.joints, path)
     coords = list(closure.x) + list(closure.q) + list(closure.passive_coords)
-    kind = spec.get("type")
+    kind = spec.type
     dims = _hinge_dims(kind, spec, path)
-    mat = default_material if spec.get("material") is None else material(spec["material"], path + ("material",))
+    mat = default_material if spec.material is None else material(spec.material, path + ("material",))
     # stiffness: given per axis (or one value for a one-axis hinge), else the hinge formula
-    raw_k = spec.get("k")
+    raw_k = spec.k
     given = _given_stiffness(raw_k, axes, path)
     formula: dict[str, float] = {}
     if kind is not None and any(a not in given for a in axes) and mat is None:
@@ -344,9 +421,9 @@ def _parse_hinge(
 
 
 def parse_hinges(
-    closure: LoopClosure, specs: Mapping[str, Any], mat: Material | None, paths: Mapping[str, tuple]
+    closure: LoopClosure, specs: Mapping[str, HingeSpec], mat: Material | None, paths: Mapping[str, tuple]
 ) -> tuple[np.ndarray, list[Hinge]]:
-    """The hinges of ``specs`` (name -> hinge mapping) on a closure: the stiffness over
+    """The hinges of ``specs`` (name -> hinge record) on a closure: the stiffness over
     the joint vector (x, q, passive) and the hinges; ``paths`` gives each hinge's key
     path for the messages.  A joint may carry one hinge only."""
     names = joint_names(closure)
@@ -364,12 +441,12 @@ def parse_hinges(
 
 
 def check_declared(closure: LoopClosure, hinges: Mapping[str, Any], material_spec: Any, path: tuple) -> None:
-    """Check a mechanism's declared hinges and material (its ``stiffness`` capability)
+    """Check a mechanism's declared hinges and material (its part ``stiffness``)
     against its closure, by the rules of a problem file's ``inputs.hinges``: joints
     that name coordinates or families, known hinge types and keys, possible geometry,
     a known material.  Key paths under ``path`` (``stiffness`` of a mechanism file)."""
     mat = None if material_spec is None else material(material_spec, path + ("material",))
-    parsed = HINGES.parse(hinges, path + ("hinges",))
+    parsed = {g: HingeSpec.parsed(v) for g, v in HINGES.parse(hinges, path + ("hinges",)).items()}
     parse_hinges(closure, parsed, mat, {g: path + ("hinges", g) for g in parsed})
 
 
@@ -380,21 +457,20 @@ def hinge_set(
     sigma_allow: float | None = None,
     path: tuple = ("inputs",),
 ) -> HingeSet:
-    """The hinges of a model: the mechanism's declared defaults (its ``stiffness``
-    capability) merged, hinge by hinge and key by key, with ``hinges`` from the
-    problem file (as written or parsed by :data:`HINGES`); ``material_spec`` overrides
+    """The hinges of a model: the mechanism's declared defaults (its part ``stiffness``,
+    parsed when it was declared) merged, hinge by hinge and key by key, with ``hinges`` from
+    the problem file (as written or parsed by :data:`HINGES`); ``material_spec`` overrides
     the default material."""
     c = model.closure
     mech = model.mechanism
-    decl = mech.stiffness if mech is not None else None
-    declared = HINGES.parse(decl.hinges, ("mechanism", "stiffness")) if decl else {}
+    decl = mech.part(JointStiffness) if mech is not None else None
     given = HINGES.parse(hinges, path + ("hinges",)) if hinges is not None else {}
-    merged: dict[str, dict] = {k: dict(v) for k, v in declared.items()}
+    merged: dict[str, HingeSpec] = dict(decl.records) if decl else {}
     for name, spec in given.items():
         if spec is None:  # null removes a default hinge
             merged.pop(name, None)
         else:
-            merged[name] = {**merged.get(name, {}), **spec}
+            merged[name] = HingeSpec.parsed(spec).over(merged.get(name))
     if not merged:
         raise InputError(
             f"mechanism {model.name} declares no joint stiffness; give inputs.hinges "
@@ -404,8 +480,8 @@ def hinge_set(
     mat = None
     if material_spec is not None:
         mat = material(material_spec, path + ("material",))
-    elif decl is not None and decl.material is not None:
-        mat = material(decl.material, ("mechanism", "stiffness", "material"))
+    elif decl is not None:
+        mat = decl.parsed_material
     paths = {g: path + ("hinges", g) if g in given else ("mechanism", "stiffness", g) for g in merged}
     k, out = parse_hinges(c, merged, mat, paths)
     coords = list(c.x) + list(c.q) + list(c.passive_coords)
@@ -434,7 +510,7 @@ def _material_at(mech: Any, out: list[Hinge], merged: Mapping, hinges: Any, mate
         if h.material is None:
             continue
         where = default
-        if isinstance(merged.get(h.group), Mapping) and merged[h.group].get("material") is not None:
+        if h.group in merged and merged[h.group].material is not None:
             given = hinges.get(h.group) if isinstance(hinges, Mapping) else None
             if isinstance(given, Mapping) and given.get("material") is not None:
                 where = (path + ("hinges", h.group, "material"), "")

@@ -1,16 +1,17 @@
 """Lagrange dynamics of a mechanism about its home configuration.
 
-A mechanism that has a dynamic model provides (in its module)
+A mechanism that has a dynamic model registers a :class:`DynamicsModel` among its
+parts (the part ``dynamics``, read by the ``dynamics`` kind):
 
 * ``lagrangian()`` -- ``ca.Function("lagrangian", [q, qd, p, w], [T, U, ...])``:
   kinetic energy T(q, qd) and potential energy U(q) (elastic and gravity),
   symbolic in the kinematic parameters p and the dynamic parameters w,
-* ``DYNAMIC_PARAMETERS`` -- the names of w: ``E`` (the hinge material's
-  Young's modulus), ``g``, the masses of ``MASSES``, or parameter names of
+* ``parameters`` -- the names of w: ``E`` (the hinge material's
+  Young's modulus), ``g``, the masses of ``masses``, or parameter names of
   the mechanism (hinge and link dimensions),
-* ``MASSES`` -- ``(name, description)`` of every rigid body's mass,
-* optionally ``dynamics_values(model, w, M, K, G)`` and
-  ``DYNAMICS_DIMENSIONS`` -- the paper's own named quantities.
+* ``masses`` -- ``(name, description)`` of every rigid body's mass,
+* optionally ``values(model, w, M, K, G)`` and ``dimensions`` -- the paper's
+  own named quantities.
 
 Lagrange's equation d/dt dL/dqd - dL/dq = F with L = T - U (prc3-li-2018.md
 eq 36-37), linearized at q = q_home, qd = 0, gives M qdd + K q + G = F (eq 38)
@@ -23,16 +24,48 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 import casadi as ca
 import numpy as np
 import scipy.linalg
 
 from ..core.errors import InputError
+from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.options import Option, validate_mapping
 from ..core.units import parse_quantity
+
+
+@dataclass(frozen=True, kw_only=True)
+class DynamicsModel(Part):
+    """A Lagrange model of the mechanism (the part ``dynamics``), used by the ``dynamics`` kind.
+
+    masses: ``(name, description)`` of each mass input (kg, or a block of the
+        hinge material given by its dimensions).
+    parameters: names, in order, of the vector w the energies take: ``E``,
+        ``g``, the masses and any mechanism parameters by name.
+    lagrangian: ``() -> ca.Function("...", [q, qd, p, w], [T, U, ...])``: the
+        kinetic and potential energies in the actuator coordinates q (nq).
+    values: optional ``(model, w, M, K, G) -> dict`` of named quantities of the
+        paper, with their dimensions in ``dimensions``.
+    """
+
+    capability: ClassVar[str] = "dynamics"
+
+    masses: tuple[tuple[str, str], ...]
+    parameters: tuple[str, ...]
+    lagrangian: Callable[[], Any]
+    values: Callable[..., dict] | None = None
+    dimensions: Mapping[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not callable(self.lagrangian) or not (self.values is None or callable(self.values)):
+            raise MechanismDeclarationError("dynamics: lagrangian must be callable, and values callable or None")
+        if not all(isinstance(n, str) for n in self.parameters):
+            raise MechanismDeclarationError(f"dynamics: parameters must be names, got {self.parameters!r:.60}")
+
 
 #: a mass given as a block: density (of the material) x length x width x height
 BLOCK = (

@@ -5,8 +5,8 @@ The pseudo-rigid-body model of :mod:`cpm_nlp.analysis.compliance` lets a hinge
 turn only about the axes the kinematics moves, so with the actuators held a
 mechanism of rigid links does not deflect at all.  A real flexure also bends
 about its second axis, twists, stretches and shears.  Here each leg is the
-serial chain of its joints at the reference configuration (the ``chains``
-capability, :mod:`cpm_nlp.core.chains`) and every hinge adds, at its joint and
+serial chain of its joints at the reference configuration (the part ``chains``,
+:class:`~cpm_nlp.core.chains.LegChains`) and every hinge adds, at its joint and
 in its own frame (length axis t, compliant axis b1, second axis b2 = b1 x t),
 the axes its joint does not move, each with the flexure library's stiffness
 (:data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, each type's ``six_axis``):
@@ -50,7 +50,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.blas import one_blas_thread
-from ..core.chains import Chains
+from ..core.chains import Chains, LegChains
 from ..core.errors import InputError
 from ..core.fast_calls import FastFunction
 from ..core.model import Model
@@ -472,7 +472,8 @@ def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
     """The six-axis hinge model, or None when the mechanism gives no chains (built once per
     mechanism, parameters and hinges, then reused)."""
     mech = model.mechanism
-    if mech is None or mech.chains is None:
+    chains = mech.part(LegChains) if mech is not None else None
+    if chains is None:
         return None
     key = _key(model, hs)
     with _LOCK:
@@ -480,7 +481,7 @@ def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
         if built is not None:
             _BUILT.move_to_end(key)
             return built
-    built = SixAxisModel(model, hs, mech.chains(model))
+    built = SixAxisModel(model, hs, chains.of(model))
     with _LOCK:
         _BUILT[key] = built
         while len(_BUILT) > _BUILT_MAX:
@@ -488,4 +489,4 @@ def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
     return built
 
 
-__all__ = ["HingeFrame", "SixAxisModel", "six_axis_model"]
+__all__ = ["HingeFrame", "LegChains", "SixAxisModel", "six_axis_model"]

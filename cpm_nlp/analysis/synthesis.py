@@ -293,7 +293,8 @@ def cuboid_synthesis(
     footprint = dict(footprint or {})
     names, lo, hi = _design_bounds(model, design, footprint)
     lc = model.characteristic_length
-    build = rebuild or (lambda params: Model(c, params, model.limits, characteristic_length=lc))
+    mech = model.mechanism
+    build = rebuild or (lambda params: Model(c, params, model.limits, characteristic_length=lc, mechanism=mech))
     design_idx = tuple(c.parameters.index(n) for n in names)
     exps = tuple(float(footprint.get(n, 0.0)) for n in names)
     d = c.nq

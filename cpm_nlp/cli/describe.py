@@ -70,9 +70,12 @@ def _write_mechanism(mt: Any, out: TextIO) -> None:
         out.write(f"  {o.name:<8} {o.description}\n")
     caps = mt.capabilities()
     out.write("capabilities: " + (", ".join(caps) if caps else "none beyond the required parts") + "\n")
-    if mt.stiffness is not None:  # the default hinges of the compliance kinds
-        out.write(f"joint stiffness ({mt.stiffness.source}):\n")
-        for hname, spec in mt.stiffness.hinges.items():
+    from ..analysis.compliance import JointStiffness
+
+    stiffness = mt.part(JointStiffness)
+    if stiffness is not None:  # the default hinges of the compliance kinds
+        out.write(f"joint stiffness ({stiffness.source}):\n")
+        for hname, spec in stiffness.hinges.items():
             text = ", ".join(f"{k}: {v}" for k, v in spec.items())
             out.write(f"  {hname:<10} {text}\n")
     if mt.kinds:

@@ -7,8 +7,10 @@ is a six-degree-of-freedom spring at its own location, so each leg is written
 as a serial chain, base first, at the reference configuration (product of
 exponentials: a joint's variable is its displacement from there).
 
-A mechanism that can give its legs this way declares the ``chains``
-capability, ``(model) -> Chains``, numeric at the model's parameters.
+A mechanism that can give its legs this way registers the part ``chains``,
+:class:`LegChains` (``(model) -> Chains``, numeric at the model's parameters);
+it sits here, beside the data it gives, so that a mechanism file declares it
+without loading the six-axis model (and scipy) at start-up.
 Mechanisms described in files get it from their legs
 (:mod:`cpm_nlp.mechanisms.described.chains`).
 
@@ -18,13 +20,15 @@ degrees of freedom (P, R: 1; C, U: 2; S: 3).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from .joints import JOINT_TYPES
+from .mechanism import MechanismDeclarationError, Part
 
 #: degrees of freedom of each joint type the chains take: the spatial joints with
 #: coordinates (the joint table's P, R, C, U, S)
@@ -90,3 +94,21 @@ class Chains:
     x_reference: np.ndarray
     q_reference: np.ndarray
     note: str = ""
+
+
+@dataclass(frozen=True)
+class LegChains(Part):
+    """The legs of a mechanism as serial chains of joints at the reference configuration
+    (the part ``chains``), for the six-axis hinge model.
+
+    of: ``(model) -> Chains`` (:class:`~cpm_nlp.core.chains.Chains`), numeric at the model's
+        parameters.
+    """
+
+    capability: ClassVar[str] = "chains"
+
+    of: Callable[[Any], Chains]
+
+    def __post_init__(self) -> None:
+        if not callable(self.of):
+            raise MechanismDeclarationError(f"chains must be callable, got {self.of!r:.60}")

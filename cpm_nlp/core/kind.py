@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
+from .mechanism import P, Part
 from .model import Coordinate, Model
 from .options import Option, validate_mapping
 from .result import Output, Result
@@ -43,6 +44,16 @@ class ProblemKind:
     plots: tuple[str, ...] = ()
     #: (x, y, value) names of the values a design map of a result shows (plot type "map")
     map_axes: tuple[str, str, str] | None = None
+    #: the mechanism parts this kind reads (:class:`~cpm_nlp.core.mechanism.Part` types,
+    #: declared with the kind), each through :meth:`part`
+    parts: tuple[type[Part], ...] = ()
+
+    def part(self, model: Model, kind: type[P]) -> P | None:
+        """The part of type ``kind`` of the model's mechanism (None without one, or for a
+        model built by hand); ``kind`` must be one this kind declares in :attr:`parts`."""
+        if kind not in self.parts:
+            raise TypeError(f"problem kind {self.name!r} reads {kind.__name__} but does not declare it in parts")
+        return model.mechanism.part(kind) if model.mechanism is not None else None
 
     def input_options(self, model: Model) -> list[Option]:
         """The declared inputs: :class:`Option` s and nodes of :mod:`cpm_nlp.core.schema`."""

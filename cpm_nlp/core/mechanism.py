@@ -1,14 +1,17 @@
 """The declared interface between a mechanism and the rest of cpm_nlp.
 
-A mechanism type is one :class:`Mechanism` value.  Its required parts say
-what the mechanism *is*; its optional capabilities say what else it can do,
-and every feature of the toolkit that needs a capability asks for it by its
-field here, never by probing a module for an attribute.  A misspelt
-capability is therefore an error when the mechanism is declared
-(:func:`declare`) or registered, not a silently missing feature.
+A mechanism type is one :class:`Mechanism` value.  Its required fields say
+what the mechanism *is*; its optional fields are what every mechanism may
+have (checks, a drawing, kinds of its own, problem files); everything a
+single kind needs from it is a :class:`Part`, declared by that kind (in its
+own module, not here) and registered by the mechanism in ``parts``.  A kind
+reads a part by its type (:meth:`Mechanism.part`), never by probing a module
+for an attribute, so core does not change when a kind needs something new.
+A misspelt field or a mistyped part is an error when the mechanism is
+declared (:func:`declare`) or registered, not a silently missing feature.
 
-Required parts
---------------
+Required fields
+---------------
 ``name``, ``title``
     the type name used in problem files (``mechanism.type``) and a one-line title.
 ``parameters``, ``limits``
@@ -24,22 +27,30 @@ Required parts
 ``build``
     ``(closure, parameters, limits) -> Model``: a model from validated values (SI).
 
-Optional capabilities
----------------------
-See the fields of :class:`Mechanism`: cross-value checks, a synthesis
-formulation, extra inscribed-cuboid inputs and values, a closed-form
-workspace membership from the paper, a dynamics model, default joint
-stiffnesses and flexure hinges, problem kinds of its own, the problem files
-that reproduce its paper's figures, and a drawing of the mechanism at a pose
-(``geometry``: base, legs, joints, platform).
+Optional fields
+---------------
+``paper``, cross-value checks (``check_parameters``, ``check_limits``), a
+drawing of the mechanism at a pose (``geometry``: base, legs, joints,
+platform), ``parts``, problem ``kinds`` of its own and the ``problem_files``
+that reproduce its paper's figures.
+
+Parts (each declared with the kind that reads it)
+-------------------------------------------------
+``synthesis`` (:class:`~cpm_nlp.kinds.synthesis.SynthesisFormulation`), ``cuboid``
+(:class:`~cpm_nlp.kinds.workspace.CuboidExtras`), ``paper_membership``
+(:class:`~cpm_nlp.kinds.workspace.PaperMembership`), ``dynamics``
+(:class:`~cpm_nlp.analysis.dynamics.DynamicsModel`), ``stiffness``
+(:class:`~cpm_nlp.analysis.compliance.JointStiffness`) and ``chains``
+(:class:`~cpm_nlp.core.chains.LegChains`, in core beside the chains it gives).
 """
 
 from __future__ import annotations
 
 import inspect
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields, replace
-from typing import Any
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+from typing import Any, ClassVar, TypeVar
 
 from .errors import suggest
 from .joints import JOINT_LETTERS
@@ -50,47 +61,6 @@ from .origin import Origin, as_origin
 class MechanismDeclarationError(TypeError):
     """A mechanism declaration that breaks the interface (raised at declaration
     or registration, with the mechanism's name and the field at fault)."""
-
-
-@dataclass(frozen=True, kw_only=True)
-class CuboidExtras:
-    """What a mechanism adds to the ``inscribed_cuboid`` kind.
-
-    options: extra inputs of the kind for this mechanism.
-    value_names: the names of the extra values, all of them (set to null when
-        no cuboid was found).
-    values: ``(model, lower, upper, inputs, solver) -> (values, dimensions)``
-        for a found box ``lower <= t <= upper`` (SI, task coordinates).
-    paper_box: optional ``(values) -> (lower, upper, label) | None``: the box of
-        the paper's own formulation read from a result's values, drawn beside
-        the found one by the workspace plot (None when the result has none).
-    """
-
-    options: tuple[Option, ...] = ()
-    value_names: tuple[str, ...] = ()
-    values: Callable[..., tuple[dict, dict]]
-    paper_box: Callable[[Mapping[str, Any]], Any] | None = None
-
-
-@dataclass(frozen=True, kw_only=True)
-class DynamicsModel:
-    """A Lagrange model of the mechanism, used by the ``dynamics`` kind.
-
-    masses: ``(name, description)`` of each mass input (kg, or a block of the
-        hinge material given by its dimensions).
-    parameters: names, in order, of the vector w the energies take: ``E``,
-        ``g``, the masses and any mechanism parameters by name.
-    lagrangian: ``() -> ca.Function("...", [q, qd, p, w], [T, U, ...])``: the
-        kinetic and potential energies in the actuator coordinates q (nq).
-    values: optional ``(model, w, M, K, G) -> dict`` of named quantities of the
-        paper, with their dimensions in ``dimensions``.
-    """
-
-    masses: tuple[tuple[str, str], ...]
-    parameters: tuple[str, ...]
-    lagrangian: Callable[[], Any]
-    values: Callable[..., dict] | None = None
-    dimensions: Mapping[str, str] = field(default_factory=dict)
 
 
 #: parts a :class:`Drawing` may join or fill, in the order they are drawn
@@ -132,32 +102,40 @@ class Drawing:
                 raise ValueError(f"drawing: joint {name!r}: {letter!r} names an unknown point or joint type")
 
 
-@dataclass(frozen=True, kw_only=True)
-class JointStiffness:
-    """The compliant joints of a mechanism as its paper gives them (the
-    ``stiffness`` capability), used by the compliance kinds as defaults that a
-    problem file may override hinge by hinge (``inputs.hinges``).
+class Part:
+    """Base of a mechanism's optional parts: what one kind (or analysis) needs from a mechanism
+    beyond its closure, declared where that kind lives, never here.
 
-    hinges: hinge name -> the same mapping a problem file gives under
-        ``inputs.hinges``: ``joints`` (a coordinate or family name of x, q or the
-        passive joints, or a mapping axis -> name with axes bend, bend2, torsion,
-        axial), ``k`` (N*m/rad on angles, N/m on lengths; one value or one per
-        axis), and optionally a flexure ``type`` with its dimensions (see
-        :data:`cpm_nlp.analysis.compliance.HINGE_TYPES`) for the stresses and the
-        stiffness of the axes k does not give.
-    material: the hinge material, a name of :data:`cpm_nlp.analysis.flexure.MATERIALS`
-        or an inline mapping ``{name, E, nu, density, yield_strength, allowable}``.
-    source: where the paper gives them (file, section, table).
+    A kind names the part types it reads (:attr:`ProblemKind.parts
+    <cpm_nlp.core.kind.ProblemKind.parts>`); a mechanism registers its implementations
+    (:attr:`Mechanism.parts`, at most one of each type); :meth:`Mechanism.part` is the one way to
+    read one.  A subclass names its ``capability`` (listed by ``cpm-nlp describe``) and checks
+    its own fields when made, raising :class:`MechanismDeclarationError`.
     """
 
-    hinges: Mapping[str, Mapping[str, Any]]
-    material: Any = None
-    source: str = ""
+    #: the name ``cpm-nlp describe`` lists the part under
+    capability: ClassVar[str] = ""
+
+
+P = TypeVar("P", bound=Part)
+
+
+def known_parts() -> dict[str, type]:
+    """capability -> part type, of every part type imported so far (for the messages of a
+    declaration that names a part as a keyword)."""
+    out: dict[str, type] = {}
+    todo = list(Part.__subclasses__())
+    while todo:
+        cls = todo.pop()
+        todo.extend(cls.__subclasses__())
+        if cls.capability and "capability" in vars(cls):
+            out.setdefault(cls.capability, cls)
+    return out
 
 
 @dataclass(frozen=True, kw_only=True)
 class Mechanism:
-    """A mechanism type: required parts and optional capabilities.
+    """A mechanism type: what every mechanism has, and its parts.
 
     Sizes in model terms: nx pose coordinates x, nq actuators q, np
     parameters p (see :class:`~cpm_nlp.core.model.LoopClosure`).
@@ -181,23 +159,12 @@ class Mechanism:
     check_parameters: Callable[[dict, tuple], None] | None = None
     #: ``(limits, path) -> None``: rules over several limits; raises InputError
     check_limits: Callable[[dict, tuple], None] | None = None
-    #: ``() -> ProblemKind``: the paper's dimensional synthesis, run by the ``synthesis`` kind
-    synthesis: Callable[[], Any] | None = None
-    #: extra inputs and values of the ``inscribed_cuboid`` kind
-    cuboid: CuboidExtras | None = None
-    #: ``(model, points (N, nq)) -> (inside (N,), margins)``: the paper's closed-form
-    #: workspace membership, reported by the ``workspace`` kind beside the general test
-    paper_membership: Callable[[Any, Any], tuple[Any, dict]] | None = None
-    #: a Lagrange model for the ``dynamics`` kind
-    dynamics: DynamicsModel | None = None
     #: ``(model, x (nx,), q (nq,)) -> Drawing``: the mechanism at a pose (base, legs,
     #: joints, platform) for the plots, from its kinematic functions
     geometry: Callable[[Any, Any, Any], Drawing] | None = None
-    #: default joint stiffnesses and flexure hinges, for the compliance kinds
-    stiffness: JointStiffness | None = None
-    #: ``(model) -> Chains``: each leg as a serial chain of joints at the reference
-    #: configuration (:mod:`cpm_nlp.core.chains`), for the six-axis hinge model
-    chains: Callable[[Any], Any] | None = None
+    #: what kinds need beyond the closure, one :class:`Part` of each type (e.g. the extra
+    #: values of the inscribed cuboid, a Lagrange model, its hinges); read by :meth:`part`
+    parts: tuple[Part, ...] = ()
     #: problem kinds of its own: kind name -> ProblemKind subclass
     kinds: Mapping[str, type] = field(default_factory=dict)
     #: its shipped problem files: examples of its kinds, and (those with a ``reproduce:``
@@ -217,105 +184,138 @@ class Mechanism:
         self, closure: Any, parameters: Mapping[str, Any] | None, limits: Mapping[str, Any] | None, path: tuple
     ) -> Any:
         """A model on ``closure`` from values given as in a problem file (numbers in SI
-        or strings with units), validated against the declared options and checks."""
+        or strings with units), validated against the declared options and checks; its
+        ``mechanism`` is this declaration."""
         params = validate_mapping(parameters or {}, self.parameters, path + ("parameters",), what="parameter")
         lims = validate_mapping(limits or {}, self.limits, path + ("limits",), what="limit")
         if self.check_parameters is not None:
             self.check_parameters(params, path + ("parameters",))
         if self.check_limits is not None:
             self.check_limits(lims, path + ("limits",))
-        return self.build(closure, params, lims)
+        model = self.build(closure, params, lims)
+        model.mechanism = self
+        return model
+
+    def part(self, kind: type[P]) -> P | None:
+        """The mechanism's part of type ``kind`` (a :class:`Part` subclass), or None."""
+        return next((p for p in self.parts if isinstance(p, kind)), None)
 
     def capabilities(self) -> list[str]:
-        """Names of the optional capabilities this mechanism declares."""
-        return [f.name for f in fields(self) if f.name in CAPABILITIES and getattr(self, f.name)]
+        """Names of what this mechanism declares beyond the required parts: its checks and
+        drawing, its parts (by their ``capability``), its own kinds and problem files."""
+        own = [name for name in ("check_parameters", "check_limits", "geometry") if getattr(self, name) is not None]
+        tail = [name for name in ("kinds", "problem_files") if getattr(self, name)]
+        return own + [p.capability for p in self.parts] + tail
 
 
 #: required parts of a mechanism
 REQUIRED = ("name", "title", "parameters", "limits", "closure", "build")
-#: optional capabilities (fields) of a mechanism
-CAPABILITIES = (
-    "check_parameters",
-    "check_limits",
-    "synthesis",
-    "cuboid",
-    "paper_membership",
-    "dynamics",
-    "geometry",
-    "stiffness",
-    "chains",
-    "kinds",
-    "problem_files",
+#: optional fields of a mechanism
+OPTIONAL = ("paper", "check_parameters", "check_limits", "geometry", "parts", "kinds", "problem_files", "origin")
+#: every field a declaration may name
+PARTS = REQUIRED + OPTIONAL
+
+
+def _options(value: Any) -> str | None:
+    if not isinstance(value, tuple) or not all(isinstance(o, Option) for o in value):
+        return "a tuple of Option"
+    names = [o.name for o in value]
+    return None if len(set(names)) == len(names) else "a tuple of Options with distinct names"
+
+
+def _callable(value: Any) -> str | None:
+    return None if callable(value) else "callable"
+
+
+def _optional_callable(value: Any) -> str | None:
+    return None if value is None or callable(value) else "callable or None"
+
+
+def _parts(value: Any) -> str | None:
+    expected = "a tuple of mechanism parts (instances of cpm_nlp.core.mechanism.Part subclasses)"
+    if not isinstance(value, tuple) or not all(isinstance(p, Part) and p.capability for p in value):
+        return expected
+    names = [p.capability for p in value]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    return f"{expected}, one of each (twice: {', '.join(twice)})" if twice else None
+
+
+def _kinds(value: Any) -> str | None:
+    expected = "a mapping of kind name -> ProblemKind subclass"
+    if not isinstance(value, Mapping):
+        return expected
+    for kname, cls in value.items():
+        if not isinstance(kname, str) or not inspect.isclass(cls) or not hasattr(cls, "run"):
+            return f"{expected} (entry {kname!r})"
+        if getattr(cls, "name", kname) != kname:
+            return f"keyed by each kind's own name ({cls.__name__}.name is {cls.name!r}, key {kname!r})"
+    return None
+
+
+def _file_names(value: Any) -> str | None:
+    ok = isinstance(value, tuple) and all(isinstance(f, str) for f in value)
+    return None if ok else "a tuple of file names"
+
+
+#: field -> its check: None if the value is right, else what was expected
+CHECKS: Mapping[str, Callable[[Any], str | None]] = MappingProxyType(
+    {
+        "title": lambda v: None if isinstance(v, str) else "a string",
+        "parameters": _options,
+        "limits": _options,
+        "closure": _callable,
+        "build": _callable,
+        "check_parameters": _optional_callable,
+        "check_limits": _optional_callable,
+        "geometry": _optional_callable,
+        "parts": _parts,
+        "kinds": _kinds,
+        "problem_files": _file_names,
+    }
 )
-#: every part a declaration may name
-PARTS = REQUIRED + CAPABILITIES + ("paper", "origin")
 
 
-def _fail(mech: Any, name: str, expected: str) -> None:
-    value = getattr(mech, name)
-    raise MechanismDeclarationError(
-        f"mechanism {mech.name!r} ({mech.origin}): {name} must be {expected}, got {type(value).__name__} {value!r:.60}"
-    )
-
-
-def validate(mech: Mechanism) -> None:  # noqa: C901 - one flat check per declared part
-    """Check the types of every part of a declaration (registration calls it too)."""
+def validate(mech: Mechanism) -> None:
+    """Check the types of every field of a declaration (registration calls it too); each
+    part checked its own fields when it was made."""
     if not isinstance(mech.name, str) or not mech.name.isidentifier():
         raise MechanismDeclarationError(f"a mechanism name must be an identifier, got {mech.name!r} ({mech.origin})")
-    if not isinstance(mech.title, str):
-        _fail(mech, "title", "a string")
-    for group in ("parameters", "limits"):
-        value = getattr(mech, group)
-        if not isinstance(value, tuple) or not all(isinstance(o, Option) for o in value):
-            _fail(mech, group, "a tuple of Option")
-        names = [o.name for o in value]
-        if len(set(names)) != len(names):
-            _fail(mech, group, "a tuple of Options with distinct names")
-    for name in ("closure", "build"):
-        if not callable(getattr(mech, name)):
-            _fail(mech, name, "callable")
-    for name in ("check_parameters", "check_limits", "synthesis", "paper_membership", "geometry", "chains"):
-        if getattr(mech, name) is not None and not callable(getattr(mech, name)):
-            _fail(mech, name, "callable or None")
-    if mech.cuboid is not None and not isinstance(mech.cuboid, CuboidExtras):
-        _fail(mech, "cuboid", "a CuboidExtras or None")
-    if mech.dynamics is not None and not isinstance(mech.dynamics, DynamicsModel):
-        _fail(mech, "dynamics", "a DynamicsModel or None")
-    if mech.stiffness is not None:
-        if not isinstance(mech.stiffness, JointStiffness):
-            _fail(mech, "stiffness", "a JointStiffness or None")
-        if not isinstance(mech.stiffness.hinges, Mapping) or not all(
-            isinstance(k, str) and isinstance(v, Mapping) for k, v in mech.stiffness.hinges.items()
-        ):
-            _fail(mech, "stiffness", "a JointStiffness whose hinges map names to hinge mappings")
-    if not isinstance(mech.kinds, Mapping):
-        _fail(mech, "kinds", "a mapping of kind name -> ProblemKind subclass")
-    for kname, cls in mech.kinds.items():
-        if not isinstance(kname, str) or not inspect.isclass(cls) or not hasattr(cls, "run"):
-            _fail(mech, "kinds", f"a mapping of kind name -> ProblemKind subclass (entry {kname!r})")
-        if getattr(cls, "name", kname) != kname:
-            _fail(mech, "kinds", f"keyed by each kind's own name ({cls.__name__}.name is {cls.name!r}, key {kname!r})")
-    if not isinstance(mech.problem_files, tuple) or not all(isinstance(f, str) for f in mech.problem_files):
-        _fail(mech, "problem_files", "a tuple of file names")
+    for name, check in CHECKS.items():
+        expected = check(getattr(mech, name))
+        if expected is not None:
+            value = getattr(mech, name)
+            raise MechanismDeclarationError(
+                f"mechanism {mech.name!r} ({mech.origin}): {name} must be {expected}, "
+                f"got {type(value).__name__} {value!r:.60}"
+            )
 
 
-def declare(**parts: Any) -> Mechanism:
-    """A :class:`Mechanism` from keyword parts, with a "did you mean" for a
-    misspelt part (``Mechanism(...)`` itself only says "unexpected keyword")."""
-    unknown = [k for k in parts if k not in PARTS]
+def unknown_field_hint(name: str) -> str:
+    """What to say of a keyword a declaration does not take: a part's capability says where it
+    goes (``parts=(...)``), else a "did you mean"."""
+    parts = known_parts()
+    if name in parts:
+        return f"{name} is a part: give parts=({parts[name].__name__}(...),)"
+    close = suggest(name, PARTS + tuple(parts))
+    return f"did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+
+
+def declare(**fields_: Any) -> Mechanism:
+    """A :class:`Mechanism` from keyword fields, with a "did you mean" for a misspelt one
+    (``Mechanism(...)`` itself only says "unexpected keyword")."""
+    unknown = [k for k in fields_ if k not in PARTS]
     if unknown:
-        hints = [f"{k!r} (did you mean {', '.join(repr(s) for s in suggest(k, PARTS))}?)" for k in unknown]
-        name = parts.get("name", "?")
+        hints = [f"{k!r} ({unknown_field_hint(k)})" if unknown_field_hint(k) else repr(k) for k in unknown]
         raise MechanismDeclarationError(
-            f"mechanism {name!r}: unknown part(s) {', '.join(hints)}; "
-            f"required: {', '.join(REQUIRED)}; optional: {', '.join(CAPABILITIES)}, paper, origin"
+            f"mechanism {fields_.get('name', '?')!r}: unknown part(s) {', '.join(hints)}; "
+            f"required: {', '.join(REQUIRED)}; optional: {', '.join(OPTIONAL)}"
         )
-    missing = [k for k in REQUIRED if k not in parts]
+    missing = [k for k in REQUIRED if k not in fields_]
     if missing:
         raise MechanismDeclarationError(
-            f"mechanism {parts.get('name', '?')!r}: missing required part(s) {', '.join(missing)}"
+            f"mechanism {fields_.get('name', '?')!r}: missing required part(s) {', '.join(missing)}"
         )
-    return Mechanism(**parts)
+    return Mechanism(**fields_)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -327,13 +327,12 @@ class Addon:
 
     parameters: optional parameters the closures do not use (e.g. a dynamics model's lengths
         and hinge sizes); a value given is kept in the model's ``parameters``, never in p.
-    check_parameters: ``(parameters, path) -> None``: rules over several parameters.
-    dynamics: ``(closure) -> DynamicsModel``: the Lagrange model, given the file's closure
-        (so that it may use the file's loop closures, e.g. their Jacobian, never a copy).
+    check_parameters, check_limits: as the :class:`Mechanism` fields of the same names.
+    parts: the paper's parts (:class:`Part`), registered as a mechanism registers its own
+        (the paper's formulations that refer to the file's mechanism).
+    closure_parts: ``(closure) -> Part`` each: a part made from the file's closure (e.g. a
+        Lagrange model that uses the file's loop closures, their Jacobian, never a copy).
     kinds: problem kinds of the paper's own: kind name -> ProblemKind subclass.
-    check_limits, synthesis, cuboid, paper_membership, stiffness, chains: as the
-        :class:`Mechanism` fields of the same names (the paper's formulations that refer to
-        the file's mechanism).
     limits: the paper's own limit options (e.g. a hinge from which a formula sets the joint
         limits, or ranges counted from home), beside the file's limit families; one named
         like a family of the file replaces it (the paper's meaning of that name wins).
@@ -348,32 +347,30 @@ class Addon:
 
     parameters: tuple[Option, ...] = ()
     check_parameters: Callable[[dict, tuple], None] | None = None
-    dynamics: Callable[[Any], DynamicsModel] | None = None
-    kinds: Mapping[str, type] = field(default_factory=dict)
     check_limits: Callable[[dict, tuple], None] | None = None
-    synthesis: Callable[[], Any] | None = None
-    cuboid: CuboidExtras | None = None
-    paper_membership: Callable[[Any, Any], tuple[Any, dict]] | None = None
-    stiffness: JointStiffness | None = None
-    chains: Callable[[Any], Any] | None = None
+    parts: tuple[Part, ...] = ()
+    closure_parts: tuple[Callable[[Any], Part], ...] = ()
+    kinds: Mapping[str, type] = field(default_factory=dict)
     limits: tuple[Option, ...] = ()
     complete: Callable[[Any, dict], None] | None = None
     plots: tuple[str, ...] = ()
 
 
-#: the add-on's parts taken as they are (each must not be given by the file too)
-ADDON_PARTS = ("check_parameters", "check_limits", "synthesis", "cuboid", "paper_membership", "stiffness", "chains")
+#: the add-on's checks, taken as they are (each must not be given by the file too)
+ADDON_CHECKS = ("check_parameters", "check_limits")
 
 
 def with_addon(mech: Mechanism, addon: Addon) -> Mechanism:
     """The mechanism of a file with its add-on's parts (validated like any declaration).  A
-    part the add-on gives that the file has too (a parameter, a kind, a check) is an error:
-    each part is written once."""
+    part the add-on gives that the file has too (a parameter, a kind, a check, a part of one
+    type) is an error: each part is written once.  The add-on's parts come first."""
     if not isinstance(addon, Addon):
         raise MechanismDeclarationError(f"mechanism {mech.name!r}: expected an Addon, got {type(addon).__name__}")
+    parts = addon.parts + tuple(make(mech.closure()) for make in addon.closure_parts)
     own = {o.name for o in mech.parameters}
     clash = sorted(own & {o.name for o in addon.parameters}) + sorted(set(mech.kinds) & set(addon.kinds))
-    clash += [part for part in ADDON_PARTS + ("dynamics",) if getattr(addon, part) and getattr(mech, part)]
+    clash += [name for name in ADDON_CHECKS if getattr(addon, name) and getattr(mech, name)]
+    clash += [p.capability for p in parts if any(p.capability == q.capability for q in mech.parts)]
     if clash:
         raise MechanismDeclarationError(
             f"mechanism {mech.name!r} ({mech.origin}): its add-on repeats what the file declares ({', '.join(clash)})"
@@ -398,7 +395,7 @@ def with_addon(mech: Mechanism, addon: Addon) -> Mechanism:
         parameters=mech.parameters + addon.parameters,
         limits=tuple(o for o in mech.limits if o.name not in own_limits) + addon.limits,
         build=build,
-        dynamics=addon.dynamics(mech.closure()) if addon.dynamics else mech.dynamics,
-        **{part: getattr(addon, part) or getattr(mech, part) for part in ADDON_PARTS},
+        **{name: getattr(addon, name) or getattr(mech, name) for name in ADDON_CHECKS},
+        parts=parts + mech.parts,
         kinds={**mech.kinds, **addon.kinds},
     )

@@ -26,7 +26,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from .solver import SolverCache, SolverConfig, SquareSolver
+from .solver import SolverCache, SolverConfig, SquareSolver, solvers_of
 
 
 @dataclass(frozen=True)
@@ -156,10 +156,6 @@ class LoopClosure:
         if phi.size1_out(0) != self.nx:
             raise ValueError(f"{name}: phi has {phi.size1_out(0)} rows, expected nx = {self.nx}")
         self._derive()
-        self.solvers = SolverCache()
-        #: the :class:`~cpm_nlp.core.mechanism.Mechanism` declaration this closure was built for
-        #: (set by the registry; None for a closure built by hand)
-        self.mechanism: Any = None
 
     # -- AD-derived functions ------------------------------------------------
     def _derive(self) -> None:
@@ -213,6 +209,12 @@ class LoopClosure:
         return np.array([float(v) for v in parts])
 
     # -- solvers (built once per configuration) -----------------------------------
+    @property
+    def solvers(self) -> SolverCache:
+        """What is built from this closure (solvers, kernels), held by the solver layer
+        (:func:`~cpm_nlp.core.solver.solvers_of`), not stored on the closure."""
+        return solvers_of(self)
+
     def fk_solver(self, config: SolverConfig) -> SquareSolver:
         return self.solvers.get(
             "fk", config, lambda: SquareSolver(f"{self.name}_fk", self.fk_residual, self.nx, self.nq + self.np, config)
@@ -257,6 +259,10 @@ class Model:
     dimensions: Mapping[str, str] = field(default_factory=dict)  # of parameters and derived values
     #: length that converts angle rates to length rates in conditioning measures
     characteristic_length: float = 1.0
+    #: the :class:`~cpm_nlp.core.mechanism.Mechanism` declaration the model was built from (its
+    #: parts), set by :meth:`Mechanism.model <cpm_nlp.core.mechanism.Mechanism.model>`; None for
+    #: a model built by hand on its closure
+    mechanism: Any = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         missing = [n for n in self.closure.parameters if n not in self.parameters]
@@ -269,11 +275,6 @@ class Model:
     @property
     def name(self) -> str:
         return self.closure.name
-
-    @property
-    def mechanism(self) -> Any:
-        """The mechanism's declaration (its capabilities), or None for a closure built by hand."""
-        return self.closure.mechanism
 
     def limit_of(self, coord: Coordinate) -> tuple[float, float] | None:
         """Declared limits of a coordinate (its own, else its family's)."""

@@ -15,6 +15,7 @@ import logging
 import re
 import threading
 import time
+import weakref
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -301,3 +302,19 @@ class SolverCache:
                     self._solvers[key] = built
                     self._building.pop(key, None)
             return built
+
+
+#: each closure's built solvers and kernels (:func:`solvers_of`), held here rather than on the
+#: closure, and weakly keyed: freed with the closure.  Code, never problem data.
+_BUILT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_BUILT_LOCK = threading.Lock()
+
+
+def solvers_of(closure: Any) -> SolverCache:
+    """The cache of what is built from ``closure`` (solvers, CasADi kernels, compiled
+    libraries), by the closure's identity; the closure itself stays a description."""
+    with _BUILT_LOCK:
+        cache = _BUILT.get(closure)
+        if cache is None:
+            cache = _BUILT[closure] = SolverCache()
+        return cache

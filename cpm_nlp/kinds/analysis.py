@@ -14,11 +14,12 @@ from typing import Any
 import numpy as np
 
 from ..analysis import dynamics as dyn
+from ..analysis.compliance import JointStiffness
+from ..analysis.dynamics import DynamicsModel
 from ..analysis.flexure import material_node
 from ..analysis.workspace import joint_box, reachable_workspace
 from ..core.errors import InputError
 from ..core.kind import ProblemKind
-from ..core.mechanism import DynamicsModel
 from ..core.model import Model
 from ..core.options import REQUIRED, Option
 from ..core.outputs import Output, declared_result, matrix, outputs_of, vector
@@ -55,6 +56,8 @@ def closed_form_result(
 
 class ActuatorWorkspace(ProblemKind):
     name = "actuator_workspace"
+    #: the hinges, the defaults of ``stress_limit``
+    parts = (JointStiffness,)
     plots = ("workspace",)
     description = "reachable workspace under the actuator strokes: vertices, bounding box, volume, linearity"
     plots = ("workspace",)  # its points (inputs.points: true): the images of the stroke grid
@@ -165,25 +168,25 @@ def _image_outputs(model: Model, partly: bool) -> tuple[Output, Output]:
 # -- dynamics -------------------------------------------------------------------------------------
 
 
-def _dynamics(model: Model) -> DynamicsModel:
-    """The mechanism's declared Lagrange model (``Mechanism.dynamics``)."""
-    return model.mechanism.dynamics
-
-
 class Dynamics(ProblemKind):
     name = "dynamics"
+    parts = (DynamicsModel,)
     plots = ("dynamics", "matrices")
     description = "Lagrange dynamics at home: M, K, G (AD of the energies) and the natural frequencies"
 
     def supports(self, model: Model) -> str | None:
-        if model.mechanism is None or model.mechanism.dynamics is None:
+        if self.part(model, DynamicsModel) is None:
             return "it has no dynamic model (no energies)"
         return None
+
+    def _lagrange(self, model: Model) -> DynamicsModel:
+        """The mechanism's Lagrange model (its part ``dynamics``; :meth:`supports` said it has one)."""
+        return self.part(model, DynamicsModel)
 
     def input_options(self, model: Model) -> list[Option]:
         masses = [
             mass_node(m, f"{d}; a mass or a block {{length, width, height}}", default=REQUIRED)
-            for m, d in _dynamics(model).masses
+            for m, d in self._lagrange(model).masses
         ]
         return [
             material_node("material", "the hinge material: a name (Al 7075-T6, ...) or inline {E, nu, density}"),
@@ -194,10 +197,10 @@ class Dynamics(ProblemKind):
     def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         """The masses of blocks of the material, and its Young's modulus E."""
         mat = inputs["material"]
-        for m, _ in _dynamics(model).masses:
+        for m, _ in self._lagrange(model).masses:
             inputs[m] = dyn.parse_mass(inputs[m], mat.density, mat.name, path + (m,))
         inputs["E"] = mat.require("E", path + ("material",), "the hinge stiffness needs it")
-        missing = [n for n in _dynamics(model).parameters if n not in inputs and n not in model.parameters]
+        missing = [n for n in self._lagrange(model).parameters if n not in inputs and n not in model.parameters]
         if missing:
             raise InputError(
                 f"missing parameter(s) {', '.join(missing)}, needed by the dynamics "
@@ -206,7 +209,7 @@ class Dynamics(ProblemKind):
             )
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
-        dm = _dynamics(model)
+        dm = self._lagrange(model)
         w = np.array([inputs[n] if n in inputs else model.parameters[n] for n in dm.parameters], dtype=float)
         M, K, G = dyn.matrices(dm.lagrangian(), model.q_home, model.p, w)
         f = dyn.natural_frequencies(M, K)
@@ -226,7 +229,7 @@ class Dynamics(ProblemKind):
         )
 
     def outputs(self, model: Model) -> list[Output]:
-        return _dynamics_outputs(model, _dynamics(model))
+        return _dynamics_outputs(model, self._lagrange(model))
 
 
 def _dynamics_outputs(model: Model, dm: DynamicsModel) -> list[Output]:

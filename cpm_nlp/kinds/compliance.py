@@ -1,6 +1,7 @@
 """Problem kinds of compliance, stiffness and strength, for any mechanism whose
-joints carry hinges (declared by the mechanism's ``stiffness`` capability or
-given under ``inputs.hinges``); the method is :mod:`cpm_nlp.analysis.compliance`.
+joints carry hinges (declared by the mechanism's part ``stiffness``, a
+:class:`~cpm_nlp.analysis.compliance.JointStiffness`, or given under
+``inputs.hinges``); the method is :mod:`cpm_nlp.analysis.compliance`.
 
 * ``actuator_forces`` -- the actuator forces, input stiffness K_q and hinge
   stresses along a motion (actuator inputs, or poses through IK), and the motion
@@ -13,7 +14,6 @@ given under ``inputs.hinges``); the method is :mod:`cpm_nlp.analysis.compliance`
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -23,7 +23,8 @@ import scipy.optimize
 from ..analysis import compliance as cm
 from ..analysis import validity
 from ..analysis.dynamics import parse_inertia, parse_mass
-from ..analysis.hinge_chains import SixAxisModel, six_axis_model
+from ..analysis.hinge_chains import LegChains, SixAxisModel
+from ..analysis.hinge_models import HINGE_MODELS, default_hinge_model, hinge_model_text
 from ..core.canonical import canonical_eigh, degenerate_note, multiplicities
 from ..core.errors import InputError
 from ..core.kind import (
@@ -45,8 +46,6 @@ from ..core.solver import SolverConfig
 from ..core.units import result_unit
 from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
 from .kinematic import _model_info, _pose_names, _pose_outputs, _pose_values
-
-log = logging.getLogger(__name__)
 
 
 def _pose_inputs(model: Model) -> list[Option]:
@@ -102,6 +101,10 @@ def _summary(sols: list[PoseSolution], batch: bool) -> tuple[Status, str, list[S
 
 class _HingeKind(ProblemKind):
     """Shared input handling: pose or actuator inputs, hinges, material, load."""
+
+    #: the mechanism's declared hinges, the defaults of ``inputs.hinges`` (read by
+    #: :func:`~cpm_nlp.analysis.compliance.hinge_set`)
+    parts = (cm.JointStiffness,)
 
     def supports(self, model: Model) -> str | None:
         c = model.closure
@@ -370,12 +373,12 @@ class ActuatorForces(_HingeKind):
         for off in c.offsets:
             names += [f"{off}_at_allowable", f"{off}_at_allowable_linear"]
         names += [f"{q}_at_allowable" for q in c.q_names]
-        decl = model.mechanism.stiffness if model.mechanism is not None else None
+        decl = self.part(model, cm.JointStiffness)
         if decl is not None:
-            names += [f"stress_{g}" for g in decl.hinges]
-            for g, spec in decl.hinges.items():  # stiffness from the hinge formula, where a geometry is given
-                if spec.get("type"):
-                    joints = spec.get("joints")
+            names += [f"stress_{g}" for g in decl.records]
+            for g, spec in decl.records.items():  # stiffness from the hinge formula, where a geometry is given
+                if spec.type:
+                    joints = spec.joints
                     names += [f"k_formula_{g}_{a}" for a in (joints if isinstance(joints, Mapping) else ("bend",))]
         return names
 
@@ -424,6 +427,8 @@ def _limit_values(
 
 class PlatformCompliance(_HingeKind):
     name = "platform_compliance"
+    #: the hinges, and the legs as serial chains for the six-axis hinge model (``hinge_axes: all``)
+    parts = (cm.JointStiffness, LegChains)
     description = (
         "output compliance C = J (K_q + K_a)^-1 J^T at a pose and the compliant forward kinematics under a load "
         "(minimum potential energy on the loop closures, IPOPT): deflection, linear deflection C f, hinge stresses"
@@ -433,17 +438,7 @@ class PlatformCompliance(_HingeKind):
     def extra_options(self, model: Model) -> list[Option]:
         return [
             k_actuator_option(model),
-            Option(
-                "hinge_axes",
-                "choice",
-                "the hinge model: 'all' (every flexure a six-axis spring at its joint, the axes the kinematics does "
-                "not move with the flexure library's stiffness; needs the mechanism's leg chains) or 'kinematic' "
-                "(pseudo-rigid-body: each hinge only about the axes the kinematics moves; with the actuators held "
-                "a mechanism of rigid links then does not deflect); default: all where the mechanism gives its "
-                "chains, else kinematic",
-                default=None,
-                choices=("all", "kinematic"),
-            ),
+            Option("hinge_axes", "choice", hinge_model_text(), default=None, choices=tuple(HINGE_MODELS)),
         ]
 
     def input_options(self, model: Model) -> list[Option]:
@@ -456,27 +451,12 @@ class PlatformCompliance(_HingeKind):
     def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         """The hinges, and the six-axis hinge model where ``hinge_axes`` asks for it (or by default can)."""
         super().resolve(inputs, model, path)
-        axes = inputs.get("hinge_axes")
-        mech = model.mechanism
-        has_chains = mech is not None and mech.chains is not None
-        if axes == "all" and not has_chains:
-            raise InputError(
-                f"hinge_axes: all needs the legs of {model.name} as serial chains (the mechanism's chains "
-                "capability; a mechanism file of spatial P, R, C, U, S legs gives them)",
-                path=path + ("hinge_axes",),
-                hint="use hinge_axes: kinematic",
-            )
-        inputs["six_axis"] = None
-        if axes == "all":
-            inputs["six_axis"] = six_axis_model(model, inputs["hinge_set"])
-        elif axes is None and has_chains:
-            try:  # the default: the six-axis model where it can place every hinge
-                inputs["six_axis"] = six_axis_model(model, inputs["hinge_set"])
-            except InputError as exc:
-                log.info("platform_compliance: the kinematic hinge model (%s)", exc.message)
-                inputs["fallback"] = (
-                    f"; hinge_axes: kinematic, as the six-axis model cannot place the hinges ({exc.message})"
-                )
+        chosen = inputs.get("hinge_axes")
+        hinges = HINGE_MODELS[chosen] if chosen is not None else default_hinge_model(model)
+        six, fallback = hinges.six_axis(model, inputs["hinge_set"], path + ("hinge_axes",), chosen is not None)
+        inputs["six_axis"] = six
+        if fallback:
+            inputs["fallback"] = fallback
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _check_pose_inputs(model, inputs, path, required=False)

@@ -2,9 +2,9 @@
 
 Every paper states its own synthesis (design variables, objective,
 constraints), so the kind dispatches to the mechanism: a mechanism that
-supports it declares its formulation, a :class:`SynthesisFormulation`
-subclass, as the capability ``Mechanism.synthesis``.  The kind itself only looks the formulation
-up and hands it the validated model, inputs and solver.
+supports it registers its formulation, an instance of a :class:`SynthesisFormulation`
+subclass, among its parts (``Mechanism.parts``; the part ``synthesis``).  The kind itself only
+looks the formulation up and hands it the validated model, inputs and solver.
 
 A mechanism that declares none gets the generic formulation,
 :class:`CuboidSynthesis`: the largest inscribed cuboid per unit of a declared
@@ -15,12 +15,13 @@ footprint, with the chosen parameters as unknowns of the cuboid NLP
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 from ..analysis.synthesis import cuboid_synthesis
 from ..analysis.workspace import check_grid_sizes, check_per_edge_option
 from ..core.errors import InputError, suggest
 from ..core.kind import ProblemKind, require_ipopt
+from ..core.mechanism import Part
 from ..core.model import Model
 from ..core.multistart import start_options
 from ..core.options import Option
@@ -30,12 +31,14 @@ from ..core.schema import Either, ListOf, Record
 from ..core.solver import SolverConfig
 
 
-class SynthesisFormulation(ProblemKind):
+class SynthesisFormulation(ProblemKind, Part):
     """A mechanism's synthesis problem (the paper's), as the synthesis kind uses it:
     a problem kind of its own (inputs, validation, run, outputs) that the
-    ``synthesis`` kind looks up by the mechanism and hands the problem to."""
+    ``synthesis`` kind looks up by the mechanism (the part ``synthesis``: an instance,
+    in ``Mechanism.parts``) and hands the problem to."""
 
     name = "synthesis"
+    capability: ClassVar[str] = "synthesis"
 
 
 def _declared(model: Model) -> dict[str, Option]:
@@ -244,13 +247,12 @@ def formulation(model: Model) -> SynthesisFormulation | None:
     mech = model.mechanism
     if mech is None:
         return None
-    if mech.synthesis is None:
-        return CuboidSynthesis()
-    return mech.synthesis()
+    return mech.part(SynthesisFormulation) or CuboidSynthesis()
 
 
 class Synthesis(ProblemKind):
     name = "synthesis"
+    parts = (SynthesisFormulation,)
     plots = ("comparison", "design")
     description = (
         "dimensional synthesis by the mechanism's own formulation, else the generic one: the largest inscribed "
@@ -260,7 +262,7 @@ class Synthesis(ProblemKind):
     def supports(self, model: Model) -> str | None:
         if formulation(model) is None:
             return f"the model '{model.name}' has no mechanism declaration (built by hand)"
-        if model.mechanism is not None and model.mechanism.synthesis is None and not model.closure.parameters:
+        if self.part(model, SynthesisFormulation) is None and not model.closure.parameters:
             return f"the mechanism '{model.name}' has no parameters: there is no dimension to synthesize"
         return None
 

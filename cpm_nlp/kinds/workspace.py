@@ -2,23 +2,25 @@
 
 Both work for any mechanism from its loop closures and joint limits (see
 :mod:`cpm_nlp.analysis.workspace`).  A mechanism may add to them through
-two declared capabilities (:class:`~cpm_nlp.core.mechanism.Mechanism`):
+two parts declared here (:class:`~cpm_nlp.core.mechanism.Part`), which a
+mechanism registers in ``Mechanism.parts``:
 
-* ``cuboid`` (:class:`~cpm_nlp.core.mechanism.CuboidExtras`): extra inputs
-  and values of the cuboid found, e.g. the paper's names for it and the
-  paper's own formulation;
-* ``paper_membership(model, points) -> (inside, margins)``: a closed-form
-  membership test from the paper, reported beside the general one.
+* ``cuboid`` (:class:`CuboidExtras`): extra inputs and values of the cuboid
+  found, e.g. the paper's names for it and the paper's own formulation;
+* ``paper_membership`` (:class:`PaperMembership`): a closed-form membership
+  test from the paper, reported beside the general one.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
 from ..analysis.certify import CERTIFICATE_NAMES, CERTIFY_OPTION, certificate_values
+from ..analysis.compliance import JointStiffness
 from ..analysis.workspace import (
     ADDED_PER_ROUND,
     CHECK_OPTION,
@@ -31,7 +33,7 @@ from ..analysis.workspace import (
 )
 from ..core.errors import InputError
 from ..core.kind import ProblemKind, broadcast, require_ipopt
-from ..core.mechanism import CuboidExtras
+from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import Model
 from ..core.multistart import start_options
 from ..core.options import Option
@@ -43,12 +45,53 @@ from .hinge_inputs import stress_limit_option
 from .kinematic import _model_info
 
 
-def _cuboid_extras(model: Model) -> CuboidExtras | None:
-    return model.mechanism.cuboid if model.mechanism is not None else None
+@dataclass(frozen=True, kw_only=True)
+class CuboidExtras(Part):
+    """What a mechanism adds to the ``inscribed_cuboid`` kind (the part ``cuboid``).
+
+    options: extra inputs of the kind for this mechanism.
+    value_names: the names of the extra values, all of them (set to null when
+        no cuboid was found).
+    values: ``(model, lower, upper, inputs, solver) -> (values, dimensions)``
+        for a found box ``lower <= t <= upper`` (SI, task coordinates).
+    paper_box: optional ``(values) -> (lower, upper, label) | None``: the box of
+        the paper's own formulation read from a result's values, drawn beside
+        the found one by the workspace plot (None when the result has none).
+    """
+
+    capability: ClassVar[str] = "cuboid"
+
+    options: tuple[Option, ...] = ()
+    value_names: tuple[str, ...] = ()
+    values: Callable[..., tuple[dict, dict]]
+    paper_box: Callable[[Mapping[str, Any]], Any] | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.options, tuple) or not all(isinstance(o, Option) for o in self.options):
+            raise MechanismDeclarationError(f"cuboid: options must be a tuple of Option, got {self.options!r:.60}")
+        if not isinstance(self.value_names, tuple) or not all(isinstance(n, str) for n in self.value_names):
+            raise MechanismDeclarationError(
+                f"cuboid: value_names must be a tuple of names, got {self.value_names!r:.60}"
+            )
+        if not callable(self.values) or not (self.paper_box is None or callable(self.paper_box)):
+            raise MechanismDeclarationError("cuboid: values must be callable, and paper_box callable or None")
 
 
-def _paper_membership(model: Model) -> Any:
-    return model.mechanism.paper_membership if model.mechanism is not None else None
+@dataclass(frozen=True)
+class PaperMembership(Part):
+    """The paper's closed-form workspace membership (the part ``paper_membership``),
+    reported by the ``workspace`` kind beside the general test.
+
+    test: ``(model, points (N, nq)) -> (inside (N,), margins)``.
+    """
+
+    capability: ClassVar[str] = "paper_membership"
+
+    test: Callable[[Any, Any], tuple[Any, dict]]
+
+    def __post_init__(self) -> None:
+        if not callable(self.test):
+            raise MechanismDeclarationError(f"paper_membership must be callable, got {self.test!r:.60}")
 
 
 #: the unit of a margin: that of whichever quantity binds (a length, an angle, a stress ...)
@@ -97,6 +140,8 @@ def _volume_dimension(model: Model) -> tuple[str, str]:
 
 class InscribedCuboid(ProblemKind):
     name = "inscribed_cuboid"
+    #: its extra inputs and values; the hinges, the defaults of ``stress_limit``
+    parts = (CuboidExtras, JointStiffness)
     description = "largest axis-aligned box of task coordinates inside the reachable workspace (IPOPT, multi-start)"
     plots = ("workspace",)
 
@@ -132,7 +177,7 @@ class InscribedCuboid(ProblemKind):
             ),
         ]
         opts += _region_options(model)
-        extras = _cuboid_extras(model)
+        extras = self.part(model, CuboidExtras)
         opts += list(extras.options) if extras else []
         return opts + [stress_limit_option(model)]
 
@@ -161,7 +206,7 @@ class InscribedCuboid(ProblemKind):
             "check_binding",
             *CERTIFICATE_NAMES,
         ]
-        extras = _cuboid_extras(model)
+        extras = self.part(model, CuboidExtras)
         return names + (list(extras.value_names) if extras else [])
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
@@ -217,7 +262,7 @@ class InscribedCuboid(ProblemKind):
         )
         values.update(cert_values)
         dims.update(cert_dims)
-        extras = _cuboid_extras(model)
+        extras = self.part(model, CuboidExtras)
         if extras is not None and res.found:
             extra, extra_dims = extras.values(model, res.lower, res.upper, dict(inputs), solver)
             values.update(extra)
@@ -250,6 +295,8 @@ class InscribedCuboid(ProblemKind):
 
 class Workspace(ProblemKind):
     name = "workspace"
+    #: the paper's membership test; the hinges, the defaults of ``stress_limit``
+    parts = (PaperMembership, JointStiffness)
     description = "membership of given points and a seeded point cloud of the reachable workspace"
     plots = ("workspace",)
 
@@ -313,9 +360,9 @@ class Workspace(ProblemKind):
                 count_inside="dimensionless",
                 count_undecided="dimensionless",
             )
-            paper = _paper_membership(model)
+            paper = self.part(model, PaperMembership)
             if paper is not None:
-                values["inside_paper"] = paper(model, T)[0].tolist()
+                values["inside_paper"] = paper.test(model, T)[0].tolist()
                 dims["inside_paper"] = "text"
         status, message = Status.SOLVED, ""
         if inputs["samples"]:

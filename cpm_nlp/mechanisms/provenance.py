@@ -137,7 +137,4 @@ def recorded_closure(mech: Mechanism) -> LoopClosure:
     """The closure of a mechanism :func:`recorded_mechanism` gave (not put in the registry)."""
     if _registered(mech):
         return closure_of(mech)
-    closure = mech.closure()
-    if closure.mechanism is None:  # the back-pointer the registry sets (a described closure is the mechanism's own)
-        closure.mechanism = mech
-    return closure
+    return mech.closure()

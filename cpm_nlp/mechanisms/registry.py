@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.errors import CpmError, InputError, suggest
-from ..core.mechanism import PARTS, Addon, Mechanism, MechanismDeclarationError, validate, with_addon
+from ..core.mechanism import Addon, Mechanism, MechanismDeclarationError, unknown_field_hint, validate, with_addon
 from ..core.model import LoopClosure, Model
 from ..core.origin import Origin
 from . import described
@@ -96,7 +96,8 @@ class _Registry:
         self._lock = threading.RLock()
         self._specs: dict[str, tuple[str, Origin]] | None = None  # name -> (target, origin)
         self._loaded: dict[str, Mechanism] = {}
-        self._closures: dict[str, LoopClosure] = {}
+        #: name -> (the declaration, its closure)
+        self._closures: dict[str, tuple[Mechanism, LoopClosure]] = {}
         #: bumped by every register/unregister, so that tables derived from the registry refresh
         self.version = 0
 
@@ -213,13 +214,13 @@ class _Registry:
 
     def closure(self, mech: Mechanism) -> LoopClosure:
         with self._lock:
-            c = self._closures.get(mech.name)
+            held = self._closures.get(mech.name)
             # by name, for this very mechanism: two described mechanisms of one name (a file
             # and an edited copy of it, loaded in turn) never share a closure
-            if c is None or c.mechanism is not mech:
-                c = _build_closure(mech)
-                self._closures[mech.name] = c
-            return c
+            if held is None or held[0] is not mech:
+                held = (mech, _build_closure(mech))
+                self._closures[mech.name] = held
+            return held[1]
 
 
 class _LoadedClosures:
@@ -242,7 +243,7 @@ class _LoadedClosures:
 
 
 def _build_closure(mech: Mechanism) -> LoopClosure:
-    """The symbolic closure of ``mech``, checked; its back-pointer set to ``mech``."""
+    """The symbolic closure of ``mech``, checked."""
     try:
         c = mech.closure()
     except CpmError:
@@ -253,7 +254,6 @@ def _build_closure(mech: Mechanism) -> LoopClosure:
         raise PluginError(
             f"mechanism {mech.name!r} ({mech.origin}): closure() must return a LoopClosure, got {type(c).__name__}"
         )
-    c.mechanism = mech
     return c
 
 
@@ -287,8 +287,8 @@ def _load(name: str, target: str, origin: Origin) -> Mechanism:
         hint = ""
         m = _UNEXPECTED.search(str(exc))
         if m:
-            close = suggest(m.group(1), PARTS)
-            hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+            said = unknown_field_hint(m.group(1))
+            hint = f"; {said}" if said else ""
         raise PluginError(f"mechanism {name!r} ({origin}) failed to load: {exc}{hint}") from exc
     except Exception as exc:
         raise PluginError(f"mechanism {name!r} ({origin}) failed to load: {type(exc).__name__}: {exc}") from exc

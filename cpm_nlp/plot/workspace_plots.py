@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.workspace import membership, probe_region, sample_workspace
+from ..kinds.workspace import CuboidExtras
 from .draw_workspace import BoundarySlice, slice_lines, workspace_figure_2d
 from .draw_workspace import workspace_figure as workspace_figure_png
 from .interactive import workspace_html
@@ -175,7 +176,7 @@ def _paper_boxes(data: ResultData) -> list[tuple]:
     """The box of the paper's own formulation, where the mechanism reads one from the result."""
     if not data.model.get("type") and data.origin is None:
         return []
-    extras = result_mechanism(data).cuboid
+    extras = result_mechanism(data).part(CuboidExtras)
     if extras is None or extras.paper_box is None:
         return []
     box = extras.paper_box(data.values)

@@ -298,10 +298,12 @@ def _biglide_with_legs():
         limits=(),
         closure=closure,
         build=lambda c, p, lim: cn.Model(c, p, {}),
-        stiffness=cn.JointStiffness(
-            hinges={"legs": {"joints": "leg", "type": "leaf_spring", "t": "0.5 mm", "l": "10 mm", "w": "10 mm"}},
-            material="Al 7075-T6",
-            source="test",
+        parts=(
+            cn.JointStiffness(
+                hinges={"legs": {"joints": "leg", "type": "leaf_spring", "t": "0.5 mm", "l": "10 mm", "w": "10 mm"}},
+                material="Al 7075-T6",
+                source="test",
+            ),
         ),
         origin="test",
     )

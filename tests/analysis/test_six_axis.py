@@ -149,7 +149,7 @@ def _rebuilt(m, hs, scale):
 
     hc.six_axis_stiffness = scaled
     try:
-        return SixAxisModel(m, hs, m.mechanism.chains(m))
+        return SixAxisModel(m, hs, m.mechanism.part(hc.LegChains).of(m))
     finally:
         hc.six_axis_stiffness = original
 

@@ -159,6 +159,31 @@ def test_declare_suggests_the_capability_meant():
         cn.declare_mechanism(name="x", title="t", parameters=(), limits=(), closure=dict, build=dict, sythesis=None)
     with pytest.raises(MechanismDeclarationError, match="missing required part"):
         cn.declare_mechanism(name="x", title="t")
+    # a part given as a field (the API before issue 22) says where it goes now
+    with pytest.raises(MechanismDeclarationError, match=r"'cuboid' \(cuboid is a part: give parts=\(CuboidExtras"):
+        cn.declare_mechanism(name="x", title="t", parameters=(), limits=(), closure=dict, build=dict, cuboid=None)
+
+
+def test_parts_are_read_by_their_type():
+    """A mechanism registers one part of each type; a kind reads it by its type, and only a
+    type it declares."""
+    member = cn.PaperMembership(lambda model, points: (points, {}))
+    mech = cn.Mechanism(name="x", title="t", parameters=(), limits=(), closure=dict, build=dict, parts=(member,))
+    assert mech.part(cn.PaperMembership) is member and mech.part(cn.CuboidExtras) is None
+    assert mech.capabilities() == ["paper_membership"]
+    with pytest.raises(MechanismDeclarationError, match=r"one of each \(twice: paper_membership\)"):
+        cn.Mechanism(name="x", title="t", parameters=(), limits=(), closure=dict, build=dict, parts=(member, member))
+    workspace = cn.problem_kind("workspace")
+    assert workspace.parts == (cn.PaperMembership, cn.JointStiffness)
+    for name in cn.kind_names():  # every kind declares part types, each with its capability name
+        assert all(issubclass(t, cn.Part) and t.capability for t in cn.problem_kind(name).parts), name
+
+    class Model:
+        mechanism = mech
+
+    assert workspace.part(Model(), cn.PaperMembership) is member
+    with pytest.raises(TypeError, match="reads CuboidExtras but does not declare it"):
+        workspace.part(Model(), cn.CuboidExtras)
 
 
 @pytest.mark.parametrize(
@@ -166,9 +191,11 @@ def test_declare_suggests_the_capability_meant():
     [
         ("parameters", ["b"], "parameters must be a tuple of Option"),
         ("closure", 3, "closure must be callable"),
-        ("synthesis", "module:Class", "synthesis must be callable or None"),
+        ("geometry", "module:function", "geometry must be callable or None"),
         ("kinds", {"k": int}, "kinds must be a mapping of kind name -> ProblemKind subclass"),
-        ("cuboid", {"options": ()}, "cuboid must be a CuboidExtras or None"),
+        ("parts", ({"options": ()},), "parts must be a tuple of mechanism parts"),
+        ("parts", [cn.PaperMembership(print)], "parts must be a tuple of mechanism parts"),
+        ("parts", (cn.SynthesisFormulation,), "parts must be a tuple of mechanism parts"),  # a class, not one
     ],
 )
 def test_declarations_are_type_checked(part, value, message):
@@ -176,6 +203,24 @@ def test_declarations_are_type_checked(part, value, message):
     parts[part] = value
     with pytest.raises(MechanismDeclarationError, match=message):
         cn.Mechanism(**parts)
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda: cn.LegChains("module:function"), "chains must be callable"),
+        (lambda: cn.PaperMembership("module:function"), "paper_membership must be callable"),
+        (
+            lambda: cn.CuboidExtras(options=({"options": ()},), values=print),
+            "cuboid: options must be a tuple of Option",
+        ),
+        (lambda: cn.DynamicsModel(masses=(), parameters=(), lagrangian=3), "dynamics: lagrangian must be callable"),
+        (lambda: cn.JointStiffness(hinges=["revolute"]), "stiffness: hinges must map names to hinge mappings"),
+    ],
+)
+def test_parts_are_type_checked(make, message):
+    with pytest.raises(MechanismDeclarationError, match=message):
+        make()
 
 
 def test_register_in_code_and_its_kinds_appear():

@@ -48,8 +48,11 @@ def test_a_changed_copy_of_a_built_in_file_is_refused_by_name(tmp_path):
     # an unchanged copy elsewhere (cpm-nlp init's problems/) is the built-in; so is the
     # shipped file itself, named by a problem file
     (tmp_path / "mechanisms" / "prs3.yaml").write_text(text)
-    assert cn.load_problem(problem).model.closure.mechanism is shipped
-    assert cn.load_problem(PROBLEMS / "prs3_file_forward_kinematics.yaml").model.closure.mechanism is shipped
+    for model in (
+        cn.load_problem(problem).model,
+        cn.load_problem(PROBLEMS / "prs3_file_forward_kinematics.yaml").model,
+    ):
+        assert model.mechanism is shipped and model.closure is shipped.closure()
     assert mechanism_type("prs3") is shipped
 
 

@@ -46,8 +46,9 @@ import math
 import casadi as ca
 import numpy as np
 
+from cpm_nlp.analysis.compliance import JointStiffness
 from cpm_nlp.core.aspect import ASPECT, ASPECT_DESCRIPTION, aspect
-from cpm_nlp.core.mechanism import Drawing, JointStiffness, Mechanism
+from cpm_nlp.core.mechanism import Drawing, Mechanism
 from cpm_nlp.core.model import Coordinate, LoopClosure, Model
 from cpm_nlp.core.options import Option
 
@@ -431,7 +432,7 @@ MECHANISM = Mechanism(
     closure=closure,
     build=build,
     geometry=geometry,
-    stiffness=STIFFNESS,
+    parts=(STIFFNESS,),
 )
 
 

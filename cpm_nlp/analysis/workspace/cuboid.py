@@ -7,8 +7,9 @@ import functools
 import itertools
 import logging
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 import casadi as ca
@@ -373,23 +374,59 @@ def _start_boxes(model: Model, seeds: list, S: np.ndarray, centre, size, config:
     return boxes
 
 
-#: formulations of the cuboid NLP: "closed_form" needs the mechanism's closed-form IK
-FORMULATIONS = ("auto", "closed_form", "poses")
+@dataclass(frozen=True)
+class CuboidFormulation:
+    """How the cuboid NLP is written (both ways solve the same NLP): ``poses``, pose unknowns
+    at every sample (any mechanism); ``closed_form``, the limited quantities through the
+    mechanism's closed-form IK (:mod:`cpm_nlp.analysis.cuboid_ik`); ``auto``, the closed form
+    where the mechanism has one and every point of the cloud drawn for the starts assembles
+    (where the IK's reach margin bounds the workspace its derivatives grow without bound, and
+    IPOPT converges there less reliably than with pose unknowns).
+
+    through_ik: True, through the closed-form IK (the mechanism must have one); False, pose
+        unknowns; None, the IK where it is safe (``auto``).
+    """
+
+    name: str
+    through_ik: bool | None
+
+    def check(self, model: Model) -> None:
+        """Raise :class:`InputError` if the formulation cannot be used for ``model``."""
+        if self.through_ik and model.closure.ik is None:
+            raise InputError(
+                f"the {self.name} cuboid formulation needs a closed-form IK; {model.name} has none (use 'poses')",
+                path=("formulation",),
+            )
+
+    def closed_form(self, model: Model, assembles: bool) -> bool:
+        """Whether to solve through the closed-form IK, given whether every point of the
+        cloud drawn for the starts assembles."""
+        if self.through_ik is None:
+            return model.closure.ik is not None and assembles
+        return self.through_ik
 
 
-def _check_formulation(model: Model, formulation: str) -> None:
-    """Bad input: a formulation not in :data:`FORMULATIONS`, or closed_form without a closed-form IK."""
+#: formulations of the cuboid NLP by name (the ``formulation`` argument)
+FORMULATIONS: Mapping[str, CuboidFormulation] = MappingProxyType(
+    {
+        "auto": CuboidFormulation("auto", None),
+        "closed_form": CuboidFormulation("closed_form", True),
+        "poses": CuboidFormulation("poses", False),
+    }
+)
+
+
+def cuboid_formulation(formulation: str | CuboidFormulation) -> CuboidFormulation:
+    """A formulation by its name in :data:`FORMULATIONS` (or as given), with "did you mean"."""
+    if isinstance(formulation, CuboidFormulation):
+        return formulation
     if formulation not in FORMULATIONS:
         raise InputError(
             f"unknown cuboid formulation {formulation!r}; expected one of: {', '.join(FORMULATIONS)}",
             path=("formulation",),
             suggestions=suggest(str(formulation), FORMULATIONS),
         )
-    if formulation == "closed_form" and model.closure.ik is None:
-        raise InputError(
-            f"the closed_form cuboid formulation needs a closed-form IK; {model.name} has none (use 'poses')",
-            path=("formulation",),
-        )
+    return FORMULATIONS[formulation]
 
 
 def _seeds(
@@ -509,7 +546,7 @@ def inscribed_cuboid(
     refinements: int = 3,
     region: tuple[np.ndarray, np.ndarray] | None = None,
     cloud: int = 2000,
-    formulation: str = "auto",
+    formulation: str | CuboidFormulation = "auto",
 ) -> CuboidResult:
     """The largest axis-aligned box in the task coordinates inside the reachable
     workspace (see the module docstring for the method).
@@ -519,15 +556,11 @@ def inscribed_cuboid(
     grid (default 5, fewer in more than 3 task coordinates, see :func:`default_per_edge`);
     check_per_edge: the dense check's surface grid (:func:`check_per_edge_of`); refinements: the
     largest number of exchange rounds; region: the box the starts are drawn
-    from (default: probed around home); formulation: "poses" (pose unknowns at
-    every sample, any mechanism), "closed_form" (the limited quantities through
-    the closed-form IK, :mod:`cpm_nlp.analysis.cuboid_ik`) or "auto" (closed_form when
-    the mechanism has a closed-form IK and every point of the cloud drawn for
-    the starts assembles: where the IK's reach margin bounds the workspace its
-    derivatives grow without bound, and IPOPT converges there less reliably
-    than with pose unknowns).  Both formulations solve the same NLP.
+    from (default: probed around home); formulation: a :class:`CuboidFormulation` or its
+    name in :data:`FORMULATIONS` ("auto", "closed_form", "poses").
     """
-    _check_formulation(model, formulation)
+    form = cuboid_formulation(formulation)
+    form.check(model)
     t_start = time.perf_counter()
     config = solver or SolverConfig()
     c = model.closure
@@ -558,8 +591,7 @@ def inscribed_cuboid(
     # auto: the closed form unless the IK's own reach limit shapes the workspace in the
     # region (a cloud point that does not assemble): its derivatives are unbounded there
     assembles = "no assembly" not in {cloud_mem.binding[k] for k in np.flatnonzero(~cloud_mem.inside)}
-    closed_form = formulation == "closed_form" or (formulation == "auto" and c.ik is not None and assembles)
-    if closed_form:
+    if form.closed_form(model, assembles):
         engine = _closed_form_cuboid(model, config, base, centre, size, cloud_mem)
     else:
         engine = _PoseCuboid(model, config, base, centre, size)

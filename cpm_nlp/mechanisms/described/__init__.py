@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis.compliance import check_declared
+from ...core.chains import LegChains
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
@@ -195,12 +196,12 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         closure=lambda: closure,
         build=build,
         problem_files=examples,
-        stiffness=d.stiffness,
         geometry=graph_geometry(*fns["graph_drawing"], gen)
         if d.is_graph
         else geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
         origin=Origin("file", d.name, path=d.file) if d.file else Origin("inline", d.name),
-        chains=chains_function(gen) if chains_supported(gen) else None,  # legs only: a graph has none
+        # its hinges, and its legs as serial chains (legs only: a graph has none)
+        parts=tuple(p for p in (d.stiffness, LegChains(chains_function(gen)) if chains_supported(gen) else None) if p),
     )
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults
         model = mech.model(closure, {}, {}, ())

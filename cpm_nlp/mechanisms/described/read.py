@@ -10,10 +10,9 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable, Mapping
 from typing import Any
 
-from ...analysis.compliance import HINGE_KEYS
+from ...analysis.compliance import HINGE_KEYS, JointStiffness
 from ...core.errors import InputError, unknown_key_error
 from ...core.finite import check_numbers
-from ...core.mechanism import JointStiffness
 from ...core.options import REQUIRED
 from ...core.units import parse_quantity
 from .read_fields import as_dimension, as_list, as_mapping, as_name, as_text, as_type_name

@@ -34,7 +34,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from ...core.mechanism import JointStiffness
+from ...analysis.compliance import JointStiffness
 from ...core.options import REQUIRED
 
 DIMENSIONS = ("length", "angle", "dimensionless")

@@ -18,7 +18,8 @@ branch, drawing, parameters, the paper, the problem files -- is the file.  This 
 
 from __future__ import annotations
 
-from ...core.mechanism import Addon, CuboidExtras
+from ...core.mechanism import Addon
+from ...kinds.workspace import CuboidExtras, PaperMembership
 from . import analysis
 from .synthesis import PantographSynthesis
 
@@ -34,7 +35,5 @@ ADDON = Addon(
     limits=analysis.LIMITS,
     check_limits=analysis.check_limits,
     complete=analysis.complete,
-    synthesis=PantographSynthesis,
-    cuboid=CUBOID,
-    paper_membership=analysis.paper_membership,
+    parts=(PantographSynthesis(), CUBOID, PaperMembership(analysis.paper_membership)),
 )

@@ -44,7 +44,7 @@ def check_parameters(params: dict, path: tuple) -> None:
 ADDON = Addon(
     parameters=PARAMETERS,
     check_parameters=check_parameters,
-    dynamics=dynamics_model,
+    closure_parts=(dynamics_model,),
     kinds={"amplifier": Amplifier},
     plots=("cpm_nlp.mechanisms.prc3.plots:PLOTS",),
 )

@@ -22,7 +22,7 @@ import casadi as ca
 import numpy as np
 
 from ...analysis import flexure
-from ...core.mechanism import DynamicsModel
+from ...analysis.dynamics import DynamicsModel
 from ...core.model import LoopClosure, Model
 
 #: the kinematic parameters the energies use, by name (the file's closures take them in p)

@@ -14,10 +14,16 @@ own parts, each run on the file's closures:
 from __future__ import annotations
 
 from ...core.mechanism import Addon
+from ...kinds.synthesis import SynthesisFormulation
 from .kinds import Compliance, JointDesign, ScrewJacobian, Synthesis, TransmissionMap, Twists
+
+
+class RprSynthesis(Synthesis, SynthesisFormulation):
+    """The RPR's synthesis (:class:`.kinds.Synthesis`) as the mechanism's part ``synthesis``."""
+
 
 ADDON = Addon(
     kinds={k.name: k for k in (ScrewJacobian, Twists, TransmissionMap, JointDesign, Compliance)},
-    synthesis=Synthesis,
+    parts=(RprSynthesis(),),
     plots=("cpm_nlp.mechanisms.rpr.plots:PLOTS",),
 )

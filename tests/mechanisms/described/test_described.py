@@ -401,5 +401,6 @@ def test_two_mechanisms_of_one_name_never_share_a_closure(tmp_path):
     (tmp_path / "prs3.yaml").write_text((PROBLEMS / "mechanisms" / "prs3.yaml").read_text() + "\n# an edited copy\n")
     copy = load_file(tmp_path / "prs3.yaml")
     assert copy is not shipped and copy.name == shipped.name
-    for mech in (shipped, copy, shipped, copy):
-        assert REGISTRY.closure(mech).mechanism is mech
+    for mech in (shipped, copy, shipped, copy):  # each its own closure (a described closure is the file's)
+        assert REGISTRY.closure(mech) is mech.closure()
+    assert shipped.closure() is not copy.closure()

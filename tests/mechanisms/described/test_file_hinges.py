@@ -44,11 +44,12 @@ def test_file_declares_the_hinges_of_the_reference():
     reference = prs3_closures.STIFFNESS
     mech = described.load_file(PROBLEMS / "mechanisms" / "prs3.yaml")
     assert cn.mechanism_type("prs3") is mech
-    assert mech.stiffness is not None and set(mech.stiffness.hinges) == set(reference.hinges)
+    stiffness = mech.part(cn.JointStiffness)
+    assert stiffness is not None and set(stiffness.hinges) == set(reference.hinges)
     for name, spec in reference.hinges.items():
-        assert mech.stiffness.hinges[name] == spec, name
-    assert mech.stiffness.material == reference.material
-    assert mech.stiffness.source == reference.source
+        assert stiffness.hinges[name] == spec, name
+    assert stiffness.material == reference.material
+    assert stiffness.source == reference.source
     assert "prs3_file_table2_forces.yaml" in " ".join(mech.problem_files)
     # the same hinge set (stiffness over the joint vector) on both models
     params = {"b": "47.91 mm", "L": "109.215 mm", "alpha0": "45 deg"}

@@ -101,8 +101,9 @@ def test_the_registered_pantograph_is_the_file_with_its_addon():
     with pytest.raises(ModuleNotFoundError, match="pantograph.yaml"):
         __import__("cpm_nlp.pantograph")
     # the add-on's parts, and the file's own
-    assert mech.synthesis is addon.ADDON.synthesis and mech.cuboid is addon.CUBOID
-    assert mech.paper_membership is analysis.paper_membership and mech.check_limits is analysis.check_limits
+    assert mech.part(cn.SynthesisFormulation) is addon.ADDON.parts[0] and mech.part(cn.CuboidExtras) is addon.CUBOID
+    assert mech.part(cn.PaperMembership).test is analysis.paper_membership
+    assert mech.check_limits is analysis.check_limits
     assert mech.geometry is not None and mech.kinds == {}
     assert registry.mechanism_type("pantograph_file") is mech
     assert "pantograph_file" not in registry.mechanism_names()
@@ -139,9 +140,12 @@ def test_a_file_of_the_same_text_is_the_built_in(tmp_path):
 
 def test_the_addon_may_not_repeat_the_file():
     mech = registry.mechanism_type("pantograph")
-    for part in ("check_limits", "cuboid", "paper_membership", "synthesis"):
-        with pytest.raises(MechanismDeclarationError, match=f"repeats what the file declares .*{part}"):
-            with_addon(mech, Addon(**{part: getattr(addon.ADDON, part)}))
+    with pytest.raises(MechanismDeclarationError, match="repeats what the file declares .*check_limits"):
+        with_addon(mech, Addon(check_limits=addon.ADDON.check_limits))
+    for part in addon.ADDON.parts:  # the synthesis, the cuboid and the paper's membership
+        with pytest.raises(MechanismDeclarationError, match=f"repeats what the file declares .*{part.capability}"):
+            with_addon(mech, Addon(parts=(part,)))
+    assert [p.capability for p in addon.ADDON.parts] == ["synthesis", "cuboid", "paper_membership"]
 
 
 def test_the_addons_limits_replace_the_family_of_their_name():

@@ -165,7 +165,7 @@ def test_lagrangian_energies_against_matrices(dyn):
     M, K, Gv = np.array(dyn["M"]), np.array(dyn["K"]), np.array(dyn["G"])
     for _ in range(5):
         q, qd = rng.uniform(0, 15e-6, 3), rng.uniform(-1e-3, 1e-3, 3)
-        out = model.mechanism.dynamics.lagrangian()(q=q, qd=qd, p=model.p, w=w)
+        out = model.mechanism.part(cn.DynamicsModel).lagrangian()(q=q, qd=qd, p=model.p, w=w)
         assert float(out["T"]) == pytest.approx(0.5 * qd @ M @ qd, rel=1e-12)
         assert float(out["U"]) == pytest.approx(0.5 * q @ K @ q + Gv @ q, rel=1e-12)
 

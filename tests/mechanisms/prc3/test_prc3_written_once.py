@@ -22,8 +22,10 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.core.mechanism import Addon, DynamicsModel, MechanismDeclarationError, with_addon
+from cpm_nlp.analysis.dynamics import DynamicsModel
+from cpm_nlp.core.mechanism import Addon, MechanismDeclarationError, with_addon
 from cpm_nlp.core.result import Status
+from cpm_nlp.kinds.workspace import PaperMembership
 from cpm_nlp.mechanisms import registry
 from cpm_nlp.mechanisms.prc3 import addon, dynamics
 from tests.conftest import PROBLEMS
@@ -77,7 +79,8 @@ def test_the_registered_prc3_is_the_file_with_its_addon():
         __import__("cpm_nlp.prc3")
     # the add-on's parts, and only those, beside the file's
     assert set(mech.kinds) == {"amplifier"} and mech.kinds["amplifier"] is addon.ADDON.kinds["amplifier"]
-    assert isinstance(mech.dynamics, DynamicsModel) and mech.dynamics.parameters == dynamics.DYNAMIC_PARAMETERS
+    dm = mech.part(DynamicsModel)
+    assert isinstance(dm, DynamicsModel) and dm.parameters == dynamics.DYNAMIC_PARAMETERS
     assert mech.check_parameters is addon.check_parameters
     assert mech.geometry is not None  # the file's drawing
     # the old name of the file twin names the same mechanism (old scripts, old problem files)
@@ -130,8 +133,8 @@ def test_an_addon_gives_the_parts_the_file_does_not():
     def member(model, points):
         return points, {}
 
-    extended = with_addon(mech, Addon(check_limits=check, paper_membership=member))
-    assert extended.check_limits is check and extended.paper_membership is member
+    extended = with_addon(mech, Addon(check_limits=check, parts=(PaperMembership(member),)))
+    assert extended.check_limits is check and extended.part(PaperMembership).test is member
     assert extended.closure is mech.closure and extended.kinds == mech.kinds
 
 
@@ -205,7 +208,7 @@ def test_the_lagrangian_on_the_file_equals_it_on_the_reference():
     """T and U of eq 28-35 built on the file's closures and on the hand-written ones: equal (the
     only kinematics they use is the closures' Jacobian at home, -A2 I by eq 26)."""
     fm = cn.load_problem(PROBLEMS / "prc3_dynamics.yaml").model
-    on_file = fm.mechanism.dynamics.lagrangian()
+    on_file = fm.mechanism.part(DynamicsModel).lagrangian()
     on_ref = dynamics.lagrangian(ref.reference_model().closure)
     rng = np.random.default_rng(28)
     w = np.concatenate([[71.7e9, 9.81, 6.5e-3, 0.5e-3, 3e-3, 26e-3, 33e-3, 59.5e-3], rng.uniform(1e-3, 0.1, 8)])

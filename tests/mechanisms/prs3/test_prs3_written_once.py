@@ -153,8 +153,8 @@ def test_what_users_see_is_what_the_module_declared():
         assert limits[o.name] == o
     # the file also offers one actuator's stroke alone (generated for every file)
     assert set(limits) - {o.name for o in ref.LIMITS} == {"s1", "s2", "s3"}
-    assert mech.stiffness == ref.STIFFNESS
-    assert mech.chains is not None and mech.geometry is not None
+    assert mech.part(cn.JointStiffness) == ref.STIFFNESS
+    assert mech.part(cn.LegChains) is not None and mech.geometry is not None
     names = [str(p) for p in mech.problem_files]
     assert any(n.endswith("prs3_forward_kinematics.yaml") for n in names)
     assert any(n.endswith("prs3_file_table2_forces.yaml") for n in names)

@@ -27,7 +27,8 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
-from cpm_nlp.core.mechanism import Addon, JointStiffness, MechanismDeclarationError, with_addon
+from cpm_nlp.analysis.compliance import JointStiffness
+from cpm_nlp.core.mechanism import Addon, MechanismDeclarationError, with_addon
 from cpm_nlp.core.result import Status
 from cpm_nlp.mechanisms import registry
 from cpm_nlp.mechanisms.rpr import addon, kinds
@@ -95,8 +96,8 @@ def test_the_registered_rpr_is_the_file_with_its_addon():
             "rpr_compliance",
         }
     )
-    assert mech.kinds["rpr_twists"] is kinds.Twists and mech.synthesis is kinds.Synthesis
-    assert mech.geometry is not None and mech.dynamics is None  # the file's drawing
+    assert mech.kinds["rpr_twists"] is kinds.Twists and isinstance(mech.part(cn.SynthesisFormulation), kinds.Synthesis)
+    assert mech.geometry is not None and mech.part(cn.DynamicsModel) is None  # the file's drawing
     # the old name of the file twin names the same mechanism (old scripts, old problem files)
     assert registry.mechanism_type("rpr_file") is mech
     assert "rpr_file" not in registry.mechanism_names()
@@ -117,9 +118,9 @@ def test_the_addon_may_not_repeat_the_file():
     with pytest.raises(MechanismDeclarationError, match="repeats what the file declares .*rpr_twists"):
         with_addon(mech, Addon(kinds={"rpr_twists": kinds.Twists}))
     with pytest.raises(MechanismDeclarationError, match="repeats what the file declares .*synthesis"):
-        with_addon(mech, Addon(synthesis=kinds.Synthesis))
+        with_addon(mech, Addon(parts=(addon.RprSynthesis(),)))
     with pytest.raises(MechanismDeclarationError, match="repeats what the file declares .*stiffness"):
-        with_addon(mech, Addon(stiffness=mech.stiffness))  # the file declares the Table 1 hinges
+        with_addon(mech, Addon(parts=(mech.part(JointStiffness),)))  # the file declares the Table 1 hinges
 
 
 @pytest.mark.parametrize("params", PARAMETER_SETS, ids=["eq26", "eq47", "eq49"])
@@ -279,7 +280,7 @@ def test_what_users_see_is_what_the_module_declared():
     names = {str(p).rsplit("/", 1)[-1] for p in mech.problem_files}
     for f in ("forward_kinematics", "screw_jacobian", "twists_eq47", "synthesis_fixed_P", "compliance"):
         assert f"rpr_{f}.yaml" in names
-    assert mech.stiffness == JointStiffness(
+    assert mech.part(JointStiffness) == JointStiffness(
         hinges={
             "R": {"joints": "theta_R", "type": "circular_notch", "r": "4 mm", "t": "0.4 mm", "w": "12 mm"},
             "U": {"joints": "theta_U", "type": "circular_notch", "r": "1 mm", "t": "0.4 mm", "w": "12 mm"},
