@@ -13,7 +13,7 @@ from ....core.result import Result, SolverInfo, Status
 from ....core.solver import SolverConfig
 from .. import design as rpr_design
 from .common import RprKind, _finish
-from .transmission import _design_values, _eta_max_option
+from .transmission import DESIGN_NAMES, _design_values, _eta_max_option
 
 
 class Synthesis(RprKind):
@@ -106,11 +106,5 @@ class Synthesis(RprKind):
             "converged",
             "at_best",
             "optima",
-            "l1_design",
-            "l2_design",
-            "l3_design",
-            "s_design",
-            "t_design",
-            "eta_design",
-            "design_in_space",
+            *DESIGN_NAMES,
         ]

@@ -31,19 +31,17 @@ def _eta_max_option() -> Option:
     )
 
 
+#: the file's own design (r1, r2, P0) in the design plane, as both kinds report it
+DESIGN_NAMES = ("l1_design", "l2_design", "l3_design", "s_design", "t_design", "eta_design", "design_in_space")
+
+
 def _design_values(model: Model, eta_max: str) -> tuple[dict, dict]:
     r1, r2, P0 = (model.parameters[k] for k in ("r1", "r2", "P0"))
     D, l1, l2, l3 = rpr_design.normalize(r1, r2, P0)
     s, t = rpr_design.to_plane(l1, l2, l3)
-    values = {
-        "l1_design": l1,
-        "l2_design": l2,
-        "l3_design": l3,
-        "s_design": s,
-        "t_design": t,
-        "eta_design": rpr_design.eta(r1, r2, P0, eta_max),
-        "design_in_space": rpr_design.design_space_violation(l1, l2, l3) is None,
-    }
+    eta = rpr_design.eta(r1, r2, P0, eta_max)
+    in_space = rpr_design.design_space_violation(l1, l2, l3) is None
+    values = dict(zip(DESIGN_NAMES, (l1, l2, l3, s, t, eta, in_space), strict=True))
     dims = {k: ("bool" if k == "design_in_space" else "dimensionless") for k in values}
     return values, dims
 
@@ -146,12 +144,6 @@ class TransmissionMap(RprKind):
             "eta_worst",
             "points_inside",
             "region_fraction",
-            "l1_design",
-            "l2_design",
-            "l3_design",
-            "s_design",
-            "t_design",
-            "eta_design",
-            "design_in_space",
+            *DESIGN_NAMES,
             "design_in_region",
         ]
