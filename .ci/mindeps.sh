@@ -25,6 +25,7 @@ print("mindeps: casadi", casadi.__version__, "numpy", numpy.__version__, "scipy"
       "pyyaml", yaml.__version__, "pint", pint.__version__, "threadpoolctl", threadpoolctl.__version__)
 PY
 cd "$repo"
-"$work/venv/bin/python" -m pytest -q -p no:cacheprovider -o addopts="" tests/test_units.py tests/test_prs3_kinematics.py \
-    tests/test_rpr_kinematics.py tests/test_pantograph_kinematics.py tests/test_prc3_kinematics.py \
-    tests/test_prs3_paper.py
+"$work/venv/bin/python" -m pytest -q -p no:cacheprovider -o addopts="" tests/core/test_units.py \
+    tests/mechanisms/prs3/test_prs3_kinematics.py tests/mechanisms/rpr/test_rpr_kinematics.py \
+    tests/mechanisms/pantograph/test_pantograph_kinematics.py tests/mechanisms/prc3/test_prc3_kinematics.py \
+    tests/mechanisms/prs3/test_prs3_paper.py

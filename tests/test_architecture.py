@@ -456,3 +456,18 @@ def test_results_are_built_from_declared_outputs_only():
                 if name == "Result":
                     calls.append(f"{path.relative_to(PKG.parent)}:{node.lineno}")
     assert not calls, calls
+
+
+def test_every_test_path_named_by_a_script_or_file_exists():
+    """The CI scripts and the shipped files name test files by path: each path still exists
+    (the mindeps step named the tests' old flat paths after the move of issue 22, item 7)."""
+    root = PKG.parent
+    named = [
+        (f.relative_to(root), m.group(0))
+        for f in [*sorted((root / ".ci").iterdir()), *sorted((root / "problems").rglob("*.yaml"))]
+        if f.is_file()
+        for m in re.finditer(r"tests/[\w/]+\.py", f.read_text())
+    ]
+    assert named, "no test path found: the check reads nothing"
+    missing = [f"{f}: {p}" for f, p in named if not (root / p).is_file()]
+    assert not missing, missing
