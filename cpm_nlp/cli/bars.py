@@ -21,6 +21,7 @@ _UNITS = {
     "certifying the assembly modes": "sub-boxes",
     "merging the converged starts": "poses",
     "sweep": "points",
+    "reproducing the published figures": "problem files",
 }
 
 
