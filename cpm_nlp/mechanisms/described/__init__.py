@@ -96,7 +96,7 @@ def load_file_description(path: str | Path, *, allow_pipe: bool = False) -> tupl
 
 def same_text(a: Mechanism, b: Mechanism) -> bool:
     """Whether two mechanisms were read from files of the same text (a shipped file and an
-    unchanged copy of it elsewhere: ``cpm-nlp init``'s problems/mechanisms)."""
+    unchanged copy of it elsewhere: ``cpm-nlp examples``' problems/mechanisms)."""
     with _LOCK:
         ha, hb = _TEXT_HASH.get(id(a)), _TEXT_HASH.get(id(b))
     return ha is not None and ha == hb
