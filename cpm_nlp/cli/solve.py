@@ -37,7 +37,7 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     elif not args.quiet:
         mech = problem.model.mechanism  # a problem's own mechanism file is not registered
         title = (mech if mech is not None else mechanism_type(problem.model.name)).title
-        out.write(render_result(result, title) + "\n")
+        out.write(render_result(result, title, tolerance=problem.solver.tolerance) + "\n")
     if args.output:
         write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])
     status = EXIT_OK if result.ok else EXIT_FAILED

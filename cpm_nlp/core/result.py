@@ -70,14 +70,28 @@ def worst_status(statuses: list[Status]) -> Status:
 
 @dataclass
 class SolverInfo:
-    """Which solver ran, how many iterations (summed over points) and how long."""
+    """Which solver ran, how many iterations (summed over points; None where the method
+    does not count them: a compiled Newton kernel) and how long the solve took
+    (``seconds``), apart from the time spent building what it ran the first time
+    (``build_seconds``: the symbolic construction and compilation of a kernel, once per
+    process).  ``path``: which formulation of the Newton FK answered ("closed": the
+    closed form, no iterations; "reduced": Newton on the task coordinates through the
+    closed-form IK; "full": Newton on the loop closures), "" for the others."""
 
     name: str
-    iterations: int = 0
+    iterations: int | None = 0
     seconds: float = 0.0
+    build_seconds: float = 0.0
+    path: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "iterations": int(self.iterations), "seconds": float(self.seconds)}
+        return {
+            "name": self.name,
+            "iterations": None if self.iterations is None else int(self.iterations),
+            "seconds": float(self.seconds),
+            "build_seconds": float(self.build_seconds),
+            "path": self.path or None,
+        }
 
 
 def _bounded_int(value: Any) -> int | None:
