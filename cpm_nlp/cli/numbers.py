@@ -13,7 +13,7 @@ Two rules, the same everywhere the CLI prints a quantity:
   in metres: Φ is a length).  A length is therefore known to about ``tol``, and any
   other quantity to about the same fraction of its scale: ``tol / L`` times the
   largest magnitude of that dimension among the values of the result (``L``: the
-  largest length among them, the mechanism's scale; 1 m if there is none).  A
+  mechanism's scale, its largest length parameter; 1 m if it has none).  A
   value below that is rounding noise of the solve and is printed as ``0`` (never
   ``-0``): ``psi 1.71766e-15 deg`` is ``0 rad``.  See :class:`Noise`.
 """
@@ -85,10 +85,15 @@ def _magnitudes(value: Any) -> Iterable[float]:
 class Noise:
     """Which printed values are rounding noise of the solve (the module docstring's rule):
     a value of dimension D below ``tolerance / L * scale[D]`` is noise, ``scale[D]`` the
-    largest magnitude of D among the result's values and ``L`` the largest length among them."""
+    largest magnitude of D among the result's values and ``L`` (``length``) the mechanism's
+    largest length parameter (1 m if it has none)."""
 
     def __init__(
-        self, tolerance: float | None, values: Mapping[str, Any], dimensions: Mapping[str, str | None]
+        self,
+        tolerance: float | None,
+        values: Mapping[str, Any],
+        dimensions: Mapping[str, str | None],
+        length: float | None = None,
     ) -> None:
         self.tolerance = tolerance
         scale: dict[str | None, float] = {}
@@ -96,7 +101,7 @@ class Noise:
             dim = dimensions.get(name)
             scale[dim] = max([scale.get(dim, 0.0), *_magnitudes(value)])
         self.scale = scale
-        self.length = scale.get("length") or 1.0
+        self.length = length if length and math.isfinite(length) and length > 0 else 1.0
 
     def threshold(self, dimension: str | None) -> float:
         """The magnitude below which a value of ``dimension`` is noise (0: none is)."""

@@ -106,9 +106,10 @@ def _milliseconds(seconds: float) -> str:
     return f"{seconds * 1e3:.3g} ms" if seconds < 1 else f"{seconds:.3g} s"
 
 
-def render_result(result: Result, title: str = "", tolerance: float | None = None) -> str:
-    """A readable table of a result.  ``tolerance``: the solve's (``solver.tolerance``), which
-    says what is rounding noise (:class:`cpm_nlp.cli.numbers.Noise`); without it only -0 is."""
+def render_result(result: Result, title: str = "", tolerance: float | None = None, length: float | None = None) -> str:
+    """A readable table of a result.  ``tolerance``: the solve's (``solver.tolerance``) and
+    ``length``: the mechanism's largest length parameter, which say what is rounding noise
+    (:class:`cpm_nlp.cli.numbers.Noise`); without a tolerance only -0 is."""
     from ..core.result import STATUS_TEXT
     from ..core.units import DIMENSIONS
 
@@ -133,7 +134,7 @@ def render_result(result: Result, title: str = "", tolerance: float | None = Non
     if not result.values:
         lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
         return "\n".join(lines + _warning_lines(result))
-    noise = Noise(tolerance, result.values, result.dimensions)
+    noise = Noise(tolerance, result.values, result.dimensions, length)
     width = max(len(k) for k in result.values)
     lines.append("")
     for name, value in result.values.items():

@@ -40,9 +40,11 @@ def _category_note(r: Any) -> str:
 
 
 def _computed(r: Any) -> str:
-    from ..core.units import format_quantity
+    """The computed value with the prefix that suits it, to five digits (one more than
+    elsewhere: the printed figure it is compared with often has four)."""
+    from .numbers import engineering
 
-    return "—" if r.computed is None else format_quantity(r.computed, r.dimension, 5)
+    return "—" if r.computed is None else engineering(r.computed, r.dimension, 5)
 
 
 def _rel(r: Any) -> str:
@@ -128,7 +130,7 @@ def render_summary(rows: Sequence[Any], summary: dict[str, Any], hint: bool = Tr
 # -- the full table as text ----------------------------------------------------------------------
 
 #: the columns of the full text table: header and width (the last one takes the rest)
-_COLUMNS = (("quantity", 24), ("source", 14), ("published", 11), ("computed", 11), ("error", 7), ("verdict", 0))
+_COLUMNS = (("quantity", 23), ("source", 14), ("published", 11), ("computed", 12), ("error", 7), ("verdict", 0))
 _INDENT = "  "
 
 

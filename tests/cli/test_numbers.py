@@ -58,17 +58,26 @@ def test_compound_units_keep_their_display_unit_and_never_show_minus_zero():
 def test_noise_is_derived_from_the_tolerance_and_the_scale_of_the_quantity():
     values = {"pz": 0.0776, "px": -6.9e-7, "psi": math.radians(1.71766e-15), "alpha1": 0.798, "F1": 20.0}
     dims = {"pz": "length", "px": "length", "psi": "angle", "alpha1": "angle", "F1": "force"}
-    noise = Noise(1e-10, values, dims)
+    L = 0.109215  # the mechanism's largest length parameter (the 3-PRS leg)
+    noise = Noise(1e-10, values, dims, L)
     # a length is known to the tolerance itself (max |Phi| <= tol, Phi a length)
     assert noise.threshold("length") == 1e-10
     # another dimension to the same fraction of its scale: tol / L times its largest value
-    assert noise.threshold("angle") == pytest.approx(1e-10 / 0.0776 * 0.798)
-    assert noise.threshold("force") == pytest.approx(1e-10 / 0.0776 * 20.0)
+    assert noise.threshold("angle") == pytest.approx(1e-10 / L * 0.798)
+    assert noise.threshold("force") == pytest.approx(1e-10 / L * 20.0)
     assert noise.clean(values["psi"], "angle") == 0.0  # issue 24: "psi 1.71766e-15 deg"
     assert noise.clean(values["px"], "length") == values["px"]  # a 0.69 um parasitic motion is real
     assert noise.clean(5e-11, "length") == 0.0 and noise.clean(2e-10, "length") == 2e-10
     assert math.copysign(1.0, noise.clean(-0.0, "length")) == 1.0  # -0 is 0
     assert Noise(None, values, dims).clean(1e-300, "length") == 1e-300  # no tolerance, no noise
+
+
+def test_a_mechanism_without_lengths_keeps_its_angles():
+    """A linkage whose pose is angles only (its residual a tiny length): the scale is 1 m,
+    never the residual, so 0.512 rad is not taken for noise."""
+    values = {"phi": 0.512024908, "theta": 1e-17, "residual": 1e-17}
+    noise = Noise(1e-10, values, {"phi": "angle", "theta": "angle", "residual": "length"})
+    assert noise.clean(0.512024908, "angle") == 0.512024908 and noise.clean(1e-17, "angle") == 0.0
 
 
 def test_solve_prints_noise_as_zero_and_keeps_every_digit_in_the_json(cli):
