@@ -94,6 +94,21 @@ class SolverInfo:
         }
 
 
+def poses_solver_info(sols: Sequence[Any], fallback: str) -> SolverInfo:
+    """The solver of solved poses (:class:`cpm_nlp.core.kinematics.PoseSolution`): its name,
+    iterations (None where a compiled kernel answered without counting them), the solve time
+    and, apart, the time spent building the kernel, and the Newton FK's path."""
+    names = sorted({s.solver for s in sols if s.solver}) or [fallback]
+    counted = all(s.details.get("iterations_counted", True) for s in sols)
+    return SolverInfo(
+        "+".join(names),
+        sum(s.iterations for s in sols) if counted else None,
+        sum(s.seconds for s in sols),
+        sum(float(s.details.get("build_seconds", 0.0)) for s in sols),
+        "+".join(sorted({s.path for s in sols if s.path})),
+    )
+
+
 def _bounded_int(value: Any) -> int | None:
     return int(value) if abs(int(value)) <= sys.float_info.max else None  # no float holds it
 

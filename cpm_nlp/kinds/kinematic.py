@@ -31,7 +31,7 @@ from ..core.multistart import DEFAULT_STARTS
 from ..core.options import Option
 from ..core.outputs import Output, declared_result, outputs_of
 from ..core.progress import track
-from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
+from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, poses_solver_info, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
@@ -100,18 +100,7 @@ def _summary(sols: Sequence[PoseSolution], batch: bool) -> tuple[Status, str, li
 
 
 def _solver_info(sols: Sequence[PoseSolution], fallback: str) -> SolverInfo:
-    """The solver of poses: its name, iterations (None where a compiled kernel answered
-    without counting them), the solve time and, apart, the time spent building the kernel."""
-    names = sorted({s.solver for s in sols if s.solver}) or [fallback]
-    counted = all(s.details.get("iterations_counted", True) for s in sols)
-    paths = sorted({s.path for s in sols if s.path})
-    return SolverInfo(
-        "+".join(names),
-        sum(s.iterations for s in sols) if counted else None,
-        sum(s.seconds for s in sols),
-        sum(float(s.details.get("build_seconds", 0.0)) for s in sols),
-        "+".join(paths),
-    )
+    return poses_solver_info(sols, fallback)
 
 
 def _result(
