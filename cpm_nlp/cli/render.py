@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Mapping
 
 from .numbers import NO_NOISE, Noise, engineering
 
@@ -106,10 +107,35 @@ def _milliseconds(seconds: float) -> str:
     return f"{seconds * 1e3:.3g} ms" if seconds < 1 else f"{seconds:.3g} s"
 
 
-def render_result(result: Result, title: str = "", tolerance: float | None = None, length: float | None = None) -> str:
+def _model_text(model: Mapping[str, Any], dims: Mapping[str, str]) -> str:
+    """The model's parameters: a declared one with its unit (``b = 47.91 mm``), the others
+    (derived values of a Python mechanism) in SI."""
+    named, plain = [], []
+    for k, v in model.items():
+        if k == "type":
+            continue
+        if isinstance(v, float) and k in dims:
+            named.append(f"{k} = {engineering(v, dims[k], 6)}")  # as typed: six digits
+        elif isinstance(v, list) and all(isinstance(e, float) for e in v):  # a derived vector
+            plain.append(f"{k} = [" + ", ".join(_plain(e) for e in v) + "]")
+        else:
+            plain.append(f"{k} = {_plain(v)}" if isinstance(v, float) else f"{k} = {v}")
+    if not named and not plain:
+        return " (no parameters)"
+    return ": " + "; ".join(x for x in (", ".join(named), ", ".join(plain) + "  (SI)" if plain else "") if x)
+
+
+def render_result(
+    result: Result,
+    title: str = "",
+    tolerance: float | None = None,
+    length: float | None = None,
+    parameter_dims: Mapping[str, str] | None = None,
+) -> str:
     """A readable table of a result.  ``tolerance``: the solve's (``solver.tolerance``) and
     ``length``: the mechanism's largest length parameter, which say what is rounding noise
-    (:class:`cpm_nlp.cli.numbers.Noise`); without a tolerance only -0 is."""
+    (:class:`cpm_nlp.cli.numbers.Noise`); without a tolerance only -0 is.  ``parameter_dims``:
+    the dimension of each declared parameter, shown with its unit."""
     from ..core.result import STATUS_TEXT
     from ..core.units import DIMENSIONS
 
@@ -121,16 +147,7 @@ def render_result(result: Result, title: str = "", tolerance: float | None = Non
     s = result.solver
     lines += _solver_lines(s)
     if result.model:
-        parts = []
-        for k, v in result.model.items():
-            if k == "type":
-                continue
-            if isinstance(v, list) and all(isinstance(e, float) for e in v):  # a derived vector
-                parts.append(f"{k} = [" + ", ".join(f"{e:.6g}" for e in v) + "]")
-            else:
-                parts.append(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
-        shown = ": " + ", ".join(parts) + "  (SI)" if parts else " (no parameters)"
-        lines.append("model   : " + result.model.get("type", "") + shown)
+        lines.append("model   : " + result.model.get("type", "") + _model_text(result.model, parameter_dims or {}))
     if not result.values:
         lines.append("(no values: the solve did not succeed)" if not result.ok else "(no values)")
         return "\n".join(lines + _warning_lines(result))

@@ -37,7 +37,9 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
     elif not args.quiet:
         mech = problem.model.mechanism  # a problem's own mechanism file is not registered
         mech = mech if mech is not None else mechanism_type(problem.model.name)
-        out.write(render_result(result, mech.title, problem.solver.tolerance, _length_scale(mech, problem)) + "\n")
+        dims = {o.name: o.kind for o in mech.parameters if o.kind in ("length", "angle")}
+        tol = problem.solver.tolerance
+        out.write(render_result(result, mech.title, tol, _length_scale(mech, problem), dims) + "\n")
     if args.output:
         write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])
     status = EXIT_OK if result.ok else EXIT_FAILED
