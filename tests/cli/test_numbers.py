@@ -137,3 +137,12 @@ def test_the_build_time_is_measured_apart_from_the_solve():
     assert first.ok and second.ok
     assert first.details["build_seconds"] > 0 and second.details["build_seconds"] < first.details["build_seconds"]
     assert first.details["iterations_counted"] is (first.path == "closed")
+
+
+def test_the_model_line_shows_declared_parameters_with_their_units(cli):
+    """prs3_forward_kinematics.yaml: b = 47.91 mm, L = 109.215 mm, alpha0 = 45 deg (as typed, six
+    digits); a and pz0 are derived by the Python add-on, without a declared unit: SI."""
+    text = cli("solve", str(PROBLEMS / "prs3_forward_kinematics.yaml")).out
+    model = next(line for line in text.splitlines() if line.startswith("model"))
+    assert model.startswith("model   : prs3: b = 47.91 mm, L = 109.215 mm, alpha0 = 45 deg; a = ")
+    assert model.endswith("(SI)")
