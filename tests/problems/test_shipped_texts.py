@@ -108,3 +108,16 @@ def test_a_shipped_data_file_names_only_shipped_paths(path):
         if not (shipped and target.exists()):
             missing.append(name)
     assert not missing, f"{path.relative_to(ROOT)} names paths that do not ship: {missing}"
+
+
+def test_what_the_library_shows_cites_papers_by_reference():
+    """Texts the user sees through ``describe`` and the results (materials' and hinge types'
+    sources) name a paper by its reference, not its file."""
+    from cpm_nlp.analysis.flexure import MATERIALS
+    from cpm_nlp.analysis.hinge_types import HINGE_TABLE
+
+    internal = re.compile(r"\b[\w-]+-(?:\d{4}|ruiz)\.md\b")
+    texts = [m.source for m in MATERIALS.values()]
+    texts += [t for h in HINGE_TABLE.values() for t in (h.source, h.limit_source)]
+    assert len(texts) > 10
+    assert not [t for t in texts if internal.search(t or "")]
