@@ -158,3 +158,23 @@ def test_a_progress_bar_only_on_a_terminal(monkeypatch, tty):
     else:
         assert drawn == ""
     assert "reproducing" not in out.getvalue()  # the bar never goes to stdout
+
+
+def test_an_unexpected_figure_gets_its_column_and_exit_1(cli, tmp_path):
+    """A figure that differs without a stated reason is counted apart, flagged in the full table,
+    and the exit status is 1 as before."""
+    import yaml
+
+    text = (PROBLEMS / "prc3_amplifier.yaml").read_text().split("reproduce:")[0]
+    row = {"quantity": "A1", "source": "eq 1", "published": 3.0, "value": "A1", "tolerance": "0.02 %"}
+    paper = "Li et al. 2018, 3-PRC micromanipulator"
+    f = tmp_path / "amp.yaml"
+    f.write_text(text + yaml.safe_dump({"reproduce": {"paper": paper, "rows": [row]}}))
+    run = cli("reproduce", str(f))
+    assert run.code == 1
+    head = next(line for line in run.out.splitlines() if line.startswith("paper"))
+    assert head.split()[-1] == "UNEXPECTED"
+    assert re.search(rf"^{re.escape(paper)} +0 \(0\) +0 +0 +1$", run.out, re.M)
+    assert "1 figures: 0 agree, 0 differ for a stated reason, 0 cannot be reproduced; 1 unexpected." in run.out
+    full = cli("reproduce", "--full", str(f))
+    assert full.code == 1 and verdict_cells_by_paper(full.out)[paper][0].endswith("UNEXPECTED")
