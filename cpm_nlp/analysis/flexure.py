@@ -76,7 +76,7 @@ MATERIALS: dict[str, Material] = {
             density=2810.0,
             yield_strength=503e6,
             allowable=400e6,
-            source="prc3-li-2018.md section 'Modal analysis' (E, nu, density); prs3-ruiz.md section 5 "
+            source="Li et al. 2018, section 'Modal analysis' (E, nu, density); Ruiz et al., section 5 "
             "('Al 7075': yield 503 MPa, and 400 MPa never exceeded, its safety factor)",
         ),
         Material(
@@ -84,19 +84,19 @@ MATERIALS: dict[str, Material] = {
             E=113.8e9,
             nu=0.342,
             yield_strength=880e6,
-            source="pantograph-3d-elgammal-2016.md Table 1 (density not given)",
+            source="Elgammal et al. 2016, Table 1 (density not given)",
         ),
         Material(
             "polypropylene",
             E=2e9,
             allowable=23.5e6,
-            source="pantograph-3d-elgammal-2016.md section 5 (E = 2 GPa, sigma_all = 23.5 MPa; "
+            source="Elgammal et al. 2016, section 5 (E = 2 GPa, sigma_all = 23.5 MPa; "
             "nu, density and yield strength not given)",
         ),
         Material(
             "Flexible-T",
             E=None,
-            source="pantograph-3d-elgammal-2016.md section 8 (the 3D-printed prototype's material; "
+            source="Elgammal et al. 2016, section 8 (the 3D-printed prototype's material; "
             "the paper gives none of its properties)",
         ),
     )

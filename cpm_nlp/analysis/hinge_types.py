@@ -237,7 +237,7 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 "cantilever_notch",
                 limit_dims=("l", "t"),
                 rotation=lambda E, sigma, d: cantilever_notch_rotation(E, d["l"], d["t"], sigma),
-                limit_source="pantograph-3d-elgammal-2016.md eq 30-31",
+                limit_source="Elgammal et al. 2016, eq 30-31",
             ),
             HingeType(
                 "circular_notch",
@@ -246,11 +246,11 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _notch_six,
                 _rect_stress,
                 "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance), Paros-Weisbord exact without nu; "
-                "stress: nominal 6M/(w t^2) at the thinnest section (the stress of pantograph-3d-elgammal-2016.md "
+                "stress: nominal 6M/(w t^2) at the thinnest section (the stress of Elgammal et al. 2016 "
                 "eq 38), times Kt (default 1)",
                 ("t", "r"),
                 lambda E, sigma, d: circular_notch_max_rotation(E, d["t"], d["r"], sigma),
-                "pantograph-3d-elgammal-2016.md eq 38",
+                "Elgammal et al. 2016, eq 38",
             ),
             HingeType(
                 "circular_rod",

@@ -21,6 +21,7 @@ _UNITS = {
     "certifying the assembly modes": "sub-boxes",
     "merging the converged starts": "poses",
     "sweep": "points",
+    "reproducing the published figures": "problem files",
 }
 
 
@@ -41,6 +42,7 @@ def progress_bars(args: argparse.Namespace) -> progress.Callback | None:
             unit = _UNITS.get(what, "items")
             bar = bars[what] = tqdm(
                 total=total or None,
+                initial=done,  # a bar starts at its first report: its rate counts from there
                 desc=what,
                 unit=f" {unit}",
                 file=args.err,

@@ -109,8 +109,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("reproduce", help="solve every problem file that reproduces a published figure")
     p.add_argument("paths", nargs="*", help="problem files or directories (default: problems/)")
-    p.add_argument("--json", action="store_true", help="print the table as JSON")
-    p.add_argument("-o", "--output", metavar="FILE", help="write the table as JSON to FILE")
+    p.add_argument("--full", action="store_true", help="print the full table, every figure and reason")
+    p.add_argument("--json", action="store_true", help="print the full table as JSON")
+    p.add_argument(
+        "-o", "--output", metavar="FILE", help="write the full table to FILE: .md, .csv or .json (atomically)"
+    )
     p.set_defaults(func=_Command("reproduce", "cmd_reproduce"))
 
     p = sub.add_parser(

@@ -14,7 +14,7 @@ from .streams import solver_output
 
 TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
 if TYPE_CHECKING:
-    from typing import TextIO
+    from typing import Any, TextIO
 
 
 def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
@@ -36,8 +36,10 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
         out.write(result.to_json() + "\n")
     elif not args.quiet:
         mech = problem.model.mechanism  # a problem's own mechanism file is not registered
-        title = (mech if mech is not None else mechanism_type(problem.model.name)).title
-        out.write(render_result(result, title) + "\n")
+        mech = mech if mech is not None else mechanism_type(problem.model.name)
+        dims = {o.name: o.kind for o in mech.parameters if o.kind in ("length", "angle")}
+        tol = problem.solver.tolerance
+        out.write(render_result(result, mech.title, tol, _length_scale(mech, problem), dims) + "\n")
     if args.output:
         write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])
     status = EXIT_OK if result.ok else EXIT_FAILED
@@ -47,6 +49,16 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
             return EXIT_FAILED
         save_figure(args, fig, out)
     return status
+
+
+def _length_scale(mech: Any, problem: Any) -> float | None:
+    """The mechanism's largest length parameter (SI), the scale of its pose: None if it has none."""
+    lengths = [
+        abs(float(problem.model.parameters[o.name]))
+        for o in mech.parameters
+        if o.kind == "length" and isinstance(problem.model.parameters.get(o.name), (int, float))
+    ]
+    return max(lengths) if lengths else None
 
 
 def cmd_check(args: argparse.Namespace, out: TextIO) -> int:

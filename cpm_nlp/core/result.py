@@ -70,14 +70,43 @@ def worst_status(statuses: list[Status]) -> Status:
 
 @dataclass
 class SolverInfo:
-    """Which solver ran, how many iterations (summed over points) and how long."""
+    """Which solver ran, how many iterations (summed over points; None where the method
+    does not count them: a compiled Newton kernel) and how long the solve took
+    (``seconds``), apart from the time spent building what it ran the first time
+    (``build_seconds``: the symbolic construction and compilation of a kernel, once per
+    process).  ``path``: which formulation of the Newton FK answered ("closed": the
+    closed form, no iterations; "reduced": Newton on the task coordinates through the
+    closed-form IK; "full": Newton on the loop closures), "" for the others."""
 
     name: str
-    iterations: int = 0
+    iterations: int | None = 0
     seconds: float = 0.0
+    build_seconds: float = 0.0
+    path: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "iterations": int(self.iterations), "seconds": float(self.seconds)}
+        return {
+            "name": self.name,
+            "iterations": None if self.iterations is None else int(self.iterations),
+            "seconds": float(self.seconds),
+            "build_seconds": float(self.build_seconds),
+            "path": self.path or None,
+        }
+
+
+def poses_solver_info(sols: Sequence[Any], fallback: str) -> SolverInfo:
+    """The solver of solved poses (:class:`cpm_nlp.core.kinematics.PoseSolution`): its name,
+    iterations (None where a compiled kernel answered without counting them), the solve time
+    and, apart, the time spent building the kernel, and the Newton FK's path."""
+    names = sorted({s.solver for s in sols if s.solver}) or [fallback]
+    counted = all(s.details.get("iterations_counted", True) for s in sols)
+    return SolverInfo(
+        "+".join(names),
+        sum(s.iterations for s in sols) if counted else None,
+        sum(s.seconds for s in sols),
+        sum(float(s.details.get("build_seconds", 0.0)) for s in sols),
+        "+".join(sorted({s.path for s in sols if s.path})),
+    )
 
 
 def _bounded_int(value: Any) -> int | None:

@@ -40,7 +40,7 @@ from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinemati
 from ..core.model import Coordinate, Model
 from ..core.options import Option
 from ..core.outputs import Output, Values, declared_result, matrix, text, vector
-from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
+from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, poses_solver_info, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
@@ -297,11 +297,7 @@ class ActuatorForces(_HingeKind):
             )
             out.extend(limit)
             message += "; " + limit_message
-        info = SolverInfo(
-            "+".join(sorted({s.solver for s in sols if s.solver})) or solver.name,
-            sum(s.iterations for s in sols),
-            sum(s.seconds for s in sols),
-        )
+        info = poses_solver_info(sols, solver.name)
         res = _hinge_result(self.name, model, status, out, info, message, statuses)
         return res.warn(*_point_warnings(hs, points, inputs.get("sigma", inputs.get("sigma_allow"))))
 
@@ -464,7 +460,7 @@ class PlatformCompliance(_HingeKind):
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         sol = _commanded_pose(model, inputs, solver)
         out = Values(_pose_outputs(model), _pose_values(model, [sol], False))
-        info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
+        info = poses_solver_info([sol], solver.name)
         if not sol.ok:
             return _hinge_result(self.name, model, sol.status, out, info, sol.message)
         note = inputs.get("fallback", "")
@@ -688,7 +684,7 @@ class NaturalFrequencies(_HingeKind):
         hs: cm.HingeSet = inputs["hinge_set"]
         sol = _commanded_pose(model, inputs, solver)
         out = Values(_pose_outputs(model), _pose_values(model, [sol], False))
-        info = SolverInfo(sol.solver or solver.name, sol.iterations, sol.seconds)
+        info = poses_solver_info([sol], solver.name)
         if not sol.ok:
             return _hinge_result(self.name, model, sol.status, out, info, sol.message)
         sp = cm.static_point(model, hs, sol.x, sol.q)

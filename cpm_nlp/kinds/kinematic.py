@@ -31,7 +31,7 @@ from ..core.multistart import DEFAULT_STARTS
 from ..core.options import Option
 from ..core.outputs import Output, declared_result, outputs_of
 from ..core.progress import track
-from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, worst_status
+from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, poses_solver_info, worst_status
 from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
@@ -100,8 +100,7 @@ def _summary(sols: Sequence[PoseSolution], batch: bool) -> tuple[Status, str, li
 
 
 def _solver_info(sols: Sequence[PoseSolution], fallback: str) -> SolverInfo:
-    names = sorted({s.solver for s in sols if s.solver}) or [fallback]
-    return SolverInfo("+".join(names), sum(s.iterations for s in sols), sum(s.seconds for s in sols))
+    return poses_solver_info(sols, fallback)
 
 
 def _result(

@@ -379,7 +379,7 @@ def resolve_described(mech: Mechanism, path: tuple) -> Mechanism:
         if current is not None and current[0].startswith("file:") and current[1].kind == "built-in":
             builtin = REGISTRY.get(mech.name)
             if builtin is mech or described.same_text(builtin, mech):
-                return builtin  # the built-in's own file, or an unchanged copy of it (cpm-nlp init)
+                return builtin  # the built-in's own file, or an unchanged copy of it (cpm-nlp examples)
             raise InputError(
                 f"the described mechanism's name {mech.name!r} is the built-in mechanism of "
                 f"{current[0][len('file:') :]}, and this description differs from it; rename it",

@@ -4,7 +4,7 @@ A problem file that reproduces published figures carries a ``reproduce``
 section::
 
     reproduce:
-      paper: prs3-ruiz.md
+      paper: Ruiz et al. (year not printed), 3-PRS compliant stage
       rows:
         - quantity: lowest actuator displacement
           source: section 4, Fig. 6
@@ -65,6 +65,8 @@ ROW_KEYS = (
     "expect",
 )
 VERDICTS = ("agrees", "differs", "not reproducible", "solve failed")
+#: what a row comes to (:attr:`Comparison.outcome`), each row exactly one of these
+OUTCOMES = ("agrees", "differs", "not reproducible", "unexpected")
 
 #: what a row's "published" value is (its ``category``), as shown beside it
 CATEGORIES = {
@@ -127,6 +129,17 @@ class Comparison:
         return self.verdict.startswith("agrees")
 
     @property
+    def outcome(self) -> str:
+        """The row in one word of :data:`OUTCOMES`: ``agrees`` and ``differs`` as the file
+        expects (a figure that differs says why), ``not reproducible`` (the model does not
+        compute it, and says why), else ``unexpected`` (a regression, or a failed solve)."""
+        if not self.expected:
+            return "unexpected"
+        if self.verdict == "not reproducible":
+            return "not reproducible"
+        return "agrees" if self.agrees else "differs"
+
+    @property
     def independent(self) -> bool:
         """An agreement with a printed number that is not an input given back."""
         return self.agrees and self.category == "published" and not self.echoes
@@ -174,7 +187,19 @@ def summarize(rows: Iterable[Comparison]) -> dict[str, Any]:
         "not_reproducible": sum(1 for r in rows if r.verdict == "not reproducible"),
         "solve_failed": sum(1 for r in rows if r.verdict == "solve failed"),
         "categories": {c: sum(1 for r in rows if r.category == c) for c in CATEGORIES},
+        "papers": by_paper(rows),
     }
+
+
+def by_paper(rows: Iterable[Comparison]) -> dict[str, dict[str, int]]:
+    """Per paper (in the order they first come), the rows of each outcome
+    (:data:`OUTCOMES`), and how many of those that agree are independent."""
+    out: dict[str, dict[str, int]] = {}
+    for r in rows:
+        counts = out.setdefault(r.paper, {**{o: 0 for o in OUTCOMES}, "independent": 0})
+        counts[r.outcome] += 1
+        counts["independent"] += int(r.outcome == "agrees" and r.independent)
+    return out
 
 
 _NUMBER = re.compile(r"\s*[-+]?(\d*)(?:\.(\d*))?(?:[eE]([-+]?\d+))?")
@@ -223,7 +248,11 @@ def parse_reproduce(raw: Any, path: tuple) -> ReproduceSpec:
             raise unknown_key_error(str(key), ("paper", "rows"), path, "reproduce key")
     paper = raw.get("paper")
     if not isinstance(paper, str) or not paper:
-        raise InputError("expected the paper's file name, e.g. prs3-ruiz.md", path=path + ("paper",))
+        raise InputError(
+            "expected the paper's short reference (authors, year, short title), "
+            "e.g. 'Li, Li, Ding, Xu 2018, 3-PRC micromanipulator'",
+            path=path + ("paper",),
+        )
     rows = raw.get("rows")
     if not isinstance(rows, list) or not rows:
         raise InputError("expected a non-empty list of published figures", path=path + ("rows",))

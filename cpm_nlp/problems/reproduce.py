@@ -8,6 +8,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from ..core.errors import InputError
+from ..core.progress import track
 from ..io.inputs import unique_paths
 from ..mechanisms.registry import mechanism_names, mechanism_type
 from .file import load_problem, solve
@@ -76,7 +77,7 @@ def reproduce(paths: Iterable[str | Path] | None = None) -> list[Comparison]:
     if not files:
         raise InputError(f"no problem files (*.yaml) to compare in {what}")
     rows: list[Comparison] = []
-    for f in files:
+    for f in track(files, "reproducing the published figures"):
         problem = load_problem(f)
         if problem.reproduce is None:
             continue

@@ -27,7 +27,7 @@ def test_solve_json_shape(cli):
     data = json.loads(run.out)
     assert data["problem"] == "forward_kinematics"
     assert data["status"] == "solved"
-    assert set(data["solver"]) == {"name", "iterations", "seconds"}
+    assert set(data["solver"]) == {"name", "iterations", "seconds", "build_seconds", "path"}
     assert data["solver"]["name"] == "ipopt" and data["solver"]["iterations"] > 0
     values = data["values"]
     assert values["s1"] == pytest.approx(1.0e-3) and values["s3"] == pytest.approx(-0.3e-3)  # SI

@@ -16,6 +16,7 @@ import yaml
 
 import cpm_nlp as cn
 from cpm_nlp.problems.published import CATEGORIES, parse_reproduce, printed_half_unit, summarize
+from tests.cli.reproduce_table import verdict_cells_by_paper
 from tests.conftest import PROBLEMS, ROOT
 
 # The amplifier file solves in milliseconds: the rows below are about the table, not the model.
@@ -24,7 +25,8 @@ AMPLIFIER = (PROBLEMS / "prc3_amplifier.yaml").read_text().split("reproduce:")[0
 
 def _file(tmp_path: Path, rows: list[dict], name: str = "amp.yaml") -> Path:
     f = tmp_path / name
-    f.write_text(AMPLIFIER + yaml.safe_dump({"reproduce": {"paper": "prc3-li-2018.md", "rows": rows}}))
+    paper = "Li et al. 2018, 3-PRC micromanipulator"
+    f.write_text(AMPLIFIER + yaml.safe_dump({"reproduce": {"paper": paper, "rows": rows}}))
     return f
 
 
@@ -52,7 +54,7 @@ def test_o_without_json_prints_the_table_and_writes_json(cli, tmp_path):
     out = tmp_path / "t.json"
     run = cli("reproduce", str(PROBLEMS / "rpr_twists_eq49.yaml"), "-o", str(out))
     assert run.code == 0, run.err
-    assert run.out.rstrip().endswith("12 figures, 0 unexpected")
+    assert "12 figures: 12 agree, 0 differ for a stated reason, 0 cannot be reproduced; 0 unexpected." in run.out
     doc = json.loads(out.read_text())
     assert [r["category"] for r in doc["figures"]].count("consistency") == 9
 
@@ -109,18 +111,24 @@ def test_categories_and_echoes_are_shown_and_counted_apart(cli, tmp_path):
     ]
     rows[-1].update(expect="differ", reason="a test of a row that differs")
     f = _file(tmp_path, rows)
-    run = cli("reproduce", str(f))
+    run = cli("reproduce", "--full", str(f))
     assert run.code == 0, run.err
     table = run.out.splitlines()
-    assert table[0].split()[:4] == ["paper", "quantity", "source", "what"]
-    assert re.search(r"A1 again, derived\s+eq 1\s+derived\s", run.out)
-    assert re.search(r"A1 read off\s+eq 1\s+read off matrix\s", run.out)
-    assert re.search(r"A1 as an input\s+eq 1\s+published, echo\s", run.out)
-    assert "computed value echoes an input: L2 / L1, both inputs" in run.out
-    assert "agree, independently: 1 " in run.out
-    assert "agree, not independently: 3 (1 derived, 1 read off matrix, 1 echo an input)" in run.out
-    assert "differ, as explained: 1; not reproducible: 0" in run.out
-    assert table[-1] == "5 figures, 0 unexpected"
+    assert table[4].split() == ["quantity", "source", "published", "computed", "error", "verdict"]
+    verdicts = _verdict_cells(run.out)  # the verdict column, each cell's lines joined
+    assert verdicts[:4] == [
+        "agrees within 0.018 %",
+        "agrees within 0.018 % (derived)",
+        "agrees within 0.018 % (read off matrix)",
+        "agrees within 0.018 % (echo) [1]",
+    ]
+    assert verdicts[4] == "differs (tolerance 1 %) [2] [3]"
+    assert "[1] the computed value echoes an input: L2 / L1, both inputs" in run.out
+    assert "5 figures: 4 agree, 1 differ for a stated reason, 0 cannot be reproduced; 0 unexpected." in run.out
+    assert "Independent agreements (1): " in run.out
+    summary = cli("reproduce", str(f)).out
+    assert summary.rsplit("\n", 2)[0] in run.out  # the summary closes the full table (without the hint)
+    assert re.search(r"^Li et al. 2018, 3-PRC micromanipulator +4 \(1\) +1 +0$", summary, re.M)
 
     doc = json.loads(cli("reproduce", str(f), "--json").out)
     s = doc["summary"]
@@ -128,6 +136,11 @@ def test_categories_and_echoes_are_shown_and_counted_apart(cli, tmp_path):
     assert s["agree_not_independent_by_category"] == {"derived": 1, "read_off_matrix": 1}
     assert [r["independent"] for r in doc["figures"]] == [True, False, False, False, False]
     assert doc["figures"][3]["echoes_input"] == "L2 / L1, both inputs"
+
+
+def _verdict_cells(text: str) -> list[str]:
+    """The verdict cells of a full table, in order (a wrapped cell's lines joined)."""
+    return [cell for cells in verdict_cells_by_paper(text).values() for cell in cells]
 
 
 def test_an_unknown_category_is_exit_2_with_did_you_mean(cli, tmp_path):
@@ -181,7 +194,7 @@ def test_a_tolerance_wider_than_the_print_needs_a_reason(cli, tmp_path):
     assert "reproduce.rows[0].tolerance" in run.err and "tolerance_reason" in run.err and "2.632" in run.err
     ok = {**wide, "tolerance_reason": "rounded up"}
     assert cli("check", str(_file(tmp_path, [ok]))).code == 0
-    run = cli("reproduce", str(_file(tmp_path, [ok])))
+    run = cli("reproduce", "--full", str(_file(tmp_path, [ok])))
     assert "tolerance: rounded up" in run.out
     # an absolute tolerance of exactly half a unit needs none
     assert cli("check", str(_file(tmp_path, [{**A1, "tolerance": "0.0005"}]))).code == 0
@@ -223,6 +236,15 @@ def _printed_numbers(text: str) -> set[float]:
     return nums
 
 
+#: the text of each paper the shipped files cite (shared/papers, beside the checkout; it does not ship)
+PAPER_FILES = {
+    "Elgammal et al. 2016, 3-D compliant pantograph": "pantograph-3d-elgammal-2016.md",
+    "Li et al. 2018, 3-PRC compliant micromanipulator": "prc3-li-2018.md",
+    "Ruiz et al. (year not printed), 3-PRS compliant stage": "prs3-ruiz.md",
+    "Zhang et al. 2022, compliant RPR mechanism": "rpr-2rpu-upr-zhang-2022.md",
+}
+
+
 def _shipped_rows():
     for f in sorted(PROBLEMS.glob("*.yaml")):
         data = yaml.safe_load(f.read_text())
@@ -239,7 +261,7 @@ def test_every_published_row_is_printed_in_its_paper():
     papers = _papers_dir()
     if papers is None:
         pytest.skip("the papers (shared/papers) are not beside this checkout")
-    printed = {p.name: _printed_numbers(p.read_text()) for p in papers.glob("*.md")}
+    printed = {paper: _printed_numbers((papers / name).read_text()) for paper, name in PAPER_FILES.items()}
     missing = []
     for name, paper, fig in _shipped_rows():
         m = re.match(r"\s*[-+]?(\d*\.?\d+(?:[eE][-+]?\d+)?)", fig.published_text)
@@ -304,7 +326,7 @@ def test_a_directory_is_read_with_its_subdirectories(cli, tmp_path):
     (tmp_path / "mechanisms" / "m.yaml").write_text("name: m\nlegs: []\n")
     run = cli("reproduce", str(tmp_path))
     assert run.code == 0, run.err
-    assert run.out.rstrip().endswith("1 figures, 0 unexpected")
+    assert "1 figures: 1 agree" in run.out
 
 
 def test_tolerances_hold_their_stated_reasons():

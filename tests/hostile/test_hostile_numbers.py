@@ -120,7 +120,8 @@ def test_a_derived_value_not_finite_for_the_given_parameters_names_them(tmp_path
     """sqrt(b*b - L*L) is an expression of the parameters: NaN only once b < L is given."""
     problem = _file_mechanism(tmp_path, derived={"value": "sqrt(b*b - L*L)", "dimension": "length"})
     line = _refused(tmp_path, ["solve", str(problem), "--json"], problem.name, "mechanism.parameters")
-    assert "derived.evil" in line and "sqrt of a negative number" in line and "b = 0.04791" in line, line
+    assert "derived.evil" in line and "sqrt of a negative number" in line and "b = 47.91 mm" in line, line
+    assert "b*b - L*L = " in line and " m^2" in line, line  # the square root's argument, with its value
 
 
 # -- numbers no float holds ------------------------------------------------------------------

@@ -415,7 +415,7 @@ STIFFNESS = JointStiffness(
         "yield_strength": "503 MPa",
         "allowable": "400 MPa",
     },
-    source="prs3-ruiz.md section 5 (K_Rrev, K_Rsph, K_Tsph; R_rev, t_rev, l_sph, t_sph, R_sph) and section 4 "
+    source="Ruiz et al. section 5 (K_Rrev, K_Rsph, K_Tsph; R_rev, t_rev, l_sph, t_sph, R_sph) and section 4 "
     "(10 x 10 mm^2 legs; Al 7075, E = 72 GPa, nu = 0.33, 2.81 g/cm^3; yield 503 MPa, 400 MPa never exceeded)",
 )
 

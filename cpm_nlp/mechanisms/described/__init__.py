@@ -96,7 +96,7 @@ def load_file_description(path: str | Path, *, allow_pipe: bool = False) -> tupl
 
 def same_text(a: Mechanism, b: Mechanism) -> bool:
     """Whether two mechanisms were read from files of the same text (a shipped file and an
-    unchanged copy of it elsewhere: ``cpm-nlp init``'s problems/mechanisms)."""
+    unchanged copy of it elsewhere: ``cpm-nlp examples``' problems/mechanisms)."""
     with _LOCK:
         ha, hb = _TEXT_HASH.get(id(a)), _TEXT_HASH.get(id(b))
     return ha is not None and ha == hb
@@ -277,12 +277,24 @@ def _check_finite(d: Description, parameters: dict, derived: list[np.ndarray], s
         if not np.all(np.isfinite(vec)):
             exc = ex.diagnose(q.value, known)
             why = f": column {exc.column}: {exc.message}" if exc is not None else ""
-            given = ", ".join(f"{n} = {_shown(val)}" for n, (val, _dim) in known.items() if n in ex.names_in(q.value))
+            names = ex.names_in(q.value)
+            given = ", ".join(f"{n} = {_quantity(val, dim)}" for n, (val, dim) in known.items() if n in names)
             raise InputError(
-                f"{q.value!r} is not finite ({_shown(v)}) for {given or 'the parameters given'} (SI){why}",
+                f"{q.value!r} is not finite ({_shown(v)}) with {given or 'the parameters given'}{why}",
                 path=("derived", q.name),
             )
         known[q.name] = (v, symbol_dims[q.name])
+
+
+def _quantity(value: float | list[float], dim: Any) -> str:
+    """A parameter's value for a message, in the unit people read (``20 mm``, ``60 deg``)."""
+    from ...core.units import format_quantity
+
+    name = {ex.LENGTH: "length", ex.ANGLE: "angle", ex.NUMBER: "dimensionless"}.get(dim)
+    if name is None or isinstance(value, list):
+        unit = ex.si_text(dim)
+        return _shown(value) + (f" {unit}" if unit else "")
+    return format_quantity(value, name, 6)
 
 
 def _shown(value: float | list[float]) -> str:

@@ -199,15 +199,43 @@ def _translate(text: str) -> tuple[str, list[int]]:
 
 
 class _Evaluator:
-    def __init__(self, symbols: Mapping[str, Value], cols: list[int], units: Mapping[str, Value] | None = None) -> None:
+    def __init__(
+        self, symbols: Mapping[str, Value], cols: list[int], units: Mapping[str, Value] | None = None, text: str = ""
+    ) -> None:
         self.symbols = symbols
         self.cols = cols
+        #: the expression as written (for quoting a part of it in a message)
+        self.text = text
         #: placeholder name -> the value of a number with its unit (see :func:`_units`)
         self.units = units or {}
 
     def col(self, node: ast.AST) -> int:
         off = getattr(node, "col_offset", 0) or 0
         return self.cols[min(off, len(self.cols) - 1)] + 1
+
+    def written(self, node: ast.AST) -> str:
+        """A part of the expression as written (``l2^2 - cx^2``, ``(1 m)^2`` with its unit)."""
+        start, end = getattr(node, "col_offset", None), getattr(node, "end_col_offset", None)
+        if start is None or end is None or not self.text or end < 1:
+            return _source(node)
+        first = self.cols[min(start, len(self.cols) - 1)]
+        last = self.cols[min(end - 1, len(self.cols) - 1)]
+        return self.text[first : last + 1].strip() or _source(node)
+
+    def culprit(self, node: ast.AST, args: list[Value]) -> str:
+        """The argument that made a function's value not finite, with its value:
+        ``: l2^2 - cx^2 = -0.000825 m^2`` (``sqrt``, ``log``, ``asin``, ``acos``, ``exp``),
+        and the divisor of a division by zero."""
+        if isinstance(node, ast.Call) and len(node.args) == 1 and args and (x := _number(args[0])) is not None:
+            arg, dim = node.args[0], args[0].dim
+        elif isinstance(node, ast.BinOp) and isinstance(node.op, ast.Div) and len(args) == 2 and _number(args[1]) == 0:
+            arg, x, dim = node.right, 0.0, args[1].dim
+        else:
+            return ""
+        if isinstance(arg, ast.Constant):  # sqrt(-1): the number is in the expression already
+            return ""
+        unit = si_text(dim)
+        return f": {self.written(arg)} = {x:.4g}" + (f" {unit}" if unit else "")
 
     def fail(self, node: ast.AST, message: str) -> ExpressionError:
         return ExpressionError(message, self.col(node))
@@ -238,7 +266,7 @@ class _Evaluator:
         for i in range(int(sx.numel())):
             e = sx[i]
             if e.is_constant() and not math.isfinite(float(ca.DM(e))):
-                raise self.fail(node, f"{_why(what, args)} (the value is {_text(e)})")
+                raise self.fail(node, f"{_why(what, args)}{self.culprit(node, args)} (the value is {_text(e)})")
         return result
 
     def _Name(self, node: ast.Name) -> Value:
@@ -418,6 +446,19 @@ def _why(what: str, args: list[Value]) -> str:
     return f"{what}() gives a number that is not finite"
 
 
+def si_text(dim: Dim) -> str:
+    """The SI unit of a dimension: ``m``, ``rad``, ``m^2``, ``m*rad`` ("" for a plain number)."""
+    if dim is None:
+        return ""
+    parts = [unit + ("" if power == 1 else f"^{power:g}") for unit, power in (("m", dim[0]), ("rad", dim[1])) if power]
+    return "*".join(parts)
+
+
+def _source(node: ast.AST) -> str:
+    """An argument as written (near enough: ``l2^2 - cx^2``)."""
+    return ast.unparse(node).replace(" ** ", "^").replace("**", "^")
+
+
 def _power_reason(x: list[float | None]) -> str:
     if x[0] == 0 and x[1] is not None and x[1] < 0:
         return "zero to a negative power"
@@ -502,7 +543,7 @@ def parse(text: object, symbols: Mapping[str, Value]) -> Value:
         raise ExpressionError(f"cannot parse the expression ({type(exc).__name__})", 1) from None
     lead = len(source) - len(source.lstrip())
     try:
-        return _Evaluator(symbols, cols[lead:], units).eval(tree)
+        return _Evaluator(symbols, cols[lead:], units, text).eval(tree)
     except RecursionError:
         raise ExpressionError("the expression is nested too deeply", 1) from None
 

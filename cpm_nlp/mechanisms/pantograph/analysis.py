@@ -1,5 +1,6 @@
-"""The paper's analyses of the 3D compliant pantograph (Elgammal, Fanni, Mohamed 2016;
-``../shared/papers/pantograph-3d-elgammal-2016.md``), on the model of its mechanism file
+"""The paper's analyses of the 3D compliant pantograph (Elgammal, Fanni, Mohamed, "Design and
+Analysis of a Novel 3D Decoupled Manipulator Based on Compliant Pantograph for
+Micromanipulation", J. Intell. Robot. Syst. 2016), on the model of its mechanism file
 problems/mechanisms/pantograph.yaml (the kinematics, eq 1-8, written once, there).
 
 Every formula here is in the parameters a, b, the joint limits and the magnification factors

@@ -1,5 +1,6 @@
-"""Lagrange dynamics of the 3-PRC micromanipulator (Li, Li, Ding, Xu 2018, eq 28-41;
-``../shared/papers/prc3-li-2018.md``): the add-on's dynamics model.
+"""Lagrange dynamics of the 3-PRC micromanipulator (Li, Li, Ding, Xu, "An investigation on
+kinematics and dynamics performance of a novel 3-PRC-compliant parallel micromanipulator",
+Adv. Mech. Eng. 2018, eq 28-41): the add-on's dynamics model.
 
 The kinematics is the mechanism file ``problems/mechanisms/prc3.yaml``.  The energies here
 use it through its loop closures only: the platform velocity is pdot = J qdot with J the AD

@@ -1,5 +1,5 @@
-"""Screw theory of the RPR compliant mechanism (Zhang, Liu, Ding, Chin. J. Mech. Eng. 2022;
-``../shared/papers/rpr-2rpu-upr-zhang-2022.md``): the motion screw system, the bases of each
+"""Screw theory of the RPR compliant mechanism (Zhang, Liu, Ding, "Design and Analysis of a Novel
+Compliant Mechanism with RPR Degrees of Freedom", Chin. J. Mech. Eng. 2022): the motion screw system, the bases of each
 leg's twist and wrench subspaces (appendix), the Jacobian by screw theory (eq 7-13) and the
 displacement twists of section 5.1.
 

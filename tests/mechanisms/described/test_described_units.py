@@ -333,7 +333,59 @@ def test_derived_vectors_in_the_export_manifest(tmp_path, cli):
 def test_a_derived_vector_that_is_not_finite_is_named(tmp_path):
     data = _stage("vector_nan")
     data["derived"] = {"P": {"value": "[l, sqrt(l^2 - (1 m)^2), 0]", "dimension": "length"}}
-    _error(tmp_path, data, "derived.P", "sqrt of a negative number", "l = 0.0735")
+    _error(tmp_path, data, "derived.P", "sqrt of a negative number", "l = 73.5 mm", "l^2 - (1 m)^2 = -0.9946 m^2")
+
+
+#: the five-bar XY stage of the file-mechanism tutorial, with a coupler too short to reach
+_SHORT_COUPLER = """
+name: xy_short
+parameters:
+  d:  {dimension: length, default: 40 mm, bounds: [1 mm, 1 m]}
+  l1: {dimension: length, default: 30 mm, bounds: [1 mm, 1 m]}
+  l2: {dimension: length, default: 20 mm, bounds: [1 mm, 1 m]}
+  th0: {dimension: angle, default: 60 deg, bounds: [10 deg, 90 deg]}
+derived:
+  cx: {value: d/2 + l1*cos(th0), dimension: length}
+  cy: {value: l1*sin(th0), dimension: length}
+  y0: {value: "cy + sqrt(l2^2 - cx^2)", dimension: length}
+platform:
+  planar: true
+  coordinates: {x: length, y: length}
+  position: [x, y]
+  rotation: []
+  task: [x, y]
+  home: {y: y0}
+legs:
+  - name: left
+    joints:
+      - {type: planar_R, at: [-d/2, 0], actuated: q1, home: [pi - th0]}
+      - {type: planar_R, at: [-cx, cy], coordinates: [e1]}
+      - {type: planar_R, at: [0, y0]}
+  - name: right
+    joints:
+      - {type: planar_R, at: [d/2, 0], actuated: q2, home: [th0]}
+      - {type: planar_R, at: [cx, cy], coordinates: [e2]}
+      - {type: planar_R, at: [0, y0]}
+"""
+
+
+def test_a_derived_parameter_that_becomes_nan_is_named_with_the_operation_and_its_value(tmp_path):
+    """Issue 24: not "residual nan ... max |Phi| = nan" but which derived parameter, its expression,
+    the operation (the square root in y0's expression) and the value it was given."""
+    d, l1, l2, th0 = 40e-3, 30e-3, 20e-3, math.radians(60)
+    cx, cy = d / 2 + l1 * math.cos(th0), l1 * math.sin(th0)  # by hand, not by the toolkit
+    radicand = l2**2 - cx**2
+    assert radicand < 0
+    msg = _error(
+        tmp_path,
+        yaml.safe_load(_SHORT_COUPLER),
+        "derived.y0",
+        "'cy + sqrt(l2^2 - cx^2)'",
+        "column 6: sqrt of a negative number",
+        f"l2^2 - cx^2 = {radicand:.4g} m^2",
+        f"l2 = 20 mm, cx = {cx * 1e3:g} mm, cy = {cy * 1e3:.6g} mm",
+    )
+    assert "residual" not in msg and "|" not in msg
 
 
 # -- describe ---------------------------------------------------------------------------------

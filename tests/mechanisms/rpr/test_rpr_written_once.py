@@ -287,7 +287,7 @@ def test_what_users_see_is_what_the_module_declared():
             "U": {"joints": "theta_U", "type": "circular_notch", "r": "1 mm", "t": "0.4 mm", "w": "12 mm"},
         },
         material="Al 7075-T6",
-        source="rpr-2rpu-upr-zhang-2022.md Table 1 (joint dimensions) and section 5 (Al-7075)",
+        source="Zhang et al. 2022 Table 1 (joint dimensions) and section 5 (Al-7075)",
     )
 
 
