@@ -46,6 +46,7 @@ from .builder import ClosureBuilder, Reported, family
 from .drawing import graph_drawing_points
 from .emit import closure_functions
 from .expand import InLeg
+from .graph_dyads import graph_closed_form
 from .graph_rows import Cut, axis_normals, cut_rows, cut_values
 from .graph_tree import GraphJoint, spanning_tree
 from .mobility import GraphInfo
@@ -259,6 +260,7 @@ class GraphGenerator(ClosureBuilder):
                 spec = Joint(g.type, home=j.home, actuated=j.actuated, gain=j.gain, limit=j.limit, range=j.range)
                 spec.path = j.path
                 actuated = self.actuator(spec, self.env)  # gain (q - q_home)
+                g.drive = actuated
             for n, ((kind, _axis), name) in enumerate(zip(motions, names)):
                 dim = "length" if kind == "P" else "angle"
                 home = self.scalar(j.home[n], j.path + ("home", n), self.env, dim) if n < len(j.home) else ca.SX(0)
@@ -270,6 +272,7 @@ class GraphGenerator(ClosureBuilder):
                 limit = None if actuated is not None else self.flexure_range(g, dim, home)  # type: ignore[arg-type]
                 self.extra.append((coord, sym, home, limit, j.path))
                 g.values.append(sym - home)
+                g.homes.append(home)
                 if actuated is not None:
                     self.actuation_rows.append((sym - home - actuated, f"actuator {j.actuated}: joint {g.name}", dim))
                     self.actuated_coords.add(name)
@@ -446,6 +449,7 @@ class GraphGenerator(ClosureBuilder):
         select_branch(self, added)
         self.check_task_count()
         fns = self.graph_functions(q)
+        fns["fk_closed"] = graph_closed_form(self, q)
         self.info = self.assembler.info
         return fns
 

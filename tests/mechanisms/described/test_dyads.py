@@ -52,7 +52,7 @@ def test_five_bar_is_recognised_and_others_are_not():
     for name in ("delta", "pantograph"):
         assert cn.build_model(name).closure.fk_closed is None, name
     fn = cn.build_model("five_bar").closure.fk_closed
-    assert fn.name() == "fk_closed" and fn.name_in() == ["q", "p"] and fn.name_out() == ["x", "disc"]
+    assert fn.name() == "fk_closed" and fn.name_in() == ["q", "x0", "p"] and fn.name_out() == ["x", "disc", "side"]
 
 
 def test_closed_form_equals_newton_and_numpy(five_bar):
@@ -78,11 +78,11 @@ def test_branch_is_the_home_one(five_bar):
     indicators keep their home signs (the file's assembly mode), and the other intersection of
     the same circles is a different assembly (a wrong branch, not the answer)."""
     m, c = five_bar, five_bar.closure
-    x, disc = c.fk_closed(m.q_home, m.p)
+    x, disc, side = c.fk_closed(m.q_home, m.x_home, m.p)
     np.testing.assert_allclose(np.asarray(x).ravel(), m.x_home, rtol=0, atol=1e-15)
-    assert float(disc) > 0
+    assert float(disc) > 0 and float(side) > 0
     for qi in _poses(m, 50, seed=1):
-        xi = np.asarray(c.fk_closed(qi, m.p)[0]).ravel()
+        xi = np.asarray(c.fk_closed(qi, m.x_home, m.p)[0]).ravel()
         assert np.all(np.asarray(c.branch(xi, qi, m.p)) > 0)
         c1 = np.array([-0.05 + 0.1 * np.cos(qi[0]), 0.1 * np.sin(qi[0])])
         c2 = np.array([0.05 + 0.1 * np.cos(qi[1]), 0.1 * np.sin(qi[1])])
@@ -100,7 +100,7 @@ def test_out_of_reach_pose_keeps_newtons_status(five_bar):
     m = cn.build_model("five_bar", {"l2": "120 mm"})
     c = m.closure
     q = np.array([[np.pi, 0.0], [np.pi - 0.1, 0.1], [3.0, 0.3]])
-    assert all(float(c.fk_closed(qi, m.p)[1]) < 0 for qi in q)
+    assert all(float(c.fk_closed(qi, m.x_home, m.p)[1]) < 0 for qi in q)
     got, ref = cn.batch_forward_kinematics(m, q), _newton_only(m, q)
     assert got.statuses == ref.statuses == [Status.NOT_CONVERGED] * 3
     assert np.isnan(got.x).all() and all(got.path(i) == "full" for i in range(3))
@@ -119,13 +119,13 @@ def test_fk_against_ik_and_ad_jacobian(five_bar):
 
     m, c = five_bar, five_bar.closure
     q_sym = ca.SX.sym("q", c.nq)
-    dx_dq = ca.Function("dx_dq", [q_sym], [ca.jacobian(c.fk_closed(q_sym, m.p)[0], q_sym)], ["q"], ["J"])
+    dx_dq = ca.Function("dx_dq", [q_sym], [ca.jacobian(c.fk_closed(q_sym, m.x_home, m.p)[0], q_sym)], ["q"], ["J"])
     for qi in _poses(m, 20, seed=2):
-        xi = np.asarray(c.fk_closed(qi, m.p)[0]).ravel()
+        xi = np.asarray(c.fk_closed(qi, m.x_home, m.p)[0]).ravel()
         q_back = np.asarray(c.ik(xi[list(c.task_index)], m.p)[1]).ravel()
         np.testing.assert_allclose(q_back, qi, rtol=0, atol=1e-12)
         jac = np.asarray(dx_dq(qi))
-        fd = central_difference(lambda v: np.asarray(c.fk_closed(v, m.p)[0]).ravel(), qi, 1e-6)
+        fd = central_difference(lambda v: np.asarray(c.fk_closed(v, m.x_home, m.p)[0]).ravel(), qi, 1e-6)
         np.testing.assert_allclose(jac, fd, rtol=0, atol=1e-8)
         np.testing.assert_allclose(jac, np.asarray(c.jacobian(xi, qi, m.p)), rtol=0, atol=1e-12)
 
@@ -147,7 +147,7 @@ def test_a_guess_in_the_other_assembly_is_left_to_newton(five_bar):
     q = _poses(m, 30, seed=3)
     mirrors = []
     for qi in q:
-        xi = np.asarray(c.fk_closed(qi, m.p)[0]).ravel()
+        xi = np.asarray(c.fk_closed(qi, m.x_home, m.p)[0]).ravel()
         c1 = np.array([-0.05 + 0.1 * np.cos(qi[0]), 0.1 * np.sin(qi[0])])
         c2 = np.array([0.05 + 0.1 * np.cos(qi[1]), 0.1 * np.sin(qi[1])])
         e = (c2 - c1) / np.linalg.norm(c2 - c1)
