@@ -181,7 +181,8 @@ def bench_fivebar(n: int, rounds: int) -> dict:
         # the circle-circle intersection alone (this model's numbers built in, no checks): what
         # pylinkage's dyad computes
         q_sym = ca.SX.sym("q", c.nq)
-        bare = ca.Function("five_bar_fk_closed_bare", [q_sym], list(c.fk_closed(q_sym, model.x_home, model.p))[:2], ["q"], ["x", "disc"])
+        closed = list(c.fk_closed(q_sym, model.x_home, model.p))[:2]
+        bare = ca.Function("five_bar_fk_closed_bare", [q_sym], closed, ["q"], ["x", "disc"])
         source = generate_source(bare, bare.name()) + batch_loop_source(bare, bare.name())
         bare_loop = NativeLoop(build_library(source, bare.name()), bare.name(), bare)
         calls["closed_form_alone"] = lambda: evaluate(bare_loop, [q], 1)

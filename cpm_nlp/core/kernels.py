@@ -427,8 +427,8 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
 def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
     """``<name>_fk_closed: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) -> (x, passive,
     residual, branch_margin, round_trip_error, cond1, limit_margin[, path], status)``: the pose from
-    the closure's closed-form FK (``fk_closed``; x0 picks the side and the turn of an angle), one flat SX graph, with the same
-    inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
+    the closure's closed-form FK (``fk_closed``; x0 picks the side and the turn of an angle), one flat
+    SX graph, with the same inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
 
     ``status`` is ``solved`` only where the closed form assembles the pose (every dyad's disc >= 0,
     finite), the guess x0 lies on each dyad's side of the pose (side > 0; else the root Newton seeks

@@ -95,8 +95,8 @@ class LoopClosure:
         optional closed-form FK of the whole closure, ``("fk_closed", [q, x0, p], [x, disc, side])``
         (planar dyads: :mod:`cpm_nlp.mechanisms.described.dyads`, ``graph_dyads``); ``disc < 0``
         where it cannot assemble the pose, ``side <= 0`` where the guess x0 lies in another assembly
-        than the one it takes (x0 also picks the turn of an angle).  The FK kernel tries it first and keeps it only where the pose
-        checks pass (:func:`cpm_nlp.core.kernels.fk_kernel`).
+        than the one it takes (x0 also picks the turn of an angle).  The FK kernel tries it first
+        and keeps it only where the pose checks pass (:func:`cpm_nlp.core.kernels.fk_kernel`).
     """
 
     def __init__(

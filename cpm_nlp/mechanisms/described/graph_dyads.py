@@ -20,7 +20,8 @@ graph's body frames are the world at the drawing, :mod:`.graph`); derived here:
   the slide, so v = -w·u + s √(|B - A|² - (w·n)²) (n ⊥ u) and θ the angle from w + v u to B - A.
 
 Each dyad has two assemblies; its sign s is the reference configuration's (the graph's assembled
-reference, with the parameters' defaults, as the graph's branch indicators are signed: :func:`.branches.graph_indicators`).
+reference, with the parameters' defaults, as the graph's branch indicators are signed:
+:func:`.branches.graph_indicators`).
 ``disc`` (the least over the dyads, negative where one does not assemble) and ``side`` (the least of
 each dyad's side at the guess x0 times its sign: positive where x0 is on the assembly taken) let the
 FK kernel (:func:`cpm_nlp.core.kernels.fk_kernel`) leave any other pose to Newton.  The pose
@@ -173,7 +174,8 @@ class Decomposition:
                 C_d = self._point_on(gr, body)
                 A = _world(self.placed[kr], self._point_on(gr, kr))
                 C, pose, dyad = self._slide_circle(gs, ks, body, C_d, A, gr.length)
-                dyad.side_x = ca.dot(self._line_x(gs, ks, body), self._wx(body, C_d) - self._wx(kr, self._point_on(gr, kr)))
+                A_x = self._wx(kr, self._point_on(gr, kr))
+                dyad.side_x = ca.dot(self._line_x(gs, ks, body), self._wx(body, C_d) - A_x)
                 self.placed[body] = pose
                 self.dyads.append(dyad)
                 return True
@@ -282,7 +284,8 @@ class Decomposition:
         B = _world(self.placed[k2], self._point_on(h2, k2))
         sign = 1 if b2 == g.b else -1
         u = sign * g.axis[:2]
-        # b2 = b1 moved by v u across the slide: B = A + R(θ)(w + v u), w = (g's point on b1 - A_d) - (g's point on b2 - B_d)
+        # b2 = b1 moved by v u across the slide: B = A + R(θ)(w + v u), with
+        # w = (g's point on b1 - A_d) - (g's point on b2 - B_d)
         w = (self._point_on(g, b1)[:2] - A_d[:2]) - (self._point_on(g, b2)[:2] - B_d[:2])
         D = B - A
         m = ca.dot(w, u)
@@ -323,28 +326,35 @@ class Decomposition:
             else:  # b's point pb onto a's pa, moved by v along the axis as a carries it
                 offset = _world(Pb, g.pb) - _world(Pa, g.pa)
                 x[k] = home + ca.dot(_rot(Pa, g.axis[:2]), offset)
-        tree = [k for k in range(len(x)) if x[k] is not None]
         rest = [k for k in range(len(x)) if x[k] is None]
-        if rest:  # the platform's coordinates: rows linear in them, one step from the guess
-            rows = ca.vertcat(*[r for r, _name in gen.platform_rows])
-            xr = ca.vertcat(*[gen.x[k] for k in rest])
-            if rows.numel() != len(rest):
-                return None
-            J = ca.jacobian(rows, xr)
-            if ca.depends_on(J, xr):
-                return None
-            z0 = ca.vertcat(*[x0[k] for k in rest])
-            f = ca.Function("platform_rows", [gen.x, gen.p], [rows, J])
-            full = ca.SX.zeros(len(x))
-            for k in tree:
-                full[k] = x[k]
-            for k in rest:
-                full[k] = x0[k]
-            r, Jv = f(full, gen.p)
-            z = z0 - ca.solve(Jv, r)
-            for i, k in enumerate(rest):
-                x[k] = z[i]
+        if rest and not self._platform(x, x0, rest):
+            return None
         return ca.vertcat(*x)
+
+    def _platform(self, x: list, x0: ca.SX, rest: list) -> bool:
+        """The platform's coordinates (``rest``, filled into x): their rows are linear in them, so one
+        Newton step from the guess solves them (False: they are not)."""
+        gen = self.gen
+        tree = [k for k in range(len(x)) if k not in rest]
+        rows = ca.vertcat(*[r for r, _name in gen.platform_rows])
+        xr = ca.vertcat(*[gen.x[k] for k in rest])
+        if rows.numel() != len(rest):
+            return False
+        J = ca.jacobian(rows, xr)
+        if ca.depends_on(J, xr):
+            return False
+        z0 = ca.vertcat(*[x0[k] for k in rest])
+        f = ca.Function("platform_rows", [gen.x, gen.p], [rows, J])
+        full = ca.SX.zeros(len(x))
+        for k in tree:
+            full[k] = x[k]
+        for k in rest:
+            full[k] = x0[k]
+        r, Jv = f(full, gen.p)
+        z = z0 - ca.solve(Jv, r)
+        for i, k in enumerate(rest):
+            x[k] = z[i]
+        return True
 
     def function(self, x_ref: np.ndarray, q_ref: np.ndarray, p_ref: np.ndarray) -> ca.Function | None:
         """``fk_closed(q, x0, p) -> (x, disc, side)``, each dyad's sign that of the reference
@@ -366,9 +376,7 @@ class Decomposition:
         sv = ca.DM(signs)
         x = ca.substitute(x, syms, sv)
         disc = ca.mmin(ca.vertcat(*[ca.substitute(dy.disc, syms, sv) for dy in self.dyads]))
-        side = ca.mmin(
-            ca.vertcat(*[dy.sign * ca.substitute(dy.side_x, gen.x, x0) for dy in self.dyads])
-        )
+        side = ca.mmin(ca.vertcat(*[dy.sign * ca.substitute(dy.side_x, gen.x, x0) for dy in self.dyads]))
         outs = ca.cse([x, disc, side])
         return ca.Function("fk_closed", [self.q, x0, gen.p], outs, ["q", "x0", "p"], ["x", "disc", "side"])
 
