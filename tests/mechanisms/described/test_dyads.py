@@ -161,3 +161,59 @@ def test_a_guess_in_the_other_assembly_is_left_to_newton(five_bar):
     assert all(got.path(i) != "closed" for i in range(len(got)))
     np.testing.assert_allclose(got.raw_joints[:, :2], ref.raw_joints[:, :2], rtol=0, atol=1e-12)
     np.testing.assert_allclose(got.raw_joints[:, :2], np.array(mirrors), rtol=0, atol=1e-12)
+
+
+RPR2 = {  # a planar 2-RPR point platform: each leg a passive R at the base, an actuated P, an R at P
+    "name": "rpr2_point",
+    "parameters": {"d": {"dimension": "length", "default": "100 mm"}, "h": {"dimension": "length", "default": "80 mm"}},
+    "platform": {
+        "planar": True,
+        "coordinates": {"x": "length", "y": "length"},
+        "position": ["x", "y"],
+        "rotation": [],
+        "task": ["x", "y"],
+        "home": {"y": "h"},
+    },
+    "legs": [
+        {
+            "name": name,
+            "joints": [
+                {"type": "planar_R", "at": [f"{sign}d/2", 0]},
+                {
+                    "type": "planar_P",
+                    "at": [f"{sign}d/2", 0],
+                    "axis": [axis, "h"],
+                    "actuated": s,
+                },
+                {"type": "planar_R", "at": [0, "h"]},
+            ],
+        }
+        for name, sign, axis, s in (("left", "-", "d/2", "s1"), ("right", "", "-d/2", "s2"))
+    ],
+}
+
+
+def test_rpr_legs_are_circles_of_the_actuated_length():
+    """An R-P-R leg (an actuated P between two point joints) is a circle of radius r + s about its
+    base joint: the 2-RPR point platform's FK is the two circles' intersection in closed form (its
+    kernel alone solves every pose), equal to the numpy derivation and to Newton near it."""
+    from cpm_nlp.mechanisms.described import from_dict
+
+    mech = from_dict(RPR2)
+    m = mech.model(mech.closure(), {}, {}, ())
+    c = m.closure
+    assert c.fk_closed is not None
+    q = m.q_home + np.random.default_rng(4).uniform(-0.01, 0.01, (60, 2))
+    kern = closed_fk_kernel(c, NEWTON)
+    out = dict(zip(kern.outputs, evaluate(kern.function, [q, m.x_home, *shared_values(kern, m, 1e-9)])))
+    assert np.all(out["status"].ravel() == code_of(Status.SOLVED))
+    got = cn.batch_forward_kinematics(m, q)
+    assert got.ok.all()
+    r0 = np.hypot(0.05, 0.08)  # the legs' length at home
+    r1, r2 = r0 + q[:, 0], r0 + q[:, 1]
+    x = (r1**2 - r2**2) / (2 * 0.1)  # circles about (-d/2, 0) and (d/2, 0), P above the base
+    np.testing.assert_allclose(got.x, np.stack([x, np.sqrt(r1**2 - (x + 0.05) ** 2)], axis=1), rtol=0, atol=1e-12)
+    kn = _newton_fk_kernel(c, NEWTON, "rpr2_fk_newton_reference")
+    guess = got.x + 1e-4
+    ref = dict(zip(kn.outputs, evaluate(kn.function, [q, guess, *shared_values(kn, m, NEWTON.tolerance)])))
+    np.testing.assert_allclose(got.x, np.asarray(ref["x"]).reshape(got.x.shape), rtol=0, atol=1e-12)
