@@ -410,6 +410,8 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
     Newton FK (:func:`_newton_fk_kernel`).
     """
     c = closure
+    if c.fk_closed is None and c.fk_seed is not None:
+        return _seeded_fk_kernel(c, config)
     if c.fk_closed is None:
         return _newton_fk_kernel(c, config, f"{c.name}_fk")
     opts = newton_options(config)
@@ -421,6 +423,25 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
 
     key = ("fk_kernel_closed", _options_key(opts))
+    return c.solvers.memo(key, build)
+
+
+def _seeded_fk_kernel(closure: LoopClosure, config: SolverConfig | None) -> Kernel:
+    """The Newton FK from the guess of a partial closed form (``fk_seed``: the dyads it can place,
+    in closed form; the rest from x0): Newton moves only what the dyads leave, its status stands."""
+    c = closure
+    opts = newton_options(config)
+
+    def build() -> Kernel:
+        newton = _newton_fk_kernel(c, config, f"{c.name}_fk_newton")
+        fn = newton.function
+        ins = [ca.MX.sym(fn.name_in(k), fn.sparsity_in(k)) for k in range(fn.n_in())]
+        q, x0, p = ins[0], ins[1], ins[2]  # (q, x0, p, ...): SHARED_INPUTS start with p
+        outs = fn(q, c.fk_seed(q, x0, p), *ins[2:])
+        f = ca.Function(f"{c.name}_fk", ins, list(outs), fn.name_in(), fn.name_out())
+        return Kernel(f, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
+
+    key = ("fk_kernel_seeded", _options_key(opts))
     return c.solvers.memo(key, build)
 
 

@@ -449,7 +449,7 @@ class GraphGenerator(ClosureBuilder):
         select_branch(self, added)
         self.check_task_count()
         fns = self.graph_functions(q)
-        fns["fk_closed"] = graph_closed_form(self, q)
+        fns["fk_closed"], fns["fk_seed"] = graph_closed_form(self, q)
         self.info = self.assembler.info
         return fns
 

@@ -28,8 +28,11 @@ FK kernel (:func:`cpm_nlp.core.kernels.fk_kernel`) leave any other pose to Newto
 coordinates follow from the bodies' poses: a tree R joint's value is its home plus the turn between
 its bodies (the turn nearest the guess x0, so a crank that has turned by whole turns stays there), a
 tree P joint's the slide between its points, the platform's coordinates by their rows (linear in
-them).  A graph that does not decompose completely (a class III group, a spatial or
-overconstrained one, a placed platform) gets no closed form: Newton solves it all.
+them).  A graph that decomposes only in part (a class III group after some dyads) gets a seed
+instead (:meth:`Decomposition.seed`): the dyads' closed form places the bodies it can, and Newton,
+started there, moves only the rest (the placed coordinates' rows are already solved, and Φ_x is
+block-triangular in them); Newton's status stands.  A spatial or overconstrained graph, or one
+whose platform is placed by its coordinates, gets neither.
 """
 
 from __future__ import annotations
@@ -98,6 +101,8 @@ class Decomposition:
         self.dyads: list[Dyad] = []
         self.joints = [g for g in gen.gjoints if g.type in ("planar_R", "planar_P", "distance")]
         self.complete = len(self.joints) == len(gen.gjoints) and self._decompose()
+        #: tree coordinates the placed bodies give (a partial decomposition: the others' stay x0's)
+        self.partial = not self.complete
 
     # -- the graph's own expressions at a pose x (for the reference's signs and the guess's side) --
     def _wx(self, body: str, point: ca.SX) -> ca.SX:
@@ -307,12 +312,16 @@ class Decomposition:
 
     # -- the pose coordinates ---------------------------------------------------------------------
     def _coordinates(self, x0: ca.SX) -> ca.SX | None:
-        """The pose coordinates from the bodies' poses (None: a coordinate it cannot give)."""
+        """The pose coordinates from the bodies' poses (None: a coordinate it cannot give); a
+        partial decomposition keeps x0's for the joints of the bodies it did not place."""
         gen = self.gen
         where = {n: k for k, n in enumerate(gen.x_names)}
         x = [None] * len(gen.x_names)
         for g in self.joints:
             if not g.tree or g.type == "distance":
+                continue
+            if g.a not in self.placed or g.b not in self.placed:
+                x[where[g.names[0]]] = self._kept(g, x0, where[g.names[0]])
                 continue
             k = where[g.names[0]]
             home = g.homes[0]
@@ -356,9 +365,42 @@ class Decomposition:
             x[k] = z[i]
         return True
 
+    def _kept(self, g: Any, x0: ca.SX, k: int) -> ca.SX:
+        """A partial decomposition's guess for a tree joint it does not place: the unplaced body keeps
+        its turn at x0 where the joint's other body is placed (its turn taken up by the joint), else x0's."""
+        if g.type != "planar_R" or (g.a in self.placed) == (g.b in self.placed):
+            return x0[k]
+        body = g.a if g.a in self.placed else g.b
+        c, s, _t = self.placed[body]
+        moved = _wrap(ca.atan2(s, c) - ca.substitute(self.gen.angle[body], self.gen.x, x0))
+        return x0[k] + (moved if body == g.b else -moved)  # turn = θ_b - θ_a
+
     def function(self, x_ref: np.ndarray, q_ref: np.ndarray, p_ref: np.ndarray) -> ca.Function | None:
         """``fk_closed(q, x0, p) -> (x, disc, side)``, each dyad's sign that of the reference
         configuration (x_ref, q_ref) with the parameters p_ref (None: a dyad is singular there)."""
+        parts = self._parts(x_ref, q_ref, p_ref)
+        if parts is None:
+            return None
+        x0, x, disc, side = parts
+        outs = ca.cse([x, disc, side])
+        return ca.Function("fk_closed", [self.q, x0, self.gen.p], outs, ["q", "x0", "p"], ["x", "disc", "side"])
+
+    def seed(self, x_ref: np.ndarray, q_ref: np.ndarray, p_ref: np.ndarray) -> ca.Function | None:
+        """``fk_seed(q, x0, p) -> x0'``: a partial decomposition's guess for Newton -- the placed
+        bodies' coordinates in closed form, the others x0's -- where every placed dyad assembles
+        and x0 is on the side of each one's assembly, else x0 itself (None: a dyad is singular at
+        the reference, or a platform coordinate it cannot give)."""
+        parts = self._parts(x_ref, q_ref, p_ref)
+        if parts is None:
+            return None
+        x0, x, disc, side = parts
+        finite = ca.sum1(ca.fabs(x) < ca.inf) == x.numel()  # false for inf and NaN
+        ok = ca.logic_and(ca.logic_and(disc >= 0, side > 0), finite)
+        guess = ca.cse(ca.if_else(ok, x, x0))
+        return ca.Function("fk_seed", [self.q, x0, self.gen.p], [guess], ["q", "x0", "p"], ["x0_seed"])
+
+    def _parts(self, x_ref: np.ndarray, q_ref: np.ndarray, p_ref: np.ndarray) -> tuple | None:
+        """(x0, x, disc, side) of the dyads placed, each its reference sign (None: see :meth:`function`)."""
         gen = self.gen
         x0 = ca.SX.sym("x0", gen.x.numel())
         signs = []
@@ -377,20 +419,23 @@ class Decomposition:
         x = ca.substitute(x, syms, sv)
         disc = ca.mmin(ca.vertcat(*[ca.substitute(dy.disc, syms, sv) for dy in self.dyads]))
         side = ca.mmin(ca.vertcat(*[dy.sign * ca.substitute(dy.side_x, gen.x, x0) for dy in self.dyads]))
-        outs = ca.cse([x, disc, side])
-        return ca.Function("fk_closed", [self.q, x0, gen.p], outs, ["q", "x0", "p"], ["x", "disc", "side"])
+        return x0, x, disc, side
 
 
-def graph_closed_form(gen: Any, q: ca.SX) -> ca.Function | None:
-    """The closed-form FK of a planar graph that decomposes into dyads (None: it does not, or it
-    is overconstrained or spatial, or its platform is placed by its coordinates)."""
+def graph_closed_form(gen: Any, q: ca.SX) -> tuple[ca.Function | None, ca.Function | None]:
+    """(``fk_closed``, ``fk_seed``) of a planar graph: the closed-form FK where it decomposes into
+    dyads, else the seed of the dyads it has (both None: none, or the graph is overconstrained or
+    spatial, or its platform is placed by its coordinates)."""
     if not gen.d.platform.planar or gen.normal_form or gen.d.platform.placed:
-        return None
+        return None, None
     dec = Decomposition(gen, q)
-    if not dec.complete or not dec.dyads:
-        return None
+    if not dec.dyads or len(dec.joints) != len(gen.gjoints):
+        return None, None
     a = gen.assembler
-    return dec.function(np.asarray(a.x_ref, float), np.asarray(a.q_ref, float), np.asarray(a.defaults, float))
+    ref = (np.asarray(a.x_ref, float), np.asarray(a.q_ref, float), np.asarray(a.defaults, float))
+    if dec.complete:
+        return dec.function(*ref), None
+    return None, dec.seed(*ref)
 
 
 __all__ = ["Decomposition", "graph_closed_form"]

@@ -148,3 +148,61 @@ def test_slider_crank_out_of_reach_and_other_assembly():
     assert not np.any(closed["status"].ravel() == code_of(Status.SOLVED))
     got, ref = cn.batch_forward_kinematics(m, q, guess=other), _newton(m, q, other)
     assert got.statuses == ref.statuses
+
+
+TRIAD = {  # an RRR dyad (coupler and rocker) placed by the crank, then a triad (a class III group)
+    "name": "dyad_then_triad",
+    "points": {
+        "G0": ["0 mm", "0 mm"],
+        "X": ["10 mm", "0 mm"],
+        "G1": ["40 mm", "0 mm"],
+        "M": ["30 mm", "25 mm"],
+        "A": ["20 mm", "50 mm"],
+        "B": ["45 mm", "55 mm"],
+        "C": ["35 mm", "70 mm"],
+        "G2": ["70 mm", "40 mm"],
+        "G3": ["0 mm", "75 mm"],
+    },
+    "bodies": {
+        "ground": ["G0", "G1", "G2", "G3"],
+        "crank": ["G0", "X"],
+        "coupler": ["X", "M"],
+        "rocker": ["G1", "M"],
+        "l1": ["M", "A"],
+        "tri": ["A", "B", "C"],
+        "l2": ["G2", "B"],
+        "l3": ["G3", "C"],
+    },
+    "joints": [
+        {"type": "R", "between": ["ground", "crank"], "at": "G0", "actuated": "theta"},
+        {"type": "R", "between": ["crank", "coupler"], "at": "X"},
+        {"type": "R", "between": ["ground", "rocker"], "at": "G1", "coordinates": ["psi"]},
+        {"type": "R", "between": ["coupler", "rocker"], "at": "M"},
+        {"type": "R", "between": ["rocker", "l1"], "at": "M"},
+        {"type": "R", "between": ["l1", "tri"], "at": "A"},
+        {"type": "R", "between": ["ground", "l2"], "at": "G2"},
+        {"type": "R", "between": ["l2", "tri"], "at": "B"},
+        {"type": "R", "between": ["ground", "l3"], "at": "G3"},
+        {"type": "R", "between": ["l3", "tri"], "at": "C"},
+    ],
+    "platform": {"planar": True, "task": ["psi"]},
+}
+
+
+def test_a_triad_after_a_dyad_is_left_to_newton():
+    """A triad (a ternary body held by three links: no dyad places it) after an RRR dyad: no closed
+    form of the whole, but a seed -- the dyad's coordinates in closed form (equal to Newton's
+    solution to 1e-12), the triad's from the guess, its links keeping their turn -- from which
+    Newton solves every pose of +-20 deg, equal to Newton from home (1e-10)."""
+    m = _model(TRIAD)
+    c = m.closure
+    assert c.fk_closed is None and c.fk_seed is not None
+    q = np.deg2rad(np.arange(-20.0, 21.0, 5.0))[:, None]
+    ref = _newton(m, q, np.tile(m.x_home, (len(q), 1)))
+    got = cn.batch_forward_kinematics(m, q)
+    assert ref.ok.all() and got.ok.all()
+    np.testing.assert_allclose(got.x, ref.x, rtol=0, atol=1e-10)
+    placed = [list(c.x_names).index(n) for n in ("J1", "J2", "psi")]  # crank, coupler, rocker
+    for qi, xi in zip(q, ref.x):
+        seed = np.asarray(c.fk_seed(qi, m.x_home, m.p)).ravel()
+        np.testing.assert_allclose(seed[placed], xi[placed], rtol=0, atol=1e-12)
