@@ -78,6 +78,8 @@ class GraphGenerator(ClosureBuilder):
         self.actuated_coords: set[str] = set()
         self.info: GraphInfo | None = None
         self.assembler: Assembler | None = None
+        #: what ``describe`` says of the closed-form FK by dyads (:mod:`.graph_dyads`), if any
+        self.closed_form_summary: str | None = None
         #: an expanded legs file: each leg's environment and rotation (id of the leg -> (env, turn))
         self._frames: dict[int, tuple[dict, ca.SX]] = {}
 

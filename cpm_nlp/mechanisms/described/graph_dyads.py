@@ -433,9 +433,20 @@ def graph_closed_form(gen: Any, q: ca.SX) -> tuple[ca.Function | None, ca.Functi
         return None, None
     a = gen.assembler
     ref = (np.asarray(a.x_ref, float), np.asarray(a.q_ref, float), np.asarray(a.defaults, float))
+    dyads = ", ".join(f"{dy.kind} ({', '.join(dy.bodies)})" for dy in dec.dyads)
     if dec.complete:
-        return dec.function(*ref), None
-    return None, dec.seed(*ref)
+        fn = dec.function(*ref)
+        if fn is not None:
+            gen.closed_form_summary = f"forward kinematics in closed form: {len(dec.dyads)} dyad(s), {dyads}"
+        return fn, None
+    seed = dec.seed(*ref)
+    if seed is not None:
+        rest = [b.name for b in gen.d.bodies if b.name not in dec.placed]
+        gen.closed_form_summary = (
+            f"forward kinematics partly in closed form: {len(dec.dyads)} dyad(s), {dyads}; "
+            f"Newton places {', '.join(rest)}"
+        )
+    return None, seed
 
 
 __all__ = ["Decomposition", "graph_closed_form"]

@@ -194,9 +194,14 @@ def test_a_triad_after_a_dyad_is_left_to_newton():
     form of the whole, but a seed -- the dyad's coordinates in closed form (equal to Newton's
     solution to 1e-12), the triad's from the guess, its links keeping their turn -- from which
     Newton solves every pose of +-20 deg, equal to Newton from home (1e-10)."""
+    from cpm_nlp.mechanisms.described.read import description_from_dict
+    from cpm_nlp.mechanisms.described.summary import summary_text
+
     m = _model(TRIAD)
     c = m.closure
     assert c.fk_closed is None and c.fk_seed is not None
+    text = summary_text(description_from_dict(TRIAD), None, "triad")
+    assert "partly in closed form: 1 dyad(s), RRR (coupler, rocker); Newton places l1, tri, l2, l3" in text
     q = np.deg2rad(np.arange(-20.0, 21.0, 5.0))[:, None]
     ref = _newton(m, q, np.tile(m.x_home, (len(q), 1)))
     got = cn.batch_forward_kinematics(m, q)

@@ -5,9 +5,12 @@ own simulation of the same leg (an independent program)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import casadi as ca
 import numpy as np
 import pytest
+import yaml
 
 import cpm_nlp as cn
 from cpm_nlp.core.batch import _finish, evaluate
@@ -17,6 +20,7 @@ from cpm_nlp.core.result import Status
 from tests.conftest import central_difference
 
 NEWTON = cn.SolverConfig("newton")
+JANSEN_FILE = Path(__file__).resolve().parents[3] / "problems" / "mechanisms" / "jansen.yaml"
 CYCLE = np.deg2rad(np.arange(1, 361, dtype=float))[:, None]  # pylinkage's steps: 1 deg .. 360 deg
 
 
@@ -44,12 +48,19 @@ def _foot(model, res):
 
 def test_jansen_decomposes_into_three_rrr_dyads(jansen):
     """The leg's graph is placed by three RRR dyads (Y with the upper triangle, W, E with the foot):
-    the closed form exists and reproduces the file's reference configuration."""
+    the closed form exists, reproduces the file's reference configuration, and ``describe`` names
+    the dyads."""
     c = jansen.closure
     assert c.fk_closed is not None and c.fk_closed.name_in() == ["q", "x0", "p"]
     x, disc, side = (np.asarray(v).ravel() for v in c.fk_closed(jansen.q_home, jansen.x_home, jansen.p))
     np.testing.assert_allclose(x, jansen.x_home, rtol=0, atol=1e-14)
     assert disc[0] > 0 and side[0] > 0
+    from cpm_nlp.mechanisms.described.read import description_from_dict
+    from cpm_nlp.mechanisms.described.summary import summary_text
+
+    text = summary_text(description_from_dict(yaml.safe_load(JANSEN_FILE.read_text())), None, "jansen.yaml")
+    dyads = "RRR (j_bar, upper), RRR (k_bar, c_bar), RRR (f_bar, foot)"
+    assert f"forward kinematics in closed form: 3 dyad(s), {dyads}" in text
 
 
 def test_cycle_closed_form_equals_newton(jansen):
