@@ -26,7 +26,8 @@ reference, with the parameters' defaults, as the graph's branch indicators are s
 each dyad's side at the guess x0 times its sign: positive where x0 is on the assembly taken) let the
 FK kernel (:func:`cpm_nlp.core.kernels.fk_kernel`) leave any other pose to Newton.  The pose
 coordinates follow from the bodies' poses: a tree R joint's value is its home plus the turn between
-its bodies (the turn nearest the guess x0, so a crank that has turned by whole turns stays there), a
+its bodies, each body's turn the one nearest its turn at the guess x0 (as Newton from x0 finds it),
+a body driven by an actuated R joint turning with it exactly (a crank keeps its whole turns), a
 tree P joint's the slide between its points, the platform's coordinates by their rows (linear in
 them).  A graph that decomposes only in part (a class III group after some dyads) gets a seed
 instead (:meth:`Decomposition.seed`): the dyads' closed form places the bodies it can, and Newton,
@@ -311,30 +312,56 @@ class Decomposition:
         self.dyads.append(dyad)
 
     # -- the pose coordinates ---------------------------------------------------------------------
+    def _turns(self, x0: ca.SX) -> dict[str, ca.SX]:
+        """Each body's turn from the drawing, a whole number of turns chosen: a body an actuated R
+        joint places turns with it exactly (a crank keeps its angle, turns and all); any other
+        placed body takes the turn nearest its turn at x0 (as Newton from x0 would), a body left
+        unplaced its turn at x0."""
+        gen = self.gen
+        at_x0 = {b: ca.substitute(ca.SX(gen.angle[b]), gen.x, x0) for b in gen.angle}
+        turns = {gen.ground: ca.SX(0)}
+        grown = True
+        while grown:  # parents first, down the spanning tree
+            grown = False
+            for child, link in gen.parent.items():
+                if child in turns or link is None or link[0] not in turns:
+                    continue
+                parent, g = link
+                if child not in self.placed:
+                    turns[child] = at_x0[child]
+                elif g.drive is not None and g.type == "planar_R":
+                    turns[child] = turns[parent] + (g.drive if child == g.b else -g.drive)
+                else:
+                    c, s, _t = self.placed[child]
+                    turns[child] = at_x0[child] + _wrap(ca.atan2(s, c) - at_x0[child])
+                grown = True
+        return turns
+
     def _coordinates(self, x0: ca.SX) -> ca.SX | None:
-        """The pose coordinates from the bodies' poses (None: a coordinate it cannot give); a
-        partial decomposition keeps x0's for the joints of the bodies it did not place."""
+        """The pose coordinates from the bodies' poses and turns (:meth:`_turns`) (None: a
+        coordinate it cannot give); a partial decomposition keeps x0's where the bodies are not placed."""
         gen = self.gen
         where = {n: k for k, n in enumerate(gen.x_names)}
         x = [None] * len(gen.x_names)
+        turns = self._turns(x0)
         for g in self.joints:
             if not g.tree or g.type == "distance":
                 continue
-            if g.a not in self.placed or g.b not in self.placed:
-                x[where[g.names[0]]] = self._kept(g, x0, where[g.names[0]])
-                continue
             k = where[g.names[0]]
             home = g.homes[0]
+            if g.type == "planar_R":  # its value moves b's turn from a's (graph.poses)
+                x[k] = home + g.drive if g.drive is not None else home + turns[g.b] - turns[g.a]
+                continue
+            if g.a not in self.placed or g.b not in self.placed:
+                x[k] = x0[k]
+                continue
             if g.drive is not None:
                 x[k] = home + g.drive
                 continue
             Pa, Pb = self.placed[g.a], self.placed[g.b]
-            if g.type == "planar_R":
-                turn = ca.atan2(Pa[0] * Pb[1] - Pa[1] * Pb[0], Pa[0] * Pb[0] + Pa[1] * Pb[1])
-                x[k] = x0[k] + _wrap(home + turn - x0[k])
-            else:  # b's point pb onto a's pa, moved by v along the axis as a carries it
-                offset = _world(Pb, g.pb) - _world(Pa, g.pa)
-                x[k] = home + ca.dot(_rot(Pa, g.axis[:2]), offset)
+            # b's point pb onto a's pa, moved by v along the axis as a carries it
+            offset = _world(Pb, g.pb) - _world(Pa, g.pa)
+            x[k] = home + ca.dot(_rot(Pa, g.axis[:2]), offset)
         rest = [k for k in range(len(x)) if x[k] is None]
         if rest and not self._platform(x, x0, rest):
             return None
@@ -364,16 +391,6 @@ class Decomposition:
         for i, k in enumerate(rest):
             x[k] = z[i]
         return True
-
-    def _kept(self, g: Any, x0: ca.SX, k: int) -> ca.SX:
-        """A partial decomposition's guess for a tree joint it does not place: the unplaced body keeps
-        its turn at x0 where the joint's other body is placed (its turn taken up by the joint), else x0's."""
-        if g.type != "planar_R" or (g.a in self.placed) == (g.b in self.placed):
-            return x0[k]
-        body = g.a if g.a in self.placed else g.b
-        c, s, _t = self.placed[body]
-        moved = _wrap(ca.atan2(s, c) - ca.substitute(self.gen.angle[body], self.gen.x, x0))
-        return x0[k] + (moved if body == g.b else -moved)  # turn = θ_b - θ_a
 
     def function(self, x_ref: np.ndarray, q_ref: np.ndarray, p_ref: np.ndarray) -> ca.Function | None:
         """``fk_closed(q, x0, p) -> (x, disc, side)``, each dyad's sign that of the reference
