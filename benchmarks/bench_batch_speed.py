@@ -25,6 +25,11 @@ Measurements
                       circle-circle intersection alone (no check), CPU µs per pose of the
                       compiled C (1 thread), interleaved; the share the closed form answers; and
                       the whole batch call per pose (target <= 0.1 µs, item 5)
+  jansen_*            Jansen's leg (problems/mechanisms/jansen.yaml) over a full turn: its FK kernel
+                      now (three closed-form dyads first, every check, Newton where they do not
+                      settle) against the Newton FK alone on the same poses from a guess near each
+                      (so that Newton converges), CPU µs per pose of the compiled C (1 thread),
+                      interleaved; and the whole batch call per pose
   single_fk_function  one call of cn.functions(model).fk on numpy arrays (target <= 10 µs), and
                       on DMs (CasADi's own call, the path every call took before)
 """
@@ -181,7 +186,8 @@ def bench_fivebar(n: int, rounds: int) -> dict:
         # the circle-circle intersection alone (this model's numbers built in, no checks): what
         # pylinkage's dyad computes
         q_sym = ca.SX.sym("q", c.nq)
-        bare = ca.Function("five_bar_fk_closed_bare", [q_sym], list(c.fk_closed(q_sym, model.p)), ["q"], ["x", "disc"])
+        closed = list(c.fk_closed(q_sym, model.x_home, model.p))[:2]
+        bare = ca.Function("five_bar_fk_closed_bare", [q_sym], closed, ["q"], ["x", "disc"])
         source = generate_source(bare, bare.name()) + batch_loop_source(bare, bare.name())
         bare_loop = NativeLoop(build_library(source, bare.name()), bare.name(), bare)
         calls["closed_form_alone"] = lambda: evaluate(bare_loop, [q], 1)
@@ -195,6 +201,35 @@ def bench_fivebar(n: int, rounds: int) -> dict:
         one_thread = lambda: cn.batch_forward_kinematics(model, q, backend="compiled", threads=1)  # noqa: E731
         one_thread()
         out["fivebar_batch_us_per_pose"] = cpu_per_item(one_thread, n, rounds)
+    out["load"] = load()
+    return out
+
+
+def bench_jansen(n: int, rounds: int) -> dict:
+    model = cn.build_model("jansen")
+    c = model.closure
+    q = (np.arange(1, n + 1) * 2 * np.pi / n)[:, None]
+    out: dict = {"poses": n, "poses_are": "crank angles over one turn"}
+    if not compiler_available():
+        return out
+    res = cn.batch_forward_kinematics(model, q, backend="compiled", threads=1)
+    out["statuses"] = res.counts()
+    guess = res.x + np.random.default_rng(0).uniform(-0.01, 0.01, res.x.shape)
+    calls = {}
+    for tag, kern in {"fk": fk_kernel(c, NEWTON), "newton_alone": _newton_fk_kernel(c, NEWTON, "jansen_fk_nw")}.items():
+        fn = NativeLoop(build_library(_source(c, kern), kern.name), kern.name, compiled_function(c, kern))
+        x0 = np.tile(model.x_home, (n, 1)) if tag == "fk" else guess
+        args = [q, x0, *shared_values(kern, model, NEWTON.tolerance)]
+        calls[tag] = lambda fn=fn, args=args: evaluate(fn, args, 1)
+    best = dict.fromkeys(calls, float("inf"))
+    for _ in range(rounds):
+        for tag, call in calls.items():
+            best[tag] = min(best[tag], cpu_per_item(call, n, 1))
+    for tag, value in best.items():
+        out[f"jansen_kernel_{tag}_us_per_pose"] = value
+    out["jansen_closed_speedup_vs_newton"] = best["newton_alone"] / best["fk"]
+    one_thread = lambda: cn.batch_forward_kinematics(model, q, backend="compiled", threads=1)  # noqa: E731
+    out["jansen_batch_us_per_pose"] = cpu_per_item(one_thread, n, rounds)
     out["load"] = load()
     return out
 
@@ -244,6 +279,7 @@ def main(argv: list[str] | None = None) -> int:
         results["kernel"] = bench_kernel(model, n_kernel, args.rounds)
         results["batch"] = bench_batch(model, n_batch, args.rounds)
     results["fivebar"] = bench_fivebar(n_five, args.rounds)
+    results["jansen"] = bench_jansen(360 if args.quick else 36_000, args.rounds)
     results["single"] = bench_single(model, n_single)
     flat = {k: v for part in results.values() for k, v in part.items()}
     results["targets"] = {

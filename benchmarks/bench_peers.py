@@ -317,6 +317,81 @@ def pylinkage_batch(model):
     return batch, HAS_NUMBA
 
 
+class PylinkageJansen:
+    """Jansen's leg (problems/mechanisms/jansen.yaml) in pylinkage: the frame pivot, a ``Crank`` and
+    five ``RRRDyad`` (Y, D, W, E, F), each hinted at the file's reference configuration; pylinkage's
+    own simulation (``Linkage.step``, one crank step per pose, each dyad's root nearest the step
+    before) over the whole turn.  The poses are the crank angles 1, 2, ..., 360 deg (k * 360/n)."""
+
+    def __init__(self, pl, model, n: int):
+        P = model.parameters
+        a, b, c, d, e, f, g, h, i, j, k, l, m = (P[x] for x in "abcdefghijklm")
+        pts = _jansen_hints(model)
+        self.pl, self.n = pl, n
+        O, Z = pl.Ground(0.0, 0.0, name="O"), pl.Ground(-a, -l, name="Z")
+        cr = pl.Crank(O, m, angular_velocity=2 * math.pi / n, initial_angle=0.0, name="crank")
+        Y = pl.RRRDyad(cr.output, Z, j, b, x=pts["Y"][0], y=pts["Y"][1], name="Y")
+        D = pl.RRRDyad(Z, Y, d, e, x=pts["D"][0], y=pts["D"][1], name="D")
+        W = pl.RRRDyad(cr.output, Z, k, c, x=pts["W"][0], y=pts["W"][1], name="W")
+        E = pl.RRRDyad(D, W, f, g, x=pts["E"][0], y=pts["E"][1], name="E")
+        F = pl.RRRDyad(W, E, i, h, x=pts["F"][0], y=pts["F"][1], name="F")
+        self.linkage = pl.Linkage([O, Z, cr, Y, D, W, E, F])
+        self.init = self.linkage.get_coords()
+
+    def cycle(self) -> tuple[np.ndarray, np.ndarray]:
+        self.linkage.set_coords(self.init)
+        feet = np.array([s[-1] for s in self.linkage.step(iterations=self.n, dt=1)], dtype=float)
+        return feet, ~np.isnan(feet).any(axis=1)
+
+
+def _jansen_hints(model) -> dict:
+    """The reference configuration's joints from the file's derived values (Yr, Dr, Wr, Er, Fr)."""
+    return {n: tuple(np.asarray(model.derived[f"{n}r"], dtype=float).ravel()[:2]) for n in "YDWEF"}
+
+
+def run_jansen(args, peers: dict) -> dict:
+    """Jansen's leg over a full crank turn: cpm_nlp's batch FK (closed-form dyads, every check)
+    against pylinkage's simulation of the same leg, the foot compared."""
+    model = cn.build_model("jansen", {})
+    n = args.jansen_n
+    qs = (np.arange(1, n + 1) * 2 * math.pi / n)[:, None]
+    names = list(model.closure.passive_names)
+    cols = [names.index("foot_x"), names.index("foot_y")]
+
+    def cpm_feet():
+        res = cn.batch_forward_kinematics(model, qs, cn.SolverConfig("newton"), backend="compiled", threads=1)
+        return np.asarray(res.passive[:, cols], dtype=float), np.asarray(res.ok, dtype=bool)
+
+    feet, ok = cpm_feet()
+    out: dict = {
+        "mechanism_file": "problems/mechanisms/jansen.yaml",
+        "parameters_SI": dict(model.parameters),
+        "poses": n,
+        "poses_are": "crank angles k * 360/n deg, k = 1..n (one turn)",
+        "cpm_nlp": {"solved": int(ok.sum()), **_cpm_timings(model, qs, args.single, args.repeat)},
+        "peers": {},
+    }
+    pl = peers.get("pylinkage")
+    if pl is None:
+        out["peers"]["pylinkage"] = {"skipped": "pylinkage is not installed"}
+        return out
+    leg = PylinkageJansen(pl, model, n)
+    pf, pok = leg.cycle()
+    agree = _agreement(feet, ok, pf, pok, ["foot_x", "foot_y"])
+    agree["output"] = "the foot F (foot_x, foot_y), m"
+    entry = {
+        "agreement": agree,
+        "single": _time(leg.cycle, args.repeat, n),
+        "batch": _time(leg.cycle, args.repeat, n),
+        "what": "Linkage.step over the turn (its own simulation: each dyad from the previous step's root); "
+        "single = batch = the same simulation (pylinkage has no per-pose solve of a multi-dyad leg here)",
+    }
+    entry["ratio_single"] = _ratio(entry["single"], out["cpm_nlp"]["single"])
+    entry["ratio_batch"] = _ratio(entry["batch"], out["cpm_nlp"]["batch"])
+    out["peers"]["pylinkage"] = entry
+    return out
+
+
 # ---------------------------------------------------------------- comparison
 
 
@@ -401,7 +476,8 @@ def run_mechanism(name: str, args, peers: dict) -> dict:
 
 def _print(name: str, res: dict) -> None:
     cpm = res["cpm_nlp"]
-    print(f"\n{name} ({res['poses']} poses, q_home +- {res['q_half_width_rad']} rad, seed {res['seed']})")
+    where = res.get("poses_are") or f"q_home +- {res['q_half_width_rad']} rad, seed {res['seed']}"
+    print(f"\n{name} ({res['poses']} poses, {where})")
     print(f"{'solver':28s} {'single CPU/wall us':>22s} {'batch CPU/wall us':>22s} {'load':>12s}  max|dx| m")
 
     def row(label, e, agree):
@@ -433,14 +509,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--half", type=float, default=0.25, help="half-width of the actuator box about home, rad")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--mechanisms", default="five_bar,delta")
+    ap.add_argument("--mechanisms", default="five_bar,delta,jansen")
+    ap.add_argument("--jansen-n", type=int, default=360, help="crank angles over Jansen's turn")
     ap.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "bench_peers.json")
     args = ap.parse_args(argv)
     args.single = max(1, min(args.single, args.n))
     peers = {"pinocchio": _peer("pinocchio", "pin (Pinocchio)"), "pylinkage": _peer("pylinkage", "pylinkage")}
     versions = {k: getattr(v, "__version__", "?") for k, v in peers.items() if v is not None}
     load_before = os.getloadavg()
-    results = {m: run_mechanism(m, args, peers) for m in args.mechanisms.split(",")}
+    results = {}
+    for m in args.mechanisms.split(","):
+        results[m] = run_jansen(args, peers) if m == "jansen" else run_mechanism(m, args, peers)
     out = {
         "issue": 23,
         "item": "7: a peer benchmark",

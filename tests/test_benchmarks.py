@@ -75,7 +75,7 @@ def _peers_bench():
     return bench
 
 
-_TINY = ["--n", "24", "--single", "4", "--repeat", "1"]
+_TINY = ["--n", "24", "--single", "4", "--repeat", "1", "--jansen-n", "36"]
 
 
 def _assert_agrees(entry: dict, n: int, tol: float) -> None:
@@ -101,7 +101,8 @@ def test_peer_benchmark_pinocchio(tmp_path, capsys):
 
 def test_peer_benchmark_pylinkage(tmp_path):
     """pylinkage's RRR dyad (objects and its solver kernels in one loop) gives cpm_nlp's five-bar
-    end effector within 1e-12 m; the Delta is skipped (pylinkage is planar)."""
+    end effector within 1e-12 m, and its simulation of Jansen's leg the foot over a turn (36 crank
+    angles) within 1e-12 m; the Delta is skipped (pylinkage is planar)."""
     pytest.importorskip("pylinkage")
     out = tmp_path / "bench_peers.json"
     assert _peers_bench().main([*_TINY, "--json", str(out)]) == 0
@@ -109,6 +110,7 @@ def test_peer_benchmark_pylinkage(tmp_path):
     entry = data["mechanisms"]["five_bar"]["peers"]["pylinkage"]
     _assert_agrees(entry, 24, 1e-12)
     _assert_agrees({"agreement": entry["agreement_batch"]}, 24, 1e-12)
+    _assert_agrees(data["mechanisms"]["jansen"]["peers"]["pylinkage"], 36, 1e-12)
     assert "planar" in data["mechanisms"]["delta"]["peers"]["pylinkage"]["skipped"]
 
 

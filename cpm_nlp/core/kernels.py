@@ -402,13 +402,16 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
     """``<name>_fk``: the FK of every path in cpm_nlp (single Newton solves, batches, the
     embedding Functions, exported code).
 
-    A closure with a closed-form FK (``fk_closed``: a planar RRR dyad): first
+    A closure with a closed-form FK (``fk_closed``: planar dyads, :mod:`cpm_nlp.mechanisms.described.dyads`
+    and :mod:`~cpm_nlp.mechanisms.described.graph_dyads`): first
     :func:`closed_fk_kernel`; a pose it does not settle as ``solved`` goes to the Newton FK
     below from x0 (a CasADi Switch), so every status other than ``solved`` is Newton's,
     exactly as without the closed form; ``path`` 2 ("closed") says it answered.  Others: the
     Newton FK (:func:`_newton_fk_kernel`).
     """
     c = closure
+    if c.fk_closed is None and c.fk_seed is not None:
+        return _seeded_fk_kernel(c, config)
     if c.fk_closed is None:
         return _newton_fk_kernel(c, config, f"{c.name}_fk")
     opts = newton_options(config)
@@ -423,15 +426,34 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
     return c.solvers.memo(key, build)
 
 
+def _seeded_fk_kernel(closure: LoopClosure, config: SolverConfig | None) -> Kernel:
+    """The Newton FK from the guess of a partial closed form (``fk_seed``: the dyads it can place,
+    in closed form; the rest from x0): Newton moves only what the dyads leave, its status stands."""
+    c = closure
+    opts = newton_options(config)
+
+    def build() -> Kernel:
+        newton = _newton_fk_kernel(c, config, f"{c.name}_fk_newton")
+        fn = newton.function
+        ins = [ca.MX.sym(fn.name_in(k), fn.sparsity_in(k)) for k in range(fn.n_in())]
+        q, x0, p = ins[0], ins[1], ins[2]  # (q, x0, p, ...): SHARED_INPUTS start with p
+        outs = fn(q, c.fk_seed(q, x0, p), *ins[2:])
+        f = ca.Function(f"{c.name}_fk", ins, list(outs), fn.name_in(), fn.name_out())
+        return Kernel(f, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
+
+    key = ("fk_kernel_seeded", _options_key(opts))
+    return c.solvers.memo(key, build)
+
+
 def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
     """``<name>_fk_closed: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) -> (x, passive,
     residual, branch_margin, round_trip_error, cond1, limit_margin[, path], status)``: the pose from
-    the closure's closed-form FK (``fk_closed``; x0 only picks the side), one flat SX graph, with the same
-    inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
+    the closure's closed-form FK (``fk_closed``; x0 picks the side and the turn of an angle), one flat
+    SX graph, with the same inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
 
-    ``status`` is ``solved`` only where the closed form assembles the pose (disc >= 0, finite),
-    the guess x0 lies on the pose's side of det Φ_x = 0 (else the root Newton seeks from x0 is
-    another assembly: Newton answers), and every check passes on (x, q): residual of Φ, branch,
+    ``status`` is ``solved`` only where the closed form assembles the pose (every dyad's disc >= 0,
+    finite), the guess x0 lies on each dyad's side of the pose (side > 0; else the root Newton seeks
+    from x0 is another assembly: Newton answers), and every check passes on (x, q): residual of Φ, branch,
     IK round trip, limits, and the conditioning with a margin of 2 on the singularity threshold
     (``cond1`` the certified bound of :func:`cond1_bound` where there is a closed-form IK, else
     the exact one).  Any other status means "not settled here": Newton decides.
@@ -451,15 +473,14 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
             jac_home = ca.SX.sym("J_home", c.nq, c.nq)
             b = ca.SX.sym("Phi_x_home_inv", c.nx, c.nx)
             ins, shared_names = ins + [jac_home, b], REDUCED_SHARED_INPUTS
-        x, disc = c.fk_closed(q, p)
+        x, disc, side = c.fk_closed(q, x0, p)
         chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
         singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))  # margin 2 over the screen
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
-        # the guess and the pose on the same side of det Φ_x = 0 (a dyad: of the line through the
-        # circles' centres, which separates its two assemblies): the root Newton is after from x0,
-        # so a search from guesses in another assembly (analysis.assembly) still finds that one
-        same_side = ca.det(c.phi_x(x0, q, p)) * ca.det(c.phi_x(x, q, p)) > 0
-        assembled = ca.logic_and(ca.logic_and(disc >= 0, all_finite(x)), same_side)
+        # every dyad assembles (disc >= 0) and the guess lies on the side of each dyad's two
+        # assemblies that the closed form takes (side > 0): the root Newton is after from x0, so a
+        # search from guesses in another assembly (analysis.assembly) still finds that one
+        assembled = ca.logic_and(ca.logic_and(disc >= 0, all_finite(x)), side > 0)
         status = _first(ca.logic_not(assembled), Status.NOT_CONVERGED, status)
         names = ["x", "passive", *_STATUS_OUTPUTS]
         outs = [x] + [ca.densify(chk[n]) for n in names[1:-1]]

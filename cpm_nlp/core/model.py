@@ -92,10 +92,16 @@ class LoopClosure:
         matrix (3 x 3) and position (3); assembly modes are told apart on it
         (not on angles, which alias).
     fk_closed:
-        optional closed-form FK of the whole closure, ``("fk_closed", [q, p], [x, disc])``
-        (a planar RRR dyad: :mod:`cpm_nlp.mechanisms.described.dyads`); ``disc < 0`` where it
-        cannot assemble the pose.  The FK kernel tries it first and keeps it only where the pose
-        checks pass (:func:`cpm_nlp.core.kernels.fk_kernel`).
+        optional closed-form FK of the whole closure, ``("fk_closed", [q, x0, p], [x, disc, side])``
+        (planar dyads: :mod:`cpm_nlp.mechanisms.described.dyads`, ``graph_dyads``); ``disc < 0``
+        where it cannot assemble the pose, ``side <= 0`` where the guess x0 lies in another assembly
+        than the one it takes (x0 also picks the turn of an angle).  The FK kernel tries it first
+        and keeps it only where the pose checks pass (:func:`cpm_nlp.core.kernels.fk_kernel`).
+    fk_seed:
+        optional ``("fk_seed", [q, x0, p], [x0_seed])``: where only part of the closure is solved
+        in closed form (some dyads before a group they cannot place), the guess Newton starts from
+        -- those coordinates in closed form, the others x0's (x0 itself where a dyad does not
+        assemble or x0 lies in another assembly); Newton's status stands.
     """
 
     def __init__(
@@ -120,9 +126,11 @@ class LoopClosure:
         frame: ca.Function | None = None,
         loops: ca.Function | None = None,
         fk_closed: ca.Function | None = None,
+        fk_seed: ca.Function | None = None,
     ) -> None:
         self.name = name
         self.fk_closed = fk_closed
+        self.fk_seed = fk_seed
         #: every closure equation (m >= nx rows), when phi holds a square combination of them (an
         #: overconstrained linkage's normal equations): a pose is checked against these too, and the
         #: closure's conditioning is that of their Jacobian (:attr:`cond_matrix`); None: phi's own

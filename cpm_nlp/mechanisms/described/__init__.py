@@ -160,6 +160,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         frame=fns["frame"],
         loops=fns.get("loops"),
         fk_closed=fns.get("fk_closed"),
+        fk_seed=fns.get("fk_seed"),
     )
     if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
         check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))

@@ -12,8 +12,13 @@ an RRR dyad):
 
 with the branch sign s = sign(e⊥·(x - o1)) at the reference configuration (the file's assembly
 mode), an expression of the parameters.  h² < 0: the circles do not meet (the pose is out of
-reach); the kernel (:func:`cpm_nlp.core.kernels.fk_kernel`) then leaves the pose to Newton, whose
+reach); a guess x0 with s e⊥·(x0 - o1) <= 0 lies in the other assembly (Newton from it seeks that
+one).  The kernel (:func:`cpm_nlp.core.kernels.fk_kernel`) then leaves the pose to Newton, whose
 status it reports, so the closed form never answers with a number for a pose it cannot assemble.
+
+An actuated P between two point joints (an R-P-R leg: |B - c| = r + s) is a circle of radius
+r + s(q): the same intersection.  Files of bodies and joints have their own decomposition into
+dyads (RRR, RRP, RPR; :mod:`.graph_dyads`).
 """
 
 from __future__ import annotations
@@ -24,11 +29,12 @@ from .builder import ClosureBuilder
 
 
 def closed_form_fk(gen: ClosureBuilder, q: ca.SX, circles: list[tuple[int, ca.SX, ca.SX, ca.SX]]) -> ca.Function | None:
-    """``fk_closed(q, p) -> (x, disc)`` of a two-circle closure (None: Φ is not one).
+    """``fk_closed(q, x0, p) -> (x, disc, side)`` of a two-circle closure (None: Φ is not one).
 
     circles: each planar circle row of Φ as (row, c, B, r): the row's position, the centre c(q, p),
-    the platform point B(x, p) and the radius r(p) (planar: the first two components).  disc: h²,
-    negative where the circles do not meet."""
+    the platform point B(x, p) and the radius r(q, p) (planar: the first two components).  disc:
+    h², negative where the circles do not meet; side: s e⊥·(x0 - o1), positive where the guess x0
+    is on the side of the centres' line of the file's assembly."""
     x = gen.x
     if not gen.d.platform.planar or x.numel() != 2 or len(gen.rows) != 2 or len(circles) != 2:
         return None
@@ -37,7 +43,7 @@ def closed_form_fk(gen: ClosureBuilder, q: ca.SX, circles: list[tuple[int, ca.SX
     centres = []
     for _row, c, B, r in circles:
         d = B[:2] - x  # B = x + d with d constant in x: the platform does not turn
-        if ca.depends_on(d, x) or ca.depends_on(c, x) or ca.depends_on(r, ca.vertcat(x, q)):
+        if ca.depends_on(d, x) or ca.depends_on(c, x) or ca.depends_on(r, x):
             return None
         centres.append((c[:2] - d, r))
     (o1, r1), (o2, r2) = centres
@@ -51,7 +57,10 @@ def closed_form_fk(gen: ClosureBuilder, q: ca.SX, circles: list[tuple[int, ca.SX
     home = ca.Function("dyad_home_side", [q, x, gen.p], [ca.dot(perp, x - o1)], ["q", "x", "p"], ["side"])
     s = ca.sign(home(q_home, gen.x_home, gen.p))
     pose = o1 + a * e + s * ca.sqrt(ca.fmax(h2, 0)) * perp
-    return ca.Function("fk_closed", [q, gen.p], [ca.cse(pose), h2], ["q", "p"], ["x", "disc"])
+    x0 = ca.SX.sym("x0", x.numel())
+    side = s * ca.dot(perp, x0 - o1)
+    outs = ca.cse([pose, h2, side])
+    return ca.Function("fk_closed", [q, x0, gen.p], outs, ["q", "x0", "p"], ["x", "disc", "side"])
 
 
 __all__ = ["closed_form_fk"]

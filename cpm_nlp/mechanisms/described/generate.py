@@ -294,6 +294,8 @@ class Generator(ClosureBuilder):
         # squared (polynomial in the pose): Newton from far starts converges far more often than on
         # |v| - length; near a solution it is (length / r)(|v| - length)
         self.rows.append(((ca.dot(v, v) - (r + slide.value) ** 2) / (2 * r), f"leg {leg.name}: length"))
+        if self.d.platform.planar:  # a circle |B - c| = r + s about the passive R (.dyads)
+            self.circles.append((len(self.rows) - 1, link.c, v + link.c, r + slide.value))
         self.indicator((r + slide.value) / r, leg, slide, "the leg's length over its reference length")
         self.indicator(ca.dot(u, v) / (r * ca.norm_2(v)), leg, elim, COSINE)
         if elim.type != "R":

@@ -46,6 +46,7 @@ from .builder import ClosureBuilder, Reported, family
 from .drawing import graph_drawing_points
 from .emit import closure_functions
 from .expand import InLeg
+from .graph_dyads import graph_closed_form
 from .graph_rows import Cut, axis_normals, cut_rows, cut_values
 from .graph_tree import GraphJoint, spanning_tree
 from .mobility import GraphInfo
@@ -77,6 +78,8 @@ class GraphGenerator(ClosureBuilder):
         self.actuated_coords: set[str] = set()
         self.info: GraphInfo | None = None
         self.assembler: Assembler | None = None
+        #: what ``describe`` says of the closed-form FK by dyads (:mod:`.graph_dyads`), if any
+        self.closed_form_summary: str | None = None
         #: an expanded legs file: each leg's environment and rotation (id of the leg -> (env, turn))
         self._frames: dict[int, tuple[dict, ca.SX]] = {}
 
@@ -259,6 +262,7 @@ class GraphGenerator(ClosureBuilder):
                 spec = Joint(g.type, home=j.home, actuated=j.actuated, gain=j.gain, limit=j.limit, range=j.range)
                 spec.path = j.path
                 actuated = self.actuator(spec, self.env)  # gain (q - q_home)
+                g.drive = actuated
             for n, ((kind, _axis), name) in enumerate(zip(motions, names)):
                 dim = "length" if kind == "P" else "angle"
                 home = self.scalar(j.home[n], j.path + ("home", n), self.env, dim) if n < len(j.home) else ca.SX(0)
@@ -270,6 +274,7 @@ class GraphGenerator(ClosureBuilder):
                 limit = None if actuated is not None else self.flexure_range(g, dim, home)  # type: ignore[arg-type]
                 self.extra.append((coord, sym, home, limit, j.path))
                 g.values.append(sym - home)
+                g.homes.append(home)
                 if actuated is not None:
                     self.actuation_rows.append((sym - home - actuated, f"actuator {j.actuated}: joint {g.name}", dim))
                     self.actuated_coords.add(name)
@@ -446,6 +451,7 @@ class GraphGenerator(ClosureBuilder):
         select_branch(self, added)
         self.check_task_count()
         fns = self.graph_functions(q)
+        fns["fk_closed"], fns["fk_seed"] = graph_closed_form(self, q)
         self.info = self.assembler.info
         return fns
 

@@ -34,6 +34,8 @@ class GraphJoint:
     names: tuple = ()
     loop: int = 0  # the loop it closes (cut joints), 1-based
     length: ca.SX | None = None
+    homes: list = field(default_factory=list)  # its coordinates' values in the drawing (tree joints)
+    drive: ca.SX | None = None  # an actuated joint's displacement from the drawing, gain (q - q_home)
 
     @property
     def name(self) -> str:

@@ -201,6 +201,8 @@ def graph_lines(gen: Any, model: Model | None, branch: bool = True) -> list[str]
     lines.append(_assembly_line(gen, model))
     if gen.branch and branch:
         lines.append("branch indicators: " + ", ".join(b[1] for b in gen.branch))
+    if gen.closed_form_summary and branch:
+        lines.append(gen.closed_form_summary)
     return lines
 
 

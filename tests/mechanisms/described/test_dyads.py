@@ -52,7 +52,7 @@ def test_five_bar_is_recognised_and_others_are_not():
     for name in ("delta", "pantograph"):
         assert cn.build_model(name).closure.fk_closed is None, name
     fn = cn.build_model("five_bar").closure.fk_closed
-    assert fn.name() == "fk_closed" and fn.name_in() == ["q", "p"] and fn.name_out() == ["x", "disc"]
+    assert fn.name() == "fk_closed" and fn.name_in() == ["q", "x0", "p"] and fn.name_out() == ["x", "disc", "side"]
 
 
 def test_closed_form_equals_newton_and_numpy(five_bar):
@@ -78,11 +78,11 @@ def test_branch_is_the_home_one(five_bar):
     indicators keep their home signs (the file's assembly mode), and the other intersection of
     the same circles is a different assembly (a wrong branch, not the answer)."""
     m, c = five_bar, five_bar.closure
-    x, disc = c.fk_closed(m.q_home, m.p)
+    x, disc, side = c.fk_closed(m.q_home, m.x_home, m.p)
     np.testing.assert_allclose(np.asarray(x).ravel(), m.x_home, rtol=0, atol=1e-15)
-    assert float(disc) > 0
+    assert float(disc) > 0 and float(side) > 0
     for qi in _poses(m, 50, seed=1):
-        xi = np.asarray(c.fk_closed(qi, m.p)[0]).ravel()
+        xi = np.asarray(c.fk_closed(qi, m.x_home, m.p)[0]).ravel()
         assert np.all(np.asarray(c.branch(xi, qi, m.p)) > 0)
         c1 = np.array([-0.05 + 0.1 * np.cos(qi[0]), 0.1 * np.sin(qi[0])])
         c2 = np.array([0.05 + 0.1 * np.cos(qi[1]), 0.1 * np.sin(qi[1])])
@@ -100,7 +100,7 @@ def test_out_of_reach_pose_keeps_newtons_status(five_bar):
     m = cn.build_model("five_bar", {"l2": "120 mm"})
     c = m.closure
     q = np.array([[np.pi, 0.0], [np.pi - 0.1, 0.1], [3.0, 0.3]])
-    assert all(float(c.fk_closed(qi, m.p)[1]) < 0 for qi in q)
+    assert all(float(c.fk_closed(qi, m.x_home, m.p)[1]) < 0 for qi in q)
     got, ref = cn.batch_forward_kinematics(m, q), _newton_only(m, q)
     assert got.statuses == ref.statuses == [Status.NOT_CONVERGED] * 3
     assert np.isnan(got.x).all() and all(got.path(i) == "full" for i in range(3))
@@ -119,13 +119,13 @@ def test_fk_against_ik_and_ad_jacobian(five_bar):
 
     m, c = five_bar, five_bar.closure
     q_sym = ca.SX.sym("q", c.nq)
-    dx_dq = ca.Function("dx_dq", [q_sym], [ca.jacobian(c.fk_closed(q_sym, m.p)[0], q_sym)], ["q"], ["J"])
+    dx_dq = ca.Function("dx_dq", [q_sym], [ca.jacobian(c.fk_closed(q_sym, m.x_home, m.p)[0], q_sym)], ["q"], ["J"])
     for qi in _poses(m, 20, seed=2):
-        xi = np.asarray(c.fk_closed(qi, m.p)[0]).ravel()
+        xi = np.asarray(c.fk_closed(qi, m.x_home, m.p)[0]).ravel()
         q_back = np.asarray(c.ik(xi[list(c.task_index)], m.p)[1]).ravel()
         np.testing.assert_allclose(q_back, qi, rtol=0, atol=1e-12)
         jac = np.asarray(dx_dq(qi))
-        fd = central_difference(lambda v: np.asarray(c.fk_closed(v, m.p)[0]).ravel(), qi, 1e-6)
+        fd = central_difference(lambda v: np.asarray(c.fk_closed(v, m.x_home, m.p)[0]).ravel(), qi, 1e-6)
         np.testing.assert_allclose(jac, fd, rtol=0, atol=1e-8)
         np.testing.assert_allclose(jac, np.asarray(c.jacobian(xi, qi, m.p)), rtol=0, atol=1e-12)
 
@@ -147,7 +147,7 @@ def test_a_guess_in_the_other_assembly_is_left_to_newton(five_bar):
     q = _poses(m, 30, seed=3)
     mirrors = []
     for qi in q:
-        xi = np.asarray(c.fk_closed(qi, m.p)[0]).ravel()
+        xi = np.asarray(c.fk_closed(qi, m.x_home, m.p)[0]).ravel()
         c1 = np.array([-0.05 + 0.1 * np.cos(qi[0]), 0.1 * np.sin(qi[0])])
         c2 = np.array([0.05 + 0.1 * np.cos(qi[1]), 0.1 * np.sin(qi[1])])
         e = (c2 - c1) / np.linalg.norm(c2 - c1)
@@ -161,3 +161,59 @@ def test_a_guess_in_the_other_assembly_is_left_to_newton(five_bar):
     assert all(got.path(i) != "closed" for i in range(len(got)))
     np.testing.assert_allclose(got.raw_joints[:, :2], ref.raw_joints[:, :2], rtol=0, atol=1e-12)
     np.testing.assert_allclose(got.raw_joints[:, :2], np.array(mirrors), rtol=0, atol=1e-12)
+
+
+RPR2 = {  # a planar 2-RPR point platform: each leg a passive R at the base, an actuated P, an R at P
+    "name": "rpr2_point",
+    "parameters": {"d": {"dimension": "length", "default": "100 mm"}, "h": {"dimension": "length", "default": "80 mm"}},
+    "platform": {
+        "planar": True,
+        "coordinates": {"x": "length", "y": "length"},
+        "position": ["x", "y"],
+        "rotation": [],
+        "task": ["x", "y"],
+        "home": {"y": "h"},
+    },
+    "legs": [
+        {
+            "name": name,
+            "joints": [
+                {"type": "planar_R", "at": [f"{sign}d/2", 0]},
+                {
+                    "type": "planar_P",
+                    "at": [f"{sign}d/2", 0],
+                    "axis": [axis, "h"],
+                    "actuated": s,
+                },
+                {"type": "planar_R", "at": [0, "h"]},
+            ],
+        }
+        for name, sign, axis, s in (("left", "-", "d/2", "s1"), ("right", "", "-d/2", "s2"))
+    ],
+}
+
+
+def test_rpr_legs_are_circles_of_the_actuated_length():
+    """An R-P-R leg (an actuated P between two point joints) is a circle of radius r + s about its
+    base joint: the 2-RPR point platform's FK is the two circles' intersection in closed form (its
+    kernel alone solves every pose), equal to the numpy derivation and to Newton near it."""
+    from cpm_nlp.mechanisms.described import from_dict
+
+    mech = from_dict(RPR2)
+    m = mech.model(mech.closure(), {}, {}, ())
+    c = m.closure
+    assert c.fk_closed is not None
+    q = m.q_home + np.random.default_rng(4).uniform(-0.01, 0.01, (60, 2))
+    kern = closed_fk_kernel(c, NEWTON)
+    out = dict(zip(kern.outputs, evaluate(kern.function, [q, m.x_home, *shared_values(kern, m, 1e-9)])))
+    assert np.all(out["status"].ravel() == code_of(Status.SOLVED))
+    got = cn.batch_forward_kinematics(m, q)
+    assert got.ok.all()
+    r0 = np.hypot(0.05, 0.08)  # the legs' length at home
+    r1, r2 = r0 + q[:, 0], r0 + q[:, 1]
+    x = (r1**2 - r2**2) / (2 * 0.1)  # circles about (-d/2, 0) and (d/2, 0), P above the base
+    np.testing.assert_allclose(got.x, np.stack([x, np.sqrt(r1**2 - (x + 0.05) ** 2)], axis=1), rtol=0, atol=1e-12)
+    kn = _newton_fk_kernel(c, NEWTON, "rpr2_fk_newton_reference")
+    guess = got.x + 1e-4
+    ref = dict(zip(kn.outputs, evaluate(kn.function, [q, guess, *shared_values(kn, m, NEWTON.tolerance)])))
+    np.testing.assert_allclose(got.x, np.asarray(ref["x"]).reshape(got.x.shape), rtol=0, atol=1e-12)
