@@ -15,7 +15,7 @@ Two rules, the same everywhere the CLI prints a quantity:
   largest magnitude of that dimension among the values of the result (``L``: the
   mechanism's scale, its largest length parameter; 1 m if it has none).  A
   value below that is rounding noise of the solve and is printed as ``0`` (never
-  ``-0``): ``psi 1.71766e-15 deg`` is ``0 rad``.  See :class:`Noise`.
+  ``-0``): ``psi 1.71766e-15 deg`` is ``0 deg``.  See :class:`Noise`.
 """
 
 from __future__ import annotations
@@ -56,8 +56,8 @@ def engineering(value: float, dimension: str | None, digits: int = DIGITS) -> st
         return str(value)
     if dimension in _PREFIXED:
         unit, prefixes = _PREFIXED[dimension]
-        if value == 0:
-            return f"0 {unit}"
+        if value == 0:  # an angle in the papers' unit, as its neighbours in a table
+            return "0 deg" if dimension == "angle" else f"0 {unit}"
         rounded = abs(float(f"{value:.{digits}g}"))  # 999.96 µm is 1 mm, not 1000 µm
         size, prefix = next(((f, p) for f, p in prefixes if rounded >= f), prefixes[-1])
         if dimension == "angle" and size >= 1e-3:  # down to 1 mrad: degrees, the papers' unit

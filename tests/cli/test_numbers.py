@@ -38,7 +38,7 @@ from tests.conftest import PROBLEMS
         (-6.012625722e-05, "angle", "-60.13 µrad"),  # below 1 mrad: µrad
         (3e-9, "angle", "3 nrad"),
         (0.0, "length", "0 m"),
-        (-0.0, "angle", "0 rad"),  # never -0
+        (-0.0, "angle", "0 deg"),  # never -0
         (-1e-30, "dimensionless", "-1e-30"),
     ],
 )
