@@ -83,6 +83,13 @@ def _fmt_list(value: list, dim: str | None, noise: Noise = NO_NOISE) -> str:
     return text
 
 
+#: solver names of results computed without an iterative solve
+_NOT_ITERATIVE = {
+    "closed_form": "closed form, no iterations",
+    "none": "no numerical solver (the formulas evaluated directly)",
+}
+
+
 def _solver_lines(s: Any) -> list[str]:
     """Which method answered and its iterations; then the solve's time and, apart, the time
     spent building what it ran (symbolic construction, compilation: once per process)."""
@@ -96,6 +103,8 @@ def _solver_lines(s: Any) -> list[str]:
         f"({REDUCED_STEPS} or {2 * REDUCED_STEPS} steps, not counted)",
         "full": f"{s.name}, full path: Newton on the loop closures ({counted})",
     }.get(getattr(s, "path", ""), f"{s.name}, {counted}")
+    if s.name in _NOT_ITERATIVE and not getattr(s, "path", ""):
+        what = _NOT_ITERATIVE[s.name]
     time = f"solve {_milliseconds(s.seconds)}"
     build = getattr(s, "build_seconds", 0.0)
     if build > 0.0005:

@@ -209,6 +209,8 @@ class BatchResult:
                 path=self.path(i),
             )
         passive = self.passive[i].copy() if self.model.closure.passive is not None else None
+        details = self.details(i)
+        details["iterations_counted"] = self.path(i) == "closed"  # a compiled kernel counts no steps
         return PoseSolution(
             status,
             self.x[i].copy(),
@@ -219,7 +221,7 @@ class BatchResult:
             per_pose,
             self.solver,
             "",
-            self.details(i),
+            details,
             self.path(i),
         )
 
@@ -518,7 +520,8 @@ def batch_forward_kinematics(
         used,
         nthreads,
         time.perf_counter() - t0,
-        "fast_newton",
+        # a closed form first, where the kernel says nothing of which answered (no "path" output)
+        "closed_form+fast_newton" if c.fk_closed is not None and "path" not in kern.outputs else "fast_newton",
     )
 
 

@@ -79,7 +79,7 @@ class SolverInfo:
     closed-form IK; "full": Newton on the loop closures), "" for the others."""
 
     name: str
-    iterations: int | None = 0
+    iterations: int | None = None  # not counted unless a kind says how many
     seconds: float = 0.0
     build_seconds: float = 0.0
     path: str = ""
