@@ -218,6 +218,7 @@ def bench_startup(repeats: int, before_checkout: str | None = None) -> dict:
         other = {"PYTHONPATH": str(Path(before_checkout).resolve())}
         runs["help_before"] = (STARTUP["help"][0], other)
         runs["solve_prs3_fk_before"] = (STARTUP["solve_prs3_fk"][0], other)
+        runs["plot_help_before"] = (STARTUP["plot_help"][0], other)
     for argv, extra in runs.values():  # warm-up: bytecode written, files in the page cache
         _child(argv, {**env, **extra})
     cpu: dict = {k: [] for k in runs}

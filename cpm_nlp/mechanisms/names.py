@@ -9,8 +9,6 @@ from :data:`ADDON_PLOTS` alone, and a plot module is imported only when its plot
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 #: built-in file mechanism -> "module:attribute" of its :class:`~cpm_nlp.core.mechanism.Addon`:
 #: what its file cannot say (the paper's own kinds, a dynamics model, checks over several
 #: parameters), added to the mechanism the file describes
@@ -29,7 +27,6 @@ ALIASES = {
 }
 
 
-@dataclass(frozen=True)
 class AddonPlot:
     """A plot type of a built-in mechanism's add-on, declared without importing it.
 
@@ -41,11 +38,21 @@ class AddonPlot:
     kinds, interactive: as :class:`~cpm_nlp.plot.plot_type.PlotType`'s fields.
     """
 
-    name: str
-    function: str
-    description: str
-    kinds: tuple[str, ...] = ()
-    interactive: bool = False
+    # a plain class, not a dataclass: every solve imports this table, and a dataclass costs
+    # 0.5 ms to create (issue 23, start-up)
+    __slots__ = ("name", "function", "description", "kinds", "interactive")
+
+    def __init__(
+        self, name: str, function: str, description: str, kinds: tuple[str, ...] = (), interactive: bool = False
+    ) -> None:
+        self.name = name
+        self.function = function
+        self.description = description
+        self.kinds = kinds
+        self.interactive = interactive
+
+    def __repr__(self) -> str:
+        return f"AddonPlot({self.name!r}, {self.function!r})"
 
 
 #: built-in mechanism (a key of :data:`ADDONS`) -> the plot types of its paper, drawn only for

@@ -156,9 +156,10 @@ def test_start_up_loads_only_what_the_command_needs():
     """`import cpm_nlp` and `cpm-nlp --help` load neither numpy, CasADi, YAML, the mechanisms
     nor a subcommand's module; a solve of a file with plain units loads neither pint, scipy,
     matplotlib, Dask nor pyarrow, and a single FK solve none of what it does not run: the
-    assembly-mode search, a graph file's generator and assembly, batches, the compiled backend, the plot layer, threadpoolctl (the
-    BLAS cap is set before numpy loads), the entry points of plugins, difflib (issues 15 and 23:
-    start-up time; benchmarks/bench_issue15.py measures it)."""
+    assembly-mode search, a graph file's generator and assembly, batches, the compiled
+    backend, the plot layer, threadpoolctl (the BLAS cap is set before numpy loads), the entry
+    points of plugins, difflib (issues 15 and 23: start-up time; benchmarks/bench_issue15.py
+    measures it)."""
     heavy = ("numpy", "casadi", "pint", "scipy", "matplotlib", "dask", "distributed", "pyarrow")
     ours = (
         "yaml",
