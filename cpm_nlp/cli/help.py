@@ -139,13 +139,14 @@ COMMANDS: dict[str, CommandHelp] = {
     "describe": CommandHelp(
         "list mechanisms and kinds; describe one, or a mechanism file",
         "Without NAME: list every mechanism and problem kind.  With a mechanism's name: its "
-        "parameters, coordinates, kinds and paper.  With a problem kind: its inputs, options and "
-        "outputs (for one mechanism with --mechanism).  With a mechanism file (.yaml): load it, "
-        "check it and describe it; --plot draws its graph of bodies and joints.",
+        "paper, parameters, limits, capabilities and hinges.  With a problem kind: its inputs with "
+        "their defaults and bounds, and the values it returns, for a mechanism (--mechanism).  "
+        "With a mechanism file (.yaml): load it, check it and describe it; --plot draws its graph "
+        "of bodies and joints.",
         (
             ("cpm-nlp describe", "every mechanism and problem kind"),
-            ("cpm-nlp describe prs3", "the 3-PRS stage: parameters, coordinates, kinds, paper"),
-            ("cpm-nlp describe forward_kinematics --mechanism prs3", "the inputs of a kind for the 3-PRS"),
+            ("cpm-nlp describe prs3", "the 3-PRS stage: paper, parameters, limits, hinges"),
+            ("cpm-nlp describe forward_kinematics --mechanism prs3", "the inputs and values of the FK for the 3-PRS"),
             (
                 "cpm-nlp describe problems/mechanisms/five_bar.yaml --plot five_bar_graph.png",
                 "check a mechanism file and draw its graph",
