@@ -12,7 +12,7 @@ import pytest
 
 import cpm_nlp as cn
 from cpm_nlp.core import pose_checks as pc
-from tests.conftest import PAPER_PRS3
+from tests.conftest import PAPER_PRS3, PROBLEMS
 
 
 def _reference(v: float, low: float, high: float) -> float:
@@ -49,11 +49,25 @@ def test_the_replayed_function_reduces_as_the_expression(v, low, high):
     assert float(replayed(v, low, high)) == pytest.approx(_reference(v, low, high), abs=1e-12)
 
 
-def test_the_pose_checks_are_the_same_function():
-    """The 3-PRS's pose checks built with the replayed reduction and with the expression:
+#: a forward kinematics file of each shipped mechanism with angles to reduce
+FK_FILES = [
+    "five_bar_forward_kinematics.yaml",
+    "delta_forward_kinematics.yaml",
+    "rrr3_forward_kinematics.yaml",
+    "pantograph_forward_kinematics.yaml",
+    "prc3_forward_kinematics.yaml",
+    "rpr_forward_kinematics.yaml",
+    "ups6_forward_kinematics.yaml",
+]
+
+
+@pytest.mark.parametrize("file", [None, *FK_FILES])
+def test_the_pose_checks_are_the_same_function(file):
+    """A mechanism's pose checks built with the replayed reduction and with the expression:
     the same number of instructions and the same outputs, to the bit, at random poses and
     limits (seeded)."""
-    c = cn.build_model("prs3", PAPER_PRS3).closure
+    model = cn.build_model("prs3", PAPER_PRS3) if file is None else cn.load_problem(PROBLEMS / file).model
+    c = model.closure
 
     def checks() -> ca.Function:
         x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
