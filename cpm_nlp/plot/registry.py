@@ -131,7 +131,8 @@ class _Registry:
             if mechanism not in self._mechanism_plots:
                 found: dict[str, PlotType] = {}
                 for declared in addon_plots(mechanism):
-                    where = f"plot {getattr(declared, 'name', declared)!r} of the add-on of mechanism {mechanism!r}"
+                    what = repr(declared.name) if isinstance(declared, AddonPlot) else repr(declared)
+                    where = f"plot {what} of the add-on of mechanism {mechanism!r}"
                     plot = validate(_from_addon(declared, mechanism, where), where)
                     if plot.name in self._types or plot.name in self._plugin_specs() or plot.name in found:
                         raise PlotDeclarationError(f"{where}: the plot type {plot.name!r} is declared twice")
