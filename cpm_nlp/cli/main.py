@@ -77,7 +77,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("plot", **parser_help("plot"))
     p.add_argument("result", help="JSON result of 'cpm-nlp solve -o', or a sweep results file (.parquet, .csv)")
-    p.add_argument("-o", "--output", metavar="FIGURE", required=True, help="figure file: .png, .svg or .pdf")
+    p.add_argument(
+        "-o", "--output", metavar="FIGURE", required=True, help="figure file: .png, .svg, .pdf (.html: interactive 3-D)"
+    )
     p.add_argument("--x", metavar="NAME", help="map: parameter (or value) on the horizontal axis")
     p.add_argument("--y", metavar="NAME", help="map: parameter (or value) on the vertical axis")
     _add_plot_arguments(p, None)
