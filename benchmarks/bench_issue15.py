@@ -218,6 +218,7 @@ def bench_startup(repeats: int, before_checkout: str | None = None) -> dict:
         other = {"PYTHONPATH": str(Path(before_checkout).resolve())}
         runs["help_before"] = (STARTUP["help"][0], other)
         runs["solve_prs3_fk_before"] = (STARTUP["solve_prs3_fk"][0], other)
+        runs["plot_help_before"] = (STARTUP["plot_help"][0], other)
     for argv, extra in runs.values():  # warm-up: bytecode written, files in the page cache
         _child(argv, {**env, **extra})
     cpu: dict = {k: [] for k in runs}
@@ -269,6 +270,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="few repeats (a smoke run, not a measurement)")
     parser.add_argument("--startup", action="store_true", help="only the start-up figures (issue 23)")
     parser.add_argument("--before", metavar="DIR", help="start-up: also run --help and the solve from this checkout")
+    parser.add_argument("--repeats", type=int, default=9, help="start-up: interleaved runs of each command (default 9)")
     parser.add_argument("-o", "--output", default=None, help="JSON file (default: issue15.json, startup.json)")
     args = parser.parse_args(argv)
     args.output = args.output or str(Path(__file__).parent / ("startup.json" if args.startup else "issue15.json"))
@@ -279,7 +281,7 @@ def main(argv: list[str] | None = None) -> int:
         "quick": args.quick,
         **({} if args.startup else bench_certify(n)),
         **({} if args.startup else bench_cuboid(n)),
-        **bench_startup(n if args.quick else 9, args.before),
+        **bench_startup(n if args.quick else args.repeats, args.before),
     }
     for name, e in results.items():
         if isinstance(e, dict) and "cpu" in e:

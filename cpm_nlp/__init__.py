@@ -22,13 +22,13 @@ built-in mechanisms), ``problems`` (problem files, kinds registry, reproduce),
 """
 
 import importlib
-import logging
 
 from . import _legacy
 from .core.version import __version__ as __version__
 
 _legacy.install()
-logging.getLogger(__name__).addHandler(logging.NullHandler())
+# the package logger's NullHandler is attached by cpm_nlp.core.errors, which every module that
+# logs imports: ``cpm-nlp --help`` then starts without the logging module (issue 23, start-up)
 
 
 def __getattr__(name: str) -> object:

@@ -31,6 +31,8 @@ LAYERS = {
 #: modules that must not name a mechanism or a paper-specific kind (code, not docstrings)
 GENERIC = ("plot", "sweep", "cli", "kinds", "problems", "io", "analysis", "core")
 MECHANISM_WORDS = ("prs3", "prc3", "rpr", "pantograph")
+#: modules of text only, whose examples name shipped files and mechanisms (no code chooses by them)
+TEXT_MODULES = ("cpm_nlp.cli.help",)
 
 
 def _modules() -> dict[str, Path]:
@@ -75,7 +77,7 @@ def graph():
 
 
 #: modules of a mechanism's package that belong to the plot layer: a paper's own plot types,
-#: named by its add-on (``Addon.plots``, "module:attribute"), never imported below the plots
+#: declared in ``cpm_nlp.mechanisms.names.ADDON_PLOTS`` ("module:attribute"), never imported below the plots
 PLOT_MODULES = re.compile(r"cpm_nlp\.mechanisms\.\w+\.plots")
 
 
@@ -161,7 +163,7 @@ def _code_words(path: Path) -> set[str]:
 def test_generic_modules_name_no_mechanism():
     bad = []
     for name, path in _modules().items():
-        if _package(name) in GENERIC:
+        if _package(name) in GENERIC and name not in TEXT_MODULES:
             hits = sorted(w for w in _code_words(path) if w.lower() in MECHANISM_WORDS)
             if hits:
                 bad.append(f"{name}: {', '.join(hits)}")
@@ -471,3 +473,75 @@ def test_every_test_path_named_by_a_script_or_file_exists():
     assert named, "no test path found: the check reads nothing"
     missing = [f"{f}: {p}" for f, p in named if not (root / p).is_file()]
     assert not missing, missing
+
+
+def _executed(body: list[ast.stmt]):
+    """The import statements that run when a module is imported: at module level (in an
+    ``if`` or ``try`` too), not in a function or class, nor under ``if TYPE_CHECKING:``."""
+    for node in body:
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            yield node
+        elif isinstance(node, ast.If):
+            if "TYPE_CHECKING" not in ast.unparse(node.test):
+                yield from _executed(node.body)
+            yield from _executed(node.orelse)
+        elif isinstance(node, ast.Try):
+            for block in (node.body, node.orelse, node.finalbody, *[h.body for h in node.handlers]):
+                yield from _executed(block)
+
+
+def _top_level_imports(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
+    """Modules of cpm_nlp that importing ``name`` imports (a package's parents too)."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found: set[str] = set()
+    for node in _executed(ast.parse(path.read_text()).body):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+            continue
+        parts = package.split(".")
+        base = ".".join(parts[: len(parts) - node.level + 1]) if node.level else ""
+        target = ".".join(t for t in (base, node.module or "") if t)
+        found |= {f"{target}.{a.name}" if f"{target}.{a.name}" in modules else target for a in node.names}
+    out = set()
+    for m in found:  # importing a.b.c runs a, a.b and a.b.c
+        parts = m.split(".")
+        out |= {".".join(parts[:k]) for k in range(1, len(parts) + 1)}
+    return {m for m in out if m in modules and m != name}
+
+
+def test_every_module_that_logs_has_the_packages_null_handler():
+    """The library never prints: the ``cpm_nlp`` logger has a NullHandler before any module
+    logs.  ``cpm_nlp/__init__`` does not import logging (``cpm-nlp --help`` starts without it,
+    issue 23); ``cpm_nlp.core.errors`` attaches the handler, and every module that makes a
+    logger imports it at module level, directly or through the modules it imports."""
+    modules = _modules()
+    graph = {name: _top_level_imports(name, path, modules) for name, path in modules.items()}
+    assert 'logging.getLogger("cpm_nlp").addHandler(logging.NullHandler())' in (PKG / "core" / "errors.py").read_text()
+
+    def reaches(start: str) -> set[str]:
+        seen, todo = set(), [start]
+        while todo:
+            for n in graph[todo.pop()] - seen:
+                seen.add(n)
+                todo.append(n)
+        return seen
+
+    # the command line is the application: main() gives the logger its own handler first
+    library = {name: path for name, path in modules.items() if _layer(name) != "cli"}
+    loggers = [name for name, path in library.items() if "getLogger(" in path.read_text()]
+    assert len(loggers) >= 10
+    bad = [m for m in loggers if m != "cpm_nlp.core.errors" and "cpm_nlp.core.errors" not in reaches(m)]
+    assert bad == [], "modules that may log before the NullHandler is attached: " + ", ".join(bad)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import cpm_nlp.core.errors, logging; "
+            "print(any(isinstance(h, logging.NullHandler) for h in logging.getLogger('cpm_nlp').handlers))",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=PKG.parent,
+        check=True,
+    )
+    assert run.stdout.strip() == "True"

@@ -2,7 +2,8 @@
 (:mod:`~cpm_nlp.cli.solve` for ``solve`` and ``check``, :mod:`~cpm_nlp.cli.sweep`,
 :mod:`~cpm_nlp.cli.plot`, :mod:`~cpm_nlp.cli.reproduce`, :mod:`~cpm_nlp.cli.export`,
 :mod:`~cpm_nlp.cli.examples`, :mod:`~cpm_nlp.cli.describe`, :mod:`~cpm_nlp.cli.urdf` for
-``import``), and the entry point with its handling of errors, Ctrl-C and a closed stdout.
+``import``; their help texts in :mod:`~cpm_nlp.cli.help`), and the entry point with its
+handling of errors, Ctrl-C and a closed stdout.
 
 Exit status (:mod:`cpm_nlp.cli.exits`): 0 solved, 1 a solve that did not succeed (the result
 says why), 2 bad input (one message naming the file, the key path and what was expected), 70
@@ -11,15 +12,14 @@ an internal error (a bug: please report it).
 Start-up is kept short on purpose (issue 23): this module imports only argparse and a few
 standard modules; a subcommand's module is imported when that subcommand runs
 (:class:`_Command`), and each subcommand and renderer imports what it needs when it runs
-(units, numpy, CasADi, the problem kinds, Matplotlib, Dask), so ``cpm-nlp --help`` loads
-none of them, nor any subcommand module.
+(units, numpy, CasADi, the problem kinds, Matplotlib, Dask, logging), so ``cpm-nlp --help``
+loads none of them, nor any subcommand module.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
-import logging
 import os
 import signal
 import sys
@@ -27,6 +27,7 @@ from collections.abc import Callable, Sequence
 
 from ..core.version import __version__
 from .exits import EXIT_BROKEN_PIPE, EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_OK
+from .help import TOP_DESCRIPTION, TOP_EXAMPLES, Formatter, examples_text, parser_help
 
 TYPE_CHECKING = False  # typing itself is not imported at start-up; the annotations are strings
 if TYPE_CHECKING:
@@ -35,21 +36,14 @@ if TYPE_CHECKING:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="cpm-nlp",
-        description="Kinematics and design of compliant parallel mechanisms (CasADi + IPOPT).",
-        epilog="Exit status: 0 solved, 1 solve failed, 2 bad input.",
+        prog="cpm-nlp", description=TOP_DESCRIPTION, epilog=examples_text(TOP_EXAMPLES), formatter_class=Formatter
     )
     parser.add_argument("--version", action="store_true", help="print the version of cpm_nlp and exit")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of internal errors")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="log progress to stderr (-vv: debug)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
-    p = sub.add_parser(
-        "solve",
-        help="solve a problem file and print the result",
-        epilog=PLOT_TYPES,
-        formatter_class=_PlotTypesFormatter,
-    )
+    p = sub.add_parser("solve", **parser_help("solve"))
     p.add_argument("file", help="problem file (YAML)")
     p.add_argument(
         "--set",
@@ -63,15 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_plot_arguments(p, "--plot")
     p.set_defaults(func=_Command("solve", "cmd_solve"))
 
-    p = sub.add_parser(
-        "sweep",
-        help="solve a problem at every point of its sweep section, on Dask",
-        description="Solve the problem of FILE at every point of its 'sweep' section (each point as "
-        "'cpm-nlp solve FILE --set KEY=VALUE' would), on a local Dask cluster or an existing one, "
-        "streaming one row per point to a Parquet or CSV file; a sweep run again resumes.",
-        epilog=PLOT_TYPES,
-        formatter_class=_PlotTypesFormatter,
-    )
+    p = sub.add_parser("sweep", **parser_help("sweep"))
     p.add_argument("file", help="problem file (YAML) with a sweep section")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file (repeatable)")
     p.add_argument(
@@ -89,25 +75,22 @@ def build_parser() -> argparse.ArgumentParser:
     _add_plot_arguments(p, "--plot")
     p.set_defaults(func=_Command("sweep", "cmd_sweep"))
 
-    p = sub.add_parser(
-        "plot",
-        help="plot a result (JSON of solve -o) or a sweep results file",
-        epilog=PLOT_TYPES,
-        formatter_class=_PlotTypesFormatter,
-    )
+    p = sub.add_parser("plot", **parser_help("plot"))
     p.add_argument("result", help="JSON result of 'cpm-nlp solve -o', or a sweep results file (.parquet, .csv)")
-    p.add_argument("-o", "--output", metavar="FIGURE", required=True, help="figure file: .png, .svg or .pdf")
+    p.add_argument(
+        "-o", "--output", metavar="FIGURE", required=True, help="figure file: .png, .svg, .pdf (.html: interactive 3-D)"
+    )
     p.add_argument("--x", metavar="NAME", help="map: parameter (or value) on the horizontal axis")
     p.add_argument("--y", metavar="NAME", help="map: parameter (or value) on the vertical axis")
     _add_plot_arguments(p, None)
     p.set_defaults(func=_Command("plot", "cmd_plot"))
 
-    p = sub.add_parser("check", help="validate a problem file without solving it")
-    p.add_argument("file")
-    p.add_argument("--set", action="append", metavar="KEY=VALUE")
+    p = sub.add_parser("check", **parser_help("check"))
+    p.add_argument("file", help="problem file (YAML)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file (repeatable)")
     p.set_defaults(func=_Command("solve", "cmd_check"))
 
-    p = sub.add_parser("reproduce", help="solve every problem file that reproduces a published figure")
+    p = sub.add_parser("reproduce", **parser_help("reproduce"))
     p.add_argument("paths", nargs="*", help="problem files or directories (default: problems/)")
     p.add_argument("--full", action="store_true", help="print the full table, every figure and reason")
     p.add_argument("--json", action="store_true", help="print the full table as JSON")
@@ -116,12 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_Command("reproduce", "cmd_reproduce"))
 
-    p = sub.add_parser(
-        "export",
-        help="write the mechanism's FK, IK and Jacobian as CasADi files or C code, with a manifest",
-        description="Export the kinematics of the mechanism of a problem file (its parameters, limits and "
-        "solver tolerance built in) as serialized CasADi Functions or as C source and header.",
-    )
+    p = sub.add_parser("export", **parser_help("export"))
     p.add_argument("file", help="problem file (YAML); its mechanism and solver section are used")
     p.add_argument("--what", default="fk,ik,jacobian", help="comma-separated: fk, ik, jacobian (default: all)")
     p.add_argument("--format", default="casadi", help="casadi (.casadi files) or c (source + header)")
@@ -129,19 +107,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the file")
     p.set_defaults(func=_Command("export", "cmd_export"))
 
-    p = sub.add_parser(
-        "examples",
-        help="copy the shipped problem files and solver presets into a directory, to edit",
-        description="Copy the shipped problem files into DIR/problems and the solver presets into DIR/configs "
-        "(where cpm-nlp looks for them when run in DIR). Existing files are left alone unless --force.",
-    )
+    p = sub.add_parser("examples", **parser_help("examples"))
     p.add_argument("dir", metavar="DIR", help="directory to copy into (created if missing)")
     p.add_argument("--force", action="store_true", help="overwrite files of the same name")
     p.set_defaults(func=_Command("examples", "cmd_examples"))
 
-    p = sub.add_parser(
-        "describe", help="list mechanisms and problem kinds, or describe one (a mechanism file: load, check, describe)"
-    )
+    p = sub.add_parser("describe", **parser_help("describe"))
     p.add_argument("name", nargs="?", help="a mechanism, a problem kind or a mechanism file (.yaml)")
     p.add_argument(
         "--mechanism",
@@ -153,13 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_Command("describe", "cmd_describe"))
 
-    p = sub.add_parser(
-        "import",
-        help="write a mechanism file (bodies and joints) from a URDF and its Extended URDF sidecar",
-        description="Read a URDF (its links, joints and zero configuration) and the loop closures and actuated "
-        "joints of its Extended URDF sidecar (robot.yaml: closed_loop, type, name_mot, joint_name, joint_type); "
-        "write a mechanism file of bodies and joints. Nothing the URDF names (meshes, includes) is opened.",
-    )
+    p = sub.add_parser("import", **parser_help("import"))
     p.add_argument("file", help="the URDF (.urdf)")
     p.add_argument("--sidecar", metavar="FILE", help="the Extended URDF sidecar (robot.yaml): closures, actuators")
     p.add_argument("-o", "--output", metavar="FILE", help="write the mechanism file to FILE (default: print it)")
@@ -186,47 +151,6 @@ class _Command:
         import importlib
 
         return getattr(importlib.import_module(f".{self.module}", __package__), self.name)
-
-
-class _Deferred(str):
-    """Help text made only when the help is printed (it reads a registry: a subcommand
-    that runs never pays for it)."""
-
-
-#: the epilog of the commands that plot: the registered plot types, listed by :func:`_plot_types_text`
-PLOT_TYPES = _Deferred("plot types")
-
-
-class _PlotTypesFormatter(argparse.HelpFormatter):
-    """Lists the registered plot types (:mod:`cpm_nlp.plot.registry`) under the help, one a line."""
-
-    def _format_text(self, text: str) -> str:
-        if isinstance(text, _Deferred):
-            return _plot_types_text(self._width) + "\n\n"
-        return super()._format_text(text)
-
-
-def _plot_types_text(width: int) -> str:
-    import textwrap
-
-    from ..core.errors import CpmError
-    from ..plot.registry import plot_type_names, plot_types
-
-    try:
-        types = plot_types()
-    except CpmError as exc:  # a broken plugin: the names, and what is wrong (the help is still printed)
-        return f"plot types (--type): {', '.join(plot_type_names())}\n(error: {exc})"
-    column = max(len(t.name) for t in types) + 4
-    lines = ["plot types (--type):"]
-    for t in types:
-        text = t.description + ("" if t.origin == "built-in" else f" [{t.origin}]")
-        lines += textwrap.wrap(
-            text,
-            max(width, column + 30),
-            initial_indent=f"  {t.name:<{column - 2}}",
-            subsequent_indent=" " * column,
-        )
-    return "\n".join(lines)
 
 
 def _add_plot_arguments(p: argparse.ArgumentParser, flag: str | None) -> None:
@@ -260,6 +184,8 @@ def main(argv: Sequence[str] | None = None, out: TextIO | None = None, err: Text
     if args.command is None:
         parser.print_help(out)
         return EXIT_INPUT
+    import logging  # here, not at the top: ``--help`` and ``--version`` run without it
+
     handler = logging.StreamHandler(err)
     handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
     root = logging.getLogger("cpm_nlp")

@@ -323,7 +323,7 @@ class Addon:
     """What a mechanism file cannot say, given in Python for the mechanism of one shipped file
     (issue 21, item 5): the file is the mechanism (its closures, IK, passive joints, branch,
     drawing, paper, problem files); the add-on refers to it by the registry's table
-    :data:`cpm_nlp.mechanisms.registry.ADDONS` and adds only what is not kinematics.
+    :data:`cpm_nlp.mechanisms.names.ADDONS` and adds only what is not kinematics.
 
     parameters: optional parameters the closures do not use (e.g. a dynamics model's lengths
         and hinge sizes); a value given is kept in the model's ``parameters``, never in p.
@@ -339,10 +339,11 @@ class Addon:
     complete: ``(model, limits) -> None``: completes the file's model with what ``limits``
         gives (joint limits on the file's coordinates) and the paper's derived quantities
         (``model.derived``), from the file's closure and model, never a copy of them.
-    plots: the paper's own plot types, each ``"module:attribute"`` of a
-        :class:`~cpm_nlp.plot.plot_type.PlotType` (named, not imported: a plot belongs to
-        the plot layer, above the mechanisms); drawn only for results of this mechanism
-        (:mod:`cpm_nlp.plot.registry`).
+
+    The paper's own plot types are not an add-on's field: they are declared, name and one
+    line each, in :data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that ``cpm-nlp plot
+    --help`` lists them without importing the add-on (a plot belongs to the plot layer,
+    above the mechanisms).
     """
 
     parameters: tuple[Option, ...] = ()
@@ -353,7 +354,6 @@ class Addon:
     kinds: Mapping[str, type] = field(default_factory=dict)
     limits: tuple[Option, ...] = ()
     complete: Callable[[Any, dict], None] | None = None
-    plots: tuple[str, ...] = ()
 
 
 #: the add-on's checks, taken as they are (each must not be given by the file too)

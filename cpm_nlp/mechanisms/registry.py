@@ -34,6 +34,7 @@ from ..core.mechanism import Addon, Mechanism, MechanismDeclarationError, unknow
 from ..core.model import LoopClosure, Model
 from ..core.origin import Origin
 from . import described
+from .names import ADDONS, ALIASES  # the built-in names' tables (read without importing a mechanism)
 
 log = logging.getLogger(__name__)
 
@@ -52,23 +53,6 @@ BUILTIN_FILES = {
     "prc3": "prc3.yaml",
     "rpr": "rpr.yaml",
     "pantograph": "pantograph.yaml",
-}
-
-#: built-in file mechanism -> "module:attribute" of its :class:`~cpm_nlp.core.mechanism.Addon`:
-#: what its file cannot say (the paper's own kinds, a dynamics model, checks over several
-#: parameters), added to the mechanism the file describes
-ADDONS = {
-    "prc3": "cpm_nlp.mechanisms.prc3.addon:ADDON",
-    "rpr": "cpm_nlp.mechanisms.rpr.addon:ADDON",
-    "pantograph": "cpm_nlp.mechanisms.pantograph.addon:ADDON",
-}
-
-#: old name -> the built-in mechanism it names now (the file twin became the built-in)
-ALIASES = {
-    "prs3_file": "prs3",
-    "prc3_file": "prc3",
-    "rpr_file": "rpr",
-    "pantograph_file": "pantograph",
 }
 
 
@@ -321,13 +305,6 @@ def _addon(name: str, target: str) -> Addon:
     if not isinstance(obj, Addon):
         raise PluginError(f"the add-on of mechanism {name!r} ({target}) must be an Addon, got {type(obj).__name__}")
     return obj
-
-
-def addon_of(name: str) -> Addon | None:
-    """The add-on of a built-in file mechanism (or of the one an old name stands for), None
-    if it has none: its plot types (``Addon.plots``) are read by :mod:`cpm_nlp.plot.registry`."""
-    name = ALIASES.get(name, name)
-    return _addon(name, ADDONS[name]) if name in ADDONS else None
 
 
 def _with_origin(mech: Mechanism, origin: Origin) -> Mechanism:

@@ -4,8 +4,10 @@ A plot type is a :class:`~cpm_nlp.plot.plot_type.PlotType` declaration.  Three
 sources extend the registry, none by editing cpm_nlp:
 
 * the built-in plot types (:data:`cpm_nlp.plot.builtin.BUILTIN`);
-* a mechanism's add-on (:attr:`cpm_nlp.core.mechanism.Addon.plots`): the plots of its
-  paper, drawn only for results of that mechanism;
+* a built-in mechanism's add-on (:data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`): the plots
+  of its paper, each declared by name, function ("module:attribute") and one line, drawn
+  only for results of that mechanism; listing them imports neither the add-on nor its
+  plot module (the function is imported when the plot is drawn);
 * a third-party package, through the entry-point group ``cpm_nlp.plots``::
 
       # the plugin's pyproject.toml
@@ -32,9 +34,9 @@ from importlib import metadata
 from typing import Any
 
 from ..core.errors import CpmError, InputError
-from ..mechanisms.registry import ADDONS, addon_of
+from ..mechanisms.names import ADDON_PLOTS, AddonPlot, addon_plots
 from .builtin import BUILTIN
-from .plot_type import PlotDeclarationError, PlotType, validate
+from .plot_type import Deferred, PlotDeclarationError, PlotType, validate
 
 log = logging.getLogger(__name__)
 
@@ -63,6 +65,24 @@ def _load_target(target: str, where: str) -> Any:
     except Exception as exc:
         raise PlotPluginError(f"{where} failed to load: {type(exc).__name__}: {exc}") from exc
     return obj
+
+
+def _from_addon(declared: AddonPlot, mechanism: str, where: str) -> PlotType:
+    """The :class:`PlotType` of an add-on's declaration, its function imported when drawn."""
+    if not isinstance(declared, AddonPlot):
+        raise PlotDeclarationError(f"{where} must be an AddonPlot declaration, got {type(declared).__name__}")
+    try:
+        function = Deferred(declared.function)
+    except PlotDeclarationError as exc:
+        raise PlotDeclarationError(f"{where}: {exc}") from None
+    return PlotType(
+        declared.name,
+        function,
+        declared.description,
+        kinds=declared.kinds,
+        interactive=declared.interactive,
+        origin=f"mechanism {mechanism}",
+    )
 
 
 class _Registry:
@@ -104,19 +124,19 @@ class _Registry:
     # -- a mechanism's own -------------------------------------------------------------------------
 
     def mechanism_plots(self, mechanism: str) -> dict[str, PlotType]:
-        """The plot types of a built-in mechanism's add-on (none for another mechanism)."""
+        """The plot types of a built-in mechanism's add-on (none for another mechanism),
+        from their declarations (:data:`~cpm_nlp.mechanisms.names.ADDON_PLOTS`): nothing is
+        imported until a plot is drawn."""
         with self._lock:
             if mechanism not in self._mechanism_plots:
-                addon = addon_of(mechanism)
                 found: dict[str, PlotType] = {}
-                for target in addon.plots if addon is not None else ():
-                    where = f"plot {target!r} of the add-on of mechanism {mechanism!r}"
-                    obj = _load_target(target, where)
-                    for plot in obj if isinstance(obj, Sequence) else (obj,):
-                        plot = validate(plot, where)
-                        if plot.name in self._types or plot.name in self._plugin_specs() or plot.name in found:
-                            raise PlotDeclarationError(f"{where}: the plot type {plot.name!r} is declared twice")
-                        found[plot.name] = PlotType(**{**plot.__dict__, "origin": f"mechanism {mechanism}"})
+                for declared in addon_plots(mechanism):
+                    what = repr(declared.name) if isinstance(declared, AddonPlot) else repr(declared)
+                    where = f"plot {what} of the add-on of mechanism {mechanism!r}"
+                    plot = validate(_from_addon(declared, mechanism, where), where)
+                    if plot.name in self._types or plot.name in self._plugin_specs() or plot.name in found:
+                        raise PlotDeclarationError(f"{where}: the plot type {plot.name!r} is declared twice")
+                    found[plot.name] = plot
                 self._mechanism_plots[mechanism] = found
             return self._mechanism_plots[mechanism]
 
@@ -146,20 +166,20 @@ class _Registry:
 
     def owners(self, name: str) -> list[str]:
         """The built-in mechanisms whose add-ons declare the plot type ``name``."""
-        return [m for m in sorted(ADDONS) if name in self.mechanism_plots(m)]
+        return [m for m in sorted(ADDON_PLOTS) if name in self.mechanism_plots(m)]
 
     def names(self) -> list[str]:
         """Every plot type's name: built-in, in code, plugins (not loaded), the mechanisms' own."""
         with self._lock:
             names = list(self._types) + list(self._plugin_specs())
-            for m in sorted(ADDONS):
+            for m in sorted(ADDON_PLOTS):
                 names += [n for n in self.mechanism_plots(m) if n not in names]
             return names
 
     def everything(self) -> list[PlotType]:
         """Every plot type (plugins loaded), the built-in first, then plugins, then the mechanisms' own."""
         plots = list(self.shared().values())
-        for m in sorted(ADDONS):
+        for m in sorted(ADDON_PLOTS):
             plots += [p for p in self.mechanism_plots(m).values() if p.name not in {q.name for q in plots}]
         return plots
 

@@ -177,8 +177,8 @@ def test_a_mechanisms_plot_is_drawn_only_for_its_results():
     from cpm_nlp.mechanisms.prc3.plots import amplifier_plot
     from cpm_nlp.mechanisms.rpr.plots import twists_plot
 
-    assert plot_type("twists", "rpr").function is twists_plot
-    assert plot_type("amplifier", "prc3").function is amplifier_plot
+    assert plot_type("twists", "rpr").function.resolve() is twists_plot
+    assert plot_type("amplifier", "prc3").function.resolve() is amplifier_plot
     for name, other in (("twists", "pantograph"), ("twists", "prc3"), ("amplifier", "rpr"), ("twists", None)):
         assert plot_type(name, other) is None, (name, other)
     assert {"twists", "amplifier"} <= set(plot_type_names())  # known to --type, before anything is solved
@@ -216,15 +216,21 @@ def test_a_plot_type_registered_in_code_is_validated_and_removed(tmp_path):
 
 
 def test_a_bad_plot_of_an_addon_is_an_error_naming_it(monkeypatch):
-    from cpm_nlp.core.mechanism import Addon
+    from cpm_nlp.mechanisms import names
     from cpm_nlp.plot import registry
 
-    monkeypatch.setattr(registry, "addon_of", lambda name: Addon(plots=("cpm_nlp.plot.builtin:NOPE",)))
-    with pytest.raises(PlotPluginError, match="of the add-on of mechanism 'prc3' failed to load: AttributeError"):
-        registry._Registry().mechanism_plots("prc3")
-    monkeypatch.setattr(registry, "addon_of", lambda name: Addon(plots=("cpm_nlp.plot.builtin:BUILTIN",)))
+    def declare(*plots):
+        monkeypatch.setitem(names.ADDON_PLOTS, "prc3", plots)
+
+    declare(names.AddonPlot("workspace", "cpm_nlp.plot.workspace_plots:workspace_plot", "a second workspace"))
     with pytest.raises(PlotDeclarationError, match="the plot type 'workspace' is declared twice"):
         registry._Registry().mechanism_plots("prc3")
-    monkeypatch.setattr(registry, "addon_of", lambda name: Addon(plots=("no colon",)))
-    with pytest.raises(PlotPluginError, match="expected 'module:attribute', got 'no colon'"):
+    declare(names.AddonPlot("amp", "no colon", "an amplifier"))
+    with pytest.raises(PlotDeclarationError, match="plot 'amp' of the add-on of mechanism 'prc3'.*'module:attribute'"):
+        registry._Registry().mechanism_plots("prc3")
+    declare(names.AddonPlot("Amp", "m:f", "an amplifier"))
+    with pytest.raises(PlotDeclarationError, match="its name must be lower case"):
+        registry._Registry().mechanism_plots("prc3")
+    declare("cpm_nlp.mechanisms.prc3.plots:amplifier_plot")
+    with pytest.raises(PlotDeclarationError, match="must be an AddonPlot declaration, got str"):
         registry._Registry().mechanism_plots("prc3")

@@ -13,9 +13,7 @@ import numpy as np
 from ...core.errors import InputError
 from ...core.options import REQUIRED
 from .builder import ClosureBuilder
-from .expand import expand_legs, expansion_gap
 from .generate import Generator
-from .graph import GraphGenerator
 from .spec import Description
 
 
@@ -25,6 +23,11 @@ def closure_parts(d: Description) -> tuple[ClosureBuilder, dict[str, Any]]:
     close (:func:`assembled_from_drawing`) gets its reference configuration by the assembly of
     the graph its legs expand into (:class:`LegsAssembler`); its closures stay the legs'."""
     if d.is_graph:
+        # the graph's generator and its assembly are imported for a graph file only: a legs
+        # file (the 3-PRS) never loads them (issue 23, start-up)
+        from .expand import expand_legs
+        from .graph import GraphGenerator
+
         if d.legs:  # a mixed file: its legs expanded, one graph with its bodies and joints
             d = expand_legs(d)
         g = GraphGenerator(d)
@@ -52,6 +55,9 @@ class LegsAssembler:
     platform's, then each proximal chain's passive joints')."""
 
     def __init__(self, d: Description, legs: Generator) -> None:
+        from .expand import expand_legs, expansion_gap
+        from .graph import GraphGenerator
+
         gap = expansion_gap(d)
         if gap is not None:
             raise InputError(

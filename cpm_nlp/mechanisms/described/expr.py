@@ -262,9 +262,9 @@ class _Evaluator:
         """``result``, or an error naming the operation when it is a known number that is
         not finite (``1/0``, ``b/0``, ``sqrt(-1)``, ``exp(1000)``; with every symbol a
         number, as :func:`diagnose` evaluates, any operation on them)."""
-        sx = result.sx
-        for i in range(int(sx.numel())):
-            e = sx[i]
+        # the structural non-zeros in one call (a structural zero is finite): indexing each
+        # entry costs CasADi's Python overloads a few microseconds apiece (issue 23, start-up)
+        for e in result.sx.nonzeros():
             if e.is_constant() and not math.isfinite(float(ca.DM(e))):
                 raise self.fail(node, f"{_why(what, args)}{self.culprit(node, args)} (the value is {_text(e)})")
         return result

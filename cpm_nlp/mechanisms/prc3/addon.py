@@ -46,5 +46,4 @@ ADDON = Addon(
     check_parameters=check_parameters,
     closure_parts=(dynamics_model,),
     kinds={"amplifier": Amplifier},
-    plots=("cpm_nlp.mechanisms.prc3.plots:PLOTS",),
 )

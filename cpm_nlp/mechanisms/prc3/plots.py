@@ -1,16 +1,15 @@
 """The 3-PRC paper's own plot: the lever amplifier's output against its input (eq 1-2).
 
-Declared here and named by the add-on (``Addon.plots``), so that it is drawn only for
-results of the 3-PRC; this module belongs to the plot layer (it imports
-:mod:`cpm_nlp.plot`; nothing in the mechanisms layer imports it).
+Declared, name and one line, in :data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that
+``cpm-nlp plot --help`` lists it without importing this module; drawn only for results of
+the 3-PRC.  This module belongs to the plot layer (it imports :mod:`cpm_nlp.plot`; nothing
+in the mechanisms layer imports it).
 """
 
 from __future__ import annotations
 
 import re
 from typing import Any
-
-from ...plot.plot_type import PlotType
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
@@ -19,8 +18,7 @@ if TYPE_CHECKING:
 
 def amplifier_plot(data: ResultData, _options: PlotOptions) -> Any:
     """Output against input of the lever amplifier, d = A2 q (prc3 paper, eq 1-2)."""
-    # the drawing modules are imported when a plot is drawn: listing the plot types
-    # (``cpm-nlp plot --help``) imports this declaration only (issue 23, start-up)
+    # the drawing modules are imported when a plot is drawn (issue 23, start-up)
     from ...plot.draw_panels import Panel, panels_figure
     from ...plot.results import NotApplicable
 
@@ -39,9 +37,3 @@ def amplifier_plot(data: ResultData, _options: PlotOptions) -> Any:
     return panels_figure(
         x, panels, xname=pairs[0][0], xdimension="length", title="Lever amplifier output (prc3, eq 1-2)"
     )
-
-
-AMPLIFIER = PlotType("amplifier", amplifier_plot, "output against input of the 3-PRC's lever amplifier (eq 1-2)")
-
-#: the plot types of the 3-PRC's add-on
-PLOTS = (AMPLIFIER,)

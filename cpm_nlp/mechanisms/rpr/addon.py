@@ -25,5 +25,4 @@ class RprSynthesis(Synthesis, SynthesisFormulation):
 ADDON = Addon(
     kinds={k.name: k for k in (ScrewJacobian, Twists, TransmissionMap, JointDesign, Compliance)},
     parts=(RprSynthesis(),),
-    plots=("cpm_nlp.mechanisms.rpr.plots:PLOTS",),
 )

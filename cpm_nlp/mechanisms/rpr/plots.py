@@ -1,15 +1,14 @@
 """The RPR paper's own plot: the displacement twists of the platform on the mechanism (eq 45).
 
-Declared here and named by the add-on (``Addon.plots``), so that it is drawn only for
-results of the RPR; this module belongs to the plot layer (it imports
-:mod:`cpm_nlp.plot`; nothing in the mechanisms layer imports it).
+Declared, name and one line, in :data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that
+``cpm-nlp plot --help`` lists it without importing this module; drawn only for results of
+the RPR.  This module belongs to the plot layer (it imports :mod:`cpm_nlp.plot`; nothing
+in the mechanisms layer imports it).
 """
 
 from __future__ import annotations
 
 from typing import Any
-
-from ...plot.plot_type import PlotType
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
@@ -20,8 +19,7 @@ def twists_plot(data: ResultData, options: PlotOptions) -> Any:
     """The displacement twists of the platform, one per actuator, as arrows on the
     mechanism at the pose: the rotation (ω) and the translation (v) of the
     reference point, each scaled to the drawing (RPR paper, eq 45)."""
-    # numpy and the drawing modules are imported when a plot is drawn: listing the plot
-    # types (``cpm-nlp plot --help``) imports this declaration only (issue 23, start-up)
+    # numpy and the drawing modules are imported when a plot is drawn (issue 23, start-up)
     import numpy as np
 
     from ...plot.draw_mechanism import Arrow, mechanism_figure
@@ -65,14 +63,3 @@ def twists_plot(data: ResultData, options: PlotOptions) -> Any:
         title=f"Displacement twists ({data.model.get('type')}, {data.problem}), at the reference point",
         note=data.units.get("T", ""),
     )
-
-
-TWISTS = PlotType(
-    "twists",
-    twists_plot,
-    "the RPR platform's displacement twists as arrows on the mechanism (eq 45)",
-    interactive=True,
-)
-
-#: the plot types of the RPR's add-on
-PLOTS = (TWISTS,)
