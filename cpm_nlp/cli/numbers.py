@@ -50,7 +50,7 @@ def _number(x: float, digits: int = DIGITS) -> str:
 
 def engineering(value: float, dimension: str | None, digits: int = DIGITS) -> str:
     """``value`` (SI) for people: a prefixed unit chosen for this value (module docstring)."""
-    from ..core.units import DIMENSIONS, format_quantity
+    from ..core.units import DIMENSIONS, format_quantity, si_unit
 
     if not math.isfinite(value):
         return str(value)
@@ -63,7 +63,7 @@ def engineering(value: float, dimension: str | None, digits: int = DIGITS) -> st
         if dimension == "angle" and size >= 1e-3:  # down to 1 mrad: degrees, the papers' unit
             return f"{_number(math.degrees(value), digits)} deg"
         return f"{_number(value / size, digits)} {prefix}{unit}"
-    if dimension in DIMENSIONS and DIMENSIONS[dimension].si:
+    if dimension in DIMENSIONS and si_unit(dimension):
         if value == 0:
             return f"0 {DIMENSIONS[dimension].display}"
         text = format_quantity(value, dimension, digits)
