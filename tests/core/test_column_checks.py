@@ -192,3 +192,46 @@ def test_a_batch_result_has_none_exactly_at_its_failed_points():
     for j, name in enumerate(c.q_names):
         np.testing.assert_allclose([out.values[name][k] for k in solved], res.q[solved, j], rtol=1e-12, atol=1e-15)
     assert [out.values["residual"][k] for k in failed] == [None] * failed.size
+
+
+# -- the CSV reader of data files (cpm_nlp.io.datafile): all values at once, else row by row --
+
+
+def _csv_table(lines: list[str]) -> tuple[list[str], np.ndarray]:
+    from cpm_nlp.io.datafile import _csv
+
+    return _csv(("s1, s2, s3\n" + "\n".join(lines) + "\n").encode(), ("inputs", "data"))
+
+
+def _rows(n: int) -> list[str]:
+    return [f"{k * 1e-6:.17g},{-k * 2e-6:.17g},{k * 3.5e-7:.17g}" for k in range(n)]
+
+
+def test_a_csv_is_read_at_once_as_row_by_row():
+    lines = _rows(2000)
+    lines[7] = " 1.5e-3 ,\t-2e-3, 0"  # spaces around numbers, as float() reads them
+    lines[9] = "1_0,-0.,1E-3"  # what float() accepts, numpy's own parser may not
+    headers, table = _csv_table(lines)
+    assert headers == ["s1", "s2", "s3"] and table.shape == (2000, 3)
+    want = np.array([[float(c) for c in line.split(",")] for line in lines])
+    np.testing.assert_array_equal(table, want)
+    assert math.copysign(1.0, table[9, 1]) == -1.0
+
+
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        ({500: "1,2,x"}, "row 501, column 's3': expected a number"),
+        ({500: "1,2"}, "row 501 has 2 value(s); the header names 3 column(s)"),
+        # the first error in row order, whichever its kind
+        ({300: "1,y,3", 900: "1,2"}, "row 301, column 's2': expected a number"),
+        ({300: "1,2,3,4", 900: "1,2,z"}, "row 301 has 4 value(s)"),
+    ],
+)
+def test_a_bad_csv_row_is_named_as_row_by_row(bad, message):
+    lines = _rows(1000)
+    for k, text in bad.items():
+        lines[k] = text
+    with pytest.raises(InputError) as got:
+        _csv_table(lines)
+    assert message in str(got.value) and got.value.path == ("inputs", "data")
