@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import cpm_nlp as cn
 from cpm_nlp.core.errors import InputError
@@ -89,6 +91,33 @@ def test_nonfinite_paths_are_the_value_by_value_walk(name):
 def test_nonfinite_paths_of_every_case_at_once():
     assert nonfinite_paths(CASES) == reference_paths(CASES)
     assert "nan late[700]" in nonfinite_paths(CASES) and "nested[1][1]" in nonfinite_paths(CASES)
+
+
+_numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(),
+    st.booleans(),
+    st.none(),
+    st.text(max_size=3),
+    st.complex_numbers(allow_nan=True, allow_infinity=True),
+    st.floats(allow_nan=True, allow_infinity=True).map(np.float64),
+)
+_nested = st.recursive(
+    _numbers,
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=5),
+        st.lists(inner, max_size=5).map(tuple),
+        st.dictionaries(st.text(max_size=3), inner, max_size=3),
+        st.lists(st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=2, max_size=2), max_size=4),
+    ),
+    max_leaves=25,
+)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(values=st.dictionaries(st.text(max_size=4), _nested, max_size=4))
+def test_nonfinite_paths_of_any_value_are_the_walks(values):
+    assert nonfinite_paths(values) == reference_paths(values)
 
 
 LENGTH = Option("s", "length", "a stroke", shape="list", lower=-0.01, upper=0.01)
