@@ -226,7 +226,43 @@ class BatchResult:
         )
 
     def solutions(self) -> list[PoseSolution]:
-        return [self.solution(i) for i in range(len(self))]
+        """Every pose as :meth:`solution` gives it; the solved ones from columns read once
+        (a batch of 100 000 poses), the others one by one (their messages)."""
+        n = len(self)
+        if n == 0:
+            return []
+        ok = self.ok.tolist()
+        per_pose = self.seconds / n
+        # details(i): the checks in their order with cond1 renamed and moved last, a NaN cond_phi_x dropped
+        keys = [k for k in self.checks if k != "cond1"] + ["cond1_phi_x"]
+        cols = [self.checks["cond1" if k == "cond1_phi_x" else k].astype(float).tolist() for k in keys]
+        rows = [dict(zip(keys, r)) for r in zip(*cols)]
+        if "cond_phi_x" in self.checks:
+            for i in np.flatnonzero(np.isnan(self.checks["cond_phi_x"])).tolist():
+                del rows[i]["cond_phi_x"]
+        passive = self.model.closure.passive is not None
+        residual = self.checks["residual"].astype(float).tolist()
+        out = []
+        for i in range(n):
+            if not ok[i]:
+                out.append(self.solution(i))
+                continue
+            out.append(
+                PoseSolution(
+                    Status.SOLVED,
+                    self.x[i].copy(),
+                    self.q[i].copy(),
+                    self.passive[i].copy() if passive else None,
+                    residual[i],
+                    0,
+                    per_pose,
+                    self.solver,
+                    "",
+                    rows[i],
+                    self.path(i),
+                )
+            )
+        return out
 
 
 # -- evaluation -------------------------------------------------------------------------------

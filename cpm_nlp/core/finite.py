@@ -51,6 +51,19 @@ def check_numbers(data: Any, path: tuple = ()) -> None:
             raise InputError(too_large(node), path=where)
 
 
+def _numeric(value: Any) -> np.ndarray | None:
+    """A list or tuple as one numeric array (numbers only, rectangular), whose first
+    non-finite entry in C order is the one the walk meets first, at the same indices;
+    None for anything else (a None, a string, a mapping, ragged rows, an object array)."""
+    if isinstance(value, np.ndarray) or len(value) < 2:
+        return None
+    try:
+        arr = np.asarray(value)
+    except (ValueError, TypeError, OverflowError):
+        return None
+    return arr if arr.dtype.kind in "biufc" else None
+
+
 def _walk(value: Any, name: str) -> Iterator[str]:
     if isinstance(value, Mapping):
         for k, v in value.items():
@@ -59,7 +72,13 @@ def _walk(value: Any, name: str) -> Iterator[str]:
         bad = np.argwhere(~np.isfinite(value))
         if bad.size:
             yield name + "".join(f"[{int(i)}]" for i in bad[0])
+    elif isinstance(value, np.ndarray) and value.dtype.kind in "biu":
+        return  # integers and booleans are finite
     elif isinstance(value, (list, tuple, np.ndarray)):
+        numbers = _numeric(value)
+        if numbers is not None:  # a list of numbers (100 000 values of a batch) at once
+            yield from _walk(numbers, name)
+            return
         for i, v in enumerate(value):
             yield from _walk(v, f"{name}[{i}]")
     elif isinstance(value, (float, np.floating, complex, np.complexfloating)) and not np.isfinite(value):

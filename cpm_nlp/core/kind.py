@@ -172,7 +172,9 @@ def broadcast(columns: Sequence[Any], names: Sequence[str], path: tuple) -> tupl
         detail = ", ".join(f"{n}: {len(v)}" for n, v in zip(names, columns) if isinstance(v, list))
         raise InputError(f"lists of inputs must have the same length (got {detail})", path=path)
     n = lengths.pop() if lengths else 1
-    arr = np.array([[v[k] if isinstance(v, list) else v for v in columns] for k in range(n)], dtype=float)
+    arr = np.empty((n, len(columns)))
+    for j, v in enumerate(columns):  # column-wise: a data file's 100 000 rows at numpy's speed
+        arr[:, j] = v
     return arr, batch
 
 

@@ -29,6 +29,8 @@ TINY = 1e-60
 
 #: Largest number of points a grid may have (keeps a typo from exhausting memory).
 MAX_GRID_POINTS = 1_000_000
+#: Lists at least this long (a data file's columns) are checked column-wise (:meth:`Option._list`).
+FAST_LIST = 256
 
 
 @dataclass(frozen=True)
@@ -138,7 +140,34 @@ class Option:
             raise InputError(f"expected a non-empty list of {self.expectation()}, got {value!r}", path=path)
         if self.max_len is not None and len(value) > self.max_len:
             raise InputError(f"expected at most {self.max_len} values, got {len(value)}", path=path)
+        fast = self._list_of_floats(value)
+        if fast is not None:
+            return fast
         return [self._scalar(v, path + (i,)) for i, v in enumerate(value)]
+
+    def _list_of_floats(self, value: list | tuple) -> list[float] | None:
+        """A long list of bare floats of a physical dimension (a data file's column, 100 000
+        values), checked column-wise with numpy: the checks of :meth:`_scalar` on every value
+        at once.  None (check value by value) for a short list, another kind, or any value
+        that is no float or fails a check: the per-value path then raises the same error,
+        naming the same first value, as it always did."""
+        if len(value) < FAST_LIST or self.kind not in DIMENSIONS or not all(type(v) is float for v in value):
+            return None
+        import numpy as np  # not at import: `cpm-nlp --help` loads this module without numpy
+
+        number = np.array(value, dtype=float)
+        bad = ~np.isfinite(number)  # parse_quantity: a bare number is finite
+        lo, hi, size = self.lower, self.upper, np.abs(number)
+        limit = DIMENSIONS[self.kind].limit
+        if not (lo is not None and hi is not None and lo >= -limit and hi <= limit):
+            bad |= size > limit
+        if self.kind != "dimensionless":
+            bad |= (number != 0) & (size < TINY)
+        if lo is not None:
+            bad |= (number <= lo) if self.strict else (number < lo)
+        if hi is not None:
+            bad |= (number >= hi) if self.strict else (number > hi)
+        return None if bad.any() else number.tolist()
 
     def _grid(self, value: Any, path: tuple) -> list:
         if isinstance(value, Mapping):

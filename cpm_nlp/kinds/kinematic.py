@@ -64,21 +64,37 @@ def _pose_outputs(model: Model) -> list[Output]:
 
 
 def _pose_values(model: Model, sols: Sequence[PoseSolution], batch: bool) -> dict[str, Any]:
-    """Values of solved poses under the papers' names; None for failed points."""
+    """Values of solved poses under the papers' names; None for failed points (column-wise:
+    a batch of 100 000 poses is a few numpy columns, not a loop per value)."""
     c = model.closure
-    cols: dict[str, list] = {n: [] for n in _pose_names(model)[0]}
-    for s in sols:
-        ok = s.ok
-        for i, name in enumerate(c.x_names):
-            cols[name].append(float(s.x[i]) if ok else None)
-        for off, target in c.offsets.items():
-            i = c.x_names.index(target)
-            cols[off].append(float(s.x[i] - model.x_home[i]) if ok else None)
-        for j, name in enumerate(c.q_names):
-            cols[name].append(float(s.q[j]) if ok else None)
-        for j, name in enumerate(c.passive_names):
-            cols[name].append(float(s.passive[j]) if ok and s.passive is not None else None)
-        cols["residual"].append(float(s.residual) if ok else None)
+    n = len(sols)
+    good = [k for k, s in enumerate(sols) if s.ok]
+    with_passive = [k for k in good if sols[k].passive is not None]
+
+    def column(rows: list[int], values: np.ndarray) -> list:
+        if len(rows) == n:
+            return values.tolist()
+        out = np.full(n, None, dtype=object)
+        out[rows] = values.tolist()
+        return out.tolist()
+
+    X = np.array([sols[k].x for k in good], dtype=float).reshape(len(good), c.nx)
+    Q = np.array([sols[k].q for k in good], dtype=float).reshape(len(good), c.nq)
+    passive_names = list(c.passive_names)
+    P = np.array([sols[k].passive for k in with_passive], dtype=float).reshape(len(with_passive), len(passive_names))
+    x_names = list(c.x_names)
+    cols: dict[str, list] = {}
+    for i, name in enumerate(x_names):
+        cols[name] = column(good, X[:, i])
+    for off, target in c.offsets.items():
+        i = x_names.index(target)
+        cols[off] = column(good, X[:, i] - model.x_home[i])
+    for j, name in enumerate(c.q_names):
+        cols[name] = column(good, Q[:, j])
+    for j, name in enumerate(passive_names):
+        cols[name] = column(with_passive, P[:, j])
+    cols["residual"] = column(good, np.array([float(sols[k].residual) for k in good], dtype=float))
+    cols = {name: cols[name] for name in _pose_names(model)[0]}
     return {k: (v if batch else v[0]) for k, v in cols.items()}
 
 
