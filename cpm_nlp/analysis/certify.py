@@ -55,6 +55,7 @@ import numpy as np
 from ..core import progress
 from ..core.model import LoopClosure, Model
 from ..core.options import Option
+from ..core.solver import solvers_of
 from .intervals import IntervalProgram, UnsupportedOperation
 from .workspace import SINGULAR_CONDITION, limit_bounds, limited_function
 
@@ -136,7 +137,7 @@ def certificate_programs(closure: LoopClosure, rows: tuple[int, ...]) -> _Progra
             IntervalProgram(full), IntervalProgram(values), tuple(rows), ("reach",) + tuple(names[r] for r in rows)
         )
 
-    return closure.solvers.memo(("certify", tuple(rows)), build)
+    return solvers_of(closure).memo(("certify", tuple(rows)), build)
 
 
 def _column_major(lo: np.ndarray, hi: np.ndarray, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:

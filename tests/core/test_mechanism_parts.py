@@ -121,7 +121,8 @@ def test_the_closure_carries_no_mechanism_and_no_solver_cache():
     model = cn.build_model("prs3", PRS3)
     c = model.closure
     assert "mechanism" not in vars(c) and "solvers" not in vars(c)
-    assert c.solvers is cs.solvers_of(c) is cs.solvers_of(c)
+    assert cs.solvers_of(c) is cs.solvers_of(c)  # one cache per closure, held by the solver layer
+    assert not hasattr(c, "solvers")  # 0.3: the property is gone (changelog: use solvers_of)
     by_hand = cn.Model(c, dict(model.parameters), dict(model.limits), dict(model.derived))
     assert by_hand.mechanism is None and model.mechanism is cn.mechanism_type("prs3")
 

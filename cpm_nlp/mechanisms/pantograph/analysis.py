@@ -56,7 +56,7 @@ from ...analysis.workspace import check_box
 from ...core.errors import InputError
 from ...core.model import Model
 from ...core.options import Option
-from ...core.solver import SolverConfig
+from ...core.solver import SolverConfig, solvers_of
 
 HALF_PI = math.pi / 2
 SQRT2 = math.sqrt(2.0)
@@ -335,7 +335,7 @@ def paper_cuboid(model: Model, reading: str = "near_face", solver: SolverConfig 
     room = Mx * math.sqrt(_radius2(a, psi_max)) - k  # eq 34a: x̂ can exceed k at all
     if not room > 0:
         return {"status": "infeasible", "message": f"eq 34a: k = {k:.6g} m is not below the outer ellipsoid"}
-    built = model.closure.solvers.get(
+    built = solvers_of(model.closure).get(
         f"paper_cuboid:{reading}:{with_phi}", config, lambda: _PaperCuboidNLP(reading, with_phi, config)
     )
     L = a * Mx
