@@ -173,9 +173,14 @@ def test_hinge_models_are_objects_and_the_inputs_choices():
     five_bar = cn.build_model("five_bar", {})
     assert hm.default_hinge_model(five_bar) is hm.HINGE_MODELS["kinematic"]
     hs = cm.hinge_set(model, None)
-    assert hm.HINGE_MODELS["kinematic"].six_axis(model, hs, ("inputs", "hinge_axes"), True) == (None, "")
-    six, note = hm.HINGE_MODELS["all"].six_axis(model, hs, ("inputs", "hinge_axes"), True)
-    assert six is not None and note == ""
+    where = ("inputs", "hinge_axes")
+    assert hm.HINGE_MODELS["kinematic"].prepare(model, hs, where, True) == hm.Prepared(hm.KINEMATIC, None, True)
+    six = hm.HINGE_MODELS["all"].prepare(model, hs, where, True)
+    assert six.hinges is hm.HINGE_MODELS["all"] and six.six_axis is not None and six.note == ""
+    # the default on a mechanism without chains is the kinematic model; "all" chosen there is bad input
+    assert hm.default_hinge_model(five_bar).prepare(five_bar, hs, where, False).hinges is hm.KINEMATIC
+    with pytest.raises(cn.InputError, match="needs the legs of five_bar as serial chains"):
+        hm.HINGE_MODELS["all"].prepare(five_bar, hs, where, True)
     problem = (PROBLEMS / "prs3_table2_forces.yaml").read_text()
     assert "hinge_axes" not in problem
     with pytest.raises(cn.InputError, match="did you mean 'kinematic'"):
