@@ -27,9 +27,14 @@ def stress_outputs(suffix: str = "") -> list[Output]:
     return [Output("stress_max" + suffix, "stress"), Output(f"stress_{{group}}{suffix}", "stress", per="hinge group")]
 
 
+def stress_groups(hs: HingeSet) -> list[str]:
+    """The hinge groups with a stress: those of a flexure type, in name order."""
+    return sorted({h.group for h in hs.hinges if h.kind is not None})
+
+
 def stress_values(hs: HingeSet, points: list[StaticPoint | None], batch: bool, suffix: str = "") -> Values:
     """The largest stress (and each hinge group's) per point."""
-    groups = sorted({h.group for h in hs.hinges if h.kind is not None})
+    groups = stress_groups(hs)
     largest, family = stress_outputs(suffix)
     cols: dict[Output, list] = {largest: []}
     cols.update({family.member(group=g): [] for g in groups})

@@ -210,6 +210,10 @@ class Output:
     problem's hinges): its name has fields in braces (``stress_{group}``), and each member
     (:meth:`member`) is an output of the family's dimension, role and unit.  A kind declares
     the family; a :class:`Result` declares only its members.
+
+    when: the input that asks for this output where the kind returns it only then
+    ("assembly_modes: all"); such an output is not among the kind's default names (a
+    sweep's columns, :meth:`~cpm_nlp.core.kind.ProblemKind.output_names`).
     """
 
     name: str
@@ -218,6 +222,7 @@ class Output:
     refers_to: str = ""
     unit: str | None = None
     per: str = ""
+    when: str = ""
 
     def __post_init__(self) -> None:
         if self.role not in ROLES:

@@ -15,6 +15,7 @@ joints carry hinges (declared by the mechanism's part ``stiffness``, a
 from __future__ import annotations
 
 from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -27,6 +28,8 @@ from ..analysis.compliance_values import (
     diagonal_output,
     force_output,
     point_warnings,
+    stress_groups,
+    stress_outputs,
     stress_values,
 )
 from ..analysis.dynamics import parse_inertia, parse_mass
@@ -52,7 +55,7 @@ from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
 from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
-from .kinematic import _model_info, _pose_names, _pose_outputs, _pose_values
+from .kinematic import _model_info, _pose_outputs, _pose_values
 
 
 def _pose_inputs(model: Model) -> list[Option]:
@@ -130,6 +133,15 @@ class _HingeKind(ProblemKind):
         inputs["hinge_set"] = cm.hinge_set(model, inputs["hinges"], inputs["material"], inputs.get("sigma_allow"), path)
 
 
+#: the stiffness of a hinge group's formula about each of its axes: on an angle coordinate, on a length
+K_FORMULA: Mapping[str, Output] = MappingProxyType(
+    {
+        kind: Output("k_formula_{group}_{axis}", dimension, per=f"hinge group with a flexure type, and axis on {on}")
+        for kind, dimension, on in (("angle", "rotational_stiffness", "an angle"), ("length", "stiffness", "a length"))
+    }
+)
+
+
 def _formula_stiffness(model: Model, hs: cm.HingeSet) -> Values:
     """The stiffness of each hinge group's formula about each of its axes (a group once)."""
     c = model.closure
@@ -140,9 +152,26 @@ def _formula_stiffness(model: Model, hs: cm.HingeSet) -> Values:
             continue
         seen.add(h.group)
         for a, kf in h.k_formula.items():
-            kind = "rotational_stiffness" if coords[h.axes[a]].kind == "angle" else "stiffness"
-            out.add(Output(f"k_formula_{h.group}_{a}", kind), kf)
+            family = K_FORMULA["angle" if coords[h.axes[a]].kind == "angle" else "length"]
+            out.add(family.member(group=h.group, axis=a), kf)
     return out
+
+
+def _declared_hinges(kind: ProblemKind, model: Model) -> cm.HingeSet | None:
+    """The mechanism's own hinges (its part ``stiffness``), as a problem without ``inputs.hinges``
+    has them: the hinge groups a result names unless the problem adds others (None: none declared)."""
+    return cm.hinge_set(model, None) if kind.part(model, cm.JointStiffness) is not None else None
+
+
+def _stress_outputs(hs: cm.HingeSet | None, suffix: str = "") -> list[Output]:
+    """The largest stress, that of each of the mechanism's hinge groups, and the family of all groups."""
+    largest, family = stress_outputs(suffix)
+    return [largest, *(family.member(group=g) for g in (stress_groups(hs) if hs is not None else ())), family]
+
+
+def _k_q_output(c: Any) -> Output:
+    stiffness = f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"
+    return matrix("K_q", f"{stiffness} (rows and columns {', '.join(c.q_names)})")
 
 
 def _hinge_result(
@@ -220,11 +249,7 @@ class ActuatorForces(_HingeKind):
         for j, q in enumerate(c.q):
             out.add(force_output(f"F{j + 1}", q), per_point([None if sp is None else float(sp.F[j]) for sp in points]))
         out.extend(stress_values(hs, points, batch))
-        stiffness = f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"
-        out.add(
-            matrix("K_q", f"{stiffness} (rows and columns {', '.join(c.q_names)})"),
-            per_point([None if sp is None else sp.K_q.tolist() for sp in points]),
-        )
+        out.add(_k_q_output(c), per_point([None if sp is None else sp.K_q.tolist() for sp in points]))
         out.add(Output("energy", "energy"), per_point([None if sp is None else sp.energy for sp in points]))
         out.extend(_formula_stiffness(model, hs))
         if inputs["stress_limit"]:
@@ -303,23 +328,22 @@ class ActuatorForces(_HingeKind):
                 return hs.material_at[h.material.name][0]
         return ("inputs", "sigma_allow")
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
+        """The pose, the actuator forces, the stresses, K_q, the energy, the formula stiffness of
+        each hinge group (the mechanism's, and the families of a problem's own), the stress limit."""
         c = model.closure
-        names = _pose_names(model)[0] + [f"F{j + 1}" for j in range(c.nq)] + ["stress_max", "K_q", "energy"]
-        names += ["sigma_allow", "scale_at_allowable", "scale_at_allowable_linear"]
-        for i in c.task_index:
-            names += [f"{c.x[i].name}_at_allowable", f"{c.x[i].name}_at_allowable_linear"]
-        for off in c.offsets:
-            names += [f"{off}_at_allowable", f"{off}_at_allowable_linear"]
-        names += [f"{q}_at_allowable" for q in c.q_names]
-        decl = self.part(model, cm.JointStiffness)
-        if decl is not None:
-            names += [f"stress_{g}" for g in decl.records]
-            for g, spec in decl.records.items():  # stiffness from the hinge formula, where a geometry is given
-                if spec.type:
-                    joints = spec.joints
-                    names += [f"k_formula_{g}_{a}" for a in (joints if isinstance(joints, Mapping) else ("bend",))]
-        return names
+        hs = _declared_hinges(self, model)
+        formula = _formula_stiffness(model, hs).outputs if hs is not None else []
+        return [
+            *_pose_outputs(model),
+            *(force_output(f"F{j + 1}", q) for j, q in enumerate(c.q)),
+            *_stress_outputs(hs),
+            _k_q_output(c),
+            Output("energy", "energy"),
+            *formula,
+            *K_FORMULA.values(),
+            *_limit_outputs(model),
+        ]
 
 
 class _OutOfReach(Exception):
@@ -343,25 +367,37 @@ class _Ray:
         return inverse_kinematics(m, self.t_home + lam * (self.t_end - self.t_home), self.solver)
 
 
+def _limit_outputs(model: Model) -> list[Output]:
+    """σ_allow, the scale of the motion where the first hinge reaches it and the pose and
+    actuators there, each also by linear extrapolation (the actuators not)."""
+    c = model.closure
+    out = [
+        Output("sigma_allow", "stress"),
+        Output("scale_at_allowable", "dimensionless"),
+        Output("scale_at_allowable_linear", "dimensionless"),
+    ]
+    for i in c.task_index:
+        out += [Output(f"{c.x[i].name}_at_allowable{s}", c.x[i].kind) for s in ("", "_linear")]
+    for off, target in c.offsets.items():
+        out += [Output(f"{off}_at_allowable{s}", c.x[c.x_names.index(target)].kind) for s in ("", "_linear")]
+    return out + [Output(f"{qn}_at_allowable", c.q[j].kind) for j, qn in enumerate(c.q_names)]
+
+
 def _limit_values(
     model: Model, ray: _Ray, sol: PoseSolution, lam: float, lam_lin: float | None, sigma: float
 ) -> Values:
     """The pose and actuators where the first hinge reaches σ_allow, and their linear extrapolation."""
     c = model.closure
-    out = Values().add(Output("sigma_allow", "stress"), sigma)
-    out.add(Output("scale_at_allowable", "dimensionless"), lam)
-    out.add(Output("scale_at_allowable_linear", "dimensionless"), lam_lin)
+    values: list[Any] = [sigma, lam, lam_lin]
+    linear = {}
     for k, i in enumerate(c.task_index):
-        name, kind = c.x[i].name, c.x[i].kind
-        out.add(Output(f"{name}_at_allowable", kind), float(sol.x[i]))
-        linear = ray.t_home[k] + lam_lin * (ray.t_end[k] - ray.t_home[k])
-        out.add(Output(f"{name}_at_allowable_linear", kind), float(linear))
-    for off, target in c.offsets.items():
+        linear[i] = ray.t_home[k] + lam_lin * (ray.t_end[k] - ray.t_home[k])
+        values += [float(sol.x[i]), float(linear[i])]
+    for target in c.offsets.values():
         i = c.x_names.index(target)
-        out.add(Output(f"{off}_at_allowable", c.x[i].kind), float(sol.x[i] - model.x_home[i]))
-        linear = out.values[f"{target}_at_allowable_linear"] - float(model.x_home[i])
-        out.add(Output(f"{off}_at_allowable_linear", c.x[i].kind), linear)
-    return out.add_all((Output(f"{qn}_at_allowable", c.q[j].kind), float(sol.q[j])) for j, qn in enumerate(c.q_names))
+        values += [float(sol.x[i] - model.x_home[i]), float(linear[i]) - float(model.x_home[i])]
+    values += [float(v) for v in sol.q]
+    return Values().add_all(zip(_limit_outputs(model), values, strict=True))
 
 
 class PlatformCompliance(_HingeKind):
@@ -417,7 +453,7 @@ class PlatformCompliance(_HingeKind):
             vector("deflection_linear", xs),
             vector("deflection", xs),
             vector("q_loaded", qs),
-            Output("stress_max_loaded", "stress"),
+            *_stress_outputs(_declared_hinges(self, model), "_loaded"),
             *(diagonal_output(x) for x in c.x),
             *(Output(f"d_{x.name}", x.kind) for x in c.x),
             text("hinge_model"),
