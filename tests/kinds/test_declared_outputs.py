@@ -126,3 +126,16 @@ def test_a_shipped_problem_gives_exactly_the_declared_outputs(name):
     plain = [o.name for o in declared if not o.family]
     assert len(plain) == len(set(plain)), name
     assert not any(re.search(r"\{\w+\}", v) for v in res.values), name
+
+
+def test_the_reference_page_lists_every_value_with_its_unit():
+    """The generated docs reference (problems/describe.reference_markdown) has a table of values
+    with unit and dimension for every kind on every mechanism, never a bare list of names."""
+    from cpm_nlp.problems.describe import reference_markdown
+
+    page = reference_markdown()
+    assert "\nValues: " not in page
+    assert "| `c_r` | rad/(N*m) | rotational_compliance |" in page
+    assert "| `stress_{group}` | Pa | stress | one per hinge group |" in page
+    assert "| `x_hat` | m | length |" in page  # the pantograph's cuboid values, from its part
+    assert "| `modes` |  | dimensionless | with assembly_modes: all |" in page
