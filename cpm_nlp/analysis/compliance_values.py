@@ -24,7 +24,10 @@ from .hinge_chains import SixAxisModel
 def stress_outputs(suffix: str = "") -> list[Output]:
     """The largest stress over every hinge, and that of each hinge group: a family, one output
     per group of the problem's hinges (``suffix`` appended to both names)."""
-    return [Output("stress_max" + suffix, "stress"), Output(f"stress_{{group}}{suffix}", "stress", per="hinge group")]
+    return [
+        Output("stress_max" + suffix, "stress"),
+        Output(f"stress_{{group}}{suffix}", "stress", per="hinge group with a flexure type"),
+    ]
 
 
 def stress_groups(hs: HingeSet) -> list[str]:

@@ -136,6 +136,6 @@ def test_the_reference_page_lists_every_value_with_its_unit():
     page = reference_markdown()
     assert "\nValues: " not in page
     assert "| `c_r` | rad/(N*m) | rotational_compliance |" in page
-    assert "| `stress_{group}` | Pa | stress | one per hinge group |" in page
+    assert "| `stress_{group}` | Pa | stress | one per hinge group with a flexure type |" in page
     assert "| `x_hat` | m | length |" in page  # the pantograph's cuboid values, from its part
     assert "| `modes` |  | dimensionless | with assembly_modes: all |" in page

@@ -128,7 +128,7 @@ class Twists(RprKind):
                 **{x.name: x.kind for x in model.closure.x},
             },
             {
-                "T": f"{rows} (linear G d, in the convention of the value convention)",
+                "T": f"{rows} (linear G d; moments in the convention the value 'convention' names)",
                 "T_fk": f"{rows}, S_t times the exact FK pose change",
                 "dT_fk": "max |T_fk - T|",
                 "convention": "",
