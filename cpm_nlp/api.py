@@ -31,6 +31,7 @@ from .core.kinematics import (
 )
 from .core.mechanism import Mechanism, Part, declare
 from .core.model import Coordinate, LoopClosure, Model
+from .core.outputs import Output
 from .core.pose_checks import status_of
 from .core.result import Result, ResultWarning, SolverInfo, Status
 from .core.solver import SolverConfig
@@ -123,6 +124,7 @@ __all__ = [
     "Membership",
     "Model",
     "ModelFunctions",
+    "Output",
     "PoseSolution",
     "Problem",
     "ProblemKind",

@@ -68,7 +68,7 @@ from ..core.model import Model
 from ..core.multistart import DEFAULT_STARTS as DEFAULT_STARTS  # the default starts of a search (defined there)
 from ..core.pose_checks import ROUND_TRIP_FACTOR, STATUSES
 from ..core.result import Status
-from ..core.solver import SolverConfig
+from ..core.solver import SolverConfig, solvers_of
 
 log = logging.getLogger(__name__)
 
@@ -418,7 +418,7 @@ def damped_newton(model: Model) -> ca.Function:
             xs = step(xs, wm, sm)
         return ca.Function(f"{c.name}_search_steps", [x0, wm, sm], [xs], ["x0", "w", "scale"], ["x"])
 
-    return c.solvers.memo(("assembly_damped_newton", DAMPED_STEPS, STEP_LIMIT), build)
+    return solvers_of(c).memo(("assembly_damped_newton", DAMPED_STEPS, STEP_LIMIT), build)
 
 
 def completeness(basins: list[int], starts: int) -> Completeness:

@@ -47,7 +47,9 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import casadi as ca
 import numpy as np
@@ -55,6 +57,7 @@ import numpy as np
 from ..core import progress
 from ..core.model import LoopClosure, Model
 from ..core.options import Option
+from ..core.solver import solvers_of
 from .intervals import IntervalProgram, UnsupportedOperation
 from .workspace import SINGULAR_CONDITION, limit_bounds, limited_function
 
@@ -136,7 +139,7 @@ def certificate_programs(closure: LoopClosure, rows: tuple[int, ...]) -> _Progra
             IntervalProgram(full), IntervalProgram(values), tuple(rows), ("reach",) + tuple(names[r] for r in rows)
         )
 
-    return closure.solvers.memo(("certify", tuple(rows)), build)
+    return solvers_of(closure).memo(("certify", tuple(rows)), build)
 
 
 def _column_major(lo: np.ndarray, hi: np.ndarray, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
@@ -432,28 +435,9 @@ CERTIFY_OPTION = Option(
     default=True,
 )
 
-#: values of :func:`certificate_values`
-CERTIFICATE_NAMES = (
-    "certified",
-    "certified_margin",
-    "certified_binding",
-    "certificate_boxes",
-    "certificate_seconds",
-    "certificate_failing",
-    "certificate_quantity",
-    "certified_shrink",
-    "certified_volume_ratio",
-    "certificate",
-)
-
-
-def certificate_values(model: Model, lower, upper, enabled: bool = True) -> tuple[dict, dict]:
-    """The certificate of the box [lower, upper] as result values and their dimensions:
-    ``certified`` (True/False; None when not requested or without a closed-form IK),
-    the proven margin and its quantity, sub-boxes, seconds, and, when not certified,
-    the failing sub-box and quantity and the largest certified shrink factor about
-    the centre (``certified_shrink``; ``certified_volume_ratio`` = its d-th power)."""
-    dims = {
+#: the values of :func:`certificate_values` and their dimensions
+CERTIFICATE_DIMENSIONS: Mapping[str, str] = MappingProxyType(
+    {
         "certified": "text",
         "certified_margin": "si",
         "certified_binding": "text",
@@ -465,6 +449,17 @@ def certificate_values(model: Model, lower, upper, enabled: bool = True) -> tupl
         "certified_volume_ratio": "dimensionless",
         "certificate": "text",
     }
+)
+CERTIFICATE_NAMES = tuple(CERTIFICATE_DIMENSIONS)
+
+
+def certificate_values(model: Model, lower, upper, enabled: bool = True) -> tuple[dict, dict]:
+    """The certificate of the box [lower, upper] as result values and their dimensions:
+    ``certified`` (True/False; None when not requested or without a closed-form IK),
+    the proven margin and its quantity, sub-boxes, seconds, and, when not certified,
+    the failing sub-box and quantity and the largest certified shrink factor about
+    the centre (``certified_shrink``; ``certified_volume_ratio`` = its d-th power)."""
+    dims = dict(CERTIFICATE_DIMENSIONS)
     values: dict = {k: None for k in CERTIFICATE_NAMES}
     c = model.closure
     if not enabled or lower is None:

@@ -52,7 +52,7 @@ import numpy as np
 
 from ..core.batch import evaluate_points
 from ..core.model import LoopClosure, Model
-from ..core.solver import SolverConfig
+from ..core.solver import SolverConfig, solvers_of
 
 log = logging.getLogger(__name__)
 
@@ -89,7 +89,7 @@ def row_function(closure: LoopClosure, limited: ca.Function, rows: tuple[int, ..
         g = ca.if_else(reach >= 0, v, ca.DM.nan(v.size1()))
         return ca.Function(f"{c.name}_cuboid_rows", [t, p], [g], ["t", "p"], ["g"])
 
-    return closure.solvers.memo(row_key(rows), build)
+    return solvers_of(closure).memo(row_key(rows), build)
 
 
 def slots(rows: int) -> int:
@@ -224,7 +224,7 @@ class ClosedFormCuboid:
 
     def _nlp(self, sel: tuple[int, ...], K: int, blocks: int = 1) -> SlotNLP:
         key = ("cuboid_slots", self.rows, sel, K, blocks, repr(sorted(self.options.items())))
-        return self.closure.solvers.get(
+        return solvers_of(self.closure).get(
             repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, sel, K, self.options, blocks)
         )
 

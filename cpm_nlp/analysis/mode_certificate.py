@@ -44,6 +44,7 @@ import numpy as np
 
 from ..core import progress
 from ..core.model import Model
+from ..core.solver import solvers_of
 from .assembly import AssemblyModes
 from .certify import regularity
 from .intervals import IntervalProgram
@@ -98,7 +99,7 @@ def closure_program(model: Model) -> IntervalProgram:
         )
         return IntervalProgram(fn)
 
-    return c.solvers.memo(("mode_certificate",), build)
+    return solvers_of(c).memo(("mode_certificate",), build)
 
 
 def _stop(boxes: int, max_boxes: int, t0: float, seconds: float | None) -> str:

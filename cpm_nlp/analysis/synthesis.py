@@ -43,7 +43,7 @@ from ..core.errors import InputError, suggest
 from ..core.model import LoopClosure, Model
 from ..core.multistart import AGREEMENT, best_and_agreement, uniform_starts
 from ..core.progress import track
-from ..core.solver import SolverConfig, run_nlp
+from ..core.solver import SolverConfig, run_nlp, solvers_of
 from .workspace import (
     CUBOID_IPOPT,
     DEFAULT_CHECK_POINTS,
@@ -307,7 +307,7 @@ def cuboid_synthesis(
     lo_b, hi_b = limit_bounds(model)
     active = tuple(bool(v) for v in (np.isfinite(lo_b) | np.isfinite(hi_b)))
     key = f"synthesis:{N}:{''.join('1' if a else '0' for a in active)}:{design_idx}:{exps}"
-    nlp = c.solvers.get(key, config, lambda: SynthesisNLP(c, N, active, design_idx, exps, config))
+    nlp = solvers_of(c).get(key, config, lambda: SynthesisNLP(c, N, active, design_idx, exps, config))
     rows = nlp.rows
     lo_a, hi_a = lo_b[rows], hi_b[rows]
     lo_a = np.where(np.isfinite(lo_a), lo_a + NLP_MARGIN, lo_a)

@@ -49,7 +49,7 @@ from .kinematics import PoseSolution, failure_message
 from .model import LoopClosure, Model
 from .pose_checks import NUMPY, STATUSES, code_of, condition_number, is_singular, status_code, status_rules
 from .result import Status
-from .solver import SolverConfig
+from .solver import SolverConfig, solvers_of
 
 log = logging.getLogger(__name__)
 
@@ -312,7 +312,7 @@ def _backend_function(kern: Kernel, model: Model, backend: str) -> tuple[ca.Func
         return resolve()
     # one look-up per call (keyed on the cache's environment: a changed CPM_NLP_CACHE means
     # other libraries), instead of the paths of compiled.cache_dir() built twice per call
-    return c.solvers.memo(("batch_backend", backend, *cache_key()) + kern.key, resolve)
+    return solvers_of(c).memo(("batch_backend", backend, *cache_key()) + kern.key, resolve)
 
 
 def _run_chunks(run: Callable[[int], int], starts: list[int], chunk: int, n: int, threads: int, what: str) -> list[int]:
@@ -440,7 +440,7 @@ def evaluate_points(
     if n >= THREADED_POINTS:
         return evaluate(function, args + [p])
     size = max(8, 1 << (n - 1).bit_length()) if n <= 256 else -(-n // 256) * 256
-    mapped = closure.solvers.memo(("mapped", size) + tuple(key), lambda: function.map(size))
+    mapped = solvers_of(closure).memo(("mapped", size) + tuple(key), lambda: function.map(size))
     padded = [np.vstack([a, np.repeat(a[:1], size - n, axis=0)]) if size > n else a for a in args]
     flat = [np.ascontiguousarray(a).reshape(-1) for a in padded] + [np.ascontiguousarray(np.tile(p, size))]
     outs = [np.empty((size, function.nnz_out(k))) for k in range(function.n_out())]

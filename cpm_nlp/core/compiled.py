@@ -35,6 +35,7 @@ from .errors import CpmError, InputError, suggest
 from .fast_calls import BoundCall
 from .kernels import Kernel
 from .model import LoopClosure
+from .solver import solvers_of
 
 log = logging.getLogger(__name__)
 
@@ -331,14 +332,14 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
                 return "map"
             return "compiled"
 
-        if closure.solvers.memo(("auto_backend", *cache_key()) + kern.key, decide) == "compiled":
+        if solvers_of(closure).memo(("auto_backend", *cache_key()) + kern.key, decide) == "compiled":
             return compiled_function(closure, kern), "compiled"
     return kern.function, "map"
 
 
 def _source(closure: LoopClosure, kern: Kernel) -> str:
     """The kernel's C source (its function and the loop over poses), generated once per process."""
-    return closure.solvers.memo(
+    return solvers_of(closure).memo(
         ("source",) + kern.key,
         lambda: generate_source(kern.function, kern.name) + batch_loop_source(kern.function, kern.name),
     )
@@ -348,19 +349,19 @@ def _library(closure: LoopClosure, kern: Kernel) -> Path:
     def build() -> Path:
         return build_library(_source(closure, kern), kern.name)
 
-    return closure.solvers.memo(("library", *cache_key()) + kern.key, build)
+    return solvers_of(closure).memo(("library", *cache_key()) + kern.key, build)
 
 
 def compiled_function(closure: LoopClosure, kern: Kernel) -> ca.Function:
     """The kernel's compiled twin (same inputs and outputs), built or loaded once per process."""
-    return closure.solvers.memo(
+    return solvers_of(closure).memo(
         ("compiled", *cache_key()) + kern.key, lambda: ca.external(kern.name, str(_library(closure, kern)))
     )
 
 
 def native_loop(closure: LoopClosure, kern: Kernel) -> NativeLoop:
     """The compiled kernel's loop over poses (:func:`batch_loop_source`), loaded once per process."""
-    return closure.solvers.memo(
+    return solvers_of(closure).memo(
         ("native_loop", *cache_key()) + kern.key,
         lambda: NativeLoop(_library(closure, kern), kern.name, compiled_function(closure, kern)),
     )

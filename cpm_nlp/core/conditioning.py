@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import casadi as ca
 
 from .model import LoopClosure
+from .solver import solvers_of
 
 
 def all_finite(v: ca.SX) -> ca.SX:
@@ -187,7 +188,7 @@ def _left_inverse_norm(d: ca.SX) -> ca.SX:
 def closure_blocks(closure: LoopClosure) -> LeftInverseBlocks | None:
     """:func:`left_inverse_blocks` of a closure's e_x (built once per closure)."""
     c = closure
-    return c.solvers.memo(
+    return solvers_of(c).memo(
         ("left_inverse_blocks",),
         lambda: left_inverse_blocks(c.cond_matrix.sparsity_out(0), c.phi_x.sparsity_out(0)),
     )

@@ -12,6 +12,7 @@ import casadi as ca
 import numpy as np
 
 from .model import LoopClosure
+from .solver import solvers_of
 
 
 class FastFunction:
@@ -122,4 +123,4 @@ class BoundCall:
 
 def fast(closure: LoopClosure, key: tuple, function: Callable[[], ca.Function]) -> FastFunction:
     """A :class:`FastFunction` built once per closure and key."""
-    return closure.solvers.memo(("fast",) + key, lambda: FastFunction(function()))
+    return solvers_of(closure).memo(("fast",) + key, lambda: FastFunction(function()))

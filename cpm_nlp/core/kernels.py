@@ -42,7 +42,7 @@ from .pose_checks import (
     status_rules,
 )
 from .result import Status
-from .solver import DEFAULT_OPTIONS, SolverConfig
+from .solver import DEFAULT_OPTIONS, SolverConfig, solvers_of
 from .solver_options import NEWTON_BATCH, NEWTON_BATCH_IGNORED
 
 #: Newton options the kernels' rootfinder (CasADi ``fast_newton``) accepts (from the one table,
@@ -177,7 +177,7 @@ def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> 
         return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, SHARED_INPUTS)
 
     key = ("full_fk_kernel", _options_key(opts))
-    return closure.solvers.memo(key, build)
+    return solvers_of(closure).memo(key, build)
 
 
 def newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
@@ -201,7 +201,7 @@ def newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
         return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
 
     key = ("newton_fk_kernel", _options_key(opts))
-    return closure.solvers.memo(key, build)
+    return solvers_of(closure).memo(key, build)
 
 
 def _settled_or(first: ca.Function, fallback: ca.Function, name: str, names: Sequence[str]) -> ca.Function:
@@ -319,7 +319,7 @@ def gauss_newton_fk_kernel(
         return Kernel(fn, "fk", ("q", "x0"), names, key, SHARED_INPUTS)
 
     key = ("gauss_newton_fk_kernel", _options_key(opts), steps)
-    return closure.solvers.memo(key, build)
+    return solvers_of(closure).memo(key, build)
 
 
 #: Newton steps of the reduced FK (unrolled: straight-line code, no loop); from the
@@ -395,7 +395,7 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
         return Kernel(fn, "fk", ("q", "x0"), names, key, REDUCED_SHARED_INPUTS)
 
     key = ("reduced_fk_kernel", _options_key(opts), steps)
-    return closure.solvers.memo(key, build)
+    return solvers_of(closure).memo(key, build)
 
 
 def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
@@ -423,7 +423,7 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
 
     key = ("fk_kernel_closed", _options_key(opts))
-    return c.solvers.memo(key, build)
+    return solvers_of(c).memo(key, build)
 
 
 def _seeded_fk_kernel(closure: LoopClosure, config: SolverConfig | None) -> Kernel:
@@ -492,7 +492,7 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
         return Kernel(fn, "fk", ("q", "x0"), tuple(names), key, shared_names)
 
     key = ("closed_fk_kernel", _options_key(opts))
-    return closure.solvers.memo(key, build)
+    return solvers_of(closure).memo(key, build)
 
 
 def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: str) -> Kernel:
@@ -554,7 +554,7 @@ def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: s
         return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS)
 
     key = ("fk_kernel", _options_key(opts), name)
-    return c.solvers.memo(key, build)
+    return solvers_of(c).memo(key, build)
 
 
 def ik_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
@@ -599,7 +599,7 @@ def ik_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
         return Kernel(fn, "ik", pose_inputs, names, key, SHARED_INPUTS)
 
     key = ("ik_kernel", _options_key(opts))
-    return closure.solvers.memo(key, build)
+    return solvers_of(closure).memo(key, build)
 
 
 def jacobian_kernel(closure: LoopClosure) -> Kernel:
@@ -614,7 +614,7 @@ def jacobian_kernel(closure: LoopClosure) -> Kernel:
         return Kernel(fn, "jacobian", ("x", "q"), names, key, ("p",))
 
     key = ("jacobian_kernel",)
-    return closure.solvers.memo(key, build)
+    return solvers_of(closure).memo(key, build)
 
 
 def kernel(closure: LoopClosure, kind: str, config: SolverConfig | None = None) -> Kernel:

@@ -79,12 +79,15 @@ class ProblemKind:
     def outputs(self, model: Model) -> list[Output]:
         """The declared outputs on ``model``: name, dimension, role (and the unit text of
         what has no SI unit), every value the kind may return, in order; its results are
-        built from them (:func:`~cpm_nlp.core.outputs.declared_result`)."""
+        built from them (:func:`~cpm_nlp.core.outputs.declared_result`).  Values whose
+        names depend on the inputs (one per hinge group of the problem's hinges) are a
+        family (``Output(..., per=...)``), of which a result holds members."""
         raise NotImplementedError
 
     def output_names(self, model: Model) -> list[str]:
-        """The names of :meth:`outputs`."""
-        return [o.name for o in self.outputs(model)]
+        """The names of :meth:`outputs` that a result has by default: not a family's (its members
+        depend on the inputs), nor one that only an input asks for (``Output.when``)."""
+        return [o.name for o in self.outputs(model) if not o.family and not o.when]
 
     def supports(self, model: Model) -> str | None:
         """None if the kind applies to this model, else the reason it does not."""

@@ -26,7 +26,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from .solver import SolverCache, SolverConfig, SquareSolver, solvers_of
+from .solver import SolverConfig, SquareSolver, solvers_of
 
 
 @dataclass(frozen=True)
@@ -216,21 +216,15 @@ class LoopClosure:
             return ca.vertcat(*parts)
         return np.array([float(v) for v in parts])
 
-    # -- solvers (built once per configuration) -----------------------------------
-    @property
-    def solvers(self) -> SolverCache:
-        """What is built from this closure (solvers, kernels), held by the solver layer
-        (:func:`~cpm_nlp.core.solver.solvers_of`), not stored on the closure."""
-        return solvers_of(self)
-
+    # -- solvers (built once per configuration, held by core.solver.solvers_of) ----
     def fk_solver(self, config: SolverConfig) -> SquareSolver:
-        return self.solvers.get(
+        return solvers_of(self).get(
             "fk", config, lambda: SquareSolver(f"{self.name}_fk", self.fk_residual, self.nx, self.nq + self.np, config)
         )
 
     def ik_solver(self, config: SolverConfig) -> SquareSolver:
         ny = len(self.dep_index) + self.nq
-        return self.solvers.get(
+        return solvers_of(self).get(
             "ik", config, lambda: SquareSolver(f"{self.name}_ik", self.ik_residual, ny, self.nq + self.np, config)
         )
 

@@ -18,10 +18,12 @@ from .result import ROLES, Entry, Output, Result, ResultWarning, SolverInfo, Sta
 from .units import DIMENSIONS, size_dimension
 
 __all__ = (
+    "BINDING_UNIT",
     "ROLES",
     "Entry",
     "Output",
     "Values",
+    "declared_for",
     "declared_result",
     "matrix",
     "output_names",
@@ -32,13 +34,22 @@ __all__ = (
 )
 
 
+#: the unit of a margin (dimension "si"): that of whichever quantity binds (a length, an angle, a stress ...)
+BINDING_UNIT = "SI unit of the binding quantity"
+
+
 def outputs_of(dims: Mapping[str, str], *, named: bool = True) -> list[Output]:
     """Outputs of the given dimensions, in their order (a matrix's and a text's role said by
     their dimension, every other one a value).  An output of no physical dimension (a text,
-    a matrix, a margin in the unit of whichever quantity binds) writes its dimension's name
-    as its unit, or with ``named=False`` no unit."""
+    a matrix) writes its dimension's name as its unit, or with ``named=False`` no unit; a
+    margin (dimension "si") is in the unit of whichever quantity binds (:data:`BINDING_UNIT`)."""
     return [
-        Output(n, d, d if d in ("matrix", "text") else "value", unit=None if named or d in DIMENSIONS else "")
+        Output(
+            n,
+            d,
+            d if d in ("matrix", "text") else "value",
+            unit=BINDING_UNIT if d == "si" else None if named or d in DIMENSIONS else "",
+        )
         for n, d in dims.items()
     ]
 
@@ -97,6 +108,17 @@ class Values:
 
 def output_names(outputs: Sequence[Output]) -> list[str]:
     return [o.name for o in outputs]
+
+
+def declared_for(kind: str, declared: Sequence[Output], names: Iterable[str]) -> list[Output]:
+    """The declarations of ``names``, in the declared order, from a kind's declared outputs (a
+    result built from them holds what the kind declares, nothing else); a name the kind
+    does not declare is a programming error (ValueError), as :class:`Result` refuses it."""
+    wanted = set(names)
+    undeclared = sorted(wanted - {o.name for o in declared if not o.family})
+    if undeclared:
+        raise ValueError(f"{kind}: value(s) the kind does not declare: {', '.join(map(str, undeclared))}")
+    return [o for o in declared if not o.family and o.name in wanted]
 
 
 def declared_result(

@@ -45,6 +45,7 @@ from .conditioning import (
 )
 from .model import Coordinate, LoopClosure, Model
 from .result import Status
+from .solver import solvers_of
 
 #: FK/IK round trips must agree to this multiple of the residual tolerance.
 ROUND_TRIP_FACTOR = 100.0
@@ -322,4 +323,4 @@ def checks_function(closure: LoopClosure) -> ca.Function:
             names + ["status"],
         )
 
-    return closure.solvers.memo(("pose_checks",), build)
+    return solvers_of(closure).memo(("pose_checks",), build)

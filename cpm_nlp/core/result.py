@@ -7,8 +7,10 @@ failed points are ``None`` (``null`` in JSON), never a number that looks right.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
+import re
 import sys
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -220,6 +222,10 @@ WARNING_CODES: Mapping[str, str] = MappingProxyType(
 ROLES = ("value", "reference", "matrix", "text")
 
 
+#: a field of a family's name ("stress_{group}")
+_FIELD = re.compile(r"\{(\w+)\}")
+
+
 @dataclass(frozen=True)
 class Output:
     """One value a kind returns, declared once.
@@ -228,6 +234,15 @@ class Output:
     (or "matrix", "vector", "text" for what has no SI unit); role: one of :data:`ROLES`;
     refers_to: the output a "reference" is taken from (x0 of an offset dx); unit: the
     unit text where the dimension's SI unit does not say it (a matrix's rows and columns).
+
+    per: a **family** of outputs, one per item of what ``per`` names (a hinge group of the
+    problem's hinges): its name has fields in braces (``stress_{group}``), and each member
+    (:meth:`member`) is an output of the family's dimension, role and unit.  A kind declares
+    the family; a :class:`Result` declares only its members.
+
+    when: the input that asks for this output where the kind returns it only then
+    ("assembly_modes: all"); such an output is not among the kind's default names (a
+    sweep's columns, :meth:`~cpm_nlp.core.kind.ProblemKind.output_names`).
     """
 
     name: str
@@ -235,17 +250,40 @@ class Output:
     role: str = "value"
     refers_to: str = ""
     unit: str | None = None
+    per: str = ""
+    when: str = ""
 
     def __post_init__(self) -> None:
         if self.role not in ROLES:
             raise ValueError(f"output {self.name!r}: role must be one of {', '.join(ROLES)}, got {self.role!r}")
         if (self.role == "reference") != bool(self.refers_to):
             raise ValueError(f"output {self.name!r}: a 'reference' output, and only it, names what it refers_to")
+        if bool(self.per) != bool(_FIELD.search(self.name)) or "{" in _FIELD.sub("", self.name):
+            raise ValueError(f"output {self.name!r}: a family (per=...), and only it, has fields in braces in its name")
 
     @property
     def si(self) -> str:
         """The unit the result writes (:func:`~cpm_nlp.core.units.result_unit` unless given)."""
         return self.unit if self.unit is not None else result_unit(self.dimension)
+
+    @property
+    def family(self) -> bool:
+        return bool(self.per)
+
+    def member(self, **fields: str) -> Output:
+        """The output of a family for the given fields (``group="leaf"`` -> ``stress_leaf``)."""
+        if not self.family:
+            raise ValueError(f"output {self.name!r} is no family")
+        return dataclasses.replace(self, name=self.name.format(**fields), per="")
+
+    def covers(self, output: Output) -> bool:
+        """Whether ``output`` is this declaration: the same output, or a member of this family."""
+        if not self.family:
+            return output == self
+        pattern = "".join("(.+)" if k % 2 else re.escape(part) for k, part in enumerate(_FIELD.split(self.name)))
+        return re.fullmatch(pattern, output.name) is not None and output == dataclasses.replace(
+            self, name=output.name, per=""
+        )
 
 
 @dataclass(frozen=True)
@@ -337,6 +375,12 @@ class Result:
 
     def declare(self, outputs: Sequence[Output]) -> Result:
         """Add declared outputs (after those declared so far); a name is declared once."""
+        families = [o.name for o in outputs if o.family]
+        if families:
+            raise ValueError(
+                f"{self.problem}: {', '.join(map(repr, families))} is a family of outputs; a result declares its "
+                "members (Output.member)"
+            )
         names = [o.name for o in outputs]
         twice = sorted({n for n in names if n in self._outputs or names.count(n) > 1})
         if twice:

@@ -14,17 +14,27 @@ joints carry hinges (declared by the mechanism's part ``stiffness``, a
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 import scipy.optimize
 
 from ..analysis import compliance as cm
-from ..analysis import validity
+from ..analysis.compliance_values import (
+    compliance_output,
+    coordinate_list,
+    diagonal_output,
+    force_output,
+    point_warnings,
+    stress_groups,
+    stress_outputs,
+    stress_values,
+)
 from ..analysis.dynamics import parse_inertia, parse_mass
-from ..analysis.hinge_chains import LegChains, SixAxisModel
-from ..analysis.hinge_models import HINGE_MODELS, default_hinge_model, hinge_model_text
+from ..analysis.hinge_chains import LegChains
+from ..analysis.hinge_models import HINGE_MODELS, Prepared, default_hinge_model, hinge_model_text
 from ..core.canonical import canonical_eigh, degenerate_note, multiplicities
 from ..core.errors import InputError
 from ..core.kind import (
@@ -37,7 +47,7 @@ from ..core.kind import (
     task_values,
 )
 from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinematics
-from ..core.model import Coordinate, Model
+from ..core.model import Model
 from ..core.options import Option
 from ..core.outputs import Output, Values, declared_result, matrix, text, vector
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, poses_solver_info, worst_status
@@ -45,7 +55,7 @@ from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
 from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
-from .kinematic import _model_info, _pose_names, _pose_outputs, _pose_values
+from .kinematic import _model_info, _pose_outputs, _pose_values
 
 
 def _pose_inputs(model: Model) -> list[Option]:
@@ -123,31 +133,13 @@ class _HingeKind(ProblemKind):
         inputs["hinge_set"] = cm.hinge_set(model, inputs["hinges"], inputs["material"], inputs.get("sigma_allow"), path)
 
 
-def _stress_values(hs: cm.HingeSet, points: list[cm.StaticPoint | None], batch: bool, suffix: str = "") -> Values:
-    """The largest stress (and each hinge group's) per point."""
-    groups = sorted({h.group for h in hs.hinges if h.kind is not None})
-    cols: dict[str, list] = {"stress_max": []}
-    cols.update({f"stress_{g}": [] for g in groups})
-    for sp in points:
-        if sp is None:
-            for v in cols.values():
-                v.append(None)
-            continue
-        cols["stress_max"].append(sp.stress_max)
-        for g in groups:
-            vals = [s for h, s in zip(hs.hinges, sp.stresses.values()) if h.group == g and s is not None]
-            cols[f"stress_{g}"].append(max(vals) if vals else None)
-    return Values().add_all((Output(k + suffix, "stress"), v if batch else v[0]) for k, v in cols.items())
-
-
-def _coordinate_list(coords: Sequence[Coordinate]) -> str:
-    """The coordinates with their units, as the unit text of a list of them."""
-    return ", ".join(f"{x.name} [{result_unit(x.kind)}]" for x in coords)
-
-
-def _force_output(name: str, coord: Coordinate) -> Output:
-    """A force on a length coordinate, a moment on an angle."""
-    return Output(name, "force" if coord.kind == "length" else "moment")
+#: the stiffness of a hinge group's formula about each of its axes: on an angle coordinate, on a length
+K_FORMULA: Mapping[str, Output] = MappingProxyType(
+    {
+        kind: Output("k_formula_{group}_{axis}", dimension, per=f"hinge group with a flexure type, and axis on {on}")
+        for kind, dimension, on in (("angle", "rotational_stiffness", "an angle"), ("length", "stiffness", "a length"))
+    }
+)
 
 
 def _formula_stiffness(model: Model, hs: cm.HingeSet) -> Values:
@@ -160,41 +152,26 @@ def _formula_stiffness(model: Model, hs: cm.HingeSet) -> Values:
             continue
         seen.add(h.group)
         for a, kf in h.k_formula.items():
-            kind = "rotational_stiffness" if coords[h.axes[a]].kind == "angle" else "stiffness"
-            out.add(Output(f"k_formula_{h.group}_{a}", kind), kf)
+            family = K_FORMULA["angle" if coords[h.axes[a]].kind == "angle" else "length"]
+            out.add(family.member(group=h.group, axis=a), kf)
     return out
 
 
-def _compliance_output(c: Any) -> Output:
-    """The output compliance C (rows and columns the pose coordinates)."""
-    units = f"{result_unit('compliance')}, {result_unit('rotational_compliance')} and mixed"
-    return matrix("C", f"rows and columns {_coordinate_list(c.x)}; {units}")
+def _declared_hinges(kind: ProblemKind, model: Model) -> cm.HingeSet | None:
+    """The mechanism's own hinges (its part ``stiffness``), as a problem without ``inputs.hinges``
+    has them: the hinge groups a result names unless the problem adds others (None: none declared)."""
+    return cm.hinge_set(model, None) if kind.part(model, cm.JointStiffness) is not None else None
 
 
-def _diagonal_output(x: Coordinate) -> Output:
-    """A diagonal entry of C: a compliance along a length, a rotational one about an angle."""
-    return Output(f"C_{x.name}", "compliance" if x.kind == "length" else "rotational_compliance")
+def _stress_outputs(hs: cm.HingeSet | None, suffix: str = "") -> list[Output]:
+    """The largest stress, that of each of the mechanism's hinge groups, and the family of all groups."""
+    largest, family = stress_outputs(suffix)
+    return [largest, *(family.member(group=g) for g in (stress_groups(hs) if hs is not None else ())), family]
 
 
-def _compliance_matrix(c: Any, C: np.ndarray, linear: np.ndarray) -> Values:
-    """The output compliance C and the linear deflection C f."""
-    out = Values().add(_compliance_output(c), C.tolist())
-    return out.add(vector("deflection_linear", _coordinate_list(c.x)), linear.tolist())
-
-
-def _diagonal_compliance(c: Any, C: np.ndarray) -> Values:
-    """The diagonal of C, one value per pose coordinate."""
-    return Values().add_all((_diagonal_output(x), float(C[i, i])) for i, x in enumerate(c.x))
-
-
-def _deflection_values(c: Any, d: np.ndarray) -> Values:
-    """The deflection under the load, as a list and per pose coordinate."""
-    out = Values().add(vector("deflection", _coordinate_list(c.x)), d.tolist())
-    return out.add_all((Output(f"d_{x.name}", x.kind), float(d[i])) for i, x in enumerate(c.x))
-
-
-def _largest(stresses: Mapping[str, float | None]) -> float | None:
-    return max((v for v in stresses.values() if v is not None), default=None)
+def _k_q_output(c: Any) -> Output:
+    stiffness = f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"
+    return matrix("K_q", f"{stiffness} (rows and columns {', '.join(c.q_names)})")
 
 
 def _hinge_result(
@@ -216,15 +193,6 @@ def _hinge_result(
         statuses=statuses,
         model=_model_info(model),
     )
-
-
-def _point_warnings(hs: cm.HingeSet, points: list[cm.StaticPoint | None], sigma: float | None = None) -> list:
-    """The hinges' geometry, stresses and deflections at the solved points (:mod:`~cpm_nlp.analysis.validity`)."""
-    pts = [
-        None if sp is None else (sp.stresses, validity.hinge_deflections(hs.hinges, sp.theta, hs.theta0))
-        for sp in points
-    ]
-    return validity.hinge_warnings(hs.hinges, pts, sigma)
 
 
 class ActuatorForces(_HingeKind):
@@ -279,13 +247,9 @@ class ActuatorForces(_HingeKind):
 
         out = Values(_pose_outputs(model), _pose_values(model, sols, batch))
         for j, q in enumerate(c.q):
-            out.add(_force_output(f"F{j + 1}", q), per_point([None if sp is None else float(sp.F[j]) for sp in points]))
-        out.extend(_stress_values(hs, points, batch))
-        stiffness = f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"
-        out.add(
-            matrix("K_q", f"{stiffness} (rows and columns {', '.join(c.q_names)})"),
-            per_point([None if sp is None else sp.K_q.tolist() for sp in points]),
-        )
+            out.add(force_output(f"F{j + 1}", q), per_point([None if sp is None else float(sp.F[j]) for sp in points]))
+        out.extend(stress_values(hs, points, batch))
+        out.add(_k_q_output(c), per_point([None if sp is None else sp.K_q.tolist() for sp in points]))
         out.add(Output("energy", "energy"), per_point([None if sp is None else sp.energy for sp in points]))
         out.extend(_formula_stiffness(model, hs))
         if inputs["stress_limit"]:
@@ -299,7 +263,7 @@ class ActuatorForces(_HingeKind):
             message += "; " + limit_message
         info = poses_solver_info(sols, solver.name)
         res = _hinge_result(self.name, model, status, out, info, message, statuses)
-        return res.warn(*_point_warnings(hs, points, inputs.get("sigma", inputs.get("sigma_allow"))))
+        return res.warn(*point_warnings(hs, points, inputs.get("sigma", inputs.get("sigma_allow"))))
 
     def _limit(
         self, model: Model, hs: cm.HingeSet, inputs: Mapping[str, Any], end: PoseSolution, solver: SolverConfig
@@ -360,23 +324,22 @@ class ActuatorForces(_HingeKind):
                 return hs.material_at[h.material.name][0]
         return ("inputs", "sigma_allow")
 
-    def output_names(self, model: Model) -> list[str]:
+    def outputs(self, model: Model) -> list[Output]:
+        """The pose, the actuator forces, the stresses, K_q, the energy, the formula stiffness of
+        each hinge group (the mechanism's, and the families of a problem's own), the stress limit."""
         c = model.closure
-        names = _pose_names(model)[0] + [f"F{j + 1}" for j in range(c.nq)] + ["stress_max", "K_q", "energy"]
-        names += ["sigma_allow", "scale_at_allowable", "scale_at_allowable_linear"]
-        for i in c.task_index:
-            names += [f"{c.x[i].name}_at_allowable", f"{c.x[i].name}_at_allowable_linear"]
-        for off in c.offsets:
-            names += [f"{off}_at_allowable", f"{off}_at_allowable_linear"]
-        names += [f"{q}_at_allowable" for q in c.q_names]
-        decl = self.part(model, cm.JointStiffness)
-        if decl is not None:
-            names += [f"stress_{g}" for g in decl.records]
-            for g, spec in decl.records.items():  # stiffness from the hinge formula, where a geometry is given
-                if spec.type:
-                    joints = spec.joints
-                    names += [f"k_formula_{g}_{a}" for a in (joints if isinstance(joints, Mapping) else ("bend",))]
-        return names
+        hs = _declared_hinges(self, model)
+        formula = _formula_stiffness(model, hs).outputs if hs is not None else []
+        return [
+            *_pose_outputs(model),
+            *(force_output(f"F{j + 1}", q) for j, q in enumerate(c.q)),
+            *_stress_outputs(hs),
+            _k_q_output(c),
+            Output("energy", "energy"),
+            *formula,
+            *K_FORMULA.values(),
+            *_limit_outputs(model),
+        ]
 
 
 class _OutOfReach(Exception):
@@ -400,25 +363,37 @@ class _Ray:
         return inverse_kinematics(m, self.t_home + lam * (self.t_end - self.t_home), self.solver)
 
 
+def _limit_outputs(model: Model) -> list[Output]:
+    """σ_allow, the scale of the motion where the first hinge reaches it and the pose and
+    actuators there, each also by linear extrapolation (the actuators not)."""
+    c = model.closure
+    out = [
+        Output("sigma_allow", "stress"),
+        Output("scale_at_allowable", "dimensionless"),
+        Output("scale_at_allowable_linear", "dimensionless"),
+    ]
+    for i in c.task_index:
+        out += [Output(f"{c.x[i].name}_at_allowable{s}", c.x[i].kind) for s in ("", "_linear")]
+    for off, target in c.offsets.items():
+        out += [Output(f"{off}_at_allowable{s}", c.x[c.x_names.index(target)].kind) for s in ("", "_linear")]
+    return out + [Output(f"{qn}_at_allowable", c.q[j].kind) for j, qn in enumerate(c.q_names)]
+
+
 def _limit_values(
     model: Model, ray: _Ray, sol: PoseSolution, lam: float, lam_lin: float | None, sigma: float
 ) -> Values:
     """The pose and actuators where the first hinge reaches σ_allow, and their linear extrapolation."""
     c = model.closure
-    out = Values().add(Output("sigma_allow", "stress"), sigma)
-    out.add(Output("scale_at_allowable", "dimensionless"), lam)
-    out.add(Output("scale_at_allowable_linear", "dimensionless"), lam_lin)
+    values: list[Any] = [sigma, lam, lam_lin]
+    linear = {}
     for k, i in enumerate(c.task_index):
-        name, kind = c.x[i].name, c.x[i].kind
-        out.add(Output(f"{name}_at_allowable", kind), float(sol.x[i]))
-        linear = ray.t_home[k] + lam_lin * (ray.t_end[k] - ray.t_home[k])
-        out.add(Output(f"{name}_at_allowable_linear", kind), float(linear))
-    for off, target in c.offsets.items():
+        linear[i] = ray.t_home[k] + lam_lin * (ray.t_end[k] - ray.t_home[k])
+        values += [float(sol.x[i]), float(linear[i])]
+    for target in c.offsets.values():
         i = c.x_names.index(target)
-        out.add(Output(f"{off}_at_allowable", c.x[i].kind), float(sol.x[i] - model.x_home[i]))
-        linear = out.values[f"{target}_at_allowable_linear"] - float(model.x_home[i])
-        out.add(Output(f"{off}_at_allowable_linear", c.x[i].kind), linear)
-    return out.add_all((Output(f"{qn}_at_allowable", c.q[j].kind), float(sol.q[j])) for j, qn in enumerate(c.q_names))
+        values += [float(sol.x[i] - model.x_home[i]), float(linear[i]) - float(model.x_home[i])]
+    values += [float(v) for v in sol.q]
+    return Values().add_all(zip(_limit_outputs(model), values, strict=True))
 
 
 class PlatformCompliance(_HingeKind):
@@ -449,10 +424,7 @@ class PlatformCompliance(_HingeKind):
         super().resolve(inputs, model, path)
         chosen = inputs.get("hinge_axes")
         hinges = HINGE_MODELS[chosen] if chosen is not None else default_hinge_model(model)
-        six, fallback = hinges.six_axis(model, inputs["hinge_set"], path + ("hinge_axes",), chosen is not None)
-        inputs["six_axis"] = six
-        if fallback:
-            inputs["fallback"] = fallback
+        inputs["hinge_model"] = hinges.prepare(model, inputs["hinge_set"], path + ("hinge_axes",), chosen is not None)
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         _check_pose_inputs(model, inputs, path, required=False)
@@ -463,134 +435,26 @@ class PlatformCompliance(_HingeKind):
         info = poses_solver_info([sol], solver.name)
         if not sol.ok:
             return _hinge_result(self.name, model, sol.status, out, info, sol.message)
-        note = inputs.get("fallback", "")
-        if inputs["six_axis"] is not None:
-            res = self._run_six_axis(model, inputs, sol, out, info)
-            if res is not None:
-                return res
-            note = (
-                "; the six-axis hinge model is singular here (a motion of the legs' chains meets no hinge, "
-                "e.g. a leg's spin between two spherical joints), so the default fell back to hinge_axes: kinematic"
-            )
-        return self._run_kinematic(model, inputs, sol, out, info, note)
-
-    def _run_kinematic(
-        self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, out: Values, info: SolverInfo, note: str
-    ) -> Result:
-        """The kinematic hinge model: the output compliance at the pose, the loaded pose by IPOPT."""
-        c = model.closure
-        hs: cm.HingeSet = inputs["hinge_set"]
-        f, ka = inputs["load"], inputs["k_actuator"]
-        out.add(text("hinge_model"), "kinematic")
-        sp = cm.static_point(model, hs, sol.x, sol.q)
-        try:
-            C = cm.output_compliance(sp, ka)
-        except np.linalg.LinAlgError:
-            msg = (
-                "K_q + K_a is singular: the hinges and actuators leave a motion without stiffness "
-                "(give a positive k_actuator, or more hinges)"
-            )
-            return _hinge_result(self.name, model, Status.SINGULAR, out, info, msg)
-        lin = C @ f
-        loaded = cm.compliant_fk(model, hs, sol.x, sol.q, sp.F, f, ka)
-        out.extend(_compliance_matrix(c, C, lin)).extend(_diagonal_compliance(c, C))
-        status, message = Status.SOLVED, "compliant forward kinematics by IPOPT (" + loaded.message + ")"
-        if not np.any(f):
-            message = "no load: the output compliance only"
-        if loaded.ok:
-            d = loaded.x - sol.x
-            out.extend(_deflection_values(c, d))
-            spl = cm.static_point(model, hs, loaded.x, loaded.q)
-            out.extend(_stress_values(hs, [spl], False, "_loaded"))
-            out.add(vector("q_loaded", _coordinate_list(c.q)), loaded.q.tolist())
-        else:
-            status = Status.NOT_CONVERGED
-        if ka is None:
-            message += "; actuators rigidly held: a pseudo-rigid-body model with rigid links does not deflect"
-        info = SolverInfo("ipopt", sol.iterations + loaded.iterations, sol.seconds)
-        res = _hinge_result(self.name, model, status, out, info, message + note)
-        if not loaded.ok:
-            return res.warn(*validity.hinge_geometry_warnings(hs.hinges))
-        res.warn(*_point_warnings(hs, [spl]))
-        return res.warn(*validity.linear_range_warnings(d, lin, c.x_names, [x.kind for x in c.x]))
-
-    def _run_six_axis(
-        self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, out: Values, info: SolverInfo
-    ) -> Result | None:
-        """The six-axis hinge model: the unloaded equilibrium at the commanded actuators and the
-        output compliance there (None where it is singular and the model was the default)."""
-        c = model.closure
-        sm: SixAxisModel = inputs["six_axis"]
-        f, ka = inputs["load"], inputs["k_actuator"]
-        try:
-            z0 = sm.start(sol.x, sol.q)
-            ok, z_u, lam_u, it_u = sm.newton(z0, np.zeros(c.nx), sol.q, None, None)
-            if not ok:
-                msg = "six-axis hinge model: no unloaded equilibrium at the commanded actuators (Newton on the KKT)"
-                return _hinge_result(self.name, model, Status.NOT_CONVERGED, out, info, msg)
-            Fc = sm.actuator_reactions(z_u, lam_u, np.zeros(c.nx))
-            C = sm.compliance(z_u, lam_u, ka, None if ka is None else Fc)
-        except np.linalg.LinAlgError:
-            if inputs.get("hinge_axes") is None:
-                return None  # the default: the caller falls back to the kinematic model
-            msg = (
-                "the six-axis hinge model's stiffness is singular: a motion of the legs' chains meets no hinge and "
-                "no actuator (e.g. a leg's spin between two spherical joints; give a positive k_actuator, more "
-                "hinges, or hinge_axes: kinematic)"
-            )
-            return _hinge_result(self.name, model, Status.SINGULAR, out, info, msg)
-        out.extend(_compliance_matrix(c, C, C @ f)).add(text("hinge_model"), "all")
-        out.extend(_diagonal_compliance(c, C))
-        out.add(Output("stress_max_unloaded", "stress"), _largest(sm.stresses(z_u)))
-        note = f"six-axis hinges: {', '.join(sm.six_axis_hinges) or 'none'}; {sm.chains.note}"
-        if not np.any(f):
-            info = SolverInfo("newton-kkt", sol.iterations + it_u, sol.seconds)
-            res = _hinge_result(
-                self.name, model, Status.SOLVED, out, info, f"no load: the output compliance only ({note})"
-            )
-            return res.warn(*_six_axis_warnings(sm, [z_u]))
-        return self._six_axis_loaded(model, inputs, sol, out, (z_u, Fc, C, it_u), note)
-
-    def _six_axis_loaded(
-        self, model: Model, inputs: Mapping[str, Any], sol: PoseSolution, out: Values, unloaded: tuple, note: str
-    ) -> Result:
-        """The six-axis model's loaded pose by IPOPT, from the unloaded equilibrium."""
-        c = model.closure
-        sm: SixAxisModel = inputs["six_axis"]
-        f, ka = inputs["load"], inputs["k_actuator"]
-        z_u, Fc, C, it_u = unloaded
-        ok, z_l, lam_l, it_l, st = sm.ipopt(z_u, f, sol.q, ka, None if ka is None else Fc)
-        info = SolverInfo("ipopt", sol.iterations + it_u + it_l, sol.seconds)
-        if not ok:
-            msg = f"six-axis compliant forward kinematics by IPOPT did not converge ({st})"
-            return _hinge_result(self.name, model, Status.NOT_CONVERGED, out, info, msg)
-        d = z_l[: c.nx] - z_u[: c.nx]
-        out.extend(_deflection_values(c, d))
-        out.add(vector("q_loaded", _coordinate_list(c.q)), z_l[c.nx : c.nx + c.nq].tolist())
-        out.add(Output("stress_max_loaded", "stress"), _largest(sm.stresses(z_l)))
-        if ka is None:
-            F = sm.actuator_reactions(z_l, lam_l, f)
-            out.add_all((_force_output(f"F{j + 1}_loaded", q), float(F[j])) for j, q in enumerate(c.q))
-        msg = f"compliant forward kinematics by IPOPT ({st}, {it_l} iterations); {note}"
-        res = _hinge_result(self.name, model, Status.SOLVED, out, info, msg)
-        res.warn(*_six_axis_warnings(sm, [z_l]))
-        return res.warn(*validity.linear_range_warnings(d, C @ f, c.x_names, [x.kind for x in c.x]))
+        hinges: Prepared = inputs["hinge_model"]
+        got = hinges.solve(model, inputs["hinge_set"], sol, inputs["load"], inputs["k_actuator"], info)
+        res = _hinge_result(self.name, model, got.status, out.extend(got.values), got.solver, got.message)
+        return res.warn(*got.warnings)
 
     def outputs(self, model: Model) -> list[Output]:
         c = model.closure
-        xs, qs = _coordinate_list(c.x), _coordinate_list(c.q)
+        xs, qs = coordinate_list(c.x), coordinate_list(c.q)
         return [
             *_pose_outputs(model),
-            _compliance_output(c),
+            compliance_output(c),
             vector("deflection_linear", xs),
             vector("deflection", xs),
             vector("q_loaded", qs),
-            Output("stress_max_loaded", "stress"),
-            *(_diagonal_output(x) for x in c.x),
+            *_stress_outputs(_declared_hinges(self, model), "_loaded"),
+            *(diagonal_output(x) for x in c.x),
             *(Output(f"d_{x.name}", x.kind) for x in c.x),
             text("hinge_model"),
             Output("stress_max_unloaded", "stress"),
-            *(_force_output(f"F{j + 1}_loaded", q) for j, q in enumerate(c.q)),
+            *(force_output(f"F{j + 1}_loaded", q) for j, q in enumerate(c.q)),
         ]
 
 
@@ -607,12 +471,6 @@ def _mode_outputs(c: Any) -> list[Output]:
         matrix("modes_q", f"rows: modes; columns {qs} (M-normalized, canonical in the pose coordinates)"),
         matrix("modes_x", f"rows: modes; columns {', '.join(c.x_names)} (J times modes_q)"),
     ]
-
-
-def _six_axis_warnings(sm: SixAxisModel, zs: list[np.ndarray]) -> list:
-    """Geometry, stresses and deflections of the six-axis model's hinges at the equilibria ``zs``."""
-    pts = [(sm.stresses(z), validity.six_axis_deflections(sm.frames, z)) for z in zs]
-    return validity.hinge_warnings(sm.hs.hinges, pts)
 
 
 class NaturalFrequencies(_HingeKind):
@@ -704,7 +562,7 @@ class NaturalFrequencies(_HingeKind):
         if repeated:
             msg += "; " + "; ".join(degenerate_note(idx) for idx in repeated)
         res = _hinge_result(self.name, model, Status.SOLVED, out, info, msg)
-        return res.warn(*_point_warnings(hs, [sp]))
+        return res.warn(*point_warnings(hs, [sp]))
 
     def outputs(self, model: Model) -> list[Output]:
         c = model.closure

@@ -7,6 +7,7 @@ entry, values come back as lists with ``null`` for points that failed).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -29,7 +30,7 @@ from ..core.kinematics import PoseSolution, forward_kinematics, inverse_kinemati
 from ..core.model import Model
 from ..core.multistart import DEFAULT_STARTS
 from ..core.options import Option
-from ..core.outputs import Output, declared_result, outputs_of
+from ..core.outputs import Output, declared_for, declared_result, outputs_of
 from ..core.progress import track
 from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, poses_solver_info, worst_status
 from ..core.schema import Record
@@ -223,9 +224,9 @@ class ForwardKinematics(ProblemKind):
         return _result(self.name, model, sols, batch, solver)
 
     def outputs(self, model: Model) -> list[Output]:
-        # the values of ``assembly_modes: all`` (:func:`mode_value_names`) are not listed: they
-        # would become columns (and change the fingerprint) of every forward_kinematics sweep
-        return _pose_outputs(model)
+        """The pose; with ``assembly_modes: all``, every mode found (declared ``when`` that input
+        asks for them, so that they are not columns of every forward_kinematics sweep)."""
+        return _pose_outputs(model) + mode_outputs(model)
 
 
 def _guess_option(model: Model) -> Record:
@@ -276,31 +277,37 @@ MODE_OPTIONS = (
 )
 
 
-def mode_value_names(model: Model) -> list[str]:
-    """Values a forward_kinematics result with ``assembly_modes: all`` adds."""
+#: what asks for the values of :func:`mode_outputs`
+ALL_MODES = "assembly_modes: all"
+
+
+def mode_outputs(model: Model) -> list[Output]:
+    """The values a forward_kinematics result with ``assembly_modes: all`` adds: each mode's pose
+    and passive joints, status, residual, branch and basin, the nearest other mode, the designated
+    pose's status, the search (and, with ``mode_certificate: true``, its certificate)."""
     c = model.closure
-    per_mode = [f"modes_{n}" for n in c.x_names + c.passive_names]
-    return [
-        "modes",
-        *per_mode,
-        "modes_status",
-        "modes_message",
-        "modes_residual",
-        "modes_designated",
-        "modes_branch",
-        "modes_basin",
-        "branch_names",
-        "nearest_mode",
-        "distance_length",
-        "distance_angle",
-        "designated_status",
-        "designated_message",
-        "mode_starts_converged",
-        "mode_region",
-        "mode_completeness",
-        "mode_search",
-        "mode_certificate",  # with mode_certificate: true
-    ]
+    dims = {"modes": "dimensionless"}
+    dims |= {f"modes_{coord.name}": coord.kind for coord in (*c.x, *c.passive_coords)}
+    dims |= {
+        "modes_status": "text",
+        "modes_message": "text",
+        "modes_residual": "length" if c.residual_unit == "m" else "dimensionless",
+        "modes_designated": "text",
+        "modes_branch": "matrix",
+        "modes_basin": "dimensionless",
+        "branch_names": "text",
+        "nearest_mode": "dimensionless",
+        "distance_length": "length",
+        "distance_angle": "angle",
+        "designated_status": "text",
+        "designated_message": "text",
+        "mode_starts_converged": "dimensionless",
+        "mode_region": "text",
+        "mode_completeness": "text",
+        "mode_search": "text",
+    }
+    out = [dataclasses.replace(o, when=ALL_MODES) for o in outputs_of(dims)]
+    return out + [Output("mode_certificate", "text", "text", when=f"{ALL_MODES} and mode_certificate: true")]
 
 
 def _modes_result(
@@ -312,13 +319,10 @@ def _modes_result(
     modes = found.modes
     work = found.working_solution
     extra: dict[str, Any] = {"modes": found.count}
-    dims: dict[str, str] = {"modes": "dimensionless"}
     for i, coord in enumerate(c.x):
         extra[f"modes_{coord.name}"] = [float(m.x[i]) for m in modes]
-        dims[f"modes_{coord.name}"] = coord.kind
     for coord in c.passive_coords:
         extra[f"modes_{coord.name}"] = [m.passive.get(coord.name) for m in modes]
-        dims[f"modes_{coord.name}"] = coord.kind
     extra["modes_status"] = [m.status.value for m in modes]
     extra["modes_message"] = [m.message for m in modes]
     extra["modes_residual"] = [m.residual for m in modes]
@@ -344,31 +348,12 @@ def _modes_result(
     )
     if cert is not None:
         extra["mode_certificate"] = cert.as_dict()
-        dims["mode_certificate"] = "text"
         extra["mode_search"] += (
             f"; certificate: no other real mode in the region ({cert.boxes} sub-boxes, {cert.seconds:.3g} s)"
             if cert.certified
             else f"; certificate: not proven ({cert.reason}; {cert.boxes} sub-boxes, {cert.seconds:.3g} s)"
         )
-    dims.update(
-        modes_status="text",
-        modes_message="text",
-        modes_residual="length" if c.residual_unit == "m" else "dimensionless",
-        modes_designated="text",
-        modes_branch="matrix",
-        modes_basin="dimensionless",
-        branch_names="text",
-        nearest_mode="dimensionless",
-        distance_length="length",
-        distance_angle="angle",
-        designated_status="text",
-        designated_message="text",
-        mode_starts_converged="dimensionless",
-        mode_region="text",
-        mode_completeness="text",
-        mode_search="text",
-    )
-    res = _result(kind, model, [work], False, solver, extra, outputs_of(dims))
+    res = _result(kind, model, [work], False, solver, extra, declared_for(kind, mode_outputs(model), extra))
     res.status = Status.SOLVED
     designated = sum(m.designated for m in modes)
     summary = f"{found.count} assembly mode(s) found, {designated} on the designated branch"

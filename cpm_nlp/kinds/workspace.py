@@ -19,7 +19,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..analysis.certify import CERTIFICATE_NAMES, CERTIFY_OPTION, certificate_values
+from ..analysis.certify import CERTIFICATE_DIMENSIONS, CERTIFY_OPTION, certificate_values
 from ..analysis.compliance import JointStiffness
 from ..analysis.workspace import (
     ADDED_PER_ROUND,
@@ -37,7 +37,7 @@ from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import Model
 from ..core.multistart import start_options
 from ..core.options import Option
-from ..core.outputs import Output, declared_result, outputs_of, size
+from ..core.outputs import Output, declared_for, declared_result, outputs_of, size
 from ..core.result import Result, SolverInfo, Status
 from ..core.solver import SolverConfig
 from ..core.units import size_dimension
@@ -50,10 +50,11 @@ class CuboidExtras(Part):
     """What a mechanism adds to the ``inscribed_cuboid`` kind (the part ``cuboid``).
 
     options: extra inputs of the kind for this mechanism.
-    value_names: the names of the extra values, all of them (set to null when
-        no cuboid was found).
-    values: ``(model, lower, upper, inputs, solver) -> (values, dimensions)``
-        for a found box ``lower <= t <= upper`` (SI, task coordinates).
+    outputs: the extra values, all of them, declared (:class:`~cpm_nlp.core.outputs.Output`:
+        name, dimension, unit text where the dimension has no SI unit); set to null when
+        no cuboid was found.
+    values: ``(model, lower, upper, inputs, solver) -> values`` for a found box
+        ``lower <= t <= upper`` (SI, task coordinates), each of a declared output.
     paper_box: optional ``(values) -> (lower, upper, label) | None``: the box of
         the paper's own formulation read from a result's values, drawn beside
         the found one by the workspace plot (None when the result has none).
@@ -62,19 +63,22 @@ class CuboidExtras(Part):
     capability: ClassVar[str] = "cuboid"
 
     options: tuple[Option, ...] = ()
-    value_names: tuple[str, ...] = ()
-    values: Callable[..., tuple[dict, dict]]
+    outputs: tuple[Output, ...] = ()
+    values: Callable[..., dict[str, Any]]
     paper_box: Callable[[Mapping[str, Any]], Any] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.options, tuple) or not all(isinstance(o, Option) for o in self.options):
             raise MechanismDeclarationError(f"cuboid: options must be a tuple of Option, got {self.options!r:.60}")
-        if not isinstance(self.value_names, tuple) or not all(isinstance(n, str) for n in self.value_names):
-            raise MechanismDeclarationError(
-                f"cuboid: value_names must be a tuple of names, got {self.value_names!r:.60}"
-            )
+        if not isinstance(self.outputs, tuple) or not all(isinstance(o, Output) and not o.family for o in self.outputs):
+            raise MechanismDeclarationError(f"cuboid: outputs must be a tuple of Output, got {self.outputs!r:.60}")
         if not callable(self.values) or not (self.paper_box is None or callable(self.paper_box)):
             raise MechanismDeclarationError("cuboid: values must be callable, and paper_box callable or None")
+
+    @property
+    def value_names(self) -> tuple[str, ...]:
+        """The names of :attr:`outputs`."""
+        return tuple(o.name for o in self.outputs)
 
 
 @dataclass(frozen=True)
@@ -94,16 +98,11 @@ class PaperMembership(Part):
             raise MechanismDeclarationError(f"paper_membership must be callable, got {self.test!r:.60}")
 
 
-#: the unit of a margin: that of whichever quantity binds (a length, an angle, a stress ...)
-BINDING_UNIT = "SI unit of the binding quantity"
-
-
 def _declared(model: Model, dims: Mapping[str, str]) -> list[Output]:
     """The outputs of the workspace kinds by their dimensions: no unit for what has none, a
     margin's of the binding quantity, a task box's size by its sides."""
     kinds = [model.closure.x[i].kind for i in model.closure.task_index]
-    special = {"si": lambda o: Output(o.name, "si", unit=BINDING_UNIT), "task volume": lambda o: size(o.name, kinds)}
-    return [special.get(o.dimension, lambda o: o)(o) for o in outputs_of(dims, named=False)]
+    return [size(o.name, kinds) if o.dimension == "task volume" else o for o in outputs_of(dims, named=False)]
 
 
 def _region_options(model: Model) -> list[Option]:
@@ -188,26 +187,21 @@ class InscribedCuboid(ProblemKind):
     def check_solver(self, solver: SolverConfig) -> None:
         require_ipopt(solver, self.name)
 
-    def output_names(self, model: Model) -> list[str]:
-        names = []
-        for t in model.closure.task:
-            names += [f"{t}_min", f"{t}_max"]
-        names += [
-            "volume",
-            "ratio",
-            "starts",
-            "starts_converged",
-            "starts_agreed",
-            "refinements",
-            "shrink",
-            "check_points",
-            "check_outside",
-            "check_margin",
-            "check_binding",
-            *CERTIFICATE_NAMES,
-        ]
+    def outputs(self, model: Model) -> list[Output]:
+        """The box (each task coordinate's bounds, its size), the starts, the membership check,
+        the certificate and the mechanism's own values (its part ``cuboid``)."""
+        c = model.closure
+        dims: dict[str, str] = {}
+        for i in c.task_index:
+            dims[f"{c.x[i].name}_min"] = dims[f"{c.x[i].name}_max"] = c.x[i].kind
+        dims["volume"] = _volume_dimension(model)[0]
+        dims |= dict.fromkeys(
+            ("ratio", "starts", "starts_converged", "starts_agreed", "refinements", "shrink"), "dimensionless"
+        )
+        dims |= {"check_points": "dimensionless", "check_outside": "dimensionless", "check_margin": "si"}
+        dims |= {"check_binding": "text", **CERTIFICATE_DIMENSIONS}
         extras = self.part(model, CuboidExtras)
-        return names + (list(extras.value_names) if extras else [])
+        return _declared(model, dims) + list(extras.outputs if extras else ())
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         model = inputs.get("stress_limit") or model
@@ -225,27 +219,19 @@ class InscribedCuboid(ProblemKind):
         )
         vdim = _volume_dimension(model)[0]
         values: dict[str, Any] = {}
-        dims: dict[str, str] = {}
         for k, t in enumerate(c.task):
-            kind = c.x[c.task_index[k]].kind
             values[f"{t}_min"] = float(res.lower[k]) if res.found else None
             values[f"{t}_max"] = float(res.upper[k]) if res.found else None
-            dims[f"{t}_min"] = dims[f"{t}_max"] = kind
         values["volume"] = res.volume
-        dims["volume"] = vdim
         vol_inst = inputs.get("installation_volume")
         if vol_inst is not None:
             values["ratio"] = res.volume / vol_inst if res.found and vdim == "volume" else None
-            dims["ratio"] = "dimensionless"
         values.update(
             starts=res.starts,
             starts_converged=res.converged,
             starts_agreed=res.agreed,
             refinements=res.refinements,
             shrink=res.shrink if res.found else None,
-        )
-        dims.update(
-            {k: "dimensionless" for k in ("starts", "starts_converged", "starts_agreed", "refinements", "shrink")}
         )
         chk = res.check
         values.update(
@@ -254,19 +240,11 @@ class InscribedCuboid(ProblemKind):
             check_margin=chk.margin if chk else None,
             check_binding=chk.binding if chk else None,
         )
-        dims.update(
-            check_points="dimensionless", check_outside="dimensionless", check_margin="si", check_binding="text"
-        )
-        cert_values, cert_dims = certificate_values(
-            model, res.lower if res.found else None, res.upper if res.found else None, inputs["certify"]
-        )
-        values.update(cert_values)
-        dims.update(cert_dims)
+        lower, upper = (res.lower, res.upper) if res.found else (None, None)
+        values.update(certificate_values(model, lower, upper, inputs["certify"])[0])
         extras = self.part(model, CuboidExtras)
         if extras is not None and res.found:
-            extra, extra_dims = extras.values(model, res.lower, res.upper, dict(inputs), solver)
-            values.update(extra)
-            dims.update(extra_dims)
+            values.update(extras.values(model, res.lower, res.upper, dict(inputs), solver))
         if not res.found:  # no numbers that look like an answer
             keep = ("starts", "starts_converged")
             values = {k: (v if k in keep else None) for k, v in values.items()}
@@ -280,12 +258,10 @@ class InscribedCuboid(ProblemKind):
             )
             if values.get("certificate"):
                 message += f"; {values['certificate']}"
-        undeclared = [k for k in values if k not in dims]  # a mechanism's values of no box: dimension not said
-        outputs = _declared(model, dims) + [Output(k, "unknown", unit="") for k in undeclared]
         return declared_result(
             self.name,
             status,
-            outputs,
+            declared_for(self.name, self.outputs(model), values),
             values,
             solver=SolverInfo("ipopt", res.iterations, res.seconds),
             message=message,

@@ -22,6 +22,7 @@ from ..core.kind import ProblemKind
 from ..core.mechanism import Mechanism
 from ..core.model import Model
 from ..core.options import Option
+from ..core.outputs import Output
 from ..core.schema import Either, ListOf, MappingOf, Named, Node, Quantity, Record, children, type_text
 from ..core.units import DIMENSIONS, format_quantity
 from ..mechanisms.registry import PluginError, build_model, mechanism_names, mechanism_type
@@ -72,12 +73,18 @@ def _value_rows(kind: ProblemKind, model: Model, names: tuple[str, ...]) -> tupl
         outputs = kind.outputs(model)
     except NotImplementedError:
         return ()
-    if tuple(o.name for o in outputs) != names:  # a kind that adds names to those it declares
+    if tuple(o.name for o in outputs if not o.family and not o.when) != names:  # names it does not declare
         return ()
-    return tuple(
-        ValueRow(o.name, o.si, o.dimension, f"{o.refers_to} relative to home" if o.role == "reference" else "")
-        for o in outputs
-    )
+    return tuple(ValueRow(o.name, o.si, o.dimension, _value_meaning(o)) for o in outputs)
+
+
+def _value_meaning(o: Output) -> str:
+    """What a value is where that is not the value itself: an offset, a family's members, one
+    that an input asks for."""
+    what = [f"{o.refers_to} relative to home"] if o.role == "reference" else []
+    what += [f"one per {o.per}"] if o.family else []
+    what += [f"with {o.when}"] if o.when else []
+    return "; ".join(what)
 
 
 @dataclass(frozen=True)

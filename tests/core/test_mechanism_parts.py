@@ -121,7 +121,8 @@ def test_the_closure_carries_no_mechanism_and_no_solver_cache():
     model = cn.build_model("prs3", PRS3)
     c = model.closure
     assert "mechanism" not in vars(c) and "solvers" not in vars(c)
-    assert c.solvers is cs.solvers_of(c) is cs.solvers_of(c)
+    assert cs.solvers_of(c) is cs.solvers_of(c)  # one cache per closure, held by the solver layer
+    assert not hasattr(c, "solvers")  # 0.3: the property is gone (changelog: use solvers_of)
     by_hand = cn.Model(c, dict(model.parameters), dict(model.limits), dict(model.derived))
     assert by_hand.mechanism is None and model.mechanism is cn.mechanism_type("prs3")
 
@@ -172,9 +173,14 @@ def test_hinge_models_are_objects_and_the_inputs_choices():
     five_bar = cn.build_model("five_bar", {})
     assert hm.default_hinge_model(five_bar) is hm.HINGE_MODELS["kinematic"]
     hs = cm.hinge_set(model, None)
-    assert hm.HINGE_MODELS["kinematic"].six_axis(model, hs, ("inputs", "hinge_axes"), True) == (None, "")
-    six, note = hm.HINGE_MODELS["all"].six_axis(model, hs, ("inputs", "hinge_axes"), True)
-    assert six is not None and note == ""
+    where = ("inputs", "hinge_axes")
+    assert hm.HINGE_MODELS["kinematic"].prepare(model, hs, where, True) == hm.Prepared(hm.KINEMATIC, None, True)
+    six = hm.HINGE_MODELS["all"].prepare(model, hs, where, True)
+    assert six.hinges is hm.HINGE_MODELS["all"] and six.six_axis is not None and six.note == ""
+    # the default on a mechanism without chains is the kinematic model; "all" chosen there is bad input
+    assert hm.default_hinge_model(five_bar).prepare(five_bar, hs, where, False).hinges is hm.KINEMATIC
+    with pytest.raises(cn.InputError, match="needs the legs of five_bar as serial chains"):
+        hm.HINGE_MODELS["all"].prepare(five_bar, hs, where, True)
     problem = (PROBLEMS / "prs3_table2_forces.yaml").read_text()
     assert "hinge_axes" not in problem
     with pytest.raises(cn.InputError, match="did you mean 'kinematic'"):

@@ -20,7 +20,7 @@ from ...core.model import LoopClosure, Model
 from ...core.multistart import AGREEMENT, best_and_agreement
 from ...core.options import Option
 from ...core.progress import track
-from ...core.solver import SolverConfig, run_nlp
+from ...core.solver import SolverConfig, run_nlp, solvers_of
 from ..cuboid_ik import ClosedFormCuboid
 from .membership import Membership, limit_bounds, limited_function, membership, poses
 from .sampling import probe_region
@@ -199,7 +199,7 @@ def cuboid_nlp(model: Model, n_samples: int, config: SolverConfig) -> CuboidNLP:
     lo, hi = limit_bounds(model)
     active = tuple(bool(v) for v in (np.isfinite(lo) | np.isfinite(hi)))
     key = f"cuboid:{n_samples}:{''.join('1' if a else '0' for a in active)}"
-    return model.closure.solvers.get(key, config, lambda: CuboidNLP(model.closure, n_samples, active, config))
+    return solvers_of(model.closure).get(key, config, lambda: CuboidNLP(model.closure, n_samples, active, config))
 
 
 @dataclass

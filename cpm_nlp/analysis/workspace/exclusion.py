@@ -23,6 +23,7 @@ import numpy as np
 
 from ...core.batch import evaluate_points
 from ...core.model import LoopClosure, Model
+from ...core.solver import solvers_of
 from ..intervals import IntervalProgram, UnsupportedOperation
 from .point_ik import NEWTON_KEY, newton_function, unknown_box
 
@@ -48,7 +49,7 @@ def _program(closure: LoopClosure, limited: ca.Function) -> IntervalProgram | No
         except UnsupportedOperation:
             return False
 
-    got = closure.solvers.memo(PROGRAM_KEY, build)
+    got = solvers_of(closure).memo(PROGRAM_KEY, build)
     return got or None
 
 

@@ -13,7 +13,7 @@ import numpy as np
 from ...core.batch import evaluate_points
 from ...core.model import LoopClosure, Model
 from ...core.pose_checks import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
-from ...core.solver import SolverConfig
+from ...core.solver import SolverConfig, solvers_of
 from .exclusion import prove_outside
 from .point_ik import IPOPT_STARTS, ipopt_solve, newton, reduce_angles, start_set
 
@@ -128,7 +128,7 @@ def pose_check_function(closure: LoopClosure) -> ca.Function:
             f"{c.name}_pose_values", [x, q, p], _pose_values(c, x, q, p), ["x", "q", "p"], ["v", "phi", "phi_x"]
         )
 
-    return closure.solvers.memo(POSE_VALUES_KEY, build)
+    return solvers_of(closure).memo(POSE_VALUES_KEY, build)
 
 
 def task_point_function(closure: LoopClosure) -> ca.Function:
@@ -148,7 +148,7 @@ def task_point_function(closure: LoopClosure) -> ca.Function:
             ["x", "q", "reach", "v", "phi", "phi_x"],
         )
 
-    return closure.solvers.memo(TASK_POINT_KEY, build)
+    return solvers_of(closure).memo(TASK_POINT_KEY, build)
 
 
 @dataclass

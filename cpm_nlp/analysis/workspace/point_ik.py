@@ -31,7 +31,7 @@ import numpy as np
 
 from ...core.batch import evaluate_points
 from ...core.model import LoopClosure, Model
-from ...core.solver import SolverConfig
+from ...core.solver import SolverConfig, solvers_of
 
 #: Halton starts per point after the linearisation and home
 HALTON_STARTS = 16
@@ -137,7 +137,7 @@ def newton_function(closure: LoopClosure):
         J = ca.densify(ca.jacobian(r, y))
         return ca.Function(f"{c.name}_ik_newton", [y, t, p], [r, ca.vec(J.T)], ["y", "t", "p"], ["phi", "phi_y"])
 
-    return closure.solvers.memo(NEWTON_KEY, build)
+    return solvers_of(closure).memo(NEWTON_KEY, build)
 
 
 def newton(model: Model, Y0: np.ndarray, T: np.ndarray, tolerance: float) -> tuple[np.ndarray, np.ndarray]:

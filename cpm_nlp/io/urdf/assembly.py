@@ -8,6 +8,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from ...core.joints import JOINT_TYPES
 from ...core.screws import axis_rotation
 from .read import UrdfJoint
 
@@ -15,7 +16,9 @@ from .read import UrdfJoint
 ASSEMBLY_STEPS, ASSEMBLY_TOL = 500, 1e-12
 
 
-_DOF = {"R": 1, "P": 1, "S": 3, "U": 2, "fixed": 0}
+def _dof(kind: str) -> int:
+    """A URDF joint's degrees of freedom: those of the joint table (R, P, S, U), none when fixed."""
+    return 0 if kind == "fixed" else JOINT_TYPES[kind].dof
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
@@ -44,8 +47,8 @@ def link_frames(order: list[str], parent_joint: dict[str, UrdfJoint]) -> tuple[c
     slots, n = {}, 0
     for lk in order[1:]:
         j = parent_joint[lk]
-        slots[j.name] = (n, n + _DOF[j.kind])
-        n += _DOF[j.kind]
+        slots[j.name] = (n, n + _dof(j.kind))
+        n += _dof(j.kind)
     q = ca.SX.sym("q", n)
     frame = {order[0]: ca.SX.eye(4)}
     for lk in order[1:]:

@@ -26,7 +26,7 @@ from .synthesis import PantographSynthesis
 #: the paper's cuboid (eq 32-34) reported beside the general one by ``inscribed_cuboid``
 CUBOID = CuboidExtras(
     options=analysis.CUBOID_OPTIONS,
-    value_names=analysis.CUBOID_VALUE_NAMES,
+    outputs=analysis.CUBOID_OUTPUTS,
     values=analysis.cuboid_values,
     paper_box=analysis.paper_box,
 )

@@ -47,6 +47,8 @@ Readings of the paper chosen here (documented, not tuned):
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from types import MappingProxyType
 
 import casadi as ca
 import numpy as np
@@ -57,7 +59,8 @@ from ...analysis.workspace import check_box
 from ...core.errors import InputError
 from ...core.model import Model
 from ...core.options import Option
-from ...core.solver import SolverConfig
+from ...core.outputs import outputs_of
+from ...core.solver import SolverConfig, solvers_of
 
 HALF_PI = math.pi / 2
 SQRT2 = math.sqrt(2.0)
@@ -336,7 +339,7 @@ def paper_cuboid(model: Model, reading: str = "near_face", solver: SolverConfig 
     room = Mx * math.sqrt(_radius2(a, psi_max)) - k  # eq 34a: x̂ can exceed k at all
     if not room > 0:
         return {"status": "infeasible", "message": f"eq 34a: k = {k:.6g} m is not below the outer ellipsoid"}
-    built = model.closure.solvers.get(
+    built = solvers_of(model.closure).get(
         f"paper_cuboid:{reading}:{with_phi}", config, lambda: _PaperCuboidNLP(reading, with_phi, config)
     )
     L = a * Mx
@@ -377,45 +380,39 @@ CUBOID_OPTIONS = (
 )
 
 
-CUBOID_VALUE_NAMES = (
-    "x_hat",
-    "y_hat",
-    "z_hat",
-    "x_near",
-    "a",
-    "b",
-    "Mx",
-    "My",
-    "Mz",
-    "omega",
-    "psi_min",
-    "psi_max",
-    "phi_max",
-    "delta_max",
-    "l",
-    "t",
-    "r",
-    "paper_x_hat",
-    "paper_y_hat",
-    "paper_z_hat",
-    "paper_k",
-    "paper_volume",
-    "paper_status",
-    "paper_check_outside",
-    "paper_check_margin",
-    "paper_check_binding",
-    "paper_certified",
-    "paper_certificate_quantity",
-    "paper_certificate_failing",
-    "paper_certificate",
+#: the values the pantograph adds to ``inscribed_cuboid`` (:data:`~.addon.CUBOID`): the cuboid under
+#: the paper's names, the parameters and derived quantities it depends on, and the paper's own
+#: formulation (eq 32-34) solved, checked and certified beside the general one
+CUBOID_DIMENSIONS: Mapping[str, str] = MappingProxyType(
+    {
+        **dict.fromkeys(("x_hat", "y_hat", "z_hat", "x_near", "a", "b"), "length"),
+        **dict.fromkeys(("Mx", "My", "Mz", "omega"), "dimensionless"),
+        **dict.fromkeys(("psi_min", "psi_max", "phi_max", "delta_max"), "angle"),
+        **dict.fromkeys(("l", "t", "r", "paper_x_hat", "paper_y_hat", "paper_z_hat", "paper_k"), "length"),
+        "paper_volume": "volume",
+        "paper_status": "text",
+        "paper_check_outside": "dimensionless",
+        "paper_check_margin": "si",
+        **dict.fromkeys(
+            (
+                "paper_check_binding",
+                "paper_certified",
+                "paper_certificate_quantity",
+                "paper_certificate_failing",
+                "paper_certificate",
+            ),
+            "text",
+        ),
+    }
 )
+CUBOID_OUTPUTS = tuple(outputs_of(CUBOID_DIMENSIONS, named=False))
 
 #: sub-box budget of the certificate of the paper's cuboid (the near-face reading touches the
 #: inner ellipsoid, eq 24, at the centre of its near face: not provable, so the budget ends it)
 PAPER_CERTIFY_BOXES = 5_000
 
 
-def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig) -> tuple[dict, dict]:
+def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig) -> dict:
     """The cuboid under the paper's names, and the paper's own formulation (eq 32-34)
     solved and checked against the membership test beside it."""
     d = model.derived
@@ -460,25 +457,7 @@ def cuboid_values(model: Model, lower, upper, inputs: dict, solver: SolverConfig
             values["paper_certificate_quantity"] = cert.failing_quantity or None
             values["paper_certificate_failing"] = cert.region(model.closure.task) or None
             values["paper_certificate"] = cert.message
-    dims = {k: "length" for k in values if k.endswith(("_hat", "_k", "x_near")) or k in ("a", "b", "l", "t", "r")}
-    dims["paper_check_margin"] = "si"
-    dims.update({k: "angle" for k in ("psi_min", "psi_max", "phi_max", "delta_max")})
-    dims.update({"paper_volume": "volume"})
-    dims.update({k: "dimensionless" for k in ("Mx", "My", "Mz", "omega", "paper_check_outside")})
-    dims.update(
-        {
-            k: "text"
-            for k in (
-                "paper_status",
-                "paper_check_binding",
-                "paper_certified",
-                "paper_certificate_quantity",
-                "paper_certificate_failing",
-                "paper_certificate",
-            )
-        }
-    )
-    return values, dims
+    return values
 
 
 def paper_box(values) -> tuple[list, list, str] | None:

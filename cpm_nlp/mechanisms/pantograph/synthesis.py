@@ -52,7 +52,7 @@ from ...core.options import Option
 from ...core.outputs import Output, declared_result, outputs_of
 from ...core.result import Result, SolverInfo, Status
 from ...core.schema import Record
-from ...core.solver import SolverConfig
+from ...core.solver import SolverConfig, solvers_of
 from ...kinds.synthesis import SynthesisFormulation
 from . import analysis as P
 
@@ -254,7 +254,7 @@ class PantographSynthesis(SynthesisFormulation):
         closure = model.closure
 
         def nlp(phase):
-            return closure.solvers.get(
+            return solvers_of(closure).get(
                 f"synthesis:{phase}:{reading}:{with_stroke}",
                 solver,
                 lambda: _SynthesisNLP(closure, reading, with_stroke, phase, solver),

@@ -67,7 +67,7 @@ from ...core import screws
 from ...core.kinematics import jacobians
 from ...core.model import LoopClosure, Model
 from ...core.result import Status
-from ...core.solver import SolverConfig, translate_casadi_error
+from ...core.solver import SolverConfig, solvers_of, translate_casadi_error
 from . import screws as rpr_screws
 from .design import optimisation_options
 
@@ -247,7 +247,7 @@ def joint_design(model: Model, joint: str, spec: JointSpec, config: SolverConfig
         raise ValueError("the material needs a yield strength (eq 32)")
     t0 = time.perf_counter()
     wrenches = design_wrenches(model, spec.couple_arm)[joint]
-    built = model.closure.solvers.get(
+    built = solvers_of(model.closure).get(
         f"rpr_joint_{joint}_{spec.rotation_limit}", config, lambda: _JointSolver(joint, spec.rotation_limit, config)
     )
     box_mm, tmin_mm = spec.box * 1e3, spec.t_min * 1e3
@@ -355,7 +355,7 @@ def passive_jacobian(closure: LoopClosure) -> ca.Function:
             ["dj_dx", "dj_dq"],
         )
 
-    return closure.solvers.memo(("rpr_passive_jacobian",), build)
+    return solvers_of(closure).memo(("rpr_passive_jacobian",), build)
 
 
 def passive_rates(model: Model, x: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:

@@ -50,7 +50,7 @@ from ...core import screws
 from ...core.errors import InputError
 from ...core.model import Model
 from ...core.result import Status
-from ...core.solver import SolverConfig, translate_casadi_error
+from ...core.solver import SolverConfig, solvers_of, translate_casadi_error
 
 log = logging.getLogger(__name__)
 
@@ -269,7 +269,7 @@ def synthesis(
     l1, l2, l3.  The built solver is cached on the model's mechanism type."""
     fixed = dict(fixed or {})
     t0 = time.perf_counter()
-    built = model.closure.solvers.get(f"rpr_synthesis_{eta_max}", config, lambda: _SynthesisSolver(eta_max, config))
+    built = solvers_of(model.closure).get(f"rpr_synthesis_{eta_max}", config, lambda: _SynthesisSolver(eta_max, config))
     lbx = np.full(3, l_min)
     ubx = np.full(3, 3.0 - 2.0 * l_min)
     for k, name in enumerate(("l1", "l2", "l3")):

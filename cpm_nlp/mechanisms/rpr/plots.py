@@ -61,5 +61,11 @@ def twists_plot(data: ResultData, options: PlotOptions) -> Any:
         pose,
         arrows=arrows,
         title=f"Displacement twists ({data.model.get('type')}, {data.problem}), at the reference point",
-        note=data.units.get("T", ""),
+        note=_note(data),
     )
+
+
+def _note(data: ResultData) -> str:
+    """What T's rows and columns are, and the convention of its moments (a result's value)."""
+    convention = data.values.get("convention")
+    return data.units.get("T", "") + (f"; {convention} convention" if isinstance(convention, str) else "")

@@ -2,6 +2,7 @@
 model (eq 33-44, eq 55, 58) of the RPR compliant mechanism."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from cpm_nlp.analysis import flexure_compliance as fc
 from cpm_nlp.mechanisms.rpr import compliance as rc
 from cpm_nlp.mechanisms.rpr import screws as rpr
 
+ROOT = Path(__file__).resolve().parents[3]
 AL = flexure.MATERIALS["Al 7075-T6"]
 SPEC = rc.JointSpec(AL, SF=2.0, theta_des=math.radians(2), box=12e-3, t_min=0.3e-3, couple_arm=1.0)
 TABLE1 = {"R": (4e-3, 0.4e-3, 12e-3), "U": (1e-3, 0.4e-3, 12e-3)}
@@ -117,3 +119,39 @@ def test_compliance_of_the_shipped_assumptions_against_eq_55_and_58(model):
     # mirror symmetry of legs 1 and 3: opposite tilts, equal alpha and P
     assert C[0, 2] == pytest.approx(-C[0, 0]) and C[1, 2] == pytest.approx(C[1, 0])
     assert C[0, 1] == pytest.approx(0.0, abs=1e-20)
+
+
+def test_compliances_carry_their_dimensions():
+    """Issue 22: c_r (eq 35: a rotation per moment) and c_t (a stretch per force) and the
+    amplifier's A11..A22 (eq 36: displacements per force) are compliances, not dimensionless
+    numbers; pint agrees that each unit is the reciprocal of its stiffness's and of the
+    quantities it relates (independent of core.units' own tables)."""
+    import pint
+
+    from cpm_nlp.core.units import DIMENSIONS
+
+    ureg = pint.UnitRegistry()
+    for name, per in (("rotational_compliance", "rad/(N*m)"), ("compliance", "m/N")):
+        assert ureg(DIMENSIONS[name].si).dimensionality == ureg(per).dimensionality
+    stiff = {"rotational_compliance": "rotational_stiffness", "compliance": "stiffness"}
+    for name, k in stiff.items():
+        assert (ureg(DIMENSIONS[name].si) * ureg(DIMENSIONS[k].si)).dimensionless
+    res = cn.solve(cn.load_problem(ROOT / "problems" / "rpr_compliance.yaml"))
+    assert res.ok, res.message
+    assert (res.dimensions["c_r"], res.units["c_r"]) == ("rotational_compliance", "rad/(N*m)")
+    assert (res.dimensions["c_t"], res.units["c_t"]) == ("compliance", "m/N")
+    assert {res.dimensions[a] for a in ("A11", "A12", "A21", "A22")} == {"compliance"}
+    # c_r = 1/k_r of the leaf hinge: the product with a rotational stiffness is a number
+    product = ureg.Quantity(res.values["c_r"], res.units["c_r"]) * ureg.Quantity(1.0, "N*m/rad")
+    assert product.dimensionless
+    # the joints' diagonal compliances (eq 28-29): a translation per force, a rotation per moment
+    joints = problem_kind_outputs("rpr_joint_design")
+    assert joints["cr_tx"].dimension == "compliance" and joints["cu_mz"].dimension == "rotational_compliance"
+    assert joints["cr_mx"].si.startswith("rad/(N*m)") and joints["cr_tx"].si.startswith("m/N")
+
+
+def problem_kind_outputs(kind: str) -> dict:
+    from cpm_nlp.problems.describe import reference_model
+
+    model, _ = reference_model("rpr")
+    return {o.name: o for o in cn.problem_kind(kind).outputs(model)}

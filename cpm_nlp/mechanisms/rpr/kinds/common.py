@@ -14,7 +14,7 @@ from ....core.errors import InputError
 from ....core.kind import ProblemKind
 from ....core.model import Model
 from ....core.options import Option
-from ....core.outputs import Output, declared_result
+from ....core.outputs import Output, declared_for, declared_result
 from ....core.result import STATUS_TEXT, Result, SolverInfo, Status
 from ....kinds.kinematic import _model_info
 
@@ -46,24 +46,21 @@ def _matrix(a: np.ndarray) -> list:
 
 
 def _finish(
-    kind: str,
+    kind: ProblemKind,
     model: Model,
     status: Status,
-    values: dict,
-    dims: dict,
-    units: dict | None = None,
+    values: Mapping[str, Any],
     solver: SolverInfo | None = None,
     message: str = "",
 ) -> Result:
-    """The result of an RPR kind: each value declared by its dimension (``dims``), with its
-    own unit text from ``units`` where the dimension's SI unit does not say it."""
+    """The result of an RPR kind: its values (none unless solved), each of an output the kind
+    declares (:meth:`~cpm_nlp.core.kind.ProblemKind.outputs`)."""
     if not status.ok:
         values = {}
-    texts = units or {}
     return declared_result(
-        kind,
+        kind.name,
         status,
-        [_output(k, dims[k], texts.get(k)) for k in values],
+        declared_for(kind.name, kind.outputs(model), values),
         values,
         solver=solver,
         message=message or STATUS_TEXT[status],
@@ -71,11 +68,18 @@ def _finish(
     )
 
 
-def _output(name: str, dimension: str, unit: str | None) -> Output:
-    """An output of an RPR kind: a matrix or a flag has no unit unless its text is given."""
-    if unit is None and dimension in ("matrix", "bool"):
-        unit = ""
-    return Output(name, dimension, dimension if dimension in ("matrix", "text") else "value", unit=unit)
+def _declare(dims: Mapping[str, str], units: Mapping[str, str] | None = None) -> list[Output]:
+    """The outputs of an RPR kind by their dimensions, in order, each with its own unit text
+    from ``units`` where the dimension's SI unit does not say it (a matrix or a flag has none
+    unless given)."""
+    texts = units or {}
+    out = []
+    for name, dimension in dims.items():
+        unit = texts.get(name)
+        if unit is None and dimension in ("matrix", "bool"):
+            unit = ""
+        out.append(Output(name, dimension, dimension if dimension in ("matrix", "text") else "value", unit=unit))
+    return out
 
 
 def _check_material(mat: Any, path: tuple) -> flexure.Material:

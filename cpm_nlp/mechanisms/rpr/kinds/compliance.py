@@ -12,11 +12,13 @@ from ....core.errors import InputError
 from ....core.kinematics import inverse_kinematics
 from ....core.model import Model
 from ....core.options import Option
+from ....core.outputs import Output
 from ....core.result import Result, SolverInfo, Status
 from ....core.schema import Record
 from ....core.solver import SolverConfig
+from ....core.units import result_unit
 from .. import compliance as rpr_compliance
-from .common import RprKind, _finish, _material_option, _matrix, _pose, _pose_options
+from .common import RprKind, _declare, _finish, _material_option, _matrix, _pose, _pose_options
 from .joint_design import _joint_dims, _joints_option
 
 # -- eq 33-44 ---------------------------------------------------------------------------------------
@@ -103,7 +105,7 @@ class Compliance(RprKind):
         x0 = _pose(model, inputs)
         sol = inverse_kinematics(model, x0, solver)
         if not sol.ok:
-            return _finish(self.name, model, sol.status, {}, {}, message=sol.message)
+            return _finish(self, model, sol.status, {}, message=sol.message)
         amp = inputs["amplifier"]
         if amp["leaf"] is not None:
             leaf = amp["leaf"]
@@ -144,65 +146,38 @@ class Compliance(RprKind):
             "amp": out["amp"].tolist(),
             "amp_free": amp["l1"] / amp["l2"],
         }
-        dims = {k_: "matrix" for k_ in values}
-        dims.update(
-            {
-                "c_r": "dimensionless",
-                "c_t": "dimensionless",
-                "k_R": "rotational_stiffness",
-                "k_U": "rotational_stiffness",
-                "A11": "dimensionless",
-                "A12": "dimensionless",
-                "A21": "dimensionless",
-                "A22": "dimensionless",
-                "K_J": "rotational_stiffness",
-                "amp": "dimensionless",
-                "amp_free": "dimensionless",
-            }
+        return _finish(
+            self,
+            model,
+            Status.SOLVED,
+            values,
+            SolverInfo("closed_form"),
+            "compliance at the pose solved by closed-form IK",
         )
+
+    def outputs(self, model: Model) -> list[Output]:
+        """The amplifier's and the joints' compliance and stiffness, the amplifier's matrix (eq 33),
+        the Jacobians, K' (eq 40), C (eq 43), C_in (eq 44) and the amplification."""
+        passive = ", ".join(model.closure.passive_names)
+        dims = {
+            "c_r": "rotational_compliance",
+            "c_t": "compliance",
+            "k_R": "rotational_stiffness",
+            "k_U": "rotational_stiffness",
+            **dict.fromkeys(("A11", "A12", "A21", "A22"), "compliance"),
+            "K_J": "rotational_stiffness",
+            **dict.fromkeys(("G", "G_p", "K_prime", "C", "C_in"), "matrix"),
+            "amp": "dimensionless",
+            "amp_free": "dimensionless",
+        }
         units = {
-            "c_r": "rad/(N m)",
-            "c_t": "m/N",
-            "A11": "m/N",
-            "A12": "m/N",
-            "A21": "m/N",
-            "A22": "m/N",
-            "K_J": "N m/rad, order " + ", ".join(model.closure.passive_names),
+            "K_J": f"{result_unit('rotational_stiffness')}, order {passive}",
             "G": "rows theta, alpha [rad], P [m] per l1 l2 l3 [m]",
-            "G_p": "rows " + ", ".join(model.closure.passive_names) + " [rad] per l1 l2 l3 [m]",
+            "G_p": f"rows {passive} [rad] per l1 l2 l3 [m]",
             "K_prime": "N/m (eq 40)",
             "C": "rows theta [rad/N], alpha [rad/N], P [m/N]; columns input forces 1, 2, 3 (eq 43)",
             "C_in": "m/N (eq 44)",
             "amp": "D_out/D_in per leg under the mechanism's load",
             "amp_free": "l1/l2, the unloaded amplification",
         }
-        return _finish(
-            self.name,
-            model,
-            Status.SOLVED,
-            values,
-            dims,
-            units,
-            SolverInfo("closed_form"),
-            "compliance at the pose solved by closed-form IK",
-        )
-
-    def output_names(self, model: Model) -> list[str]:
-        return [
-            "c_r",
-            "c_t",
-            "k_R",
-            "k_U",
-            "A11",
-            "A12",
-            "A21",
-            "A22",
-            "K_J",
-            "G",
-            "G_p",
-            "K_prime",
-            "C",
-            "C_in",
-            "amp",
-            "amp_free",
-        ]
+        return _declare(dims, units)

@@ -10,11 +10,13 @@ from ....core.errors import InputError
 from ....core.kind import require_ipopt
 from ....core.model import Model
 from ....core.options import Option
+from ....core.outputs import Output
 from ....core.result import Result, SolverInfo, Status
 from ....core.schema import Record
 from ....core.solver import SolverConfig
+from ....core.units import result_unit
 from .. import compliance as rpr_compliance
-from .common import MM, RprKind, _finish, _material_option
+from .common import MM, RprKind, _declare, _finish, _material_option
 
 # -- eq 27-32 ---------------------------------------------------------------------------------------
 
@@ -135,7 +137,6 @@ class JointDesign(RprKind):
         )
         wrenches = rpr_compliance.design_wrenches(model, spec.couple_arm)
         values: dict[str, Any] = {}
-        dims: dict[str, str] = {}
         iters, seconds, messages, status = 0, 0.0, [], Status.SOLVED
         for joint in rpr_compliance.JOINTS:
             d = rpr_compliance.joint_design(model, joint, spec, solver, inputs["starts"])
@@ -145,22 +146,13 @@ class JointDesign(RprKind):
             if not d.status.ok:
                 status = d.status
                 continue
-            names = rpr_compliance.VARIABLES[joint]
-            for n, v in zip(names, d.dims):
-                values[f"{n}_{joint}"] = v
-                dims[f"{n}_{joint}"] = "length"
+            values.update({f"{n}_{joint}": v for n, v in zip(rpr_compliance.VARIABLES[joint], d.dims)})
             if joint == "R":
                 values["h_R"] = d.dims[1] + 2 * d.dims[0]  # the smallest block holding the notch
-                dims["h_R"] = "length"
             values[f"f_{joint}"] = d.f
             values[f"theta_max_{joint}"] = d.theta_max
             values[f"k_{joint}"] = 1.0 / d.working
-            dims.update(
-                {f"f_{joint}": "dimensionless", f"theta_max_{joint}": "angle", f"k_{joint}": "rotational_stiffness"}
-            )
-            for k, v in d.compliances.items():
-                values[k] = v
-                dims[k] = "dimensionless"
+            values.update(d.compliances)
             for joint_c, geometry in inputs["compare"].items():
                 if joint_c != joint:
                     continue
@@ -169,34 +161,23 @@ class JointDesign(RprKind):
                 values[f"theta_max_{joint}_compare"] = ev["theta_max"]
                 values[f"feasible_{joint}_compare"] = ev["feasible"]
                 values[f"f_ratio_{joint}"] = ev["f"] / d.f
-                dims.update(
-                    {
-                        f"f_{joint}_compare": "dimensionless",
-                        f"theta_max_{joint}_compare": "angle",
-                        f"feasible_{joint}_compare": "bool",
-                        f"f_ratio_{joint}": "dimensionless",
-                    }
-                )
-        units = {
-            k: ("m/N" if k[3] == "t" else "rad/(N m)") + ", joint frame (z along the leg)"
-            for k in values
-            if k.startswith(("cr_", "cu_"))
-        }
-        units.update({"f_R": "J per unit wrench (eq 27)", "f_U": "J per unit wrench (eq 27)"})
-        return _finish(
-            self.name, model, status, values, dims, units, SolverInfo("ipopt", iters, seconds), "; ".join(messages)
-        )
+        return _finish(self, model, status, values, SolverInfo("ipopt", iters, seconds), "; ".join(messages))
 
-    def output_names(self, model: Model) -> list[str]:
-        names = []
+    def outputs(self, model: Model) -> list[Output]:
+        """Per joint (R, U): the optimal notch, f (eq 27), the rotation capability, the working
+        stiffness, the diagonal compliances (eq 28-29) and those of a compared joint."""
+        dims: dict[str, str] = {}
+        units: dict[str, str] = {}
         for joint in rpr_compliance.JOINTS:
-            names += [f"{n}_{joint}" for n in rpr_compliance.VARIABLES[joint]]
-            names += (["h_R"] if joint == "R" else []) + [f"f_{joint}", f"theta_max_{joint}", f"k_{joint}"]
-            names += [f"c{joint.lower()}_{n}" for n in rpr_compliance.COMPLIANCE_NAMES]
-            names += [
-                f"f_{joint}_compare",
-                f"theta_max_{joint}_compare",
-                f"feasible_{joint}_compare",
-                f"f_ratio_{joint}",
-            ]
-        return names
+            dims.update({f"{n}_{joint}": "length" for n in rpr_compliance.VARIABLES[joint]})
+            dims.update({"h_R": "length"} if joint == "R" else {})
+            dims.update({f"f_{joint}": "dimensionless", f"theta_max_{joint}": "angle"})
+            dims[f"k_{joint}"] = "rotational_stiffness"
+            units[f"f_{joint}"] = units[f"f_{joint}_compare"] = "J per unit wrench (eq 27)"
+            for n in rpr_compliance.COMPLIANCE_NAMES:  # eq 28-29: a translation per force, a rotation per moment
+                name = f"c{joint.lower()}_{n}"
+                dims[name] = "compliance" if n.startswith("t") else "rotational_compliance"
+                units[name] = f"{result_unit(dims[name])}, joint frame (z along the leg)"
+            dims.update({f"f_{joint}_compare": "dimensionless", f"theta_max_{joint}_compare": "angle"})
+            dims.update({f"feasible_{joint}_compare": "bool", f"f_ratio_{joint}": "dimensionless"})
+        return _declare(dims, units)

@@ -39,29 +39,40 @@ class ScrewJacobian(RprKind, Jacobian):
         st = rpr_screws.screw_jacobian(model, x)
         G_p_ad = rpr_compliance.passive_rates(model, x)[1]
         J_ad = np.array(res.values["J_inv"])
-        passive = ", ".join(model.closure.passive_names)
-        extra = (
-            Values()
-            .add(matrix("S_t", "columns theta, alpha, P; rows wx wy wz [rad] vx vy vz [m] at o'"), _matrix(st.S_t))
-            .add(matrix("J_a", "eq 9"), _matrix(st.J_a))
-            .add(matrix("J_b", "eq 9"), _matrix(st.J_b))
-            .add(
-                matrix("J_st", "rows l1 l2 l3 per columns theta, alpha [rad], P [m] (eq 10; = J_inv by AD)"),
-                _matrix(st.J),
-            )
-            .add(
-                matrix("G_st", "rows theta, alpha [rad], P [m] per columns l1 l2 l3 [m] (eq 11; = J by AD)"),
-                _matrix(st.G),
-            )
-            .add(matrix("G_p", f"rows {passive} [rad] per l1 l2 l3 [m] (eq 13)"), _matrix(st.G_p))
-            .add(matrix("G_p_ad", "as G_p, by AD of the passive joint angles"), _matrix(G_p_ad))
-            .add(_agreement_output("dJ", "J_st - J_inv"), _agreement(st.J, J_ad))
-            .add(_agreement_output("dG_p", "G_p - G_p_ad"), _agreement(st.G_p, G_p_ad))
+        values = (
+            _matrix(st.S_t),
+            _matrix(st.J_a),
+            _matrix(st.J_b),
+            _matrix(st.J),
+            _matrix(st.G),
+            _matrix(st.G_p),
+            _matrix(G_p_ad),
+            _agreement(st.J, J_ad),
+            _agreement(st.G_p, G_p_ad),
         )
+        extra = Values().add_all(zip(_screw_outputs(model), values, strict=True))
         return res.declare(extra.outputs).set(extra.values)
 
-    def output_names(self, model: Model) -> list[str]:
-        return super().output_names(model) + ["S_t", "J_a", "J_b", "J_st", "G_st", "G_p", "G_p_ad", "dJ", "dG_p"]
+    def outputs(self, model: Model) -> list[Output]:
+        """The AD Jacobians (:class:`~cpm_nlp.kinds.kinematic.Jacobian`), then eq 7-13 by screw theory."""
+        return super().outputs(model) + _screw_outputs(model)
+
+
+def _screw_outputs(model: Model) -> list[Output]:
+    """S_t, J_a, J_b (eq 7-9), J and G (eq 10-11), G_p (eq 13) and G_p by AD, and how far the screw
+    and the AD matrices differ."""
+    passive = ", ".join(model.closure.passive_names)
+    return [
+        matrix("S_t", "columns theta, alpha, P; rows wx wy wz [rad] vx vy vz [m] at o'"),
+        matrix("J_a", "eq 9"),
+        matrix("J_b", "eq 9"),
+        matrix("J_st", "rows l1 l2 l3 per columns theta, alpha [rad], P [m] (eq 10; = J_inv by AD)"),
+        matrix("G_st", "rows theta, alpha [rad], P [m] per columns l1 l2 l3 [m] (eq 11; = J by AD)"),
+        matrix("G_p", f"rows {passive} [rad] per l1 l2 l3 [m] (eq 13)"),
+        matrix("G_p_ad", "as G_p, by AD of the passive joint angles"),
+        _agreement_output("dJ", "J_st - J_inv"),
+        _agreement_output("dG_p", "G_p - G_p_ad"),
+    ]
 
 
 #: two computations of one matrix agree "within rounding" below this fraction of its largest entry

@@ -9,11 +9,24 @@ from typing import Any
 from ....core.kind import require_ipopt
 from ....core.model import Model
 from ....core.options import Option
+from ....core.outputs import Output
 from ....core.result import Result, SolverInfo, Status
 from ....core.solver import SolverConfig
 from .. import design as rpr_design
-from .common import RprKind, _finish
-from .transmission import DESIGN_NAMES, _design_values, _eta_max_option
+from .common import RprKind, _declare, _finish
+from .transmission import DESIGN_DIMENSIONS, _design_values, _eta_max_option
+
+#: the optimum (normalized and in length), the starts, every distinct local optimum, and the file's own design
+SYNTHESIS_OUTPUTS = _declare(
+    {
+        **dict.fromkeys(("l1", "l2", "l3", "s", "t", "eta"), "dimensionless"),
+        **dict.fromkeys(("D", "r1", "r2", "P"), "length"),
+        **dict.fromkeys(("starts", "converged", "at_best"), "dimensionless"),
+        "optima": "matrix",
+        **DESIGN_DIMENSIONS,
+    },
+    {"optima": "rows l1, l2, l3, eta of each distinct local optimum, best first"},
+)
 
 
 class Synthesis(RprKind):
@@ -62,7 +75,7 @@ class Synthesis(RprKind):
         )
         info = SolverInfo("ipopt", res.iterations, res.seconds)
         if not res.status.ok:
-            return _finish(self.name, model, res.status, {}, {}, solver=info, message=res.message)
+            return _finish(self, model, res.status, {}, solver=info, message=res.message)
         l1, l2, l3 = res.l
         s, t = rpr_design.to_plane(l1, l2, l3)
         D = model.derived["D"]
@@ -82,29 +95,8 @@ class Synthesis(RprKind):
             "at_best": res.at_best,
             "optima": [list(o) for o in res.optima],
         }
-        dims = {k: "dimensionless" for k in values}
-        dims.update({"D": "length", "r1": "length", "r2": "length", "P": "length", "optima": "matrix"})
-        design, ddims = _design_values(model, mode)
-        values.update(design)
-        dims.update(ddims)
-        units = {"optima": "rows l1, l2, l3, eta of each distinct local optimum, best first"}
-        return _finish(self.name, model, Status.SOLVED, values, dims, units, info, res.message)
+        values.update(_design_values(model, mode))
+        return _finish(self, model, Status.SOLVED, values, info, res.message)
 
-    def output_names(self, model: Model) -> list[str]:
-        return [
-            "l1",
-            "l2",
-            "l3",
-            "s",
-            "t",
-            "eta",
-            "D",
-            "r1",
-            "r2",
-            "P",
-            "starts",
-            "converged",
-            "at_best",
-            "optima",
-            *DESIGN_NAMES,
-        ]
+    def outputs(self, model: Model) -> list[Output]:
+        return list(SYNTHESIS_OUTPUTS)

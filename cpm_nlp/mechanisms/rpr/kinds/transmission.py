@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -12,10 +13,11 @@ import numpy as np
 from ....core.errors import InputError
 from ....core.model import Model
 from ....core.options import Option
+from ....core.outputs import Output
 from ....core.result import Result, Status
 from ....core.solver import SolverConfig
 from .. import design as rpr_design
-from .common import RprKind, _finish
+from .common import RprKind, _declare, _finish
 
 # -- eq 14-26 ---------------------------------------------------------------------------------------
 
@@ -35,15 +37,37 @@ def _eta_max_option() -> Option:
 DESIGN_NAMES = ("l1_design", "l2_design", "l3_design", "s_design", "t_design", "eta_design", "design_in_space")
 
 
-def _design_values(model: Model, eta_max: str) -> tuple[dict, dict]:
+#: the dimensions of :data:`DESIGN_NAMES`
+DESIGN_DIMENSIONS = MappingProxyType({k: ("bool" if k == "design_in_space" else "dimensionless") for k in DESIGN_NAMES})
+
+
+def _design_values(model: Model, eta_max: str) -> dict:
     r1, r2, P0 = (model.parameters[k] for k in ("r1", "r2", "P0"))
     D, l1, l2, l3 = rpr_design.normalize(r1, r2, P0)
     s, t = rpr_design.to_plane(l1, l2, l3)
     eta = rpr_design.eta(r1, r2, P0, eta_max)
     in_space = rpr_design.design_space_violation(l1, l2, l3) is None
-    values = dict(zip(DESIGN_NAMES, (l1, l2, l3, s, t, eta, in_space), strict=True))
-    dims = {k: ("bool" if k == "design_in_space" else "dimensionless") for k in values}
-    return values, dims
+    return dict(zip(DESIGN_NAMES, (l1, l2, l3, s, t, eta, in_space), strict=True))
+
+
+#: the map over the (s, t) grid, its best and worst points, and the file's own design
+MAP_OUTPUTS = _declare(
+    {
+        "s": "dimensionless",
+        "t": "dimensionless",
+        "eta": "matrix",
+        "in_region": "matrix",
+        "eta_best": "dimensionless",
+        "s_best": "dimensionless",
+        "t_best": "dimensionless",
+        "eta_worst": "dimensionless",
+        "points_inside": "dimensionless",
+        "region_fraction": "dimensionless",
+        **DESIGN_DIMENSIONS,
+        "design_in_region": "bool",
+    },
+    {"eta": "rows t, columns s; null outside eq 22", "in_region": "eta >= eta_region; null outside eq 22"},
+)
 
 
 class TransmissionMap(RprKind):
@@ -89,10 +113,9 @@ class TransmissionMap(RprKind):
                 [None if not ok else bool(v) for ok, v in zip(irow, rrow)] for irow, rrow in zip(inside, region)
             ],
         }
-        dims = {"s": "dimensionless", "t": "dimensionless", "eta": "matrix", "in_region": "matrix"}
         if not inside.any():
             return _finish(
-                self.name, model, Status.INFEASIBLE, {}, {}, message="no grid point lies in the design space of eq 22"
+                self, model, Status.INFEASIBLE, {}, message="no grid point lies in the design space of eq 22"
             )
         k = np.nanargmax(E)
         i, j = np.unravel_index(k, E.shape)
@@ -106,44 +129,12 @@ class TransmissionMap(RprKind):
                 "region_fraction": float(region[inside].mean()),
             }
         )
-        design, ddims = _design_values(model, mode)
+        design = _design_values(model, mode)
         design["design_in_region"] = bool(design["eta_design"] >= inputs["eta_region"])
-        ddims["design_in_region"] = "bool"
         values.update(design)
-        dims.update(
-            {
-                "eta_best": "dimensionless",
-                "s_best": "dimensionless",
-                "t_best": "dimensionless",
-                "eta_worst": "dimensionless",
-                "points_inside": "dimensionless",
-                "region_fraction": "dimensionless",
-                **ddims,
-            }
-        )
-        units = {"eta": "rows t, columns s; null outside eq 22", "in_region": "eta >= eta_region; null outside eq 22"}
         return _finish(
-            self.name,
-            model,
-            Status.SOLVED,
-            values,
-            dims,
-            units,
-            message=f"{int(inside.sum())} of {E.size} grid points inside eq 22",
+            self, model, Status.SOLVED, values, message=f"{int(inside.sum())} of {E.size} grid points inside eq 22"
         )
 
-    def output_names(self, model: Model) -> list[str]:
-        return [
-            "s",
-            "t",
-            "eta",
-            "in_region",
-            "eta_best",
-            "s_best",
-            "t_best",
-            "eta_worst",
-            "points_inside",
-            "region_fraction",
-            *DESIGN_NAMES,
-            "design_in_region",
-        ]
+    def outputs(self, model: Model) -> list[Output]:
+        return list(MAP_OUTPUTS)

@@ -11,10 +11,11 @@ from ....core.errors import InputError
 from ....core.kinematics import forward_kinematics, inverse_kinematics
 from ....core.model import Model
 from ....core.options import Option
+from ....core.outputs import Output
 from ....core.result import Result, SolverInfo, Status
 from ....core.solver import SolverConfig
 from .. import screws as rpr_screws
-from .common import RprKind, _finish, _matrix, _pose, _pose_options
+from .common import RprKind, _declare, _finish, _matrix, _pose, _pose_options
 
 # -- section 5.1 ------------------------------------------------------------------------------------
 
@@ -75,7 +76,7 @@ class Twists(RprKind):
         x0 = _pose(model, inputs)
         sol = inverse_kinematics(model, x0, solver)
         if not sol.ok:
-            return _finish(self.name, model, sol.status, {}, {}, message=sol.message)
+            return _finish(self, model, sol.status, {}, message=sol.message)
         c = rpr_screws.reference_point(model, sol.x, inputs["reference"], inputs.get("point"))
         S = rpr_screws.twist_basis(model, sol.x, c, inputs["convention"])
         G = rpr_screws.screw_jacobian(model, sol.x).G
@@ -92,42 +93,44 @@ class Twists(RprKind):
                 break
             fk_cols.append(S @ (fk.x - sol.x))
         if not status.ok:
-            return _finish(self.name, model, status, {}, {}, message=msg)
+            return _finish(self, model, status, {}, message=msg)
         T_fk = np.column_stack(fk_cols)
         values = {
             "T": _matrix(T),
             "T_fk": _matrix(T_fk),
             "dT_fk": float(np.max(np.abs(T_fk - T))),
             "reference_point": c.tolist(),
+            "convention": inputs["convention"],
             "theta": float(sol.x[0]),
             "alpha": float(sol.x[1]),
             "P": float(sol.x[2]),
         }
-        dims = {
-            "T": "matrix",
-            "T_fk": "matrix",
-            "dT_fk": "dimensionless",
-            "reference_point": "length",
-            "theta": "angle",
-            "alpha": "angle",
-            "P": "length",
-        }
-        rows = "rows wx, wy, wz [rad], vx, vy, vz [m]; columns actuators 1, 2, 3"
-        units = {
-            "T": f"{rows} ({inputs['convention']} convention, linear G d)",
-            "T_fk": f"{rows}, S_t times the exact FK pose change",
-            "dT_fk": "max |T_fk - T|",
-        }
         return _finish(
-            self.name,
+            self,
             model,
             Status.SOLVED,
             values,
-            dims,
-            units,
             SolverInfo(solver.name, iters),
             f"twists for d = {d:.3g} m on each actuator, {inputs['convention']} convention",
         )
 
-    def output_names(self, model: Model) -> list[str]:
-        return ["T", "T_fk", "dT_fk", "reference_point", "theta", "alpha", "P"]
+    def outputs(self, model: Model) -> list[Output]:
+        """The twists by G d and by the exact FK, their difference, the point they refer to, the
+        convention of their moments, and the pose."""
+        rows = "rows wx, wy, wz [rad], vx, vy, vz [m]; columns actuators 1, 2, 3"
+        return _declare(
+            {
+                "T": "matrix",
+                "T_fk": "matrix",
+                "dT_fk": "dimensionless",
+                "reference_point": "length",
+                "convention": "text",
+                **{x.name: x.kind for x in model.closure.x},
+            },
+            {
+                "T": f"{rows} (linear G d; moments in the convention the value 'convention' names)",
+                "T_fk": f"{rows}, S_t times the exact FK pose change",
+                "dT_fk": "max |T_fk - T|",
+                "convention": "",
+            },
+        )
