@@ -19,7 +19,7 @@ class CommandHelp:
     """The help of one subcommand.
 
     summary: one line, listed under ``cpm-nlp --help``.
-    description: one paragraph, at the top of ``cpm-nlp COMMAND --help``.
+    description: one paragraph, at the top of the ``--help`` of each subcommand.
     examples: ``(command line, what it does)`` pairs, listed under the options.
     plot_types: list the registered plot types under the examples (commands that plot).
     """

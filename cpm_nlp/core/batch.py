@@ -247,6 +247,7 @@ class BatchResult:
             if not ok[i]:
                 out.append(self.solution(i))
                 continue
+            rows[i]["iterations_counted"] = self.path(i) == "closed"  # as solution(i)
             out.append(
                 PoseSolution(
                     Status.SOLVED,
