@@ -15,9 +15,9 @@ from .comparison_plots import comparisons
 from .draw_compliance import dynamics_figure, ellipsoid_figure, modes_figure
 from .draw_mechanism import Arrow, modes_mechanism_figure
 from .draw_panels import Panel, panels_figure
-from .pose import geometry_of, model_for, single_pose
+from .pose import geometry_of, mechanism_title, model_for, single_pose
 from .results import NotApplicable, PlotOptions, ResultData, dimension_of, pose_name, require_lists, result_closure
-from .style import as_floats
+from .style import as_floats, display_unit, number
 
 # -- dynamics ---------------------------------------------------------------------------------------------
 
@@ -161,13 +161,18 @@ def mode_arrows(model: Any, geometry: Any, x: np.ndarray, q: np.ndarray, mx: Any
     if peak == 0.0:
         return []
     D *= MODE_ARROW * span / peak
+    factor, unit = display_unit("length", P)
+    label = (
+        f"point displacement in the mode, scaled: the largest drawn {number(MODE_ARROW * span * factor)} {unit} "
+        f"long ({MODE_ARROW:.0%} of the mechanism's size; a mode shape has no amplitude of its own)"
+    )
     arrows: list[Arrow] = []
     seen: list[np.ndarray] = []
     for p, d in zip(P, D):
         if np.linalg.norm(d) < 1e-3 * MODE_ARROW * span or any(np.linalg.norm(p - o) < 1e-9 * span for o in seen):
             continue
         seen.append(p)
-        arrows.append(Arrow(p, d, "" if arrows else "displacement in the mode (scaled)", "tab:red"))
+        arrows.append(Arrow(p, d, "" if arrows else label, "tab:red"))
     return arrows
 
 
@@ -186,7 +191,7 @@ def modes_plot(data: ResultData, _options: PlotOptions) -> Any:
         arrows = [mode_arrows(model, geometry, x, q, mx, mq) for mx, mq in modes]
         freqs = [data.values[f"f{k + 1}"] for k in range(len(modes))]
         pose = geometry(model, x, q)
-        title = _with_degenerate_note(f"Mode shapes ({data.model.get('type')})", _mode_clusters(data), len(modes))
+        title = _with_degenerate_note(f"Mode shapes: {mechanism_title(model)}", _mode_clusters(data), len(modes))
         return modes_mechanism_figure(pose, arrows, freqs, title=title, note=pose.note)
     idx = _translational(c)
     platform = np.zeros(3)
