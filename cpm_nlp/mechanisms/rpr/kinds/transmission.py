@@ -104,6 +104,7 @@ class TransmissionMap(RprKind):
                 "eta_worst": float(np.nanmin(E)),
                 "points_inside": int(inside.sum()),
                 "region_fraction": float(region[inside].mean()),
+                "eta_region": float(inputs["eta_region"]),  # the bound of in_region (a map states it)
             }
         )
         design, ddims = _design_values(model, mode)
@@ -118,6 +119,7 @@ class TransmissionMap(RprKind):
                 "eta_worst": "dimensionless",
                 "points_inside": "dimensionless",
                 "region_fraction": "dimensionless",
+                "eta_region": "dimensionless",
                 **ddims,
             }
         )
@@ -144,6 +146,7 @@ class TransmissionMap(RprKind):
             "eta_worst",
             "points_inside",
             "region_fraction",
+            "eta_region",
             *DESIGN_NAMES,
             "design_in_region",
         ]
