@@ -269,7 +269,9 @@ def workspace_figure(
     ax = fig.add_subplot(2, 2, 1, projection="3d")
     if len(P):
         label = f"{points_label} ({len(P)})"
-        ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=sc.size, c=P[:, 2], cmap="viridis", alpha=0.5, label=label)
+        cloud = ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=sc.size, c=P[:, 2], cmap="viridis", alpha=0.5, label=label)
+        # the colour is the height: a colour bar says so, in the unit of that axis
+        fig.colorbar(cloud, ax=ax, shrink=0.6, pad=0.12, label=f"colour: {sc.labels[2]}")
     ax.set_xlabel(sc.labels[0])
     ax.set_ylabel(sc.labels[1])
     ax.set_zlabel(sc.labels[2])

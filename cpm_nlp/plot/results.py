@@ -175,13 +175,17 @@ def result_mechanism(data: ResultData) -> Any:
     return recorded_mechanism(data.origin, name, data.source or None)
 
 
-def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None) -> Any:
+def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None, with_limits: bool = False) -> Any:
     """A model of the result's mechanism (:func:`result_mechanism`) from ``parameters``
-    (default: the ones the result records), without registering it."""
+    (default: the ones the result records), without registering it; ``with_limits``: with the
+    joint limits the result records too (its workspace is then the one solved)."""
     mech = result_mechanism(data)
     if parameters is None:
         parameters = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
-    return recorded_model(mech, parameters)
+    limits = None
+    if with_limits:
+        limits = {o.name: data.model[o.name] for o in mech.limits if data.model.get(o.name) is not None}
+    return recorded_model(mech, parameters, limits=limits)
 
 
 def value_list(data: ResultData, name: str) -> list | None:
