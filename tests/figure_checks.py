@@ -49,6 +49,41 @@ def _labels(fig):
     return out
 
 
+def _axes_texts(artist):
+    """The texts drawn in an axes, at any depth (point labels, annotations, contour labels,
+    titles), not those of its axis ticks and labels nor of its legend."""
+    from matplotlib.axis import Axis
+    from matplotlib.legend import Legend
+    from matplotlib.text import Text
+
+    for child in artist.get_children():
+        if isinstance(child, (Axis, Legend)):
+            continue
+        if isinstance(child, Text):
+            yield child
+        else:
+            yield from _axes_texts(child)
+
+
+def assert_labels_apart(fig, slack=1.0):
+    """No two texts drawn in one axes of a Matplotlib figure overlap (point labels of a
+    mechanism, annotations, contour labels, titles), measured on the rendered figure; boxes
+    may touch within ``slack`` pixels."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    for ax in fig.axes:
+        shown = [t for t in _axes_texts(ax) if t.get_visible() and t.get_text().strip()]
+        boxes = [t.get_window_extent(renderer).expanded(1.0, 1.0).padded(-slack) for t in shown]
+        for a in range(len(shown)):
+            for b in range(a + 1, len(shown)):
+                assert not boxes[a].overlaps(boxes[b]), (
+                    f"texts {shown[a].get_text()!r} and {shown[b].get_text()!r} overlap: {boxes[a]} and {boxes[b]}"
+                )
+
+
 def assert_figure_readable(fig):
     """Every title, label and legend text of a Matplotlib figure lies inside the
     figure (nothing clipped at its edges), and no legend holds a template placeholder."""

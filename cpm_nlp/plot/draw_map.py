@@ -64,6 +64,8 @@ class _Layers:
     levels: Any
     #: the grid's cells outside the design space are drawn (else their points, as dots)
     blank_drawn: bool = False
+    #: the region's outline (polylines, display units)
+    outline: tuple = ()
 
 
 #: colour of the points or cells outside the design space (the legend's swatch is the same)
@@ -151,8 +153,16 @@ def _grid_layer(m: _Layers, grid: tuple, fx: float, fy: float) -> Any:
     if m.region is not None and m.region.any():
         mask = np.zeros_like(cells)
         mask[iy, ix] = m.region.astype(float)
-        m.ax.contour(ux * fx, uy * fy, mask, levels=[0.5], colors="tab:red", linewidths=2)
+        _outline(m, m.ax.contour(ux * fx, uy * fy, mask, levels=[0.5]))
     return mappable
+
+
+def _outline(m: _Layers, cs: Any) -> None:
+    """Keep the lines of a contour set as the region's outline (drawn as lines, so that the
+    legend names what is drawn) and remove the contour set."""
+    lines = [poly for path in cs.get_paths() for poly in path.to_polygons(closed_only=False) if len(poly) > 1]
+    cs.remove()
+    m.outline = tuple(lines)
 
 
 def _triangulated(m: _Layers) -> Any:
@@ -179,7 +189,7 @@ def _triangulated(m: _Layers) -> Any:
         cs = m.ax.tricontour(tri, Zf, levels=m.levels, colors="k", linewidths=0.6, alpha=0.7)
         m.ax.clabel(cs, fontsize="x-small", fmt=level_format(m.levels))
     if m.region is not None and m.region[use].any():
-        m.ax.tricontour(tri, m.region[use].astype(float), levels=[0.5], colors="tab:red", linewidths=2)
+        _outline(m, m.ax.tricontour(tri, m.region[use].astype(float), levels=[0.5]))
     return mappable
 
 
@@ -199,8 +209,8 @@ def _point_layers(m: _Layers, region_label: str) -> None:
     """The region's legend entry, the points outside the design space and those not solved,
     the domain's outline."""
     ax, X, Y = m.ax, m.X, m.Y
-    if m.region is not None and m.region.any():
-        ax.plot([], [], color="tab:red", lw=2, label=region_label)
+    for n, line in enumerate(m.outline):  # the region's outline, named once in the legend
+        ax.plot(line[:, 0], line[:, 1], color="tab:red", lw=2, label="_" if n else region_label)
     away = m.away
     if away.any() and not m.blank_drawn:  # scattered points outside: dots (a grid's cells: _grid_layer)
         ax.plot(

@@ -66,6 +66,8 @@ ZORDER = {"faint": 0.5, "base": 1.0, "platform": 1.5, "link": 2.0, "leg": 2.0, "
 ZORDER_ARROW, ZORDER_LABEL = 4.0, 5.0
 #: a face's opacity: translucent, so that what is behind it shows
 FACE_ALPHA = 0.22
+#: the lines of a reference pose (home), drawn under the pose
+FAINT_LINE = {"color": "0.6", "lw": 1.0, "ls": "--", "zorder": ZORDER["faint"]}
 
 
 def draw_mechanism(
@@ -91,12 +93,13 @@ def draw_mechanism(
             Poly3DCollection(
                 [poly],
                 facecolor=colour,
-                edgecolor="0.5" if faint else colour,
+                edgecolor="none" if faint else colour,
                 alpha=0.1 if faint else FACE_ALPHA,
-                linestyles="--" if faint else "-",
                 zorder=ZORDER["faint"] if faint else ZORDER.get(part, 1.0),
             )
         )
+        if faint:  # its outline dashed, as the home pose's links
+            ax.plot(*np.vstack([poly, poly[:1]]).T, label="home pose", **FAINT_LINE)
     if not _links_and_joints(ax, drawing, pts, set(), faint, {"depthshade": False}):
         return
     if label_points:
@@ -111,7 +114,7 @@ def draw_mechanism(
 
 #: an actuator segment shorter than this fraction of the drawing is not named in the legend (the
 #: actuated joint's marker shows where the actuator is)
-SHORT_STROKE = 0.03
+SHORT_STROKE = 0.06
 
 
 def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: bool, joint_style: dict) -> bool:
@@ -128,24 +131,19 @@ def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: b
         label = "_" if faint or part in seen or short else part
         if label != "_":
             seen.add(part)
-        if faint:
-            style = {"color": "0.6", "lw": 1.0, "ls": "--", "zorder": ZORDER["faint"]}
-            if "home pose" not in seen:  # the home pose in the legend from a segment drawn, not an empty line
-                label = "home pose"
-                seen.add("home pose")
+        if faint:  # every segment of the home pose named (the legend names it once): some show
+            style, label = FAINT_LINE, "home pose"
         else:
             style = {"color": colour, "lw": width, "ls": "-", "zorder": ZORDER[part], "solid_capstyle": "butt"}
         ax.plot(*ends.T, label=label, **style)
     if faint:
         return False
-    kinds: set[tuple[str, bool]] = set()
     driven = set(drawing.actuated)
-    for name, letter in drawing.joints.items():
+    for name, letter in drawing.joints.items():  # every marker named (the legend names each kind once)
         act = name in driven
         face = ACTUATED_FACE if act else "white" if letter == "S" else "k"
         what = f"{JOINT_NAME[letter]} joint ({letter})"
-        label = "_" if (letter, act) in kinds else (f"actuated {what}" if act else what)
-        kinds.add((letter, act))
+        label = f"actuated {what}" if act else what
         ax.scatter(
             *pts[name],
             marker=JOINT_MARKER[letter],
@@ -153,7 +151,7 @@ def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: b
             facecolor=face,
             edgecolor="k",
             label=label,
-            zorder=ZORDER["joint"],
+            zorder=ZORDER["joint"] + (0 if act else 0.1),  # a passive joint at an actuated one: on top, smaller
             **joint_style,
         )
     return True
@@ -197,13 +195,14 @@ def draw_mechanism_2d(
                 poly,
                 closed=True,
                 facecolor=colour,
-                edgecolor="0.5" if faint else colour,
+                edgecolor="none" if faint else colour,
                 alpha=0.1 if faint else FACE_ALPHA,
-                linestyle="--" if faint else "-",
                 label=label,
                 zorder=ZORDER["faint"] if faint else ZORDER.get(part, 1.0),
             )
         )
+        if faint:  # its outline dashed, as the home pose's links
+            ax.plot(*np.vstack([poly, poly[:1]]).T, label="home pose", **FAINT_LINE)
     if not _links_and_joints(ax, drawing, pts, seen, faint, {}):
         return
     if label_points:
@@ -384,6 +383,16 @@ def equal_aspect(ax: Any, points: np.ndarray) -> None:
     ax.set_box_aspect((1, 1, 1))
 
 
+def _same_pose(a: Any, b: Any) -> bool:
+    """Whether two drawings put every point at the same place (to 1e-9 of their size)."""
+    if set(a.points) != set(b.points):
+        return False
+    P = np.array([np.asarray(a.points[n], dtype=float).ravel()[:3] for n in a.points])
+    Q = np.array([np.asarray(b.points[n], dtype=float).ravel()[:3] for n in a.points])
+    span = float(np.ptp(P, axis=0).max()) if len(P) > 1 else 1.0
+    return bool(np.abs(P - Q).max() <= 1e-9 * (span or 1.0))
+
+
 def _planar_view(ax: Any, unit: str, frame: np.ndarray | None) -> None:
     """Equal scales, axis labels and a grid of a planar drawing; ``frame`` (shown units): the
     points its ranges hold (else the drawing's, with a margin)."""
@@ -397,6 +406,21 @@ def _planar_view(ax: Any, unit: str, frame: np.ndarray | None) -> None:
     ax.set_xlabel(f"x ({unit})")
     ax.set_ylabel(f"y ({unit})")
     ax.grid(True, alpha=0.3)
+
+
+def _frame_3d(ax: Any, allpts: np.ndarray, arrows: Sequence[Arrow], frame: Any, factor: float) -> None:
+    """Equal scales around the points and arrows (or ``frame``, SI); a nearly flat mechanism
+    (its height under a fifth of its size) seen from higher up, so that its plane opens."""
+    shown = allpts * factor
+    for arrow in arrows:
+        o = np.asarray(arrow.origin, dtype=float) * factor
+        shown = np.vstack([shown, o, o + np.asarray(arrow.vector, dtype=float) * factor])
+    if frame is not None:
+        shown = np.asarray(frame, dtype=float) * factor
+    equal_aspect(ax, shown)
+    span = float(np.ptp(allpts, axis=0).max()) or 1.0
+    if np.ptp(allpts[:, 2]) < 0.2 * span:
+        ax.view_init(elev=55, azim=-70)
 
 
 def mechanism_axes(
@@ -416,6 +440,8 @@ def mechanism_axes(
     points (SI, n x 3) the view must hold; panels given the same frame share their ranges.
     A nearly flat mechanism (its height under a fifth of its size) is seen from higher up."""
     allpts = np.array([np.asarray(v, dtype=float).ravel()[:3] for v in drawing.points.values()])
+    if home is not None and _same_pose(drawing, home):
+        home = None  # at home: nothing to draw faintly (it would hide under the pose)
     if home is not None:
         allpts = np.vstack([allpts, [np.asarray(v, dtype=float).ravel()[:3] for v in home.points.values()]])
     factor, unit = display_unit("length", allpts)
@@ -432,16 +458,7 @@ def mechanism_axes(
     if home is not None:
         draw_mechanism(ax, home, factor=factor, faint=True)
     draw_mechanism(ax, drawing, factor=factor, arrows=arrows, label_points=label_points)
-    shown = allpts * factor
-    for arrow in arrows:
-        o = np.asarray(arrow.origin, dtype=float) * factor
-        shown = np.vstack([shown, o, o + np.asarray(arrow.vector, dtype=float) * factor])
-    if frame is not None:
-        shown = np.asarray(frame, dtype=float) * factor
-    equal_aspect(ax, shown)
-    span = float(np.ptp(allpts, axis=0).max()) or 1.0
-    if np.ptp(allpts[:, 2]) < 0.2 * span:  # nearly flat: from higher up, so that its plane opens
-        ax.view_init(elev=55, azim=-70)
+    _frame_3d(ax, allpts, arrows, frame, factor)
     ax.set_xlabel(f"x ({unit})")
     ax.set_ylabel(f"y ({unit})")
     ax.set_zlabel(f"z ({unit})")

@@ -134,10 +134,8 @@ def _slices_3d(ax: Any, sc: _Scene, label: str) -> None:
             xyz = np.zeros((len(line), 3))
             xyz[:, i], xyz[:, j], xyz[:, k] = line[:, 0], line[:, 1], sl.at
             xyz = xyz * sc.f
-            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label=None if drawn else "_b")
+            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label="_" if drawn else label)
             drawn = True
-    if drawn:
-        ax.plot([], [], color="k", lw=1.2, label=label)
 
 
 def _boxes_3d(ax: Any, sc: _Scene, cuboid_label: str) -> None:
@@ -269,7 +267,9 @@ def workspace_figure(
     ax = fig.add_subplot(2, 2, 1, projection="3d")
     if len(P):
         label = f"{points_label} ({len(P)})"
-        cloud = ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=sc.size, c=P[:, 2], cmap="viridis", alpha=0.5, label=label)
+        cloud = ax.scatter(
+            P[:, 0], P[:, 1], P[:, 2], s=sc.size, c=P[:, 2], cmap="viridis", alpha=0.5, depthshade=False, label=label
+        )
         # the colour is the height: a colour bar says so, in the unit of that axis
         fig.colorbar(cloud, ax=ax, shrink=0.6, pad=0.12, label=f"colour: {sc.labels[2]}")
     ax.set_xlabel(sc.labels[0])
@@ -282,7 +282,12 @@ def workspace_figure(
     _boxes_3d(ax, sc, cuboid_label)
     handles = [h for h, lab in zip(*ax.get_legend_handles_labels()) if not lab.startswith("_")]
     if handles:
-        fig.legend(handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize="small")
+        legend = fig.legend(handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize="small")
+        if len(P):  # the points' swatch in the colour of a point drawn (the middle one by height)
+            middle = P[np.argsort(P[:, 2])[len(P) // 2], 2]
+            swatch = legend.legend_handles[0]
+            swatch.set_array(None)  # one colour, not mapped again when drawn
+            swatch.set_facecolor(cloud.to_rgba(middle, alpha=0.5))
     for n, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
         _projection(fig.add_subplot(2, 2, n + 2), sc, i, j)
     if title:
