@@ -270,8 +270,10 @@ def workspace_figure(
         cloud = ax.scatter(
             P[:, 0], P[:, 1], P[:, 2], s=sc.size, c=P[:, 2], cmap="viridis", alpha=0.5, depthshade=False, label=label
         )
-        # the colour is the height: a colour bar says so, in the unit of that axis
-        fig.colorbar(cloud, ax=ax, shrink=0.6, pad=0.12, label=f"colour: {sc.labels[2]}")
+        # the colour is the height: a colour bar says so, in the unit of that axis (an inset of the
+        # 3-D view: the figure's axes stay the view and its three projections)
+        bar = ax.inset_axes((1.18, 0.2, 0.035, 0.6))
+        fig.colorbar(cloud, cax=bar, label=f"colour: {sc.labels[2]}")
     ax.set_xlabel(sc.labels[0])
     ax.set_ylabel(sc.labels[1])
     ax.set_zlabel(sc.labels[2])
