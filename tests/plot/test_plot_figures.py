@@ -24,7 +24,6 @@ from cpm_nlp.plot.draw import (
     Panel,
     comparison_figure,
     design_map_figure,
-    mechanism_figure,
     panels_figure,
     save,
     unit_text,
