@@ -75,12 +75,13 @@ def draw_mechanism(
     drawing: Any,
     *,
     factor: float,
-    faint: bool = False,
+    faint: bool | str = False,
     label_points: bool = True,
     arrows: Sequence[Arrow] = (),
 ) -> None:
     """Draw a :class:`~cpm_nlp.core.mechanism.Drawing` (SI) into a 3-D axes,
-    shown = SI * factor; ``faint``: a reference pose (thin, grey, no labels).
+    shown = SI * factor; ``faint``: a reference pose (thin, grey, no labels; a text: its legend,
+    else "home pose").
     The layers are drawn in a fixed order (:data:`ZORDER`), faces translucent."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
@@ -99,7 +100,7 @@ def draw_mechanism(
             )
         )
         if faint:  # its outline dashed, as the home pose's links
-            ax.plot(*np.vstack([poly, poly[:1]]).T, label="home pose", **FAINT_LINE)
+            ax.plot(*np.vstack([poly, poly[:1]]).T, label=faint_label(faint), **FAINT_LINE)
     if not _links_and_joints(ax, drawing, pts, set(), faint, {"depthshade": False}):
         return
     if label_points:
@@ -117,7 +118,12 @@ def draw_mechanism(
 SHORT_STROKE = 0.06
 
 
-def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: bool, joint_style: dict) -> bool:
+def faint_label(faint: bool | str) -> str:
+    """The legend of a faint drawing: ``faint`` itself if a text, else "home pose"."""
+    return faint if isinstance(faint, str) else "home pose"
+
+
+def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: Any, joint_style: dict) -> bool:
     """The links of a drawing (one legend entry per part not in ``seen``) and, unless
     ``faint``, its joints (one legend entry per joint type; actuated joints filled in the
     actuators' colour), in 2-D or 3-D axes alike (the points ``pts`` have 2 or 3
@@ -132,7 +138,7 @@ def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: b
         if label != "_":
             seen.add(part)
         if faint:  # every segment of the home pose named (the legend names it once): some show
-            style, label = FAINT_LINE, "home pose"
+            style, label = FAINT_LINE, faint_label(faint)
         else:
             style = {"color": colour, "lw": width, "ls": "-", "zorder": ZORDER[part], "solid_capstyle": "butt"}
         ax.plot(*ends.T, label=label, **style)
@@ -176,7 +182,7 @@ def draw_mechanism_2d(
     drawing: Any,
     *,
     factor: float,
-    faint: bool = False,
+    faint: bool | str = False,
     label_points: bool = True,
     arrows: Sequence[Arrow] = (),
 ) -> None:
@@ -202,7 +208,7 @@ def draw_mechanism_2d(
             )
         )
         if faint:  # its outline dashed, as the home pose's links
-            ax.plot(*np.vstack([poly, poly[:1]]).T, label="home pose", **FAINT_LINE)
+            ax.plot(*np.vstack([poly, poly[:1]]).T, label=faint_label(faint), **FAINT_LINE)
     if not _links_and_joints(ax, drawing, pts, seen, faint, {}):
         return
     if label_points:
@@ -433,6 +439,7 @@ def mechanism_axes(
     title: str = "",
     label_points: bool = True,
     frame: Any = None,
+    home_label: str = "home pose",
 ) -> Any:
     """A 3-D axes of ``fig`` (subplot ``position``) with the mechanism drawn at
     its pose (and faintly at ``home``), axes in one length unit, equal scales; a
@@ -448,7 +455,7 @@ def mechanism_axes(
     if is_planar(drawing, *([home] if home is not None else [])):
         ax = fig.add_subplot(*position)
         if home is not None:
-            draw_mechanism_2d(ax, home, factor=factor, faint=True)
+            draw_mechanism_2d(ax, home, factor=factor, faint=home_label)
         draw_mechanism_2d(ax, drawing, factor=factor, arrows=arrows, label_points=label_points)
         _planar_view(ax, unit, None if frame is None else np.asarray(frame, dtype=float)[:, :2] * factor)
         if title:
@@ -456,7 +463,7 @@ def mechanism_axes(
         return ax
     ax = fig.add_subplot(*position, projection="3d")
     if home is not None:
-        draw_mechanism(ax, home, factor=factor, faint=True)
+        draw_mechanism(ax, home, factor=factor, faint=home_label)
     draw_mechanism(ax, drawing, factor=factor, arrows=arrows, label_points=label_points)
     _frame_3d(ax, allpts, arrows, frame, factor)
     ax.set_xlabel(f"x ({unit})")
@@ -469,12 +476,19 @@ def mechanism_axes(
 
 
 def mechanism_figure(
-    drawing: Any, *, home: Any = None, arrows: Sequence[Arrow] = (), title: str = "", note: str = ""
+    drawing: Any,
+    *,
+    home: Any = None,
+    arrows: Sequence[Arrow] = (),
+    title: str = "",
+    note: str = "",
+    home_label: str = "home pose",
 ) -> Any:
-    """The mechanism at a pose, alone: a 3-D view with its legend and ``note`` below."""
+    """The mechanism at a pose, alone: a 3-D view with its legend and ``note`` below; ``home``
+    drawn faintly under it, named ``home_label`` in the legend."""
     Figure = figure_class()
     fig = Figure(figsize=(8, 7.5), layout="constrained")
-    ax = mechanism_axes(fig, (1, 1, 1), drawing, home=home, arrows=arrows)
+    ax = mechanism_axes(fig, (1, 1, 1), drawing, home=home, arrows=arrows, home_label=home_label)
     legend_below(fig, ax, note)
     if title:
         fig.suptitle(title)

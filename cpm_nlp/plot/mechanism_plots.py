@@ -55,9 +55,10 @@ def design_plot(data: ResultData, options: PlotOptions) -> Any:
     shown = [(k, v, *display_unit(kinds[k], [v])) for k, v in found.items()]
     text = ", ".join(f"{k} = {v * f:.4g} {unit}".rstrip() for k, v, f, unit in shown)
     title = f"{mechanism_title(model)}\ndesigned by {data.problem.replace('_', ' ')}, at home: {text}"
-    note = "; ".join(t for t in (pose.note, "dashed: the design in the file" if home is not None else "") if t)
-    draw = mechanism_html if options.interactive else mechanism_figure
-    return draw(pose, home=home, title=title, note=note)
+    if options.interactive:
+        note = "; ".join(t for t in (pose.note, "dashed: the design in the file" if home is not None else "") if t)
+        return mechanism_html(pose, home=home, title=title, note=note)
+    return mechanism_figure(pose, home=home, title=title, note=pose.note, home_label="the design in the file (at home)")
 
 
 # -- jacobian --------------------------------------------------------------------------------------------
