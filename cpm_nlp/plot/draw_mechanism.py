@@ -247,20 +247,23 @@ _LEG_POINT = re.compile(r"([A-Za-z]+?)(\d+)_(\d+)")
 
 def readable_names(names: Sequence[str], joints: Mapping[str, str]) -> dict[str, str]:
     """The label of each point: a leg's joint ``leg3_2`` by its joint letter and leg,
-    ``$R_{3}$`` (``$R_{3,2}$`` where the leg has two joints of that letter); other names
-    as they are (``A''``, ``P``)."""
+    ``$R_{3}$`` (``$R_{3,2}$`` where the leg has two joints of that letter; the leg by its
+    number where every leg's name is one word and a number, else by its name: ``$U_{a1}$``,
+    ``$U_{b1}$``); other names as they are (``A''``, ``P``)."""
     legs: dict[tuple[str, str], list[str]] = {}
     for name in names:
         m = _LEG_POINT.fullmatch(name)
         if m and name in joints:
             legs.setdefault(m.group(1, 2), []).append(joints[name])
+    numbered = len({word for word, _ in legs}) == 1  # leg1, leg2 ...: the numbers name them
     out = {}
     for name in names:
         m = _LEG_POINT.fullmatch(name)
         if not (m and name in joints):
             out[name] = name
             continue
-        letter, leg, n = joints[name], m.group(2), m.group(3)
+        letter, n = joints[name], m.group(3)
+        leg = m.group(2) if numbered else m.group(1) + m.group(2)
         sub = leg if legs[m.group(1, 2)].count(letter) == 1 else f"{leg},{n}"
         out[name] = f"${letter}_{{{sub}}}$"
     return out

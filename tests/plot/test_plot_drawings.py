@@ -87,6 +87,9 @@ def test_joint_labels_read_as_letter_and_leg():
     names = readable_names([*joints, "P", "A''"], joints)
     assert names["leg3_1"] == "$P_{3}$" and names["leg3_2"] == "$R_{3}$" and names["leg3_3"] == "$S_{3}$"
     assert names["leg1_2"] == "$R_{1,2}$" and names["P"] == "P" and names["A''"] == "A''"
+    # legs named by a word and a number each (the 6-UPS: a1 ... b3): by the name, not the number alone
+    six = {"a1_1": "U", "b1_1": "U", "a1_3": "S"}
+    assert readable_names(list(six), six) == {"a1_1": "$U_{a1}$", "b1_1": "$U_{b1}$", "a1_3": "$S_{a1}$"}
 
 
 def test_prs3_drawing_labels_apart_legs_seen_actuators_marked(tmp_path):
