@@ -44,7 +44,7 @@ def _colour(name: str) -> str:
 
 def _layout(fig: Any, title: str, labels: Sequence[str], aspect: str = "cube") -> None:
     fig.update_layout(
-        title={"text": title.replace("\n", "<br>"), "x": 0.5},
+        title={"text": _mathless(title).replace("\n", "<br>"), "x": 0.5},
         scene={
             "xaxis_title": labels[0],
             "yaxis_title": labels[1],
@@ -57,9 +57,21 @@ def _layout(fig: Any, title: str, labels: Sequence[str], aspect: str = "cube") -
     )
 
 
+def _greek(m: Any) -> str:
+    import unicodedata
+
+    try:
+        return unicodedata.lookup(f"GREEK SMALL LETTER {m.group(1).upper()}")
+    except KeyError:
+        return m.group(1)
+
+
 def _mathless(label: str) -> str:
-    """An axis label without Matplotlib's mathtext dollars (Plotly shows them literally)."""
-    return label.replace("$", "").replace("\\", "").replace("{", "").replace("}", "")
+    """A label without Matplotlib's mathtext (Plotly shows it literally): ``$\\psi$`` -> ψ."""
+    import re
+
+    label = re.sub(r"\\([A-Za-z]+)", _greek, label)
+    return label.replace("$", "").replace("{", "").replace("}", "")
 
 
 def workspace_html(
