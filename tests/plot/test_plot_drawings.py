@@ -334,3 +334,30 @@ def test_a_result_whose_cloud_the_rebuilt_model_does_not_hold_gets_no_boundary(c
     path.write_text(json.dumps(result))
     fig, _ = figures.figure(figures.load(path))
     assert not any(t.get_text().startswith("workspace boundary") for t in fig.legends[0].get_texts())
+
+
+# -- every shipped mechanism's drawing ------------------------------------------------------------------------
+
+FK_FILES = (
+    "delta_forward_kinematics",
+    "five_bar_forward_kinematics",
+    "pantograph_forward_kinematics",
+    "prc3_forward_kinematics",
+    "prs3_as_built_forward_kinematics",
+    "rpr_file_forward_kinematics",
+    "rps3_forward_kinematics",
+    "rrr3_forward_kinematics",
+    "ups6_forward_kinematics",
+)
+
+
+@pytest.mark.parametrize("name", FK_FILES)
+def test_every_shipped_mechanism_drawing_is_readable(solved_file, name):
+    """Labels apart, legends naming what shows (an actuator, each joint type, the home pose),
+    titled by the mechanism's own title."""
+    data = solved_file(name)
+    fig, kind = figures.figure(data)
+    assert kind == "mechanism"
+    checked(fig)
+    title = fig._suptitle.get_text()
+    assert title.split("\n")[1].startswith("forward kinematics: ") and "_" not in title.split("\n")[0]
