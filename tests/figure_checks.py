@@ -1,8 +1,14 @@
-"""Checks that a figure file is valid and drawn (not blank)."""
+"""Checks of figures: a file is valid and drawn (not blank), texts are not clipped,
+legend entries match what is drawn, and a figure matches its baseline image drawn in
+a fixed style."""
 
 from __future__ import annotations
 
+import os
+import shutil
 import xml.etree.ElementTree as ET
+from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 
@@ -273,3 +279,57 @@ def _check_legends(fig, artists, atol):
                 break
         else:
             raise AssertionError(f"legend entry {label!r} does not match what is drawn: {'; '.join(problems)}")
+
+
+# -- baseline images -------------------------------------------------------------------------------
+
+#: the committed baseline images
+BASELINES = Path(__file__).resolve().parent / "baseline_images"
+
+#: the style a baseline image is drawn in, so that it holds on other platforms: the fonts
+#: Matplotlib ships (DejaVu Sans, DejaVu mathtext: never a system font found by family), no
+#: font hinting (FreeType versions hint glyphs differently), a fixed resolution
+BASELINE_STYLE = {
+    "font.family": "sans-serif",
+    "font.sans-serif": ["DejaVu Sans"],
+    "mathtext.fontset": "dejavusans",
+    "text.hinting": "none",
+    "figure.dpi": 100,
+    "savefig.dpi": 100,
+}
+
+
+@contextmanager
+def baseline_style():
+    """Matplotlib's settings of :data:`BASELINE_STYLE` while a baseline figure is built and drawn."""
+    import matplotlib
+
+    with matplotlib.rc_context(BASELINE_STYLE):
+        yield
+
+
+def assert_matches_baseline(build, name, tmp_path, *, tol, reason, dpi=100):
+    """The figure ``build()`` makes, drawn in :data:`BASELINE_STYLE`, against the
+    committed ``baseline_images/<name>.png`` within ``tol`` (RMS difference of 0-255
+    pixels, :func:`matplotlib.testing.compare.compare_images`); ``reason`` says why that
+    tolerance (required: a tolerance without one is a guess). Regenerate with
+    CPM_NLP_UPDATE_BASELINES=1 after a deliberate change, and look at the images.
+    Returns the figure (its texts and legends checked by the caller within
+    :func:`baseline_style`)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.testing.compare import compare_images
+
+    assert reason.strip(), "say why the tolerance is what it is"
+    with baseline_style():
+        fig = build()
+        out = tmp_path / f"{name}.png"
+        FigureCanvasAgg(fig)
+        fig.savefig(out, dpi=dpi)
+    baseline = BASELINES / f"{name}.png"
+    if os.environ.get("CPM_NLP_UPDATE_BASELINES"):
+        BASELINES.mkdir(exist_ok=True)
+        shutil.copy(out, baseline)
+    assert baseline.exists(), f"no baseline image {baseline}; run with CPM_NLP_UPDATE_BASELINES=1"
+    diff = compare_images(str(baseline), str(out), tol=tol)
+    assert diff is None, diff
+    return fig

@@ -102,3 +102,24 @@ def _broken(way):
 def test_a_figure_built_to_fail_fails(way, message):
     with pytest.raises(AssertionError, match=message):
         assert_legend_matches_artists(_broken(way))
+
+
+def test_a_baseline_in_the_fixed_style_matches_itself_and_catches_a_lost_layer(tmp_path, monkeypatch):
+    from tests import figure_checks
+
+    monkeypatch.setattr(figure_checks, "BASELINES", tmp_path / "baselines")
+    monkeypatch.setenv("CPM_NLP_UPDATE_BASELINES", "1")
+    fig = figure_checks.assert_matches_baseline(lambda: _sound()[0], "sound", tmp_path, tol=1, reason="same run")
+    assert fig.texts is not None and (tmp_path / "baselines" / "sound.png").exists()
+    monkeypatch.delenv("CPM_NLP_UPDATE_BASELINES")
+    figure_checks.assert_matches_baseline(lambda: _sound()[0], "sound", tmp_path, tol=1, reason="same run")
+
+    def without_band():
+        fig, ax = _sound()
+        ax.collections[-2].set_visible(False)  # the band (the bar and error bars come after it)
+        return fig
+
+    with pytest.raises(AssertionError, match="did not match"):
+        figure_checks.assert_matches_baseline(without_band, "sound", tmp_path, tol=1, reason="same run")
+    with pytest.raises(AssertionError, match="say why"):
+        figure_checks.assert_matches_baseline(lambda: _sound()[0], "sound", tmp_path, tol=1, reason=" ")
