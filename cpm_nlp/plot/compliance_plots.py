@@ -22,10 +22,10 @@ from .results import (
     PlotOptions,
     ResultData,
     dimension_of,
+    mechanism_title,
     pose_name,
     require_lists,
     result_closure,
-    result_mechanism,
 )
 from .style import as_floats, display_unit, pretty
 
@@ -109,7 +109,7 @@ def forces_plot(data: ResultData, _options: PlotOptions) -> Any:
         f"{words} {' = '.join(pretty(n) for n in same)}",
         dimension_of(data, x),
         [p for p in panels if p is not None],
-        title=f"Actuator forces and hinge stresses: {_mechanism_title(data)}",
+        title=f"Actuator forces and hinge stresses: {mechanism_title(data)}",
         subtitle=motion,
     )
 
@@ -250,14 +250,6 @@ def _allowable(data: ResultData) -> float | None:
         )
     except InputError:  # no material: no allowable stress to draw
         return None
-
-
-def _mechanism_title(data: ResultData) -> str:
-    """The mechanism's title (its file's), else its type name."""
-    try:
-        return str(result_mechanism(data).title)
-    except (NotApplicable, AttributeError):
-        return str(data.model.get("type"))
 
 
 def _translational(c: Any) -> list[int]:

@@ -193,6 +193,14 @@ def result_mechanism(data: ResultData) -> Any:
     return recorded_mechanism(data.origin, name, data.source or None)
 
 
+def mechanism_title(data: ResultData) -> str:
+    """The mechanism's title for a figure ("3-PRS compliant stage (Ruiz et al.)"), else its type name."""
+    try:
+        return str(result_mechanism(data).title)
+    except (InputError, AttributeError):
+        return str(data.model.get("type") or data.problem)
+
+
 def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None) -> Any:
     """A model of the result's mechanism (:func:`result_mechanism`) from ``parameters``
     (default: the ones the result records), without registering it."""

@@ -283,7 +283,6 @@ def _solved_figure(name):
 
 
 FIGURES = {
-    "workspace_boundary_and_boxes": synthetic_workspace,
     "map_best_max": lambda: synthetic_map()[0],
     "map_volume_unit": lambda: synthetic_map()[1],
     "lines_one_panel": synthetic_lines,
@@ -331,13 +330,15 @@ def test_map_marks_the_max_as_it_is_and_keeps_its_colorbar_attached():
 def test_workspace_legend_and_boundary_layers():
     fig = synthetic_workspace()
     legend = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert legend[1:] == [
+    assert legend == [
+        "reachable points: 800 points",
         "workspace boundary (slices through the box centre)",
         "maximal inscribed cuboid (3.46 × 2.31 × 1.15 mm)",
         "printed formulation (2.77 × 1.85 × 1.85 mm)",
+        "reachable region of each section (membership on a 41 × 41 grid)",
     ]
-    for ax in fig.axes[1:]:
-        assert len(ax.patches) == 2 and ax.get_title().startswith("boundary at ")
+    for ax in fig.axes[1:]:  # the sections: the two boxes over the shaded region, no projected points
+        assert len(ax.patches) == 3 and ax.get_title().startswith("section at ") and not ax.collections
         assert sum(len(ln.get_xdata()) > 10 for ln in ax.lines) == 1  # one closed boundary (an ellipse)
     # the 3-D view keeps at most four ticks per axis (long labels of a short range overlapped)
     assert all(len(a.get_major_locator()()) <= 5 for a in (fig.axes[0].xaxis, fig.axes[0].yaxis, fig.axes[0].zaxis))

@@ -116,3 +116,83 @@ def test_cli_plots_the_table2_forces(cli, tmp_path):
     out = tmp_path / "f.png"
     run = cli("solve", str(PROBLEMS / "prs3_table2_forces.yaml"), "-q", "--plot", str(out))
     assert run.code == 0 and run.err == "" and out.exists(), run.err
+
+
+# -- cuboid --------------------------------------------------------------------------------------------
+
+
+def test_cuboid_sections_draw_what_lies_in_their_plane(solved_file):
+    """issue 24: the 2-D panels projected every sampled point onto the slices (py = ±37 against
+    a boundary at ±23). Now each panel is the section: its region shaded where the membership
+    test holds (checked here point by point against cn.membership, independently of the
+    drawing's grid), its boundary, the two boxes; no projected point."""
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path
+
+    import cpm_nlp as cn
+
+    data = solved_file("pantograph_cuboid")
+    fig, kind = figures.figure(data)
+    assert kind == "workspace"
+    model = data.live
+    v = data.values
+    centre = np.array([(v[f"{t}_min"] + v[f"{t}_max"]) / 2 for t in ("px", "py", "pz")])
+    for ax, (i, j) in zip(fig.axes[1:], ((0, 1), (0, 2), (1, 2))):
+        assert not ax.collections, "no point is projected onto a section"
+        k = 3 - i - j
+        assert ax.get_title().startswith(f"section at ${['px', 'py', 'pz'][k]}$ = ")
+        region = [Path.make_compound_path(*(p.get_path() for p in ax.patches if isinstance(p, PathPatch)))]
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        U, V = np.meshgrid(np.linspace(x0, x1, 17)[1:-1], np.linspace(y0, y1, 17)[1:-1])
+        uv = np.c_[U.ravel(), V.ravel()]
+        drawn = region[0].contains_points(uv)
+        T = np.tile(centre, (len(uv), 1))
+        T[:, i], T[:, j] = uv[:, 0] / 1e3, uv[:, 1] / 1e3
+        member = cn.membership(model, T).inside
+        # the shading is the membership on a 61 x 61 grid: it may differ from the test only in the
+        # grid cells the boundary crosses (a few of the 225 points here)
+        assert (drawn == member).mean() >= 0.96, (i, j, (drawn != member).sum())
+        assert drawn.any() and (~drawn).any()
+    # the section at px = centre: the boundary reaches py = ±23 mm, the cuboid lies inside it
+    yz = fig.axes[3]
+    boundary = max((ln for ln in yz.lines), key=lambda ln: len(ln.get_xdata()))
+    assert np.abs(boundary.get_xdata()).max() == pytest.approx(23, abs=1.0)
+    assert_legend_matches_artists(fig)  # the legend's points are the drawn points' colour (was yellow on blue)
+
+
+def test_cuboid_legend_says_what_the_points_count(solved_file):
+    """issue 24: "(308)" was unexplained."""
+    fig, _ = figures.figure(solved_file("pantograph_cuboid"))
+    cloud = fig.axes[0].collections[0]
+    n = len(cloud.get_offsets())
+    label = cloud.get_label()
+    assert label == f"reachable points: {n} of 6000 drawn uniformly (seed 0) in a box around the cuboid"
+    assert label in [t.get_text() for t in fig.legends[0].get_texts()]
+
+
+def test_cuboid_html_shows_our_box_over_the_paper_box(solved_file):
+    """issue 24: in the HTML figure our optimum box was hidden under the paper's (equal) box:
+    now the paper's is drawn first, wide and dashed, ours after it, solid and shaded."""
+    pytest.importorskip("plotly")
+    fig, _ = figures.figure(solved_file("pantograph_cuboid"), interactive=True)
+    names = [t.name for t in fig.data]
+    ours = names.index("maximal inscribed cuboid")  # the shaded faces (no legend entry of their own)
+    paper = next(k for k, n in enumerate(names) if n.startswith("paper's eq 32-34 box"))
+    edges = [t for t in fig.data if t.name == "maximal inscribed cuboid" and t.type == "scatter3d"]
+    assert paper < ours and fig.data[ours].type == "mesh3d" and fig.data[ours].opacity < 1
+    assert len(edges) == 1 and edges[0].line.dash in (None, "solid") and fig.data[paper].line.dash == "dash"
+    assert fig.data[paper].line.width > edges[0].line.width  # the paper's shows around ours
+    cloud = fig.data[0]
+    assert cloud.marker.color == "#1f77b4" and cloud.name.startswith("reachable points: ")
+
+
+def test_cuboid_baselines(solved_file, tmp_path):
+    from tests.plot.test_plot_figures import synthetic_workspace
+
+    for name, build in (
+        ("cuboid_synthetic", synthetic_workspace),
+        ("cuboid_pantograph", lambda: figures.figure(solved_file("pantograph_cuboid"))[0]),
+    ):
+        fig = assert_matches_baseline(build, name, tmp_path, tol=TOLERANCE, reason=REASON)
+        assert_figure_readable(fig)
+        assert_legend_matches_artists(fig)
