@@ -48,7 +48,7 @@ def dynamics_plot(data: ResultData, _options: PlotOptions) -> Any:
     freqs = np.sqrt(np.clip(w2, 0, None)) / (2 * math.pi)
     closure = result_closure(data)
     groups = comparisons(data)
-    title = _with_degenerate_note(f"Dynamics ({data.model.get('type')})", clusters, len(freqs))
+    title = _with_degenerate_note(f"Natural frequencies: {mechanism_title(data)}", clusters, len(freqs))
     return dynamics_figure(freqs, modes, closure.q_names, groups, title=title)
 
 

@@ -171,8 +171,9 @@ def dynamics_figure(
     Figure = figure_class()
     freqs = np.asarray(freqs, dtype=float)
     modes = np.asarray(modes, dtype=float)
-    fig = Figure(figsize=(11, 4.2 + (2.0 if groups else 0)), layout="constrained")
-    top, bottom = fig.subfigures(2, 1, height_ratios=[4.2, 2.0 * len(groups)]) if groups else (fig, None)
+    heights = [0.55 * len(rows) + 1.2 for _, rows in groups]  # inches: a row of bars and its written values each
+    fig = Figure(figsize=(11, 4.2 + sum(heights)), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=[4.2, sum(heights)]) if groups else (fig, None)
     a1, a2 = top.subplots(1, 2)
     labels = [f"mode {k + 1}" for k in range(len(freqs))]
     a1.bar(labels, freqs, color="tab:blue", width=0.6)
@@ -187,10 +188,12 @@ def dynamics_figure(
     a2.set_xticks(range(len(coords)), [pretty(c) for c in coords])
     a2.axhline(0, color="k", lw=0.8)
     a2.set_ylabel("mode shape (normalised)")
-    a2.legend(fontsize="x-small")
+    low = float(np.min(modes / np.abs(modes).max(axis=0), initial=0.0))
+    a2.set_ylim(1.1 * low if low < 0 else 0.0, 1.45)  # room above the bars for the legend
+    a2.legend(fontsize="x-small", loc="upper center", ncols=max(modes.shape[1], 1))
     a2.set_title("eigenvectors of K v = ω² M v", fontsize="small")
     if bottom is not None:
-        axes = bottom.subplots(len(groups), 1, squeeze=False)[:, 0]
+        axes = bottom.subplots(len(groups), 1, squeeze=False, height_ratios=heights)[:, 0]
         for ax, (label, rows) in zip(axes, groups):
             comparison_axes(ax, rows, reference_label=label)
     if title:

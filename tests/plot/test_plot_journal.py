@@ -196,3 +196,51 @@ def test_cuboid_baselines(solved_file, tmp_path):
         fig = assert_matches_baseline(build, name, tmp_path, tol=TOLERANCE, reason=REASON)
         assert_figure_readable(fig)
         assert_legend_matches_artists(fig)
+
+
+# -- dynamics --------------------------------------------------------------------------------------------
+
+#: prc3-li-2018.md, eq 41: "f = 1/(2 pi) sqrt(K_e/M_e) = 93.83 Hz", the number the paper prints
+PRC3_F_PRINTED_HZ = 93.83
+
+
+def _texts(fig):
+    out = [fig._suptitle.get_text()] if fig._suptitle else []
+    for ax in fig.axes:
+        out += [ax.get_title(), ax.get_xlabel(), ax.get_ylabel(), *(t.get_text() for t in ax.texts)]
+        out += [t.get_text() for t in ax.get_yticklabels()]
+    return out
+
+
+def test_dynamics_labels_each_value_for_what_it_is(solved_file):
+    """issue 24: "paper (printed) 96.5 Hz" was eq 38 evaluated with the file's assumed masses;
+    the paper prints 93.83 Hz. Now eq 38's value is "printed formulas (evaluated here)" and the
+    printed 93.83 Hz (the file's reproduce rows) stands beside f1 and eq 38's f, with its source."""
+    data = solved_file("prc3_dynamics")
+    fig, kind = figures.figure(data)
+    assert kind == "dynamics"
+    texts = _texts(fig)
+    assert not any("paper (printed)" in t for t in texts)
+    evaluated = next(t for t in texts if t.startswith("this model") and "96.5 Hz" in t)
+    assert evaluated == f"this model {data.values['f']:.4g} · printed formulas (evaluated here) 96.5 Hz"
+    assert data.values["f_printed"] == pytest.approx(96.5015, rel=1e-5)  # eq 38 with the assumed masses
+    printed = [t for t in texts if "printed in the paper" in t and t.startswith("this model")]
+    assert printed == [
+        f"this model {data.values['f_printed']:.4g} · printed in the paper {PRC3_F_PRINTED_HZ:.4g} Hz",
+        f"this model {data.values['f1']:.4g} · printed in the paper {PRC3_F_PRINTED_HZ:.4g} Hz",
+    ]
+    assert "$f_{1}$\n(eq 28-35, 40)" in texts and "$f_{printed}$\n(eq 38, 41)" in texts
+    assert_figure_readable(fig)
+    assert_legend_matches_artists(fig)
+
+
+def test_dynamics_and_comparison_baselines(solved_file, tmp_path):
+    from tests.plot.test_plot_figures import synthetic_comparison
+
+    for name, build in (
+        ("dynamics_prc3", lambda: figures.figure(solved_file("prc3_dynamics"))[0]),
+        ("comparison_synthetic", synthetic_comparison),
+    ):
+        fig = assert_matches_baseline(build, name, tmp_path, tol=TOLERANCE, reason=REASON)
+        assert_figure_readable(fig)
+        assert_legend_matches_artists(fig)
