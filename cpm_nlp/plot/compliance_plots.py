@@ -274,7 +274,7 @@ def ellipsoid_plot(data: ResultData, _options: PlotOptions) -> Any:
     return ellipsoid_figure(
         C,
         [c.x_names[i] for i in idx],
-        title=f"Compliance ellipsoid of the platform ({data.model.get('type')})",
+        title=f"Compliance ellipsoid of the platform: {mechanism_title(data)}",
         drawing=drawing,
         centre=centre,
         note=note,

@@ -289,7 +289,6 @@ FIGURES = {
     "mechanism_prs3": prs3_drawing,
     "mechanism_five_bar_file": five_bar_file_drawing,
     "modes_prs3": lambda: _solved_figure("prs3_natural_frequencies"),
-    "ellipsoid_prs3": lambda: _solved_figure("prs3_cutting_force"),
 }
 
 

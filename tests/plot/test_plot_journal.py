@@ -244,3 +244,55 @@ def test_dynamics_and_comparison_baselines(solved_file, tmp_path):
         fig = assert_matches_baseline(build, name, tmp_path, tol=TOLERANCE, reason=REASON)
         assert_figure_readable(fig)
         assert_legend_matches_artists(fig)
+
+
+# -- ellipsoid -------------------------------------------------------------------------------------------
+
+
+def test_engineering_prefixes():
+    from cpm_nlp.plot.draw_compliance import compliance_text, prefixed
+
+    assert prefixed(10000.0, "N") == "10 kN" and prefixed(100.0, "N") == "100 N" and prefixed(0.5, "N") == "500 mN"
+    assert compliance_text(3.49e-6) == "3.49 µm/N" and compliance_text(1.63e-8) == "16.3 nm/N"
+
+
+@pytest.mark.parametrize("name", ["prs3_cutting_force", "rrr3_platform_compliance"])
+def test_ellipsoid_axes_labelled_with_lengths_and_units(solved_file, name):
+    """issue 24: the subtitle read "|f| = 10000 N" and the principal axes were unlabelled. Each
+    axis is drawn with its half-length (a principal compliance, checked against numpy's
+    eigenvalues of the result's translational block) in the legend, with its unit."""
+    from cpm_nlp.plot.compliance_plots import _translational
+    from cpm_nlp.plot.draw_compliance import compliance_text
+    from cpm_nlp.plot.results import result_closure
+
+    data = solved_file(name)
+    fig, kind = figures.figure(data)
+    assert kind == "ellipsoid"
+    on, ax = fig.axes[0], fig.axes[-1]
+    assert "N in any direction" in on.get_title() and "10000" not in on.get_title()
+    idx = _translational(result_closure(data))
+    C = np.asarray(data.values["C"])[np.ix_(idx, idx)]
+    w = np.sort(np.linalg.eigvalsh((C + C.T) / 2))[::-1]  # independent of the plot's canonical_eigh
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    axes = [t for t in labels if " along (" in t]
+    assert [t.split(" along ")[0] for t in axes] == [compliance_text(c) for c in w]
+    drawn = [ln for ln in ax.get_lines() if " along (" in ln.get_label()]
+    f = 1e6  # both figures' compliances are µm/N
+    for ln, c in zip(drawn, w):
+        ends = np.array(ln.get_data_3d() if hasattr(ln, "get_data_3d") else ln.get_data()).T
+        assert np.linalg.norm(ends[1] - ends[0]) / 2 == pytest.approx(c * f, rel=1e-9)
+    assert ax.get_title() == "principal compliances: " + ", ".join(compliance_text(c) for c in w)
+    assert_figure_readable(fig)
+    assert_legend_matches_artists(fig)
+
+
+def test_ellipsoid_baseline(solved_file, tmp_path):
+    fig = assert_matches_baseline(
+        lambda: figures.figure(solved_file("prs3_cutting_force"))[0],
+        "ellipsoid_prs3",
+        tmp_path,
+        tol=TOLERANCE,
+        reason=REASON,
+    )
+    assert_figure_readable(fig)
+    assert_legend_matches_artists(fig)
