@@ -296,3 +296,44 @@ def test_ellipsoid_baseline(solved_file, tmp_path):
     )
     assert_figure_readable(fig)
     assert_legend_matches_artists(fig)
+
+
+# -- requirements -----------------------------------------------------------------------------------------
+
+#: prs3-ruiz.md, section 4 (read off Fig. 6-7): the actuator range -2.15 ... 2.30 mm (the file's
+#: reproduce rows, drawn as the published range)
+PRS3_S_RANGE_MM = (-2.15, 2.30)
+
+
+def test_requirements_draw_unrelated_poses_as_points(solved_file):
+    """issue 24: lines joined unrelated pose indices (the 27 poses are a grid of z, psi, theta,
+    not a path). Now each pose is a point (the series of a pose side by side, distinct markers),
+    the range is titled as such, and the paper's range is drawn where the file gives it."""
+    data = solved_file("prs3_joint_requirements")
+    fig, kind = figures.figure(data)
+    assert kind == "requirements"
+    for ax in fig.axes:
+        series = [ln for ln in ax.get_lines() if not ln.get_label().startswith(("_", "published"))]
+        assert series and all(ln.get_linestyle() == "None" for ln in series)  # no line joins two poses
+        assert len({ln.get_marker() for ln in series}) == len(series)
+    s = next(ax for ax in fig.axes if ax.get_ylabel() == "$s$ (mm)")
+    published = [ln for ln in s.get_lines() if ln.get_label().startswith(("published range", "_level"))]
+    assert sorted(ln.get_ydata()[0] for ln in published) == pytest.approx(PRS3_S_RANGE_MM)
+    assert s.get_title() == f"range {data.values['s_min'] * 1e3:.3g} … {data.values['s_max'] * 1e3:.3g} mm"
+    # each pose's three actuators at its number, side by side: s1 left of s2 left of s3
+    x1, x2, x3 = (ln.get_xdata() for ln in s.get_lines()[:3])
+    assert np.all(x1 < x2) and np.all(x2 < x3) and np.allclose((x1 + x3) / 2, np.arange(1, 28))
+    assert_figure_readable(fig)
+    assert_legend_matches_artists(fig)
+
+
+def test_requirements_baseline(solved_file, tmp_path):
+    fig = assert_matches_baseline(
+        lambda: figures.figure(solved_file("prs3_joint_requirements"))[0],
+        "requirements_prs3",
+        tmp_path,
+        tol=TOLERANCE,
+        reason=REASON,
+    )
+    assert_figure_readable(fig)
+    assert_legend_matches_artists(fig)
