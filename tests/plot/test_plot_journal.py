@@ -337,3 +337,46 @@ def test_requirements_baseline(solved_file, tmp_path):
     )
     assert_figure_readable(fig)
     assert_legend_matches_artists(fig)
+
+
+# -- a figure for every shipped problem file ----------------------------------------------------------------
+
+
+def _shipped():
+    from tests.conftest import PROBLEMS
+
+    return sorted(p.stem for p in PROBLEMS.glob("*.yaml"))
+
+
+@pytest.mark.parametrize("name", _shipped())
+def test_every_shipped_problem_file_plots(solved_file, name, tmp_path):
+    """issue 24: `--plot` gives a figure on every shipped problem file (as solve --plot draws
+    it: the whole result, the problem at hand), drawn, its texts inside the figure. Saved at
+    a small resolution: what is checked is that a figure is made and drawn."""
+    from tests.figure_checks import assert_png_drawn
+
+    fig, kind = figures.figure(solved_file(name))
+    out = tmp_path / f"{name}.png"
+    fig.savefig(out, dpi=30)
+    assert_png_drawn(out)
+    assert_figure_readable(fig)
+
+
+def test_cli_plots_a_file_with_an_outputs_selection_from_the_whole_result(cli, tmp_path):
+    """sweep_prs3_requirements.yaml records the ranges only (its outputs selection): solve
+    --plot draws the requirements of the 27 poses, and prints and writes the selection."""
+    import json
+
+    from tests.conftest import PROBLEMS
+
+    fig, res = tmp_path / "r.png", tmp_path / "r.json"
+    run = cli("solve", str(PROBLEMS / "sweep_prs3_requirements.yaml"), "--plot", str(fig), "-o", str(res))
+    assert run.code == 0 and f"plot    : {fig} (requirements)" in run.out, run.err
+    written = json.loads(res.read_text())["values"]
+    assert set(written) == {"s_min", "s_max", "dalpha_min", "dalpha_max", "beta_m_min", "beta_m_max"} | {
+        "beta_n_min",
+        "beta_n_max",
+        "beta_l_min",
+        "beta_l_max",
+    }
+    assert not any(line.startswith("s1 ") for line in run.out.splitlines())
