@@ -21,6 +21,7 @@ from .results import (
     PlotOptions,
     ResultData,
     dimension_of,
+    mechanism_title,
     pose_name,
     require_lists,
     result_closure,
@@ -178,16 +179,21 @@ def _cloud_with_boundary(
         points_label="reachable points (seeded sample)",
         slices=slices,
         slices_label=label,
+        colour_by_height=True,
     )
 
 
 def _cuboid_plot(data: ResultData, cuboid: tuple, axes: tuple, workspace_figure: Any, title: str) -> Any:
     """A cuboid (and the paper's box), with the workspace around it where the model is at hand."""
     task, kinds, box_label, hull = axes
+    if data.problem == "inscribed_cuboid":
+        title = (
+            f"Maximal inscribed cuboid: {mechanism_title(data)}" + title.partition("\n")[1] + title.partition("\n")[2]
+        )
     pts, label, slices = np.zeros((0, 3)), "", ()
     if data.live is not None and data.problem == "inscribed_cuboid":
         pts, slices = _workspace_around(data.live, cuboid)
-        label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+        label = f"reachable points: {{n}} of {CLOUD_SAMPLE} drawn uniformly (seed 0) in a box around the cuboid"
     elif data.problem == "inscribed_cuboid":
         title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
     return workspace_figure(
@@ -442,7 +448,7 @@ def _planar_rectangle_plot(data: ResultData, cuboid: tuple, common: dict) -> Any
         pts = sample_workspace(data.live, CLOUD_SAMPLE, 0, (lo, hi))[0]
         slices = _boundary_slices(data.live, lo, hi, centre, PLANAR_GRID)
         outline = [line for sl in slices for line in _refined_boundary(data.live, sl, centre)]
-        label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+        label = f"reachable points: {{n}} of {CLOUD_SAMPLE} drawn uniformly (seed 0) in a box around the rectangle"
     else:
         common = {
             **common,

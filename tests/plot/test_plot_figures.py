@@ -251,7 +251,7 @@ def synthetic_lines():
 
 def synthetic_comparison():
     rows = [Comparison("f", 107.3, 96.5, "frequency"), Comparison("M_e", 5.514, 5.523, "mass")]
-    return comparison_figure([("paper (printed)", rows)], {"starts": 8, "starts_converged": 8}, title="synthetic")
+    return comparison_figure([("printed in the paper", rows)], {"starts": 8, "starts_converged": 8}, title="synthetic")
 
 
 def _solved_figure(name):
@@ -267,10 +267,7 @@ def _solved_figure(name):
 #: the mechanism drawings, the modes and the maps are pinned in the fixed style by
 #: tests/plot/test_plot_drawings.py
 FIGURES = {
-    "workspace_boundary_and_boxes": synthetic_workspace,
     "lines_one_panel": synthetic_lines,
-    "comparison": synthetic_comparison,
-    "ellipsoid_prs3": lambda: _solved_figure("prs3_cutting_force"),
 }
 
 
@@ -310,13 +307,15 @@ def test_map_marks_the_max_as_it_is_and_keeps_its_colorbar_attached():
 def test_workspace_legend_and_boundary_layers():
     fig = synthetic_workspace()
     legend = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert legend[1:] == [
+    assert legend == [
+        "reachable points: 800 points",
         "workspace boundary (slices through the box centre)",
         "maximal inscribed cuboid (3.46 × 2.31 × 1.15 mm)",
         "printed formulation (2.77 × 1.85 × 1.85 mm)",
+        "reachable region of each section (membership on a 41 × 41 grid)",
     ]
-    for ax in fig.axes[1:]:
-        assert len(ax.patches) == 2 and ax.get_title().startswith("boundary at ")
+    for ax in fig.axes[1:]:  # the sections: the two boxes over the shaded region, no projected points
+        assert len(ax.patches) == 3 and ax.get_title().startswith("section at ") and not ax.collections
         assert sum(len(ln.get_xdata()) > 10 for ln in ax.lines) == 1  # one closed boundary (an ellipse)
     # the 3-D view keeps at most four ticks per axis (long labels of a short range overlapped)
     assert all(len(a.get_major_locator()()) <= 5 for a in (fig.axes[0].xaxis, fig.axes[0].yaxis, fig.axes[0].zaxis))
@@ -463,7 +462,7 @@ def test_dynamics_plot_frequencies_are_the_eigenvalues_of_K_and_M(solved):
     assert kind == "dynamics"
     bars = [p.get_height() for p in fig.axes[0].patches]
     assert bars == pytest.approx([data.values[f"f{i}"] for i in (1, 2, 3)], rel=1e-9)
-    assert any("paper (printed)" in ax.get_xlabel() for ax in fig.axes)
+    assert any("printed formulas (evaluated here)" in ax.get_xlabel() for ax in fig.axes)
     assert_figure_readable(fig)
 
 

@@ -329,7 +329,9 @@ def test_pantograph_printed_eq34c_box_beside_ours_in_the_workspace(tmp_path):
     assert any(t.startswith("paper's eq 32-34 box, 544 of 1663 check points outside") for t in legend), legend
     assert any(t.startswith("workspace boundary") for t in legend)
     xz = fig.axes[2]  # px-pz projection, the boundary slice at py = 0, in mm
-    ours, paper = xz.patches
+    from matplotlib.patches import Rectangle
+
+    ours, paper = [p for p in xz.patches if isinstance(p, Rectangle)]  # beside the section's shading
     assert ours.get_width() == pytest.approx((v["px_max"] - v["px_min"]) * 1e3)
     assert paper.get_x() == pytest.approx(v["paper_k"] * 1e3) and paper.get_linestyle() == "--"
     assert paper.get_height() == pytest.approx(2 * v["paper_z_hat"] * 1e3)
