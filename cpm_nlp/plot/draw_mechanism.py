@@ -272,14 +272,17 @@ def readable_names(names: Sequence[str], joints: Mapping[str, str]) -> dict[str,
 def point_labels(pts: Mapping[str, np.ndarray], joints: Mapping[str, str]) -> Any:
     """The names of a drawing's points as one Matplotlib artist, placed when drawn (the view
     and the layout are then final): points that coincide share one label ("E = P"), points
-    closer on the page than :data:`LABEL_NEAR` one label ("$P_{1}$, $R_{1}$"); each label goes
+    closer on the page than :data:`LABEL_NEAR` and in space than :data:`LABEL_NEAR_SPACE` one
+    label ("$P_{1}$, $R_{1}$"); each label goes
     to the first place around its point (:data:`LABEL_OFFSETS`) where it overlaps no other
     label and no other point."""
     return _point_labels_class()(pts, joints)
 
 
-#: points closer than this on the page (points, 1/72 inch) share a label
+#: points closer than this on the page (points, 1/72 inch) and than this fraction of the drawing's
+#: size in space share a label
 LABEL_NEAR = 10.0
+LABEL_NEAR_SPACE = 0.05
 #: where a label may go, in order of preference: (dx, dy) in points from its point
 LABEL_OFFSETS = tuple(
     (r * dx, r * dy)
@@ -288,12 +291,14 @@ LABEL_OFFSETS = tuple(
 )
 
 
-def _near_groups(at: np.ndarray, limit: float) -> list[list[int]]:
-    """Indices of the points (pixels) grouped where they lie within ``limit`` of a group's first."""
+def _near_groups(at: np.ndarray, limit: float, where: np.ndarray, near: float) -> list[list[int]]:
+    """Indices of the points grouped where they lie within ``limit`` of a group's first on the
+    page (``at``, pixels) and within ``near`` of it in space (``where``): points that only look
+    close from this view (one behind the other) keep their own labels."""
     groups: list[list[int]] = []
     for k in range(len(at)):
         for g in groups:
-            if np.linalg.norm(at[g[0]] - at[k]) <= limit:
+            if np.linalg.norm(at[g[0]] - at[k]) <= limit and np.linalg.norm(where[g[0]] - where[k]) <= near:
                 g.append(k)
                 break
         else:
@@ -361,7 +366,9 @@ def _point_labels_class() -> Any:
             half = 5 * scale
             dots = [Bbox.from_extents(*(p - half), *(p + half)) for p in at]
             placed: list[Any] = []
-            for g in _near_groups(at, LABEL_NEAR * scale):
+            P = self._anchors
+            near = LABEL_NEAR_SPACE * (float(np.ptp(P, axis=0).max()) if len(P) > 1 else 1.0)
+            for g in _near_groups(at, LABEL_NEAR * scale, P, near):
                 text = Text(
                     0,
                     0,

@@ -258,6 +258,20 @@ def test_a_map_over_decades_has_round_levels(tmp_path):
     assert texts and set(texts) <= {"50", "100", "200", "500", "1000", "2000", "5000", "10000", "20000", "50000"}
 
 
+@pytest.mark.parametrize(("name", "which"), [("map_best_max", 0), ("map_volume_unit", 1)])
+def test_synthetic_maps(name, which, tmp_path):
+    """The maps of tests/plot/test_plot_figures.synthetic_map (the max marked as it is; mm³),
+    now with round levels."""
+    from tests.plot.test_plot_figures import synthetic_map
+
+    fig = assert_matches_baseline(lambda: synthetic_map()[which], name, tmp_path, tol=TOLERANCE, reason=REASON)
+    checked(fig)
+    levels = np.unique([float(t.get_text()) for t in fig.axes[0].texts if t.get_text().replace(".", "").isdigit()])
+    step = float(np.diff(levels).min())  # linear levels: multiples of a 1-2-2.5-5 step
+    assert len(levels) >= 3 and round(step / 10 ** math.floor(math.log10(step)), 9) in (1, 2, 2.5, 5)
+    assert np.allclose(levels / step, np.round(levels / step), atol=1e-9)
+
+
 def test_rpr_map_swatch_and_region_bound(solved_file, tmp_path):
     """issue 24: a grey legend swatch stood for a white region, and the optimum region's bound was
     not stated. The bound comes from the result (eta_region, the kind's input), not the plot."""
@@ -311,7 +325,8 @@ def test_pantograph_workspace_from_its_result_file(cli, tmp_path):
     (bar,) = fig.axes[0].child_axes  # the colour bar of the 3-D view
     assert bar.get_ylabel() == "colour: $pz$ (mm)"
     cloud = next(c for c in fig.axes[0].collections if c.get_label().startswith("reachable points"))
-    assert cloud.get_array() == pytest.approx(np.asarray(json.loads(path.read_text())["values"]["cloud_pz"]) * 1e3)
+    pz = np.asarray(json.loads(path.read_text())["values"]["cloud_pz"], dtype=float) * 1e3
+    assert np.asarray(cloud.get_array(), dtype=float).tolist() == pytest.approx(pz.tolist())  # the colour: pz
     entries = [t.get_text() for t in fig.legends[0].get_texts()]
     assert any(
         e.startswith("workspace boundary") and "rebuilt from the result's parameters and limits" in e for e in entries
@@ -319,7 +334,7 @@ def test_pantograph_workspace_from_its_result_file(cli, tmp_path):
     # on the axis py = pz = 0 the boundary is where psi reaches its limits (eq 9-10, 17, derived
     # here): q = px a / (a + b) = 2 a cos(h), psi = pi - 2 h, so px = 2 (a + b) cos((pi - psi) / 2):
     # psi_max = 135 deg gives the outer 129.35 mm, psi_min = 45 deg the inner 53.58 mm
-    slice_xy = next(ax for ax in fig.axes if ax.get_title().startswith("boundary at $pz$"))
+    slice_xy = next(ax for ax in fig.axes if ax.get_title().startswith("section at $pz$"))
     pts = np.vstack([ln.get_xydata() for ln in slice_xy.get_lines() if len(ln.get_xdata()) > 10])
     on_axis = pts[np.abs(pts[:, 1]) < 0.5, 0]
     a, b = 20.0, 50.0
