@@ -30,11 +30,13 @@ from tests.figure_checks import (
 matplotlib = pytest.importorskip("matplotlib")
 
 #: RMS (0-255) a baseline may differ by: drawn in the fixed style (DejaVu fonts, no hinting,
-#: fixed dpi), another platform differs in anti-aliased edges and sub-pixel text placement only;
-#: a lost layer moves it by more (measured here: the point labels of the 3-PRS drawing alone
-#: 3.4, the red optimum outline of the RPR map 4.9, one mode panel's arrows 2.6)
-TOLERANCE = 2.0
-REASON = "fixed fonts without hinting: only anti-aliasing differs; a lost layer moves it by 2.6 or more (measured)"
+#: fixed dpi, tests/figure_checks.BASELINE_STYLE) it is 0.0 run to run here; another platform
+#: differs in anti-aliased edges and sub-pixel text placement only. The smallest lost layer
+#: measured (load 7, this run): the contour labels of map_log_levels 1.86, the point labels of
+#: mechanism_prs3 3.95, the optimum outline of map_rpr_transmission 7.17, the arrows of one
+#: panel of modes_prs3 19.7: a tolerance under the smallest
+TOLERANCE = 1.5
+REASON = "fixed fonts without hinting: only anti-aliasing differs; the smallest lost layer moves it by 1.86 (measured)"
 
 #: a pose of the 3-PRS away from home (SI) and its parameters (prs3-ruiz.md, Table 1)
 PRS3_POSE = [0.0792, 0.03, -0.02]
