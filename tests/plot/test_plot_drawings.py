@@ -72,6 +72,26 @@ def _point_labels(fig):
     ]
 
 
+def test_the_label_check_fails_on_overlapping_labels():
+    """assert_labels_apart catches what issue 24 saw: two point labels a few pixels apart
+    ("leg3_1" over "leg3_2"), in 2-D and 3-D axes; labels apart pass."""
+    from cpm_nlp.plot.style import figure_class
+
+    fig = figure_class()(figsize=(4, 3))
+    ax = fig.add_subplot(1, 2, 1)
+    ax.text(0.5, 0.5, "leg3_1")
+    ax.text(0.51, 0.51, "leg3_2")
+    with pytest.raises(AssertionError, match="'leg3_1' and 'leg3_2' overlap"):
+        assert_labels_apart(fig)
+    ax.texts[1].set_position((0.5, 0.1))
+    assert_labels_apart(fig)
+    ax3 = fig.add_subplot(1, 2, 2, projection="3d")
+    ax3.text(0, 0, 0, "B3 = C2")
+    ax3.text(0, 0, 0.01, "B3")
+    with pytest.raises(AssertionError, match="overlap"):
+        assert_labels_apart(fig)
+
+
 # -- mechanism drawings ---------------------------------------------------------------------------------
 
 
