@@ -14,7 +14,7 @@ from ..core.errors import InputError
 from ..core.kinematics import jacobians
 from .draw_mechanism import jacobian_figure, mechanism_figure
 from .interactive import mechanism_html
-from .pose import drawings, geometry_of, mechanism_title, model_for, pose_title, single_pose, span_of
+from .pose import drawings, geometry_of, model_for, model_title, pose_title, single_pose, span_of
 from .results import NotApplicable, PlotOptions, ResultData, result_mechanism, result_model
 from .style import display_unit
 
@@ -54,7 +54,7 @@ def design_plot(data: ResultData, options: PlotOptions) -> Any:
     kinds = {o.name: o.kind for o in mech.parameters}
     shown = [(k, v, *display_unit(kinds[k], [v])) for k, v in found.items()]
     text = ", ".join(f"{k} = {v * f:.4g} {unit}".rstrip() for k, v, f, unit in shown)
-    title = f"{mechanism_title(model)}\ndesigned by {data.problem.replace('_', ' ')}, at home: {text}"
+    title = f"{model_title(model)}\ndesigned by {data.problem.replace('_', ' ')}, at home: {text}"
     if options.interactive:
         note = "; ".join(t for t in (pose.note, "dashed: the design in the file" if home is not None else "") if t)
         return mechanism_html(pose, home=home, title=title, note=note)

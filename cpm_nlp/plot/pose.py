@@ -93,8 +93,9 @@ def span_of(drawing: Any) -> float:
 TITLE_NOISE = 1e-9
 
 
-def mechanism_title(model: Any) -> str:
-    """The mechanism's own title ("3-PRS compliant stage (Ruiz et al.)"), else its name."""
+def model_title(model: Any) -> str:
+    """The title of the model's mechanism ("3-PRS compliant stage (Ruiz et al.)"), else its name
+    (:func:`.results.mechanism_title` gives it from a result)."""
     mech = model.mechanism
     return str(mech.title) if mech is not None and mech.title else str(model.name)
 
@@ -118,5 +119,5 @@ def pose_title(model: Any, x: np.ndarray, k: float, size: float = 0.0, how: str 
         parts.append(f"{pretty(c.x[i].name)} = {v * f:.4g} {unit}".rstrip())
     lines = [", ".join(parts[n : n + 3]) for n in range(0, len(parts), 3)]  # three coordinates a line
     head = f"{how.replace('_', ' ')}: " if how else "pose: "
-    text = mechanism_title(model) + "\n" + head + ",\n".join(lines)
+    text = model_title(model) + "\n" + head + ",\n".join(lines)
     return text + (f"\n(displacements from home drawn ×{k:g})" if k != 1.0 else "")

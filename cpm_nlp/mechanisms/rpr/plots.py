@@ -26,7 +26,7 @@ def twists_plot(data: ResultData, options: PlotOptions) -> Any:
 
     from ...plot.draw_mechanism import Arrow, mechanism_figure
     from ...plot.interactive import mechanism_html
-    from ...plot.pose import geometry_of, mechanism_title, model_for
+    from ...plot.pose import geometry_of, model_for, model_title
     from ...plot.results import NotApplicable
 
     T = data.values.get("T")
@@ -62,7 +62,7 @@ def twists_plot(data: ResultData, options: PlotOptions) -> Any:
     return draw(
         pose,
         arrows=arrows,
-        title=f"{mechanism_title(model)}\ndisplacement twists of the platform, at the reference point",
+        title=f"{model_title(model)}\ndisplacement twists of the platform, at the reference point",
         note=data.units.get("T", ""),
     )
 
