@@ -300,9 +300,8 @@ def _figure_legend(fig: Any, cloud: Any, points_label: str) -> None:
                 handles.setdefault(lab, h)
     if not handles:
         return
-    ncols = 1 if max(len(lab) for lab in handles) > 60 else min(2, len(handles))  # long entries: one column
     legend = fig.legend(
-        list(handles.values()), list(handles), loc="outside lower center", ncols=ncols, fontsize="small"
+        list(handles.values()), list(handles), loc="outside lower center", ncols=min(2, len(handles)), fontsize="small"
     )
     if cloud is not None and cloud.get_array() is not None and points_label in handles:
         z = np.asarray(cloud.get_array())

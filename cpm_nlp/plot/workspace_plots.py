@@ -167,7 +167,7 @@ def _cloud_with_boundary(
         slices = [replace(sl, lines=_refined_boundary(model, sl, centre)) for sl in slices]
     label = "workspace boundary (slices through the home pose)"
     if rebuilt:
-        label = "workspace boundary (through home; the model rebuilt from the result's parameters and limits)"
+        label = "workspace boundary (of the model rebuilt from the result)"
     return workspace_figure(
         pts,
         names=task,

@@ -350,9 +350,7 @@ def test_pantograph_workspace_from_its_result_file(cli, tmp_path):
     pz = np.asarray(json.loads(path.read_text())["values"]["cloud_pz"], dtype=float) * 1e3
     assert np.asarray(cloud.get_array(), dtype=float).tolist() == pytest.approx(pz.tolist())  # the colour: pz
     entries = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert any(
-        e.startswith("workspace boundary") and "rebuilt from the result's parameters and limits" in e for e in entries
-    )
+    assert any(e.startswith("workspace boundary") and "(of the model rebuilt from the result)" in e for e in entries)
     # on the axis py = pz = 0 the boundary is where psi reaches its limits (eq 9-10, 17, derived
     # here): q = px a / (a + b) = 2 a cos(h), psi = pi - 2 h, so px = 2 (a + b) cos((pi - psi) / 2):
     # psi_max = 135 deg gives the outer 129.35 mm, psi_min = 45 deg the inner 53.58 mm
