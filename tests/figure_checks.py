@@ -1,8 +1,14 @@
-"""Checks that a figure file is valid and drawn (not blank)."""
+"""Checks of figures: a file is valid and drawn (not blank), texts are not clipped,
+legend entries match what is drawn, and a figure matches its baseline image drawn in
+a fixed style."""
 
 from __future__ import annotations
 
+import os
+import shutil
 import xml.etree.ElementTree as ET
+from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 
@@ -49,6 +55,41 @@ def _labels(fig):
     return out
 
 
+def _axes_texts(artist):
+    """The texts drawn in an axes, at any depth (point labels, annotations, contour labels,
+    titles), not those of its axis ticks and labels nor of its legend."""
+    from matplotlib.axis import Axis
+    from matplotlib.legend import Legend
+    from matplotlib.text import Text
+
+    for child in artist.get_children():
+        if isinstance(child, (Axis, Legend)):
+            continue
+        if isinstance(child, Text):
+            yield child
+        else:
+            yield from _axes_texts(child)
+
+
+def assert_labels_apart(fig, slack=1.0):
+    """No two texts drawn in one axes of a Matplotlib figure overlap (point labels of a
+    mechanism, annotations, contour labels, titles), measured on the rendered figure; boxes
+    may touch within ``slack`` pixels."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    for ax in fig.axes:
+        shown = [t for t in _axes_texts(ax) if t.get_visible() and t.get_text().strip()]
+        boxes = [t.get_window_extent(renderer).expanded(1.0, 1.0).padded(-slack) for t in shown]
+        for a in range(len(shown)):
+            for b in range(a + 1, len(shown)):
+                assert not boxes[a].overlaps(boxes[b]), (
+                    f"texts {shown[a].get_text()!r} and {shown[b].get_text()!r} overlap: {boxes[a]} and {boxes[b]}"
+                )
+
+
 def assert_figure_readable(fig):
     """Every title, label and legend text of a Matplotlib figure lies inside the
     figure (nothing clipped at its edges), and no legend holds a template placeholder."""
@@ -70,3 +111,260 @@ def assert_figure_readable(fig):
         for t in legend.get_texts():
             text = t.get_text()
             assert not any(c in text.replace("$", "") for c in "<>`"), f"legend holds a placeholder: {text!r}"
+
+
+def _rgba(c):
+    from matplotlib.colors import to_rgba_array
+
+    if c is None or (isinstance(c, str) and c == "none"):
+        return np.empty((0, 4))
+    return to_rgba_array(c).reshape(-1, 4)
+
+
+def _line_colours(line):
+    from matplotlib.colors import to_rgba
+
+    alpha, rows = line.get_alpha(), []
+    if line.get_linestyle() not in ("None", "", " ") and line.get_linewidth() > 0:
+        rows.append(to_rgba(line.get_color(), alpha))
+    if line.get_marker() not in (None, "None", "", " "):
+        face = line.get_markerfacecolor()
+        if not (isinstance(face, str) and face == "none"):
+            rows.append(to_rgba(face, alpha))
+        if line.get_markeredgewidth() > 0:
+            rows.append(to_rgba(line.get_markeredgecolor(), alpha))
+    return [np.array(rows).reshape(-1, 4)]
+
+
+def _collection_colours(coll):
+    rows = [_rgba(coll.get_facecolor())]
+    if coll.get_array() is not None:
+        rows.append(_rgba(coll.to_rgba(coll.get_array())))  # colour-mapped faces
+    if np.any(np.asarray(coll.get_linewidth()) > 0):
+        rows.append(_rgba(coll.get_edgecolor()))
+    return rows
+
+
+def _patch_colours(patch):
+    rows = [_rgba(patch.get_facecolor())] if patch.get_fill() else []
+    if patch.get_linewidth() > 0:
+        rows.append(_rgba(patch.get_edgecolor()))
+    return rows
+
+
+def _rgba_set(artist):
+    """The colours a reader sees of one artist (or legend handle), as RGBA rows:
+    a line's colour when its line is drawn, a marker's face and edge, a patch's or
+    collection's faces and edges. Fully transparent colours are dropped."""
+    from matplotlib.collections import Collection
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    if isinstance(artist, Line2D):
+        rows = _line_colours(artist)
+    elif isinstance(artist, Collection):
+        rows = _collection_colours(artist)
+    elif isinstance(artist, Patch):
+        rows = _patch_colours(artist)
+    else:  # an artist this check does not know: its single colour, when it has one
+        get = getattr(type(artist), "get_color", None)
+        rows = [_rgba(get(artist))] if get is not None else []
+    out = np.concatenate(rows) if rows else np.empty((0, 4))
+    return out[out[:, 3] > 0]
+
+
+def _marker_path(artist):
+    """The marker shape of a line or scatter (vertices in marker units, unit size), or None."""
+    from matplotlib.collections import PathCollection
+    from matplotlib.lines import Line2D
+    from matplotlib.markers import MarkerStyle
+
+    if isinstance(artist, Line2D):
+        if artist.get_marker() in (None, "None", "", " "):
+            return None
+        m = MarkerStyle(artist.get_marker())
+        verts = m.get_path().transformed(m.get_transform()).vertices
+    elif isinstance(artist, PathCollection) and artist.get_paths():
+        verts = artist.get_paths()[0].vertices
+    else:
+        return None
+    span = np.ptp(verts, axis=0).max()
+    return verts / span if span > 0 else verts
+
+
+def _same_marker(handle, artist):
+    a, b = _marker_path(handle), _marker_path(artist)
+    if a is None:  # the legend shows no marker: nothing to match
+        return True
+    if b is None:
+        return False
+    return a.shape == b.shape and np.allclose(a, b, atol=1e-6)
+
+
+def _pixels(fig):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba()).astype(np.int16)
+
+
+def _draws_pixels(fig, artist, reference, min_pixels=3, min_step=8):
+    """Whether hiding the artist changes the rendered figure (at least `min_pixels`
+    pixels by more than `min_step` of 255): an artist that is invisible, fully
+    transparent, outside the view or covered by others changes nothing. The figure is
+    rendered without anti-aliasing, so that a curve drawn exactly on top of an equal
+    one changes no pixel (anti-aliased edges would darken where two equal curves overlap)."""
+    if not artist.get_visible():
+        return False
+    artist.set_visible(False)
+    try:
+        without = _pixels(fig)
+    finally:
+        artist.set_visible(True)
+    changed = (np.abs(without - reference) > min_step).any(axis=-1)
+    return int(changed.sum()) >= min_pixels
+
+
+class _Aliased:
+    """Anti-aliasing off on every drawn artist for the duration of a check."""
+
+    def __init__(self, artists):
+        self.saved = [(a, a.get_antialiased()) for a in artists if hasattr(a, "set_antialiased")]
+
+    def __enter__(self):
+        for a, _ in self.saved:
+            a.set_antialiased(False)
+
+    def __exit__(self, *exc):
+        for a, aa in self.saved:
+            a.set_antialiased(aa)
+
+
+def _legend_entries(fig):
+    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+    for legend in legends:
+        for handle, text in zip(legend.legend_handles, legend.get_texts(), strict=True):
+            yield handle, text.get_text()
+
+
+def _drawn_artists(fig):
+    """Every artist of the figure that a legend could describe (not legends themselves, not texts)."""
+    from matplotlib.legend import Legend
+    from matplotlib.text import Text
+
+    seen = set()
+    for ax in fig.axes:
+        for a in ax.get_children():
+            if isinstance(a, (Legend, Text)) or id(a) in seen:
+                continue
+            seen.add(id(a))
+            yield a
+
+
+def assert_legend_matches_artists(fig, atol=0.02):
+    """Every legend entry of a Matplotlib figure describes what is drawn: an artist with
+    the entry's label exists, has the legend's colours (line, marker face/edge, patch
+    face/edge, compared as RGBA within `atol`) and marker shape, and shows on the
+    rendered figure (hiding it changes pixels: not invisible, not zero alpha, not outside
+    the view, not covered by other artists)."""
+    artists = list(_drawn_artists(fig))
+    with _Aliased(artists):
+        _check_legends(fig, artists, atol)
+
+
+def _candidates(fig, artists, label):
+    """The drawn things a legend entry may name, each as the list of its artists: single
+    artists with the label, and containers (bars, error bars) with it."""
+    out = [[a] for a in artists if a.get_label() == label]
+    for ax in fig.axes:
+        for c in ax.containers:
+            if c.get_label() == label:
+                out.append([a for a in _flat(c) if a is not None])
+    return out
+
+
+def _flat(container):
+    for a in container:
+        if isinstance(a, (tuple, list)):
+            yield from _flat(a)
+        else:
+            yield a
+
+
+def _check_legends(fig, artists, atol):
+    reference = _pixels(fig)
+    for handle, label in _legend_entries(fig):
+        if handle is None:
+            continue
+        named = _candidates(fig, artists, label)
+        assert named, f"legend entry {label!r}: no drawn artist carries this label"
+        want = _rgba_set(handle)
+        problems = []
+        for group in named:
+            have = np.concatenate([_rgba_set(a) for a in group])
+            missing = [c for c in want if not len(have) or np.abs(have - c).max(axis=1).min() > atol]
+            if missing:
+                problems.append(f"colour {np.round(missing[0], 3).tolist()} not among the artist's colours")
+            elif not any(_same_marker(handle, a) for a in group):
+                problems.append("marker differs from the legend's")
+            elif not any(_draws_pixels(fig, a, reference) for a in group):
+                problems.append("not visible (hidden, transparent, outside the view or covered)")
+            else:
+                break
+        else:
+            raise AssertionError(f"legend entry {label!r} does not match what is drawn: {'; '.join(problems)}")
+
+
+# -- baseline images -------------------------------------------------------------------------------
+
+#: the committed baseline images
+BASELINES = Path(__file__).resolve().parent / "baseline_images"
+
+#: the style a baseline image is drawn in, so that it holds on other platforms: the fonts
+#: Matplotlib ships (DejaVu Sans, DejaVu mathtext: never a system font found by family), no
+#: font hinting (FreeType versions hint glyphs differently), a fixed resolution
+BASELINE_STYLE = {
+    "font.family": "sans-serif",
+    "font.sans-serif": ["DejaVu Sans"],
+    "mathtext.fontset": "dejavusans",
+    "text.hinting": "none",
+    "figure.dpi": 100,
+    "savefig.dpi": 100,
+}
+
+
+@contextmanager
+def baseline_style():
+    """Matplotlib's settings of :data:`BASELINE_STYLE` while a baseline figure is built and drawn."""
+    import matplotlib
+
+    with matplotlib.rc_context(BASELINE_STYLE):
+        yield
+
+
+def assert_matches_baseline(build, name, tmp_path, *, tol, reason, dpi=100):
+    """The figure ``build()`` makes, drawn in :data:`BASELINE_STYLE`, against the
+    committed ``baseline_images/<name>.png`` within ``tol`` (RMS difference of 0-255
+    pixels, :func:`matplotlib.testing.compare.compare_images`); ``reason`` says why that
+    tolerance (required: a tolerance without one is a guess). Regenerate with
+    CPM_NLP_UPDATE_BASELINES=1 after a deliberate change, and look at the images.
+    Returns the figure (its texts and legends checked by the caller within
+    :func:`baseline_style`)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.testing.compare import compare_images
+
+    assert reason.strip(), "say why the tolerance is what it is"
+    with baseline_style():
+        fig = build()
+        out = tmp_path / f"{name}.png"
+        FigureCanvasAgg(fig)
+        fig.savefig(out, dpi=dpi)
+    baseline = BASELINES / f"{name}.png"
+    if os.environ.get("CPM_NLP_UPDATE_BASELINES"):
+        BASELINES.mkdir(exist_ok=True)
+        shutil.copy(out, baseline)
+    assert baseline.exists(), f"no baseline image {baseline}; run with CPM_NLP_UPDATE_BASELINES=1"
+    diff = compare_images(str(baseline), str(out), tol=tol)
+    assert diff is None, diff
+    return fig

@@ -38,16 +38,10 @@ def check_plot_args(args: argparse.Namespace, inputs: Sequence[str | None] = ())
 def result_figure(args: argparse.Namespace, result: Result, problem: Any) -> Any:
     """The figure of a solved result, or None (with a message on stderr) if it
     cannot be drawn: no point solved, or no plot fits the result."""
-    from ..plot.figures import figure, from_result
+    from ..plot.figures import figure
+    from ..plot.results import from_solved
 
-    data = from_result(result)
-    data.live = problem.model
-    if problem.reproduce is not None:
-        data.published = [
-            (row.value, row.published, f"published ({row.source})")
-            for row in problem.reproduce.rows
-            if row.value and row.published is not None
-        ]
+    data = from_solved(result, problem)
     try:
         return figure(data, args.type, plot_options(args), interactive=interactive(args.plot))
     except InputError as exc:  # the result is out already: a plot that cannot be drawn is a failure, exit 1

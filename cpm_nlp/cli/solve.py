@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import copy
+from dataclasses import replace
 
 from ..core import blas, progress
 from ..io.atomic import check_output_path, write_atomic
@@ -30,7 +32,10 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
         with solver_output(args):
             problem = load_problem(args.file, args.set or [])
         with solver_output(args, problem.solver):
-            result = solve(problem)
+            # with --plot and an outputs selection: solved whole, the figure drawn from every value,
+            # the selection printed and written (it limits what is recorded, not what is drawn)
+            whole = solve(replace(problem, outputs=None)) if args.plot and problem.outputs is not None else None
+            result = solve(problem) if whole is None else copy.copy(whole).keep(problem.outputs)
     # the result first: a plot that cannot be drawn never takes it away
     if args.json:
         out.write(result.to_json() + "\n")
@@ -44,7 +49,7 @@ def cmd_solve(args: argparse.Namespace, out: TextIO) -> int:
         write_atomic(args.output, result.to_json() + "\n", inputs=[args.file])
     status = EXIT_OK if result.ok else EXIT_FAILED
     if args.plot:
-        fig = result_figure(args, result, problem)
+        fig = result_figure(args, result if whole is None else whole, problem)
         if fig is None:
             return EXIT_FAILED
         save_figure(args, fig, out)

@@ -80,6 +80,8 @@ class Drawing:
         is one of :data:`DRAWING_PARTS` (a rail or a lever is ``actuator``).
     faces: ``(part, (names ...))``: a filled polygon (the base, the platform).
     joints: point name -> joint letter (:data:`JOINT_TYPES`), marked on the drawing.
+    actuated: the points of the actuated joints (drawn in the actuators' colour, seen
+        even where the actuator's stroke is too short to draw).
     note: what the drawing leaves out or where it departs from scale (shown with it).
     """
 
@@ -87,6 +89,7 @@ class Drawing:
     segments: tuple[tuple[str, str, str], ...] = ()
     faces: tuple[tuple[str, tuple[str, ...]], ...] = ()
     joints: Mapping[str, str] = field(default_factory=dict)
+    actuated: tuple[str, ...] = ()
     note: str = ""
 
     def __post_init__(self) -> None:
@@ -100,6 +103,8 @@ class Drawing:
         for name, letter in self.joints.items():
             if name not in names or letter not in JOINT_TYPES:
                 raise ValueError(f"drawing: joint {name!r}: {letter!r} names an unknown point or joint type")
+        if not set(self.actuated) <= set(self.joints):
+            raise ValueError(f"drawing: actuated {self.actuated!r} names a point that is not a joint")
 
 
 class Part:

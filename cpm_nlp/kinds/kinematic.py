@@ -182,7 +182,7 @@ def _model_info(model: Model) -> dict[str, Any]:
 class ForwardKinematics(ProblemKind):
     name = "forward_kinematics"
     description = "platform pose from the actuator displacements (FK), checked against IK"
-    plots = ("io", "mechanism", "workspace")
+    plots = ("io", "assembly_modes", "mechanism", "workspace")
 
     def input_options(self, model: Model) -> list[Option]:
         return actuator_options(model, "grid") + list(MODE_OPTIONS) + [_guess_option(model)]

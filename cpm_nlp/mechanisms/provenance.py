@@ -120,13 +120,18 @@ def _recorded_inline(origin: Origin, source: str | None) -> Mechanism:
     return described.from_dict(desc, base_dir=Path(origin.path) if origin.path else None)
 
 
-def recorded_model(mech: Mechanism, parameters: Mapping[str, Any] | None, path: tuple = ("model",)) -> Model:
+def recorded_model(
+    mech: Mechanism,
+    parameters: Mapping[str, Any] | None,
+    path: tuple = ("model",),
+    limits: Mapping[str, Any] | None = None,
+) -> Model:
     """A model of a mechanism :func:`recorded_mechanism` gave: a registered one through the
     registry (its shared closure), one read back from a file or a description without
-    registering it (the registry keeps what it had)."""
+    registering it (the registry keeps what it had); ``limits``: its joint limits, if given."""
     if _registered(mech):
-        return build_model(mech.name, parameters, path=path)
-    return mech.model(recorded_closure(mech), parameters, None, path)
+        return build_model(mech.name, parameters, limits, path=path)
+    return mech.model(recorded_closure(mech), parameters, limits, path)
 
 
 def _registered(mech: Mechanism) -> bool:

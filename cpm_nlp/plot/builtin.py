@@ -43,6 +43,11 @@ BUILTIN = (
         interactive=True,
     ),
     PlotType(
+        "assembly_modes",
+        _in("assembly_plots", "assembly_modes_plot"),
+        "the mechanism in each assembly mode a forward kinematics mode search found",
+    ),
+    PlotType(
         "design",
         _in("mechanism_plots", "design_plot"),
         "a synthesised design drawn at home, the file's design faintly",

@@ -14,14 +14,21 @@ from .results import NotApplicable, PlotOptions, ResultData, dimension_of
 
 # -- comparisons, matrices ----------------------------------------------------------------------------
 
-#: how a result names a reference value beside its own (prefix or suffix, legend label)
+#: how a result names a reference value beside its own (prefix or suffix, legend label). Each
+#: label says what the reference is: a value computed here from a paper's formulas or
+#: formulation is not a number the paper prints (issue 24: eq 38 of prc3-li-2018.md evaluated
+#: with assumed masses, 96.5 Hz, was labelled "paper (printed)"; the paper prints 93.83 Hz).
+#: Numbers a paper prints come from the problem's reproduce rows (:data:`PRINTED`).
 REFERENCES = (
     ("reference_", "", "reference design"),
-    ("paper_", "", "paper"),
-    ("", "_printed", "paper (printed)"),
+    ("paper_", "", "paper's formulation (solved here)"),
+    ("", "_printed", "printed formulas (evaluated here)"),
     ("", "_compare", "compared design"),
     ("", "_design", "design in the file"),
 )
+
+#: the label of the numbers a paper prints (the problem's ``reproduce`` rows)
+PRINTED = "printed in the paper"
 
 
 def comparisons(data: ResultData) -> list[tuple[str, list[Comparison]]]:
@@ -40,7 +47,22 @@ def comparisons(data: ResultData) -> list[tuple[str, list[Comparison]]]:
             rows.append(Comparison(base, float(ours), float(ref), dimension_of(data, base)))
         if rows:
             groups.append((label, rows))
+    printed = printed_comparisons(data)
+    if printed:
+        groups.append((PRINTED, printed))
     return groups
+
+
+def printed_comparisons(data: ResultData) -> list[Comparison]:
+    """The result's scalar values beside the numbers the paper prints for them (the problem's
+    ``reproduce`` rows, at hand with ``cpm-nlp solve FILE --plot``), each named with its source."""
+    rows = []
+    for expr, published, label in data.published:
+        ours = data.values.get(expr)
+        if isinstance(ours, (int, float)) and not isinstance(ours, bool):
+            source = label[label.find("(") + 1 : -1] if label.endswith(")") and "(" in label else label
+            rows.append(Comparison(expr, float(ours), float(published), dimension_of(data, expr), source))
+    return rows
 
 
 def comparison_plot(data: ResultData, _options: PlotOptions) -> Any:

@@ -6,6 +6,7 @@ platform, mode shapes on the mechanism, natural frequencies.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -13,11 +14,20 @@ import numpy as np
 from ..core.canonical import canonical_eigh, degenerate_note, eigen_clusters
 from .comparison_plots import comparisons
 from .draw_compliance import dynamics_figure, ellipsoid_figure, modes_figure
+from .draw_forces import ForcePanel, Quantity, forces_figure, published_by_value, readable_group
 from .draw_mechanism import Arrow, modes_mechanism_figure
-from .draw_panels import Panel, panels_figure
 from .pose import geometry_of, model_for, single_pose
-from .results import NotApplicable, PlotOptions, ResultData, dimension_of, pose_name, require_lists, result_closure
-from .style import as_floats
+from .results import (
+    NotApplicable,
+    PlotOptions,
+    ResultData,
+    dimension_of,
+    mechanism_title,
+    pose_name,
+    require_lists,
+    result_closure,
+)
+from .style import as_floats, display_unit, number, pretty
 
 # -- dynamics ---------------------------------------------------------------------------------------------
 
@@ -38,7 +48,7 @@ def dynamics_plot(data: ResultData, _options: PlotOptions) -> Any:
     freqs = np.sqrt(np.clip(w2, 0, None)) / (2 * math.pi)
     closure = result_closure(data)
     groups = comparisons(data)
-    title = _with_degenerate_note(f"Dynamics ({data.model.get('type')})", clusters, len(freqs))
+    title = _with_degenerate_note(f"Natural frequencies: {mechanism_title(data)}", clusters, len(freqs))
     return dynamics_figure(freqs, modes, closure.q_names, groups, title=title)
 
 
@@ -60,33 +70,186 @@ def _mode_clusters(data: ResultData) -> list[list[int]]:
 
 
 def forces_plot(data: ResultData, _options: PlotOptions) -> Any:
-    """Actuator forces and hinge stresses along a motion (actuator_forces over a
-    list of inputs; prs3-ruiz.md Table 2 extended to a curve), against the input
-    that varies most."""
+    """Actuator forces and hinge stresses along a motion (prs3-ruiz.md Table 2 extended
+    to a curve), against the input that varies most: the result's points for a batch;
+    for one pose, the motion from home through it (solved again along it, out past the
+    pose where the first hinge reaches the allowable stress). With the allowable
+    stress, that pose, and the published points of the problem's ``reproduce`` rows."""
     if data.sweep:
         raise NotApplicable("'forces' plots one actuator_forces result; for a sweep use 'lines'")
     c = result_closure(data)
     inputs = c.q_names + [pose_name(data, c, t) for t in c.task]
     forces = [f"F{j + 1}" for j in range(c.nq)]
-    stresses = sorted(k for k in data.values if k.startswith("stress_") and not k.endswith("_loaded"))
-    require_lists(data, forces + inputs, "a forces plot (give the motion as lists)")
-    cols = {n: as_floats(data.values[n]) for n in inputs}
+    single = all(isinstance(data.values.get(n), (int, float)) for n in forces + inputs)
+    if not single:
+        require_lists(data, forces + inputs, "a forces plot (give the motion as lists, or one pose)")
+    ray = _ray(data)
+    if ray is not None:
+        values, motion = _along(data, ray)
+    elif single:
+        raise NotApplicable(
+            "a forces plot of one pose draws the motion from home through it, which needs the problem "
+            "('cpm-nlp solve FILE --plot'); or give the motion as lists"
+        )
+    else:
+        values, motion = data.values, f"at the {len(data.values[forces[0]])} solved points"
+    cols = {n: as_floats(values[n]) for n in inputs}
     spread = {n: np.nanmax(v) - np.nanmin(v) if np.isfinite(v).any() else 0.0 for n, v in cols.items()}
     x = max(inputs, key=lambda n: spread[n])
     if spread[x] <= 0:
         raise NotApplicable("no input varies over the motion")
+    same = [n for n in inputs if np.allclose(cols[n], cols[x], equal_nan=True) and dimension_of(data, n)]
     order = np.argsort(cols[x])
-    panels = [Panel("actuator force", "force", {f: [data.values[f][i] for i in order] for f in forces})]
-    if stresses and isinstance(data.values[stresses[0]], list):
-        panels.append(Panel("hinge stress", "stress", {s: [data.values[s][i] for i in order] for s in stresses}))
-    return panels_figure(
+    at = {None: float(data.values[x])} if single else dict(enumerate(as_floats(data.values[x]).tolist()))
+    published = published_by_value(data.published, at)
+    panels = [_force_panel(values, forces, order, published), _stress_panel(data, values, order, published, x)]
+    words = "actuator displacement" if x in c.q_names else "platform motion"
+    return forces_figure(
         cols[x][order],
-        panels,
-        xname=x,
-        xdimension=dimension_of(data, x),
-        title=f"Actuator forces and hinge stresses ({data.model.get('type')})",
-        ncols=len(panels),
+        f"{words} {' = '.join(pretty(n) for n in same)}",
+        dimension_of(data, x),
+        [p for p in panels if p is not None],
+        title=f"Actuator forces and hinge stresses: {mechanism_title(data)}",
+        subtitle=motion,
     )
+
+
+#: samples of the motion from home through the solved poses, for the forces plot
+MOTION_SAMPLES = 33
+
+
+@dataclass
+class _Ray:
+    """The motion from home through the solved poses, when they lie on one ray: the
+    inputs that give it (actuators, else task coordinates), their home values, the
+    last pose's, and each pose's scale along the ray (1 at the last)."""
+
+    keys: list[str]
+    home: np.ndarray
+    end: np.ndarray
+    scales: np.ndarray
+
+
+def _ray(data: ResultData) -> _Ray | None:
+    """The ray from home through the problem's poses; None without the problem at hand,
+    or when its poses do not lie on one ray from home."""
+    problem = data.solved_problem
+    if problem is None:
+        return None
+    model, inputs = problem.model, problem.inputs
+    c = model.closure
+    homes = {n: float(model.q_home[j]) for j, n in enumerate(c.q_names)}
+    keys = [n for n in c.q_names if inputs.get(n) is not None]
+    if not keys:
+        homes = {c.x[i].name: float(model.x_home[i]) for i in c.task_index} | dict.fromkeys(c.offsets, 0.0)
+        keys = [n for n in homes if inputs.get(n) is not None]
+    if not keys:
+        return None
+    n = max((len(inputs[k]) for k in keys if isinstance(inputs[k], list)), default=1)
+    pts = np.array([[float(v) for v in inputs[k]] if isinstance(inputs[k], list) else [inputs[k]] * n for k in keys]).T
+    home = np.array([homes[k] for k in keys])
+    d = pts[-1] - home
+    if not np.linalg.norm(d) > 0:
+        return None
+    scales = (pts - home) @ d / (d @ d)
+    if np.linalg.norm(pts - home - np.outer(scales, d)) > 1e-9 * np.linalg.norm(d) * n:
+        return None
+    return _Ray(keys, home, pts[-1], scales)
+
+
+def _along(data: ResultData, ray: _Ray) -> tuple[dict[str, Any], str]:
+    """The result's problem solved along its ray from home, out to 1.15 times the
+    farthest of its poses and the pose where the first hinge reaches the allowable
+    stress, the solved poses among the samples: the values as lists, and a line saying so."""
+    problem = data.solved_problem
+    scale = data.values.get("scale_at_allowable")
+    top = 1.15 * max(1.0, float(ray.scales.max()), float(scale) if isinstance(scale, (int, float)) else 0.0)
+    lams = np.unique(np.r_[np.linspace(0.0, top, MOTION_SAMPLES), ray.scales])
+    inputs = dict(problem.inputs)
+    for k, h, e in zip(ray.keys, ray.home, ray.end):
+        inputs[k] = [float(h + lam * (e - h)) for lam in lams]
+    inputs["stress_limit"] = False
+    result = problem.kind.run(problem.model, inputs, problem.solver)
+    through = "the solved pose" if len(ray.scales) == 1 else f"the {len(ray.scales)} solved poses"
+    return dict(result.values), f"along the motion from home through {through} ({_end_text(data, ray)})"
+
+
+def _end_text(data: ResultData, ray: _Ray) -> str:
+    """The last pose's inputs, equal ones together: "s1 = s2 = s3 = 2.865 mm"."""
+    parts: list[tuple[list[str], float]] = []
+    for k, v in zip(ray.keys, ray.end):
+        for names, value in parts:
+            if value == v:
+                names.append(k)
+                break
+        else:
+            parts.append(([k], float(v)))
+    out = []
+    for names, v in parts:
+        f, unit = display_unit(dimension_of(data, names[0]), [v])
+        out.append(" = ".join(pretty(k) for k in names) + f" = {v * f:.4g} {unit}".rstrip())
+    return ", ".join(out)
+
+
+def _force_panel(values: dict, forces: list[str], order: np.ndarray, published: dict) -> ForcePanel:
+    curves = [Quantity(pretty(f), as_floats(values[f])[order]) for f in forces]
+    points = [
+        (x, y, f"{text}: {' = '.join(pretty(f) for f in forces if f in published)}")
+        for f in forces
+        for x, y, text in published.get(f, ())
+    ]
+    return ForcePanel("actuator force", "force", curves, points=points)
+
+
+def _stress_panel(data: ResultData, values: dict, order: np.ndarray, published: dict, x: str) -> ForcePanel | None:
+    """Each hinge group's largest stress (the largest of all, stress_max, is their upper
+    envelope: drawn only without groups), the allowable stress and where it is reached."""
+    groups = sorted(k for k in values if k.startswith("stress_") and k not in ("stress_max",) and "_loaded" not in k)
+    groups = [g for g in groups if isinstance(values[g], list)]
+    if not groups and not isinstance(values.get("stress_max"), list):
+        return None
+    curves = [Quantity(readable_group(g.removeprefix("stress_")), as_floats(values[g])[order]) for g in groups]
+    if not curves:
+        curves = [Quantity("largest hinge stress", as_floats(values["stress_max"])[order])]
+    points = [(px, py, f"{text}: largest joint stress") for px, py, text in published.get("stress_max", ())]
+    for g in groups:
+        name = readable_group(g.removeprefix("stress_"))
+        points += [(px, py, f"{text}: {name}") for px, py, text in published.get(g, ())]
+    lines, marks = [], []
+    sigma = _allowable(data)
+    if sigma is not None:
+        lines.append((sigma, f"allowable stress {_stress_text(sigma)}"))
+        reached = data.values.get(f"{x}_at_allowable")
+        if isinstance(reached, (int, float)):
+            f, unit = display_unit(dimension_of(data, x), [reached])
+            text = f"first hinge at the allowable: {pretty(x)} = {reached * f:.4g} {unit}"
+            marks.append((float(reached), sigma, text))
+    return ForcePanel("hinge stress", "stress", curves, points=points, lines=lines, marks=marks)
+
+
+def _stress_text(sigma: float) -> str:
+    f, unit = display_unit("stress", [sigma])
+    return f"{sigma * f:.4g} {unit}"
+
+
+def _allowable(data: ResultData) -> float | None:
+    """The allowable stress: the result's (a stress limit was asked), else the one the
+    problem's hinges give (their material's), else None."""
+    sigma = data.values.get("sigma_allow")
+    if isinstance(sigma, (int, float)):
+        return float(sigma)
+    problem = data.solved_problem
+    if problem is None or "hinge_set" not in problem.inputs:
+        return None
+    from ..analysis.compliance import allowable
+    from ..core.errors import InputError
+
+    try:
+        return allowable(
+            problem.inputs["hinge_set"], problem.inputs.get("sigma_allow"), problem.inputs.get("safety_factor", 1.0), ()
+        )
+    except InputError:  # no material: no allowable stress to draw
+        return None
 
 
 def _translational(c: Any) -> list[int]:
@@ -111,7 +274,7 @@ def ellipsoid_plot(data: ResultData, _options: PlotOptions) -> Any:
     return ellipsoid_figure(
         C,
         [c.x_names[i] for i in idx],
-        title=f"Compliance ellipsoid of the platform ({data.model.get('type')})",
+        title=f"Compliance ellipsoid of the platform: {mechanism_title(data)}",
         drawing=drawing,
         centre=centre,
         note=note,
@@ -161,13 +324,18 @@ def mode_arrows(model: Any, geometry: Any, x: np.ndarray, q: np.ndarray, mx: Any
     if peak == 0.0:
         return []
     D *= MODE_ARROW * span / peak
+    factor, unit = display_unit("length", P)
+    label = (
+        f"point displacement in the mode, scaled: the largest drawn {number(MODE_ARROW * span * factor)} {unit} "
+        f"long ({MODE_ARROW:.0%} of the mechanism's size; a mode shape has no amplitude of its own)"
+    )
     arrows: list[Arrow] = []
     seen: list[np.ndarray] = []
     for p, d in zip(P, D):
         if np.linalg.norm(d) < 1e-3 * MODE_ARROW * span or any(np.linalg.norm(p - o) < 1e-9 * span for o in seen):
             continue
         seen.append(p)
-        arrows.append(Arrow(p, d, "" if arrows else "displacement in the mode (scaled)", "tab:red"))
+        arrows.append(Arrow(p, d, "" if arrows else label, "tab:red"))
     return arrows
 
 
@@ -186,7 +354,7 @@ def modes_plot(data: ResultData, _options: PlotOptions) -> Any:
         arrows = [mode_arrows(model, geometry, x, q, mx, mq) for mx, mq in modes]
         freqs = [data.values[f"f{k + 1}"] for k in range(len(modes))]
         pose = geometry(model, x, q)
-        title = _with_degenerate_note(f"Mode shapes ({data.model.get('type')})", _mode_clusters(data), len(modes))
+        title = _with_degenerate_note(f"Mode shapes: {mechanism_title(data)}", _mode_clusters(data), len(modes))
         return modes_mechanism_figure(pose, arrows, freqs, title=title, note=pose.note)
     idx = _translational(c)
     platform = np.zeros(3)

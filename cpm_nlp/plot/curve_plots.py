@@ -17,6 +17,7 @@ from .results import (
     PlotOptions,
     ResultData,
     dimension_of,
+    mechanism_title,
     pose_name,
     require_lists,
     result_closure,
@@ -48,7 +49,8 @@ def requirements_plot(data: ResultData, _options: PlotOptions) -> Any:
         for t, x in zip(task, c.task)
     ]
     for fam, coords in _families(c.q).items():
-        panels.append(Panel(fam, coords[0].kind, {q.name: data.values[q.name] for q in coords}, annotate_range=True))
+        series = {q.name: data.values[q.name] for q in coords}
+        panels.append(Panel(fam, coords[0].kind, series, annotate_range=True, levels=_published_range(data, fam)))
     home: dict[str, float] = {}
     if c.passive is not None:
         try:
@@ -63,14 +65,23 @@ def requirements_plot(data: ResultData, _options: PlotOptions) -> Any:
             ("d" if relative else "") + j.name: [None if v is None else v - shift[j.name] for v in data.values[j.name]]
             for j in coords
         }
-        panels.append(Panel(("d" if relative else "") + fam, coords[0].kind, series, annotate_range=True))
+        name = ("d" if relative else "") + fam
+        panels.append(Panel(name, coords[0].kind, series, annotate_range=True, levels=_published_range(data, name)))
     return panels_figure(
         list(range(1, n + 1)),
         panels,
-        xname="studied pose",
-        title=f"Joint requirements of {data.model.get('type')} over {n} poses",
+        xname="studied pose (number)",
+        title=f"Joint requirements over {n} studied poses: {mechanism_title(data)}",
         ncols=len(task) + len(_families(c.q)),
+        joined=False,  # the poses are cases of a grid, not a path: no line joins them
     )
+
+
+def _published_range(data: ResultData, family: str) -> list[tuple[float, str]]:
+    """The published ends of a family's range (``<family>_min``, ``<family>_max`` of the
+    problem's reproduce rows), as levels to draw."""
+    ends = (f"{family}_min", f"{family}_max")
+    return [(float(v), label.replace("published", "published range", 1)) for e, v, label in data.published if e in ends]
 
 
 def io_plot(data: ResultData, options: PlotOptions) -> Any:

@@ -45,8 +45,8 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
         w, V = principal_axes(S2)
         for k in range(2):
             a = V[:, k] * w[k] * scale
-            ax.plot(*np.array([centre[:2] - a, centre[:2] + a]).T, color="tab:purple", lw=3, zorder=10)
-        ax.plot([], [], color="tab:purple", lw=3, label="compliance ellipse (scaled)")
+            label = "compliance ellipse (scaled)" if k == 0 else "_axis"
+            ax.plot(*np.array([centre[:2] - a, centre[:2] + a]).T, color="tab:purple", lw=3, zorder=10, label=label)
         return
     if n == 3:
         u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
@@ -61,9 +61,42 @@ def _ellipsoid_on(ax: Any, S: np.ndarray, centre: np.ndarray, scale: float) -> N
     for k in range(n):  # the principal axes: seen even where the ellipsoid is flat
         a = np.zeros(3)
         a[:n] = V[:, k] * w[k] * scale
-        ax.plot(*np.array([centre - a, centre + a]).T, color="tab:purple", lw=3, zorder=10)
+        label = "compliance ellipsoid (scaled)" if k == n - 1 else "_axis"
+        ax.plot(*np.array([centre - a, centre + a]).T, color="tab:purple", lw=3, zorder=10, label=label)
     ax.computed_zorder = False  # the ellipsoid over the platform's face
-    ax.plot([], [], color="tab:purple", lw=3, label="compliance ellipsoid (scaled)")
+
+
+#: colours of the principal axes, the largest compliance first
+AXIS_COLOURS = ("tab:red", "tab:orange", "tab:green")
+_PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p"))
+
+
+def prefixed(value: float, unit: str) -> str:
+    """A value with the engineering prefix that puts it in [1, 1000): 10000 N -> "10 kN"."""
+    mag = abs(value)
+    scale, prefix = next(((s, p) for s, p in _PREFIXES if mag >= s * (1 - 1e-12)), _PREFIXES[-1])
+    if mag == 0:
+        scale, prefix = 1.0, ""
+    return f"{number(value / scale)} {prefix}{unit}"
+
+
+def compliance_text(c: float) -> str:
+    """A compliance (m/N) in its own length prefix: 3.49 µm/N, 16.3 nm/N."""
+    return prefixed(abs(c), "m/N")
+
+
+def _principal_axes_on(ax: Any, w: np.ndarray, V: np.ndarray, f: float, names: Sequence[str]) -> None:
+    """The principal axes of the ellipsoid (2-D: ellipse) centred at 0, the largest first, each
+    labelled with its half-length (the principal compliance) and direction; marked at its ends so
+    that an axis too short to see as a line still shows."""
+    n = len(w)
+    order = np.argsort(-np.abs(w), kind="stable")
+    for rank, k in enumerate(order):
+        a = V[:, k] * abs(w[k]) * f
+        direction = ", ".join(f"{0.0 if abs(c) < 5e-4 else c:.3g}" for c in V[:, k])
+        label = f"{compliance_text(w[k])} along ({direction}) in ({', '.join(names[:n])})"
+        ends = np.array([-a, a]).T
+        ax.plot(*ends, color=AXIS_COLOURS[rank % 3], lw=2.2, marker="o", ms=4, label=label, zorder=5)
 
 
 # -- (d) compliance ellipsoid and mode shapes -------------------------------------------------------
@@ -86,7 +119,7 @@ def ellipsoid_figure(
     w, V = principal_axes(S)
     peak = float(np.max(np.abs(w))) if w.size else 0.0
     f, unit = display_unit("length", [peak])
-    text = ", ".join(f"{number(abs(v) * f)} {unit}/N" for v in w[::-1])
+    text = ", ".join(compliance_text(v) for v in w[::-1])
     panels = 1 if drawing is None else 2
     fig = Figure(figsize=(7 * panels, 6.5 if drawing is not None else 6), layout="constrained")
     if drawing is not None:
@@ -97,17 +130,18 @@ def ellipsoid_figure(
         force = 0.25 * span / (peak or 1.0)
         force = float(10 ** math.floor(math.log10(force)))
         _ellipsoid_on(on, S, np.asarray(centre, dtype=float).ravel()[:3] * df, force * df)
-        on.set_title(f"at the platform centre: the deflections under |f| = {force:g} N", fontsize="small")
+        on.set_title(
+            f"at the platform centre: the deflections under a force of {prefixed(force, 'N')} in any direction",
+            fontsize="small",
+        )
         legend_below(fig, on, note)
     if n == 3:
         ax = fig.add_subplot(1, panels, panels, projection="3d")
         u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
         dirs = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
         pts = dirs @ S.T * f
-        ax.plot_surface(pts[..., 0], pts[..., 1], pts[..., 2], alpha=0.35, color="tab:blue")
-        for k in range(3):
-            a = V[:, k] * w[k] * f
-            ax.plot([-a[0], a[0]], [-a[1], a[1]], [-a[2], a[2]], color="tab:red", lw=2)
+        ax.plot_surface(pts[..., 0], pts[..., 1], pts[..., 2], alpha=0.25, color="tab:blue")
+        _principal_axes_on(ax, w, V, f, names)
         ax.set_zlabel(axis_label(names[2], unit + "/N"))
         # equal scales on the three axes, so a flat ellipsoid looks flat (not a sphere)
         lim = 1.05 * peak * f or 1.0
@@ -117,12 +151,22 @@ def ellipsoid_figure(
         ax = fig.add_subplot(1, panels, panels)
         t = np.linspace(0, 2 * np.pi, 200)
         pts = np.stack([np.cos(t), np.sin(t)], axis=-1) @ S.T * f
-        ax.plot(pts[:, 0], pts[:, 1], color="tab:blue")
+        ax.plot(pts[:, 0], pts[:, 1], color="tab:blue", label="compliance ellipse")
+        _principal_axes_on(ax, w, V, f, names)
         ax.set_aspect("equal")
         ax.grid(True, alpha=0.3)
     ax.set_xlabel(axis_label(names[0], unit + "/N"))
     ax.set_ylabel(axis_label(names[1], unit + "/N"))
     ax.set_title(f"principal compliances: {text}", fontsize="small")
+    ranked = np.sort(np.abs(w))[::-1]
+    equal = [k for k in range(len(ranked) - 1) if abs(ranked[k] - ranked[k + 1]) <= 1e-9 * max(peak, 1e-300)]
+    heading = "principal axes (half-lengths)"
+    if equal:  # a circle or a sphere in those axes: the directions drawn are one choice of many
+        pairs = "; ".join(f"axes {k + 1} and {k + 2} equal: any direction in their plane is principal" for k in equal)
+        heading += "\n" + pairs
+    # 3-D: in the view's empty top corner; 2-D: below the axes (inside, it would cover the ellipse)
+    where = {"loc": "upper left"} if n == 3 else {"loc": "upper center", "bbox_to_anchor": (0.5, -0.12)}
+    ax.legend(fontsize="x-small", title=heading, title_fontsize="x-small", **where)
     if title:
         fig.suptitle(title)
     return fig
@@ -171,8 +215,9 @@ def dynamics_figure(
     Figure = figure_class()
     freqs = np.asarray(freqs, dtype=float)
     modes = np.asarray(modes, dtype=float)
-    fig = Figure(figsize=(11, 4.2 + (2.0 if groups else 0)), layout="constrained")
-    top, bottom = fig.subfigures(2, 1, height_ratios=[4.2, 2.0 * len(groups)]) if groups else (fig, None)
+    heights = [0.55 * len(rows) + 1.2 for _, rows in groups]  # inches: a row of bars and its written values each
+    fig = Figure(figsize=(11, 4.2 + sum(heights)), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=[4.2, sum(heights)]) if groups else (fig, None)
     a1, a2 = top.subplots(1, 2)
     labels = [f"mode {k + 1}" for k in range(len(freqs))]
     a1.bar(labels, freqs, color="tab:blue", width=0.6)
@@ -187,10 +232,12 @@ def dynamics_figure(
     a2.set_xticks(range(len(coords)), [pretty(c) for c in coords])
     a2.axhline(0, color="k", lw=0.8)
     a2.set_ylabel("mode shape (normalised)")
-    a2.legend(fontsize="x-small")
+    low = float(np.min(modes / np.abs(modes).max(axis=0), initial=0.0))
+    a2.set_ylim(1.1 * low if low < 0 else 0.0, 1.45)  # room above the bars for the legend
+    a2.legend(fontsize="x-small", loc="upper center", ncols=max(modes.shape[1], 1))
     a2.set_title("eigenvectors of K v = ω² M v", fontsize="small")
     if bottom is not None:
-        axes = bottom.subplots(len(groups), 1, squeeze=False)[:, 0]
+        axes = bottom.subplots(len(groups), 1, squeeze=False, height_ratios=heights)[:, 0]
         for ax, (label, rows) in zip(axes, groups):
             comparison_axes(ax, rows, reference_label=label)
     if title:

@@ -62,15 +62,62 @@ class _Layers:
     poly: np.ndarray | None
     norm: Any
     levels: Any
+    #: the grid's cells outside the design space are drawn (else their points, as dots)
+    blank_drawn: bool = False
+    #: the region's outline (polylines, display units)
+    outline: tuple = ()
+
+
+#: colour of the points or cells outside the design space (the legend's swatch is the same)
+OUTSIDE_COLOUR = "0.86"
 
 
 def _colour_scale(zpos: np.ndarray) -> tuple[Any, Any]:
-    """The colour norm and contour levels: logarithmic for values over decades, else linear."""
-    if zpos.min() > 0 and zpos.max() / zpos.min() > 1000:  # values over decades: a log scale shows them all
+    """The colour norm and contour levels: logarithmic for values over decades, else linear;
+    the levels round numbers inside the values' range (:func:`contour_levels`)."""
+    lo, hi = float(zpos.min()), float(zpos.max())
+    if lo > 0 and hi / lo > 1000:  # values over decades: a log scale shows them all
         from matplotlib.colors import LogNorm
 
-        return LogNorm(zpos.min(), zpos.max()), np.geomspace(zpos.min(), zpos.max(), 9)[1:-1]
-    return None, 8
+        return LogNorm(lo, hi), contour_levels(lo, hi, log=True)
+    return None, contour_levels(lo, hi)
+
+
+def contour_levels(lo: float, hi: float, log: bool = False) -> np.ndarray:
+    """Round contour levels strictly inside (lo, hi), as Matplotlib's tickers choose them:
+    1-2-5 steps of each decade on a log scale (every decade alone where that gives more than
+    nine), about eight 1-2-2.5-5 steps on a linear one."""
+    from matplotlib.ticker import LogLocator, MaxNLocator
+
+    if hi <= lo:
+        return np.array([])
+    if log:
+        for subs in ((1.0, 2.0, 5.0), (1.0,)):
+            levels = LogLocator(base=10.0, subs=subs).tick_values(lo, hi)
+            levels = levels[(levels > lo) & (levels < hi)]
+            if len(levels) <= 9:
+                break
+        return levels
+    levels = MaxNLocator(nbins=8, steps=[1, 2, 2.5, 5, 10]).tick_values(lo, hi)
+    levels[np.abs(levels) < 1e-9 * (hi - lo)] = 0.0  # the level 0, not its rounding noise
+    return levels[(levels > lo) & (levels < hi)]
+
+
+def level_format(levels: Any) -> Any:
+    """A formatter of contour levels: the fewest significant digits that write every level
+    exactly ("0.15", "2000", "2.305", "1e-05"), so that round levels read round and close
+    ones stay apart."""
+    levels = np.asarray(levels, dtype=float)
+    for digits in range(1, 13):
+        if all(abs(float(f"{v:.{digits}g}") - v) <= 1e-9 * abs(v) for v in levels):
+            break
+
+    def text(v: float) -> str:
+        if 1 <= abs(v) < 1e6:  # no exponent: "30", "2000", "2.305"
+            return f"{v:.{max(0, digits - 1 - int(np.floor(np.log10(abs(v)))))}f}"
+        return f"{v:.{digits}g}"
+
+    return text
 
 
 def _grid_layer(m: _Layers, grid: tuple, fx: float, fy: float) -> Any:
@@ -82,14 +129,40 @@ def _grid_layer(m: _Layers, grid: tuple, fx: float, fy: float) -> Any:
     mappable = m.ax.pcolormesh(
         cell_edges(ux * fx), cell_edges(uy * fy), masked, cmap="viridis", shading="flat", norm=m.norm
     )
-    if np.count_nonzero(np.isfinite(cells)) >= 4 and np.nanmax(cells) > np.nanmin(cells):
+    if np.count_nonzero(np.isfinite(cells)) >= 4 and np.nanmax(cells) > np.nanmin(cells) and len(m.levels):
         cs = m.ax.contour(ux * fx, uy * fy, masked, levels=m.levels, colors="k", linewidths=0.6, alpha=0.7)
-        m.ax.clabel(cs, fontsize="x-small", fmt="%.3g")
+        m.ax.clabel(cs, fontsize="x-small", fmt=level_format(m.levels))
+    if m.away.any():  # cells outside the design space: one light grey, named in the legend
+        from matplotlib.collections import PolyCollection
+
+        ex, ey = cell_edges(ux * fx), cell_edges(uy * fy)
+        i, j = ix[m.away], iy[m.away]
+        cells_out = np.stack(
+            [np.c_[ex[i], ey[j]], np.c_[ex[i + 1], ey[j]], np.c_[ex[i + 1], ey[j + 1]], np.c_[ex[i], ey[j + 1]]], axis=1
+        )
+        m.ax.add_collection(
+            PolyCollection(
+                cells_out,
+                facecolors=OUTSIDE_COLOUR,
+                edgecolors=OUTSIDE_COLOUR,
+                linewidths=0.3,
+                label=f"outside the design space ({int(m.away.sum())} grid points)",
+            )
+        )
+        m.blank_drawn = True
     if m.region is not None and m.region.any():
         mask = np.zeros_like(cells)
         mask[iy, ix] = m.region.astype(float)
-        m.ax.contour(ux * fx, uy * fy, mask, levels=[0.5], colors="tab:red", linewidths=2)
+        _outline(m, m.ax.contour(ux * fx, uy * fy, mask, levels=[0.5]))
     return mappable
+
+
+def _outline(m: _Layers, cs: Any) -> None:
+    """Keep the lines of a contour set as the region's outline (drawn as lines, so that the
+    legend names what is drawn) and remove the contour set."""
+    lines = [poly for path in cs.get_paths() for poly in path.to_polygons(closed_only=False) if len(poly) > 1]
+    cs.remove()
+    m.outline = tuple(lines)
 
 
 def _triangulated(m: _Layers) -> Any:
@@ -112,11 +185,11 @@ def _triangulated(m: _Layers) -> Any:
         raise ValueError("every triangle has a point that did not solve")
     Zf = np.where(m.good, m.Z, np.nanmean(m.Z[m.good]))[use]
     mappable = m.ax.tripcolor(tri, Zf, cmap="viridis", shading="gouraud", norm=m.norm)
-    if np.ptp(m.Z[m.good]) > 0:
+    if np.ptp(m.Z[m.good]) > 0 and len(m.levels):
         cs = m.ax.tricontour(tri, Zf, levels=m.levels, colors="k", linewidths=0.6, alpha=0.7)
-        m.ax.clabel(cs, fontsize="x-small", fmt="%.3g")
+        m.ax.clabel(cs, fontsize="x-small", fmt=level_format(m.levels))
     if m.region is not None and m.region[use].any():
-        m.ax.tricontour(tri, m.region[use].astype(float), levels=[0.5], colors="tab:red", linewidths=2)
+        _outline(m, m.ax.tricontour(tri, m.region[use].astype(float), levels=[0.5]))
     return mappable
 
 
@@ -136,17 +209,12 @@ def _point_layers(m: _Layers, region_label: str) -> None:
     """The region's legend entry, the points outside the design space and those not solved,
     the domain's outline."""
     ax, X, Y = m.ax, m.X, m.Y
-    if m.region is not None and m.region.any():
-        ax.plot([], [], color="tab:red", lw=2, label=region_label)
+    for n, line in enumerate(m.outline):  # the region's outline, named once in the legend
+        ax.plot(line[:, 0], line[:, 1], color="tab:red", lw=2, label="_" if n else region_label)
     away = m.away
-    if away.any():  # few: dotted; many (a grid around the domain): the blank says it
-        few = away.sum() <= 400
+    if away.any() and not m.blank_drawn:  # scattered points outside: dots (a grid's cells: _grid_layer)
         ax.plot(
-            *((X[away], Y[away]) if few else ([], [])),
-            "." if few else "s",
-            color="0.8",
-            ms=2 if few else 6,
-            label=f"outside the design space ({int(away.sum())}{'' if few else ', blank'})",
+            X[away], Y[away], ".", color=OUTSIDE_COLOUR, ms=2, label=f"outside the design space ({int(away.sum())})"
         )
     failed = ~m.good & ~away
     if failed.any():

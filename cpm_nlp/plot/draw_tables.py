@@ -14,7 +14,6 @@ import numpy as np
 from .style import (
     display_unit,
     figure_class,
-    number,
     pretty,
     unit_text,
     wrap,
@@ -32,6 +31,8 @@ class Comparison:
     ours: float
     reference: float
     dimension: str | None = None
+    #: where the reference comes from (a paper's table or equation), shown beside the name
+    source: str = ""
 
 
 def comparison_axes(
@@ -52,12 +53,11 @@ def comparison_axes(
         color=["tab:green" if abs(r - 1) < 0.01 else "tab:orange" for r in np.nan_to_num(ratios, nan=1)],
         height=0.6,
     )
-    ax.set_yticks(y, [pretty(r.name) for r in rows])
+    ax.set_yticks(y, [pretty(r.name) + (f"\n({r.source})" if r.source else "") for r in rows])
     for yi, r in zip(y, rows):
         f, unit = display_unit(r.dimension, [r.ours, r.reference])
         ax.annotate(
-            f"{ours_label} {number(r.ours * f)} · {reference_label} {number(r.reference * f)} "
-            f"{unit_text(unit)}".rstrip(),
+            f"{ours_label} {r.ours * f:.4g} · {reference_label} {r.reference * f:.4g} {unit_text(unit)}".rstrip(),
             (0, yi),
             xycoords=("axes fraction", "data"),
             xytext=(4, 9),

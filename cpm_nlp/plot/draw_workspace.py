@@ -51,26 +51,41 @@ def slice_lines(sl: BoundarySlice) -> list[np.ndarray]:
 
     if sl.lines is not None:
         return [np.asarray(line, dtype=float).reshape(-1, 2) for line in sl.lines]
-    raw = np.asarray(sl.inside)
-    level = 0.5 if raw.dtype == bool else 0.0
-    z = raw.astype(float)
-    finite = z[np.isfinite(z)]
-    if not finite.size:
+    field = slice_field(sl)
+    if field is None:
         return []
-    # a point that does not assemble (margin -inf or nan) is outside, below every finite margin
-    low = min(float(finite.min()), level) - (float(np.ptp(finite)) or 1.0)
-    z = np.where(np.isfinite(z), z, np.where(z == np.inf, float(finite.max()), low))
+    z, level = field
     if z.min() >= level or z.max() <= level:
         return []
     gen = contour_generator(np.asarray(sl.x, dtype=float), np.asarray(sl.y, dtype=float), z)
     return [np.asarray(line) for line in gen.lines(level)]
 
 
+def slice_field(sl: BoundarySlice) -> tuple[np.ndarray, float] | None:
+    """The slice's membership as a finite field on its grid and the level of its boundary
+    (above it: inside); None when no grid point has a finite margin."""
+    raw = np.asarray(sl.inside)
+    level = 0.5 if raw.dtype == bool else 0.0
+    z = raw.astype(float)
+    finite = z[np.isfinite(z)]
+    if not finite.size:
+        return None
+    # a point that does not assemble (margin -inf or nan) is outside, below every finite margin
+    low = min(float(finite.min()), level) - (float(np.ptp(finite)) or 1.0)
+    return np.where(np.isfinite(z), z, np.where(z == np.inf, float(finite.max()), low)), level
+
+
+def points_text(label: str, n: int) -> str:
+    """A point set's legend text saying what it counts: ``label`` with ``{n}`` filled in,
+    else "label: n points"."""
+    return label.format(n=n) if "{n}" in label else f"{label}: {n} points"
+
+
 def box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
 
 
-_BOX_FACES = ([0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5])
+BOX_FACES = ([0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5])
 BOX_EDGES = ((0, 1), (1, 3), (3, 2), (2, 0), (4, 5), (5, 7), (7, 6), (6, 4), (0, 4), (1, 5), (2, 6), (3, 7))
 #: colours of further boxes (a paper's formulation beside ours)
 OTHER_BOXES = ("tab:purple", "tab:orange", "tab:green")
@@ -119,9 +134,10 @@ def _hull_3d(ax: Any, sc: _Scene) -> None:
 
     H = sc.hull_pts * sc.f
     faces = ConvexHull(H).simplices
-    ax.add_collection3d(Poly3DCollection([H[fc] for fc in faces], facecolor="tab:blue", edgecolor="none", alpha=0.15))
+    hull = Poly3DCollection([H[fc] for fc in faces], facecolor="tab:blue", edgecolor="none", alpha=0.15)
+    hull.set_label(f"workspace: hull of {len(H)} vertices")
+    ax.add_collection3d(hull)
     ax.scatter(H[:, 0], H[:, 1], H[:, 2], color="tab:blue", s=12)
-    ax.plot([], [], color="tab:blue", lw=6, alpha=0.3, label=f"workspace: hull of {len(H)} vertices")
 
 
 def _slices_3d(ax: Any, sc: _Scene, label: str) -> None:
@@ -134,10 +150,8 @@ def _slices_3d(ax: Any, sc: _Scene, label: str) -> None:
             xyz = np.zeros((len(line), 3))
             xyz[:, i], xyz[:, j], xyz[:, k] = line[:, 0], line[:, 1], sl.at
             xyz = xyz * sc.f
-            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label=None if drawn else "_b")
+            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], color="k", lw=1.2, label="_b" if drawn else label)
             drawn = True
-    if drawn:
-        ax.plot([], [], color="k", lw=1.2, label=label)
 
 
 def _boxes_3d(ax: Any, sc: _Scene, cuboid_label: str) -> None:
@@ -147,16 +161,17 @@ def _boxes_3d(ax: Any, sc: _Scene, cuboid_label: str) -> None:
     if sc.B is not None:
         lo, hi = sc.B.min(axis=0), sc.B.max(axis=0)
         corners = box_corners(lo, hi)
-        ax.add_collection3d(
-            Poly3DCollection([corners[fc] for fc in _BOX_FACES], facecolor="tab:red", edgecolor="darkred", alpha=0.25)
+        faces = Poly3DCollection(
+            [corners[fc] for fc in BOX_FACES], facecolor="tab:red", edgecolor="darkred", alpha=0.25
         )
-        ax.plot([], [], color="tab:red", lw=6, alpha=0.4, label=f"{cuboid_label} ({_box_sizes(lo, hi, sc.scales)})")
+        faces.set_label(f"{cuboid_label} ({_box_sizes(lo, hi, sc.scales)})")
+        ax.add_collection3d(faces)
     for (olo, ohi, olabel), colour in zip(sc.others, OTHER_BOXES):
         lo, hi = np.minimum(olo, ohi) * sc.f, np.maximum(olo, ohi) * sc.f
         corners = box_corners(lo, hi)
-        for a, b in BOX_EDGES:
-            ax.plot(*corners[[a, b]].T, color=colour, lw=1.8, ls="--")
-        ax.plot([], [], color=colour, lw=1.8, ls="--", label=f"{olabel} ({_box_sizes(lo, hi, sc.scales)})")
+        label = f"{olabel} ({_box_sizes(lo, hi, sc.scales)})"
+        for n, (a, b) in enumerate(BOX_EDGES):
+            ax.plot(*corners[[a, b]].T, color=colour, lw=1.8, ls="--", label=label if n == 0 else "_edge")
 
 
 def _hull_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
@@ -171,20 +186,57 @@ def _hull_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
         a2.plot(H2[:, 0], H2[:, 1], "o", color="tab:blue")
 
 
+def section_label(sl: BoundarySlice) -> str:
+    """The legend text of the sections' shaded regions."""
+    return f"reachable region of each section (membership on a {len(sl.x)} × {len(sl.y)} grid)"
+
+
+def _slice_of(sc: _Scene, i: int, j: int) -> tuple[BoundarySlice, list] | None:
+    return next(((sl, lines) for sl, lines in sc.lines_by_slice if set(sl.axes) == {i, j}), None)
+
+
+def _fill_region(ax: Any, u: np.ndarray, v: np.ndarray, w: np.ndarray, level: float, label: str) -> None:
+    """The region where the field ``w`` (on the grid u, v) lies above ``level``, shaded:
+    patches (one legend entry, ``label``)."""
+    from contourpy import FillType, contour_generator
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path
+
+    gen = contour_generator(u, v, w, fill_type=FillType.OuterCode)
+    points, codes = gen.filled(level, max(float(w.max()), level) + 1.0)
+    for n, (pts, code) in enumerate(zip(points, codes)):
+        patch = PathPatch(Path(pts, code), facecolor="tab:blue", edgecolor="none", alpha=0.15, zorder=0.5)
+        patch.set_label(label if n == 0 else "_region")
+        ax.add_patch(patch)
+
+
 def _slices_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
-    """The slices in the plane of this projection, titled by where they cut."""
+    """The section of the workspace in the plane of axes i, j where a slice is given: its
+    reachable region shaded and its boundary, titled by where it cuts (the cloud's points,
+    off the plane, are not projected onto it: a section shows what lies in its plane);
+    without a slice, the projection of all points, titled so."""
     f = sc.f
-    for sl, lines in sc.lines_by_slice:
-        if set(sl.axes) != {i, j}:
-            continue
-        swap = sl.axes != (i, j)
-        for line in lines:
-            u, v = (line[:, 1], line[:, 0]) if swap else (line[:, 0], line[:, 1])
-            a2.plot(u * f[i], v * f[j], color="k", lw=1.2)
-        k = 3 - i - j
-        at = sl.at * f[k]
-        at = 0.0 if abs(at) < 1e-9 * max(np.ptp(sc.both[:, k] * f[k]), 1e-300) else at
-        a2.set_title(f"boundary at {pretty(sc.names[k])} = {number(at)} {sc.scales[k][1]}".rstrip(), fontsize="small")
+    found = _slice_of(sc, i, j)
+    if found is None:
+        if len(sc.P):
+            a2.scatter(sc.P[:, i], sc.P[:, j], s=sc.size, color="tab:blue", alpha=0.3, lw=0, label="_projection")
+            a2.set_title("projection of all points", fontsize="small")
+        return
+    sl, lines = found
+    swap = sl.axes != (i, j)
+    field = slice_field(sl)
+    if field is not None and field[0].max() > field[1]:
+        z, level = field
+        gx, gy = np.asarray(sl.x, dtype=float) * f[sl.axes[0]], np.asarray(sl.y, dtype=float) * f[sl.axes[1]]
+        u, v, w = (gy, gx, z.T) if swap else (gx, gy, z)
+        _fill_region(a2, u, v, w, level, section_label(sl))
+    for line in lines:
+        u, v = (line[:, 1], line[:, 0]) if swap else (line[:, 0], line[:, 1])
+        a2.plot(u * f[i], v * f[j], color="k", lw=1.2)
+    k = 3 - i - j
+    at = sl.at * f[k]
+    at = 0.0 if abs(at) < 1e-9 * max(np.ptp(sc.both[:, k] * f[k]), 1e-300) else at
+    a2.set_title(f"section at {pretty(sc.names[k])} = {number(at)} {sc.scales[k][1]}".rstrip(), fontsize="small")
 
 
 def _boxes_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
@@ -192,19 +244,20 @@ def _boxes_2d(a2: Any, sc: _Scene, i: int, j: int) -> None:
 
     if sc.B is not None:
         lo, hi = sc.B.min(axis=0), sc.B.max(axis=0)
-        a2.add_patch(Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor="tab:red", lw=2))
+        a2.add_patch(
+            Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor="tab:red", lw=2.6, zorder=4)
+        )
     for (olo, ohi, _), colour in zip(sc.others, OTHER_BOXES):
         lo, hi = np.minimum(olo, ohi) * sc.f, np.maximum(olo, ohi) * sc.f
         a2.add_patch(
-            Rectangle((lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor=colour, lw=1.8, ls="--")
+            Rectangle(
+                (lo[i], lo[j]), hi[i] - lo[i], hi[j] - lo[j], fill=False, edgecolor=colour, lw=1.6, ls="--", zorder=5
+            )
         )
 
 
 def _projection(a2: Any, sc: _Scene, i: int, j: int) -> None:
-    """The projection on the plane of axes i, j: points, hull, slices, boxes."""
-    P = sc.P
-    if len(P):
-        a2.scatter(P[:, i], P[:, j], s=sc.size, color="tab:blue", alpha=0.3, lw=0)
+    """The plane of axes i, j: the section there (or the projection of the points), hull, boxes."""
     if sc.hull_pts is not None:
         _hull_2d(a2, sc, i, j)
     _slices_2d(a2, sc, i, j)
@@ -213,6 +266,48 @@ def _projection(a2: Any, sc: _Scene, i: int, j: int) -> None:
     a2.set_ylabel(sc.labels[j])
     a2.grid(True, alpha=0.3)
     a2.autoscale_view()
+
+
+def _cloud_3d(fig: Any, ax: Any, sc: _Scene, label: str, colour_by_height: bool) -> Any:
+    """The cloud in the 3-D view (None without points): one colour, or coloured by its height
+    with a colour bar saying so, in the unit of that axis (an inset of the view: the figure's
+    axes stay the view and its sections)."""
+    P = sc.P
+    if not len(P):
+        return None
+    cloud = ax.scatter(
+        P[:, 0],
+        P[:, 1],
+        P[:, 2],
+        s=sc.size,
+        alpha=0.4,
+        depthshade=False,
+        label=label,
+        **({"c": P[:, 2], "cmap": "viridis"} if colour_by_height else {"color": "tab:blue"}),
+    )
+    if colour_by_height:
+        fig.colorbar(cloud, cax=ax.inset_axes((1.18, 0.2, 0.035, 0.6)), label=f"colour: {sc.labels[2]}")
+    return cloud
+
+
+def _figure_legend(fig: Any, cloud: Any, points_label: str) -> None:
+    """One legend entry per label, the 3-D view's first, then the sections'; a colour-mapped
+    cloud's swatch in the colour of a point drawn (the middle one by height)."""
+    handles: dict[str, Any] = {}
+    for a in fig.axes:
+        for h, lab in zip(*a.get_legend_handles_labels()):
+            if not lab.startswith("_"):
+                handles.setdefault(lab, h)
+    if not handles:
+        return
+    legend = fig.legend(
+        list(handles.values()), list(handles), loc="outside lower center", ncols=min(2, len(handles)), fontsize="small"
+    )
+    if cloud is not None and cloud.get_array() is not None and points_label in handles:
+        z = np.asarray(cloud.get_array())
+        swatch = legend.legend_handles[list(handles).index(points_label)]
+        swatch.set_array(None)  # one colour, not mapped again when drawn
+        swatch.set_facecolor(cloud.to_rgba(z[np.argsort(z)[len(z) // 2]], alpha=cloud.get_alpha()))
 
 
 def workspace_figure(
@@ -228,8 +323,10 @@ def workspace_figure(
     slices: Sequence[BoundarySlice] = (),
     hull: Any = None,
     slices_label: str = "workspace boundary (slices through the box centre)",
+    colour_by_height: bool = False,
 ) -> Any:
-    """A point cloud (N x 3, SI) in 3-D and its three projections, with an
+    """A point cloud (N x 3, SI) in 3-D and its three projections (``colour_by_height``: the
+    points coloured by their third coordinate, with a colour bar saying so), with an
     optional cuboid ``(lower corner, upper corner)`` drawn in, further
     ``boxes`` (lower, upper, label: e.g. a paper's formulation, dashed),
     boundary ``slices`` (the workspace's boundary in a plane through the box,
@@ -267,9 +364,7 @@ def workspace_figure(
     )
     fig = Figure(figsize=(11, 9), layout="constrained")
     ax = fig.add_subplot(2, 2, 1, projection="3d")
-    if len(P):
-        label = f"{points_label} ({len(P)})"
-        ax.scatter(P[:, 0], P[:, 1], P[:, 2], s=sc.size, c=P[:, 2], cmap="viridis", alpha=0.5, label=label)
+    cloud = _cloud_3d(fig, ax, sc, points_text(points_label, len(P)), colour_by_height)
     ax.set_xlabel(sc.labels[0])
     ax.set_ylabel(sc.labels[1])
     ax.set_zlabel(sc.labels[2])
@@ -278,11 +373,9 @@ def workspace_figure(
         _hull_3d(ax, sc)
     _slices_3d(ax, sc, slices_label)
     _boxes_3d(ax, sc, cuboid_label)
-    handles = [h for h, lab in zip(*ax.get_legend_handles_labels()) if not lab.startswith("_")]
-    if handles:
-        fig.legend(handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize="small")
     for n, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
         _projection(fig.add_subplot(2, 2, n + 2), sc, i, j)
+    _figure_legend(fig, cloud, points_text(points_label, len(P)))
     if title:
         fig.suptitle(title)
     return fig
@@ -331,7 +424,9 @@ def workspace_figure_2d(
     if len(pts):
         P = pts * f
         size = float(np.clip(3000 / max(len(P), 1), 2, 25))
-        ax.scatter(P[:, 0], P[:, 1], s=size, color="tab:blue", alpha=0.35, lw=0, label=f"{points_label} ({len(P)})")
+        ax.scatter(
+            P[:, 0], P[:, 1], s=size, color="tab:blue", alpha=0.35, lw=0, label=points_text(points_label, len(P))
+        )
     for n, line in enumerate(lines):
         ax.plot(line[:, 0] * f[0], line[:, 1] * f[1], color="k", lw=1.4, label="_" if n else boundary_label)
     if cor is not None:
@@ -361,7 +456,7 @@ def workspace_figure_2d(
             [h for h, _ in handles],
             [lab for _, lab in handles],
             loc="outside lower center",
-            ncols=min(2, len(handles)),
+            ncols=1 if max(len(lab) for _, lab in handles) > 55 else min(2, len(handles)),
             fontsize="small",
             title=wrap(note, 95) or None,
             title_fontsize="x-small",

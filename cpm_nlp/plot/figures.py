@@ -23,7 +23,8 @@ the built-in plot types read (SI values, units in the result):
 * ``map`` -- the kind's ``map_axes`` name (x, y, value): x and y: x and y
   lists and the value either a list of the same length or a matrix
   (rows y, columns x; ``null`` outside the design space); optional
-  ``in_region`` (same shape: outlined), ``<x>_best``/``<y>_best`` and
+  ``in_region`` (same shape: outlined; ``<value>_region``: the bound the value
+  reaches there, stated in the legend), ``<x>_best``/``<y>_best`` and
   ``<x>_design``/``<y>_design`` (marked), ``domain`` (vertices, outlined).
   A sweep maps a value over its two swept parameters.
 """

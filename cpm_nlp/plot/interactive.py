@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from .draw_mechanism import JOINT_NAME, PART_STYLE, Arrow
-from .draw_workspace import BOX_EDGES, OTHER_BOXES, BoundarySlice, box_corners, slice_lines
-from .style import display_unit
+from .draw_workspace import BOX_EDGES, BOX_FACES, OTHER_BOXES, BoundarySlice, box_corners, points_text, slice_lines
+from .style import axis_label, display_unit
 
 _PLOTLY_COLOURS = {
     "tab:blue": "#1f77b4",
@@ -44,7 +44,7 @@ def _colour(name: str) -> str:
 
 def _layout(fig: Any, title: str, labels: Sequence[str], aspect: str = "cube") -> None:
     fig.update_layout(
-        title={"text": title.replace("\n", "<br>"), "x": 0.5},
+        title={"text": _mathless(title).replace("\n", "<br>"), "x": 0.5},
         scene={
             "xaxis_title": labels[0],
             "yaxis_title": labels[1],
@@ -57,9 +57,30 @@ def _layout(fig: Any, title: str, labels: Sequence[str], aspect: str = "cube") -
     )
 
 
+def _greek(m: Any) -> str:
+    import unicodedata
+
+    try:
+        return unicodedata.lookup(f"GREEK SMALL LETTER {m.group(1).upper()}")
+    except KeyError:
+        return m.group(1)
+
+
 def _mathless(label: str) -> str:
-    """An axis label without Matplotlib's mathtext dollars (Plotly shows them literally)."""
-    return label.replace("$", "").replace("\\", "").replace("{", "").replace("}", "")
+    """A label without Matplotlib's mathtext (Plotly shows it literally): ``$\\psi$`` -> ψ."""
+    import re
+
+    label = re.sub(r"\\([A-Za-z]+)", _greek, label)
+    return label.replace("$", "").replace("{", "").replace("}", "")
+
+
+def _box_edges(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The twelve edges of a box as one polyline, NaN between edges (display units)."""
+    corners = box_corners(lo, hi)
+    xyz = []
+    for a, b in BOX_EDGES:
+        xyz += [corners[a], corners[b], [np.nan] * 3]
+    return np.array(xyz)
 
 
 def workspace_html(
@@ -74,6 +95,8 @@ def workspace_html(
     boxes: Sequence[tuple] = (),
     slices: Sequence[BoundarySlice] = (),
     hull: Any = None,
+    slices_label: str = "workspace boundary (slices through the box centre)",
+    colour_by_height: bool = False,
 ) -> Any:
     """The 3-D view of :func:`~cpm_nlp.plot.draw.workspace_figure` as a Plotly figure."""
     go = _go()
@@ -99,8 +122,16 @@ def workspace_html(
                 y=P[:, 1],
                 z=P[:, 2],
                 mode="markers",
-                marker={"size": 2, "color": P[:, 2], "colorscale": "Viridis", "opacity": 0.5},
-                name=f"{points_label} ({len(P)})",
+                marker={"size": 2, "color": _colour("tab:blue"), "opacity": 0.5}
+                if not colour_by_height
+                else {
+                    "size": 2,
+                    "color": P[:, 2],
+                    "colorscale": "Viridis",
+                    "opacity": 0.5,
+                    "colorbar": {"title": {"text": f"colour: {_mathless(axis_label(names[2], scales[2][1]))}"}},
+                },
+                name=points_text(points_label, len(P)),
             )
         )
     if hull is not None:
@@ -135,23 +166,49 @@ def workspace_html(
                     z=xyz[:, 2],
                     mode="lines",
                     line={"color": "black", "width": 3},
-                    name="workspace boundary (slices through the box centre)",
+                    name=slices_label,
                     legendgroup="boundary",
                     showlegend=first,
                 )
             )
             first = False
-    all_boxes = [] if cuboid is None else [(*np.asarray(cuboid, dtype=float).reshape(2, 3), cuboid_label, "#d62728")]
-    all_boxes += [(np.asarray(lo), np.asarray(hi), label, _colour(c)) for (lo, hi, label), c in zip(boxes, OTHER_BOXES)]
-    for lo, hi, label, colour in all_boxes:
-        corners = box_corners(np.minimum(lo, hi) * f, np.maximum(lo, hi) * f)
-        xyz = []
-        for a, b in BOX_EDGES:
-            xyz += [corners[a], corners[b], [np.nan] * 3]
-        xyz = np.array(xyz)
+    # the paper's boxes first, wide and dashed; ours last, over them: shaded, solid edges (issue 24:
+    # ours was hidden under an equal paper's box)
+    for (lo, hi, label), colour in zip(boxes, OTHER_BOXES):
+        xyz = _box_edges(np.minimum(lo, hi) * f, np.maximum(lo, hi) * f)
+        line = {"color": _colour(colour), "width": 10, "dash": "dash"}
+        fig.add_trace(go.Scatter3d(x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="lines", line=line, name=label))
+    if cuboid is not None:
+        lo, hi = np.asarray(cuboid, dtype=float).reshape(2, 3) * f
+        corners = box_corners(np.minimum(lo, hi), np.maximum(lo, hi))
+        tri = np.array(
+            [[a, b, c] for face in BOX_FACES for a, b, c in ((face[0], face[1], face[2]), (face[0], face[2], face[3]))]
+        )
+        fig.add_trace(
+            go.Mesh3d(
+                x=corners[:, 0],
+                y=corners[:, 1],
+                z=corners[:, 2],
+                i=tri[:, 0],
+                j=tri[:, 1],
+                k=tri[:, 2],
+                color=_colour("tab:red"),
+                opacity=0.25,
+                name=cuboid_label,
+                legendgroup="cuboid",
+                showlegend=False,
+            )
+        )
+        xyz = _box_edges(np.minimum(lo, hi), np.maximum(lo, hi))
         fig.add_trace(
             go.Scatter3d(
-                x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="lines", line={"color": colour, "width": 5}, name=label
+                x=xyz[:, 0],
+                y=xyz[:, 1],
+                z=xyz[:, 2],
+                mode="lines",
+                line={"color": _colour("tab:red"), "width": 4},
+                name=cuboid_label,
+                legendgroup="cuboid",
             )
         )
     labels = [_mathless(f"{n} ({u})" if u else n) for n, (_, u) in zip(names, scales)]

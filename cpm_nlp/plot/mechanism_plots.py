@@ -14,7 +14,7 @@ from ..core.errors import InputError
 from ..core.kinematics import jacobians
 from .draw_mechanism import jacobian_figure, mechanism_figure
 from .interactive import mechanism_html
-from .pose import drawings, geometry_of, model_for, pose_title, single_pose, span_of
+from .pose import drawings, geometry_of, model_for, model_title, pose_title, single_pose, span_of
 from .results import NotApplicable, PlotOptions, ResultData, result_mechanism, result_model
 from .style import display_unit
 
@@ -27,7 +27,7 @@ def mechanism_plot(data: ResultData, options: PlotOptions) -> Any:
     x, q = single_pose(data, model)
     pose, home, k = drawings(model, x, q)
     draw = mechanism_html if options.interactive else mechanism_figure
-    return draw(pose, home=home, title=pose_title(model, x, k, span_of(home)) + f" ({data.problem})", note=pose.note)
+    return draw(pose, home=home, title=pose_title(model, x, k, span_of(home), data.problem), note=pose.note)
 
 
 def design_plot(data: ResultData, options: PlotOptions) -> Any:
@@ -54,10 +54,11 @@ def design_plot(data: ResultData, options: PlotOptions) -> Any:
     kinds = {o.name: o.kind for o in mech.parameters}
     shown = [(k, v, *display_unit(kinds[k], [v])) for k, v in found.items()]
     text = ", ".join(f"{k} = {v * f:.4g} {unit}".rstrip() for k, v, f, unit in shown)
-    title = f"Designed {name} at home: {text} ({data.problem})"
-    note = "; ".join(t for t in (pose.note, "dashed: the design in the file" if home is not None else "") if t)
-    draw = mechanism_html if options.interactive else mechanism_figure
-    return draw(pose, home=home, title=title, note=note)
+    title = f"{model_title(model)}\ndesigned by {data.problem.replace('_', ' ')}, at home: {text}"
+    if options.interactive:
+        note = "; ".join(t for t in (pose.note, "dashed: the design in the file" if home is not None else "") if t)
+        return mechanism_html(pose, home=home, title=title, note=note)
+    return mechanism_figure(pose, home=home, title=title, note=pose.note, home_label="the design in the file (at home)")
 
 
 # -- jacobian --------------------------------------------------------------------------------------------
@@ -104,10 +105,10 @@ def jacobian_plot(data: ResultData, options: PlotOptions) -> Any:
     pose, home, k = drawings(model, x, q)
     if options.interactive:
         return mechanism_html(
-            pose, home=home, title=pose_title(model, x, k, span_of(home)) + f" ({data.problem})", note=pose.note
+            pose, home=home, title=pose_title(model, x, k, span_of(home), data.problem), note=pose.note
         )
     got = _conditioning_slice(model, x)
     panels = [("cond", 2), ("manipulability", 3)] if got is not None else []
     fig = jacobian_figure(pose, home, got, panels, data.values)
-    fig.suptitle(pose_title(model, x, k, span_of(home)) + f" ({data.problem})")
+    fig.suptitle(pose_title(model, x, k, span_of(home), data.problem))
     return fig

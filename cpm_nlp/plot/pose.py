@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.errors import InputError
 from .results import NotApplicable, ResultData, result_mechanism, result_model
-from .style import display_unit
+from .style import display_unit, pretty
 
 # -- the mechanism ------------------------------------------------------------------------------------
 
@@ -93,11 +93,20 @@ def span_of(drawing: Any) -> float:
 TITLE_NOISE = 1e-9
 
 
-def pose_title(model: Any, x: np.ndarray, k: float, size: float = 0.0) -> str:
-    """ "five_bar at x = 0 mm, y = 203.8 mm": the task coordinates of the pose, each in its
-    own unit; a value below :data:`TITLE_NOISE` of the mechanism's ``size`` (SI: the span
-    of its drawing; lengths) or of a degree (angles) is rounding noise, shown as 0 in the
-    unit of the size (not "x = -7.939e-12 nm")."""
+def model_title(model: Any) -> str:
+    """The title of the model's mechanism ("3-PRS compliant stage (Ruiz et al.)"), else its name
+    (:func:`.results.mechanism_title` gives it from a result)."""
+    mech = model.mechanism
+    return str(mech.title) if mech is not None and mech.title else str(model.name)
+
+
+def pose_title(model: Any, x: np.ndarray, k: float, size: float = 0.0, how: str = "") -> str:
+    """The mechanism's title over its pose, e.g. "planar five-bar linkage (2-RRR), elbows out" /
+    "forward kinematics: x = 0 mm, y = 203.8 mm": the task coordinates of the pose (symbols, each
+    value in its own unit) after ``how`` the pose was found (a problem kind, "_" read as " ").  A
+    value below :data:`TITLE_NOISE` of the mechanism's ``size`` (SI: the span of its drawing;
+    lengths) or of a degree (angles) is rounding noise, shown as 0 in the unit of the size (not
+    "x = -7.939e-12 nm")."""
     c = model.closure
     lengths = [abs(x[i]) for i in c.task_index if c.x[i].kind == "length"]
     size = max([size, *lengths]) if lengths or size else 0.0
@@ -107,7 +116,8 @@ def pose_title(model: Any, x: np.ndarray, k: float, size: float = 0.0) -> str:
         scale = size if kind == "length" else math.radians(1.0) if kind == "angle" else 0.0
         v = 0.0 if abs(x[i]) <= TITLE_NOISE * scale else x[i]
         f, unit = display_unit(kind, [scale] if v == 0.0 and kind == "length" else [v])
-        parts.append(f"{c.x[i].name} = {v * f:.4g} {unit}".rstrip())
+        parts.append(f"{pretty(c.x[i].name)} = {v * f:.4g} {unit}".rstrip())
     lines = [", ".join(parts[n : n + 3]) for n in range(0, len(parts), 3)]  # three coordinates a line
-    text = f"{model.name} at " + ",\n".join(lines)
+    head = f"{how.replace('_', ' ')}: " if how else "pose: "
+    text = model_title(model) + "\n" + head + ",\n".join(lines)
     return text + (f"\n(displacements from home drawn ×{k:g})" if k != 1.0 else "")

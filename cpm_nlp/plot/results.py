@@ -78,6 +78,9 @@ class ResultData:
     warnings: list[Any] = field(default_factory=list)
     #: where the mechanism came from, as the result records it (``origin``; None in older results)
     origin: Any = None
+    #: the problem solved, when at hand (solve --plot): lets a plot solve it along a motion
+    #: (the forces of one pose drawn as a curve from home through it)
+    solved_problem: Any = None
 
     @property
     def kind(self) -> str:
@@ -112,6 +115,21 @@ def from_result(result: Any, source: str = "") -> ResultData:
         warnings=[ResultWarning.from_dict(w) for w in d.get("warnings") or [] if isinstance(d.get("warnings"), list)],
         origin=d.get("origin"),
     )
+
+
+def from_solved(result: Any, problem: Any) -> ResultData:
+    """A result with the problem that gave it (``cpm-nlp solve FILE --plot``): the model
+    at hand, the published figures of its ``reproduce`` section (drawn beside the values)."""
+    data = from_result(result)
+    data.live = problem.model
+    data.solved_problem = problem
+    if problem.reproduce is not None:
+        data.published = [
+            (row.value, row.published, f"published ({row.source})")
+            for row in problem.reproduce.rows
+            if row.value and row.published is not None
+        ]
+    return data
 
 
 def from_table(table: Any) -> ResultData:
@@ -175,13 +193,25 @@ def result_mechanism(data: ResultData) -> Any:
     return recorded_mechanism(data.origin, name, data.source or None)
 
 
-def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None) -> Any:
+def mechanism_title(data: ResultData) -> str:
+    """The mechanism's title for a figure ("3-PRS compliant stage (Ruiz et al.)"), else its type name."""
+    try:
+        return str(result_mechanism(data).title)
+    except (InputError, AttributeError):
+        return str(data.model.get("type") or data.problem)
+
+
+def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None, with_limits: bool = False) -> Any:
     """A model of the result's mechanism (:func:`result_mechanism`) from ``parameters``
-    (default: the ones the result records), without registering it."""
+    (default: the ones the result records), without registering it; ``with_limits``: with the
+    joint limits the result records too (its workspace is then the one solved)."""
     mech = result_mechanism(data)
     if parameters is None:
         parameters = {o.name: data.model[o.name] for o in mech.parameters if data.model.get(o.name) is not None}
-    return recorded_model(mech, parameters)
+    limits = None
+    if with_limits:
+        limits = {o.name: data.model[o.name] for o in mech.limits if data.model.get(o.name) is not None}
+    return recorded_model(mech, parameters, limits=limits)
 
 
 def value_list(data: ResultData, name: str) -> list | None:

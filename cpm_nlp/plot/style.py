@@ -157,6 +157,7 @@ def legend_below(fig: Any, ax: Any, note: str = "") -> None:
     note = wrap(note, 140) if len(note) > 140 else note  # a long note in lines, not past the figure's edges
     handles, labels = ax.get_legend_handles_labels()
     keep = [(h, lab) for h, lab in zip(handles, labels) if not lab.startswith("_")]
+    keep = [(h, lab) for n, (h, lab) in enumerate(keep) if lab not in [k[1] for k in keep[:n]]]  # each label once
     if keep:
         fig.legend(
             [h for h, _ in keep],

@@ -13,7 +13,7 @@ from ..problems.registry import kind_names, problem_kind
 from .draw_map import design_map_figure
 from .draw_panels import Panel, panels_figure
 from .results import OUTSIDE, NotApplicable, PlotOptions, ResultData, dimension_of, value_list
-from .style import pretty
+from .style import pretty, value_text
 
 # -- map ---------------------------------------------------------------------------------------------
 
@@ -99,11 +99,20 @@ def map_plot(data: ResultData, options: PlotOptions) -> Any:
         ),
         outside=outside,
         region=region if isinstance(region, list) and len(region) == len(z) else None,
+        region_label=_region_label(zk, v.get(zk + "_region")),
         domain=v.get("domain"),
         best=options.best,
         marks=marks,
         title=f"{data.problem}, {data.model.get('type') or ''}",
     )
+
+
+def _region_label(name: str, bound: Any) -> str:
+    """The legend of a map's region: the bound the result gives (``<value>_region``, the
+    region being where the value reaches it), e.g. "optimum region: η ≥ 0.99"."""
+    if isinstance(bound, (int, float)) and not isinstance(bound, bool):
+        return f"optimum region: {pretty(name)} ≥ {value_text(bound)}"
+    return "optimum region"
 
 
 def _sweep_map(data: ResultData, options: PlotOptions) -> Any:

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.workspace import membership, probe_region, sample_workspace
+from ..core.errors import InputError
 from ..kinds.workspace import CuboidExtras
 from .draw_workspace import BoundarySlice, slice_lines, workspace_figure_2d
 from .draw_workspace import workspace_figure as workspace_figure_png
@@ -20,10 +21,12 @@ from .results import (
     PlotOptions,
     ResultData,
     dimension_of,
+    mechanism_title,
     pose_name,
     require_lists,
     result_closure,
     result_mechanism,
+    result_model,
     value_list,
 )
 from .style import as_floats
@@ -110,8 +113,10 @@ def _task_workspace_plot(data: ResultData, closure: Any, workspace_figure: Any, 
     if all(value_list(data, f"cloud_{t}") is not None for t in task):  # the workspace kind
         pts = np.array([as_floats(v[f"cloud_{t}"]) for t in task]).T
         label = "reachable points (seeded sample)"
-        if data.live is not None and all(isinstance(v.get(f"{t}_range"), list) for t in task):
-            return _cloud_with_boundary(data, pts, task, kinds, workspace_figure, title)
+        if all(isinstance(v.get(f"{t}_range"), list) for t in task):
+            model, rebuilt = _model_for_boundary(data, pts)
+            if model is not None:
+                return _cloud_with_boundary(data, model, rebuilt, pts, task, kinds, workspace_figure, title)
     elif cuboid is not None:  # inscribed_cuboid: the workspace around it from the model, if at hand
         return _cuboid_plot(data, cuboid, (task, kinds, box_label, hull), workspace_figure, title)
     else:  # a batch of poses, one sweep point per pose
@@ -127,17 +132,42 @@ def _task_workspace_plot(data: ResultData, closure: Any, workspace_figure: Any, 
     )
 
 
+def _model_for_boundary(data: ResultData, pts: np.ndarray) -> tuple[Any, bool]:
+    """(the model whose boundary to draw, whether it was rebuilt): the model solved when at hand,
+    else one rebuilt from the parameters and joint limits the result records, used only if every
+    point of the result's cloud is inside it (else None: no boundary rather than another one)."""
+    if data.live is not None:
+        return data.live, False
+    try:
+        model = result_model(data, with_limits=True)
+    except InputError:
+        return None, False
+    inside = np.asarray(membership(model, pts[np.all(np.isfinite(pts), axis=1)]).inside, dtype=bool)
+    return (model, True) if inside.all() else (None, False)
+
+
 def _cloud_with_boundary(
-    data: ResultData, pts: np.ndarray, task: list[str], kinds: list[str], workspace_figure: Any, title: str
+    data: ResultData,
+    model: Any,
+    rebuilt: bool,
+    pts: np.ndarray,
+    task: list[str],
+    kinds: list[str],
+    workspace_figure: Any,
+    title: str,
 ) -> Any:
-    """The workspace kind's cloud with the boundary in the planes through the home pose."""
+    """The workspace kind's cloud with the boundary of ``model`` in the planes through the home
+    pose (``rebuilt``: a model rebuilt from the result, which the legend says)."""
     v = data.values
     lo = np.array([v[f"{t}_range"][0] for t in task], dtype=float)
     hi = np.array([v[f"{t}_range"][1] for t in task], dtype=float)
-    centre = np.clip(data.live.task_of(data.live.x_home), lo, hi)
-    slices = _boundary_slices(data.live, lo, hi, centre)
-    if data.live.closure.ik is not None:  # membership is cheap: each vertex bisected onto the boundary
-        slices = [replace(sl, lines=_refined_boundary(data.live, sl, centre)) for sl in slices]
+    centre = np.clip(model.task_of(model.x_home), lo, hi)
+    slices = _boundary_slices(model, lo, hi, centre)
+    if model.closure.ik is not None:  # membership is cheap: each vertex bisected onto the boundary
+        slices = [replace(sl, lines=_refined_boundary(model, sl, centre)) for sl in slices]
+    label = "workspace boundary (slices through the home pose)"
+    if rebuilt:
+        label = "workspace boundary (of the model rebuilt from the result)"
     return workspace_figure(
         pts,
         names=task,
@@ -145,17 +175,22 @@ def _cloud_with_boundary(
         title=title,
         points_label="reachable points (seeded sample)",
         slices=slices,
-        slices_label="workspace boundary (slices through the home pose)",
+        slices_label=label,
+        colour_by_height=True,
     )
 
 
 def _cuboid_plot(data: ResultData, cuboid: tuple, axes: tuple, workspace_figure: Any, title: str) -> Any:
     """A cuboid (and the paper's box), with the workspace around it where the model is at hand."""
     task, kinds, box_label, hull = axes
+    if data.problem == "inscribed_cuboid":
+        title = (
+            f"Maximal inscribed cuboid: {mechanism_title(data)}" + title.partition("\n")[1] + title.partition("\n")[2]
+        )
     pts, label, slices = np.zeros((0, 3)), "", ()
     if data.live is not None and data.problem == "inscribed_cuboid":
         pts, slices = _workspace_around(data.live, cuboid)
-        label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+        label = f"reachable points: {{n}} of {CLOUD_SAMPLE} drawn uniformly (seed 0) in a box around the cuboid"
     elif data.problem == "inscribed_cuboid":
         title += "\n(the cuboid alone: `cpm-nlp solve FILE --plot` draws the workspace around it)"
     return workspace_figure(
@@ -410,7 +445,7 @@ def _planar_rectangle_plot(data: ResultData, cuboid: tuple, common: dict) -> Any
         pts = sample_workspace(data.live, CLOUD_SAMPLE, 0, (lo, hi))[0]
         slices = _boundary_slices(data.live, lo, hi, centre, PLANAR_GRID)
         outline = [line for sl in slices for line in _refined_boundary(data.live, sl, centre)]
-        label = f"reachable points (sample of {CLOUD_SAMPLE}, seed 0)"
+        label = f"reachable points: {{n}} of {CLOUD_SAMPLE} drawn uniformly (seed 0) in a box around the rectangle"
     else:
         common = {
             **common,

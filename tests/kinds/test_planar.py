@@ -234,8 +234,9 @@ def test_the_pose_title_has_no_rounding_noise():
     pose, home, k = plot_pose.drawings(model, x, model.q_home)
     assert k == 1.0  # at home: nothing to exaggerate
     title = plot_pose.pose_title(model, x, k, plot_pose.span_of(home))
-    assert title.startswith("five_bar at x = 0 mm, y = 198.4 mm"), title
-    assert "e-" not in title and "nm" not in title
+    assert title.startswith("planar five-bar linkage (2-RRR), elbows out\npose: $x$ = 0 mm, $y$ = 198.4 mm"), title
+    pose_line = title.split("\n")[1]  # the mechanism's title over it ("five-bar" has its own "e-")
+    assert "e-" not in pose_line and "nm" not in pose_line
 
 
 # -- six real assembly modes ----------------------------------------------------------------------

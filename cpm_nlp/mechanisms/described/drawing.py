@@ -67,15 +67,17 @@ def build_drawing(values: Any, layout: Layout, planar: bool) -> Drawing:
     pts: dict[str, np.ndarray] = {}
     joints: dict[str, str] = {}
     segments: list[tuple[str, str, str]] = []
-    first, last = [], []
+    first, last, driven = [], [], []
     col = 0
     for leg, legjoints in layout:
         names = []
-        for n, (letter, _actuated, _slides) in enumerate(legjoints):
+        for n, (letter, is_actuated, _slides) in enumerate(legjoints):
             name = f"{leg}_{n + 1}"
             pts[name] = V[:, col].copy()
             joints[name] = letter
             names.append(name)
+            if is_actuated:
+                driven.append(name)
             col += 1
         for n in range(len(names) - 1):
             actuated = legjoints[n][1]
@@ -98,6 +100,7 @@ def build_drawing(values: Any, layout: Layout, planar: bool) -> Drawing:
         segments=tuple(base_segments) + tuple(segments) + tuple(plat_segments),
         faces=tuple(base_faces) + tuple(plat_faces),
         joints=joints,
+        actuated=tuple(driven),
         note=note,
     )
 
@@ -126,6 +129,35 @@ def fixed_links(layout: Layout) -> list[tuple[str, str]]:
     return out
 
 
+def _named_point(g: Any) -> bool:
+    """Whether a graph joint sits at a named point of its bodies (``at: C``), not at coordinates."""
+    return isinstance(g.spec.at, str) and g.spec.at.isidentifier()
+
+
+def _graph_joints(gen: Any, layout: list) -> tuple[dict[str, str], list[tuple[str, str]], list[str]]:
+    """A graph's joints as drawn: the letter at each drawn point, the strokes of the actuated P
+    joints (from their point on the proximal body to the distal one's) and the actuated points.
+    A joint is marked at its point on its distal body: a point name on several bodies is drawn
+    once where a joint keeps them together, primed across a P joint (A, A', A''); where several
+    joints share a point, the actuated joint's letter marks it."""
+    drawn = {(body, name.rstrip("'")): name for body, name in layout}
+    named = [(g, drawn.get((g.b, g.spec.at), g.spec.at) if _named_point(g) else g.name) for g in gen.gjoints]
+    named.sort(key=lambda gk: gk[0].spec.actuated is not None)
+    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type not in ("distance", "pose")}
+    strokes = [
+        (drawn.get((g.a, g.spec.at), g.spec.at), key)
+        for g, key in named
+        if g.spec.actuated is not None and g.type == "P" and _named_point(g)
+    ]
+    driven = [key for g, key in named if g.spec.actuated is not None and g.type not in ("distance", "pose")]
+    return letters, strokes, driven
+
+
+def _strokes(pts: dict, strokes: list[tuple[str, str]], tol: float) -> list[tuple[str, str, str]]:
+    """The actuator segments of actuated P joints: each stroke from where it starts (none at home)."""
+    return [(a, b, "actuator") for a, b in strokes if a in pts and b in pts and np.linalg.norm(pts[a] - pts[b]) > tol]
+
+
 def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any], Drawing]:
     """The ``geometry`` capability of a graph (``gen``: its :class:`~.graph.GraphGenerator`; ``fn``:
     its ``drawing_points`` of (x, q, p), ``layout`` the body and name of each point): every body's
@@ -134,8 +166,7 @@ def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any],
     d = gen.d
     ground, platform = gen.ground, gen.platform_body
     actuated = {g.b if not g.reversed else g.a for g in gen.gjoints if g.tree and g.spec.actuated is not None}
-    named = [(g, g.spec.at if isinstance(g.spec.at, str) and g.spec.at.isidentifier() else g.name) for g in gen.gjoints]
-    letters = {key: JOINT_TYPES[g.type].letter for g, key in named if g.type not in ("distance", "pose")}
+    letters, strokes, driven = _graph_joints(gen, layout)
     ends = [(g.spec.at, g.spec.to) for g in gen.gjoints if g.type == "distance"]
 
     def rods(pts: dict) -> list[tuple[str, str, str]]:
@@ -171,7 +202,7 @@ def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any],
                 faces.append((part, tuple(ring)))
             elif len(ring) == 2:
                 segments.append((ring[0], ring[1], part))
-        segments += rods(pts)
+        segments += rods(pts) + _strokes(pts, strokes, 1e-9 * span)
         note = "bodies as straight links (two points) or polygons (three or more) through their points"
         if d.platform.planar:
             note += "; a planar mechanism, drawn in its plane z = 0"
@@ -180,6 +211,7 @@ def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any],
             segments=tuple(segments),
             faces=tuple(faces),
             joints={n: letter for n, letter in letters.items() if n in pts},
+            actuated=tuple(dict.fromkeys(n for n in driven if n in pts and n in letters)),
             note=note,
         )
 

@@ -24,7 +24,7 @@ def twists_plot(data: ResultData, options: PlotOptions) -> Any:
 
     from ...plot.draw_mechanism import Arrow, mechanism_figure
     from ...plot.interactive import mechanism_html
-    from ...plot.pose import geometry_of, model_for
+    from ...plot.pose import geometry_of, model_for, model_title
     from ...plot.results import NotApplicable
 
     T = data.values.get("T")
@@ -60,7 +60,7 @@ def twists_plot(data: ResultData, options: PlotOptions) -> Any:
     return draw(
         pose,
         arrows=arrows,
-        title=f"Displacement twists ({data.model.get('type')}, {data.problem}), at the reference point",
+        title=f"{model_title(model)}\ndisplacement twists of the platform, at the reference point",
         note=_note(data),
     )
 

@@ -63,6 +63,7 @@ MAP_OUTPUTS = _declare(
         "eta_worst": "dimensionless",
         "points_inside": "dimensionless",
         "region_fraction": "dimensionless",
+        "eta_region": "dimensionless",  # the bound of in_region, as the problem gave it
         **DESIGN_DIMENSIONS,
         "design_in_region": "bool",
     },
@@ -127,6 +128,7 @@ class TransmissionMap(RprKind):
                 "eta_worst": float(np.nanmin(E)),
                 "points_inside": int(inside.sum()),
                 "region_fraction": float(region[inside].mean()),
+                "eta_region": float(inputs["eta_region"]),  # the bound of in_region (a map states it)
             }
         )
         design = _design_values(model, mode)
