@@ -398,7 +398,7 @@ def test_interactive_html_renders_in_a_headless_browser(tmp_path, cli):
     assert coloured > 0.001, coloured
     # a workspace figure too (its boxes drawn as coloured lines)
     fig = synthetic_workspace_html()
-    assert {t.name for t in fig.data} >= {"maximal inscribed cuboid", "printed formulation"}
+    assert {t.name.split(" (")[0] for t in fig.data} >= {"maximal inscribed cuboid", "printed formulation"}
     page = tmp_path / "ws.html"
     save(fig, page)
     rgb = _screenshot(exe, page, tmp_path)
