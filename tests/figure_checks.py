@@ -90,15 +90,21 @@ def assert_labels_apart(fig, slack=1.0):
                 )
 
 
+#: two texts may share this many square pixels (anti-aliased edges of neighbouring glyphs)
+OVERLAP_PIXELS = 4.0
+
+
 def assert_figure_readable(fig):
     """Every title, label and legend text of a Matplotlib figure lies inside the
-    figure (nothing clipped at its edges), and no legend holds a template placeholder."""
+    figure (nothing clipped at its edges), no two of them overlap, and no legend
+    holds a template placeholder."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     canvas = FigureCanvasAgg(fig)
     canvas.draw()
     renderer = canvas.get_renderer()
     width, height = fig.bbox.width, fig.bbox.height
+    boxes = []
     for t in _labels(fig):
         if t is None or not t.get_visible() or not t.get_text().strip():
             continue
@@ -106,6 +112,11 @@ def assert_figure_readable(fig):
         assert box.x0 >= -1 and box.y0 >= -1 and box.x1 <= width + 1 and box.y1 <= height + 1, (
             f"text {t.get_text()!r} is clipped: {box} outside the figure {width} x {height}"
         )
+        boxes.append((t, box))
+    for k, (t, a) in enumerate(boxes):
+        for u, b in boxes[k + 1 :]:
+            shared = max(0.0, min(a.x1, b.x1) - max(a.x0, b.x0)) * max(0.0, min(a.y1, b.y1) - max(a.y0, b.y0))
+            assert shared <= OVERLAP_PIXELS, f"texts {t.get_text()!r} and {u.get_text()!r} overlap ({shared:.0f} px²)"
     legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
     for legend in legends:
         for t in legend.get_texts():

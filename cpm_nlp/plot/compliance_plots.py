@@ -164,7 +164,8 @@ def _along(data: ResultData, ray: _Ray) -> tuple[dict[str, Any], str]:
     problem = data.solved_problem
     scale = data.values.get("scale_at_allowable")
     top = 1.15 * max(1.0, float(ray.scales.max()), float(scale) if isinstance(scale, (int, float)) else 0.0)
-    lams = np.unique(np.r_[np.linspace(0.0, top, MOTION_SAMPLES), ray.scales])
+    bottom = 1.15 * min(0.0, float(ray.scales.min()))  # poses on both sides of home: the curve through both
+    lams = np.unique(np.r_[np.linspace(bottom, top, MOTION_SAMPLES), 0.0, ray.scales])
     inputs = dict(problem.inputs)
     for k, h, e in zip(ray.keys, ray.home, ray.end):
         inputs[k] = [float(h + lam * (e - h)) for lam in lams]

@@ -164,8 +164,8 @@ def ellipsoid_figure(
     if equal:  # a circle or a sphere in those axes: the directions drawn are one choice of many
         pairs = "; ".join(f"axes {k + 1} and {k + 2} equal: any direction in their plane is principal" for k in equal)
         heading += "\n" + pairs
-    # 3-D: in the view's empty top corner; 2-D: below the axes (inside, it would cover the ellipse)
-    where = {"loc": "upper left"} if n == 3 else {"loc": "upper center", "bbox_to_anchor": (0.5, -0.12)}
+    # 3-D: in the view's empty top corner; 2-D: beside the axes (inside, it would cover the ellipse)
+    where = {"loc": "upper left"} if n == 3 else {"loc": "upper left", "bbox_to_anchor": (1.02, 1.0)}
     ax.legend(fontsize="x-small", title=heading, title_fontsize="x-small", **where)
     if title:
         fig.suptitle(title)

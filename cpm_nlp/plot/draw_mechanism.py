@@ -552,6 +552,7 @@ def jacobian_figure(pose: Any, home: Any, got: Any, panels: Sequence[tuple[str, 
     is no slice."""
     Figure = figure_class()
     fig = Figure(figsize=(15, 5.2), layout="constrained")
+    fig.get_layout_engine().set(wspace=0.12)  # the 3-D view's z label reaches past its axes: room beside it
     ax = mechanism_axes(fig, (1, 3, 1), pose, home=home)
     legend_below(fig, ax, pose.note)
     if got is None:

@@ -91,7 +91,7 @@ BOX_EDGES = ((0, 1), (1, 3), (3, 2), (2, 0), (4, 5), (5, 7), (7, 6), (6, 4), (0,
 OTHER_BOXES = ("tab:purple", "tab:orange", "tab:green")
 
 
-def _box_sizes(lo: np.ndarray, hi: np.ndarray, scales: Sequence[tuple[float, str]]) -> str:
+def box_sizes(lo: np.ndarray, hi: np.ndarray, scales: Sequence[tuple[float, str]]) -> str:
     units = {s[1] for s in scales}
     if len(units) == 1:
         return " × ".join(number(d) for d in hi - lo) + f" {units.pop()}".rstrip()
@@ -164,12 +164,12 @@ def _boxes_3d(ax: Any, sc: _Scene, cuboid_label: str) -> None:
         faces = Poly3DCollection(
             [corners[fc] for fc in BOX_FACES], facecolor="tab:red", edgecolor="darkred", alpha=0.25
         )
-        faces.set_label(f"{cuboid_label} ({_box_sizes(lo, hi, sc.scales)})")
+        faces.set_label(f"{cuboid_label} ({box_sizes(lo, hi, sc.scales)})")
         ax.add_collection3d(faces)
     for (olo, ohi, olabel), colour in zip(sc.others, OTHER_BOXES):
         lo, hi = np.minimum(olo, ohi) * sc.f, np.maximum(olo, ohi) * sc.f
         corners = box_corners(lo, hi)
-        label = f"{olabel} ({_box_sizes(lo, hi, sc.scales)})"
+        label = f"{olabel} ({box_sizes(lo, hi, sc.scales)})"
         for n, (a, b) in enumerate(BOX_EDGES):
             ax.plot(*corners[[a, b]].T, color=colour, lw=1.8, ls="--", label=label if n == 0 else "_edge")
 
@@ -441,7 +441,7 @@ def workspace_figure_2d(
                 fill=False,
                 edgecolor="tab:red",
                 lw=2,
-                label=f"{cuboid_label} ({_box_sizes(lo, hi, scales)})",
+                label=f"{cuboid_label} ({box_sizes(lo, hi, scales)})",
             )
         )
     ax.set_xlabel(axis_label(names[0], scales[0][1]))

@@ -14,7 +14,16 @@ from typing import Any
 import numpy as np
 
 from .draw_mechanism import JOINT_NAME, PART_STYLE, Arrow
-from .draw_workspace import BOX_EDGES, BOX_FACES, OTHER_BOXES, BoundarySlice, box_corners, points_text, slice_lines
+from .draw_workspace import (
+    BOX_EDGES,
+    BOX_FACES,
+    OTHER_BOXES,
+    BoundarySlice,
+    box_corners,
+    box_sizes,
+    points_text,
+    slice_lines,
+)
 from .style import axis_label, display_unit
 
 _PLOTLY_COLOURS = {
@@ -175,11 +184,15 @@ def workspace_html(
     # the paper's boxes first, wide and dashed; ours last, over them: shaded, solid edges (issue 24:
     # ours was hidden under an equal paper's box)
     for (lo, hi, label), colour in zip(boxes, OTHER_BOXES):
-        xyz = _box_edges(np.minimum(lo, hi) * f, np.maximum(lo, hi) * f)
+        lo, hi = np.minimum(lo, hi) * f, np.maximum(lo, hi) * f
+        xyz = _box_edges(lo, hi)
         line = {"color": _colour(colour), "width": 10, "dash": "dash"}
-        fig.add_trace(go.Scatter3d(x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="lines", line=line, name=label))
+        name = f"{label} ({box_sizes(lo, hi, scales)})"
+        fig.add_trace(go.Scatter3d(x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="lines", line=line, name=name))
     if cuboid is not None:
         lo, hi = np.asarray(cuboid, dtype=float).reshape(2, 3) * f
+        lo, hi = np.minimum(lo, hi), np.maximum(lo, hi)
+        cuboid_label = f"{cuboid_label} ({box_sizes(lo, hi, scales)})"
         corners = box_corners(np.minimum(lo, hi), np.maximum(lo, hi))
         tri = np.array(
             [[a, b, c] for face in BOX_FACES for a, b, c in ((face[0], face[1], face[2]), (face[0], face[2], face[3]))]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.figure_checks import assert_legend_matches_artists
+from tests.figure_checks import assert_figure_readable, assert_legend_matches_artists
 
 matplotlib = pytest.importorskip("matplotlib")
 
@@ -13,7 +13,7 @@ matplotlib = pytest.importorskip("matplotlib")
 def _figure():
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(3, 2.2), dpi=60)
+    fig = Figure(figsize=(3, 2.2), dpi=60, layout="constrained")
     return fig, fig.add_subplot()
 
 
@@ -123,3 +123,15 @@ def test_a_baseline_in_the_fixed_style_matches_itself_and_catches_a_lost_layer(t
         figure_checks.assert_matches_baseline(without_band, "sound", tmp_path, tol=1, reason="same run")
     with pytest.raises(AssertionError, match="say why"):
         figure_checks.assert_matches_baseline(lambda: _sound()[0], "sound", tmp_path, tol=1, reason=" ")
+
+
+def test_readable_passes_a_sound_figure_and_fails_overlapping_or_clipped_labels():
+    assert_figure_readable(_sound()[0])
+    fig, ax = _figure()
+    ax.set_title("a title long enough to run past both edges of a small figure, clipped")
+    with pytest.raises(AssertionError, match="is clipped"):
+        assert_figure_readable(fig)
+    fig, ax = _figure()
+    ax.set_xticks([0.0, 0.02], ["first long tick label", "second long tick label"])
+    with pytest.raises(AssertionError, match="overlap"):
+        assert_figure_readable(fig)

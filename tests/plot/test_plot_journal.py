@@ -176,9 +176,10 @@ def test_cuboid_html_shows_our_box_over_the_paper_box(solved_file):
     pytest.importorskip("plotly")
     fig, _ = figures.figure(solved_file("pantograph_cuboid"), interactive=True)
     names = [t.name for t in fig.data]
-    ours = names.index("maximal inscribed cuboid")  # the shaded faces (no legend entry of their own)
+    label = "maximal inscribed cuboid (5.12 × 32.3 × 10.8 mm)"  # with its sizes, as in the .png legend
+    ours = names.index(label)  # the shaded faces (no legend entry of their own)
     paper = next(k for k, n in enumerate(names) if n.startswith("paper's eq 32-34 box"))
-    edges = [t for t in fig.data if t.name == "maximal inscribed cuboid" and t.type == "scatter3d"]
+    edges = [t for t in fig.data if t.name == label and t.type == "scatter3d"]
     assert paper < ours and fig.data[ours].type == "mesh3d" and fig.data[ours].opacity < 1
     assert len(edges) == 1 and edges[0].line.dash in (None, "solid") and fig.data[paper].line.dash == "dash"
     assert fig.data[paper].line.width > edges[0].line.width  # the paper's shows around ours

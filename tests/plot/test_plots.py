@@ -71,8 +71,9 @@ def test_requirements_plot_like_fig_6_7(requirements, tmp_path):
     assert all(len(ax.lines) == n for ax, n in zip(fig.axes, [1, 1, 1, 3, 3, 3, 3, 3]))
     v = requirements.values
     # the ranges written in the panels are the result's (prs3-ruiz.md, Fig. 6: -2.15 ... 2.30 mm)
-    assert fig.axes[3].get_title() == f"{v['s_min'] * 1e3:.3g} … {v['s_max'] * 1e3:.3g} mm"
-    assert fig.axes[4].get_title() == f"{math.degrees(v['dalpha_min']):.3g} … {math.degrees(v['dalpha_max']):.3g} deg"
+    assert fig.axes[3].get_title() == f"range {v['s_min'] * 1e3:.3g} … {v['s_max'] * 1e3:.3g} mm"
+    dalpha = f"{math.degrees(v['dalpha_min']):.3g} … {math.degrees(v['dalpha_max']):.3g} deg"
+    assert fig.axes[4].get_title() == f"range {dalpha}"
     assert np.allclose(fig.axes[3].lines[0].get_ydata(), np.array(v["s1"]) * 1e3)
     save(fig, tmp_path / "r.png")
     assert_png_drawn(tmp_path / "r.png")
@@ -255,7 +256,7 @@ def test_plot_bad_input(cli, tmp_path):
     assert run.err == f"error: {out}: a map of a single result needs --x, --y and --value naming three of its lists\n"
     run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--type", "heatmap")
     assert run.err.startswith(
-        "error: --type: unknown plot type 'heatmap'; expected one of: amplifier, comparison, design"
+        "error: --type: unknown plot type 'heatmap'; expected one of: amplifier, assembly_modes, comparison, design"
     )
     assert run.err.endswith("did you mean 'map'?\n")
     run = cli("plot", str(out), "-o", str(tmp_path / "x.jpg"))
