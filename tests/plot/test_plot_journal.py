@@ -352,15 +352,18 @@ def _shipped():
 @pytest.mark.parametrize("name", _shipped())
 def test_every_shipped_problem_file_plots(solved_file, name, tmp_path):
     """issue 24: `--plot` gives a figure on every shipped problem file (as solve --plot draws
-    it: the whole result, the problem at hand), drawn, its texts inside the figure. Saved at
-    a small resolution: what is checked is that a figure is made and drawn."""
-    from tests.figure_checks import assert_png_drawn
+    it: the whole result, the problem at hand), drawn, its texts inside the figure and apart,
+    each legend entry naming a drawn artist of its colour and marker. Saved at a small
+    resolution: what is checked is that a figure is made and drawn."""
+    from tests.figure_checks import assert_labels_apart, assert_png_drawn
 
     fig, kind = figures.figure(solved_file(name))
     out = tmp_path / f"{name}.png"
     fig.savefig(out, dpi=30)
     assert_png_drawn(out)
     assert_figure_readable(fig)
+    assert_labels_apart(fig)
+    assert_legend_matches_artists(fig)
 
 
 def test_cli_plots_a_file_with_an_outputs_selection_from_the_whole_result(cli, tmp_path):
