@@ -442,7 +442,7 @@ def _seeded_fk_kernel(closure: LoopClosure, config: SolverConfig | None) -> Kern
         return Kernel(f, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
 
     key = ("fk_kernel_seeded", _options_key(opts))
-    return c.solvers.memo(key, build)
+    return solvers_of(c).memo(key, build)
 
 
 def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .draw_tables import Comparison, comparison_figure, matrices_figure
-from .results import NotApplicable, PlotOptions, ResultData, dimension_of
+from .results import NotApplicable, PlotOptions, ResultData, dimension_of, figure_title, problem_words
 
 # -- comparisons, matrices ----------------------------------------------------------------------------
 
@@ -76,7 +76,7 @@ def comparison_plot(data: ResultData, _options: PlotOptions) -> Any:
         raise NotApplicable("the result has no value beside a reference (reference_*, paper_*, *_printed ...)")
     spread = _multistart(data)
     return comparison_figure(
-        groups, spread, title=f"{data.problem} ({data.model.get('type')}): ours against references"
+        groups, spread, title=figure_title(data, f"{problem_words(data)}: ours against references")
     )
 
 
@@ -109,4 +109,4 @@ def matrices_plot(data: ResultData, _options: PlotOptions) -> Any:
     mats = _matrices(data)
     if not mats:
         raise NotApplicable("the result has no matrix")
-    return matrices_figure(mats, data.units, title=f"{data.problem} ({data.model.get('type')})")
+    return matrices_figure(mats, data.units, title=figure_title(data))

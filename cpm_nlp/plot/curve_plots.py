@@ -17,8 +17,10 @@ from .results import (
     PlotOptions,
     ResultData,
     dimension_of,
+    figure_title,
     mechanism_title,
     pose_name,
+    problem_words,
     require_lists,
     result_closure,
     result_model,
@@ -123,7 +125,7 @@ def io_plot(data: ResultData, options: PlotOptions) -> Any:
         panels.append(Panel(o, dimension_of(data, o), series, points=refs.get(o, ())))
     if not panels:
         raise NotApplicable("every output is constant over the batch")
-    title = f"Outputs against {xname} ({data.model.get('type')}, {data.problem})"
+    title = figure_title(data, f"{problem_words(data)}: outputs against {xname}")
     if flat:
         title += "\nconstant over the batch: " + ", ".join(_constant_text(data, o) for o in flat)
     return panels_figure(cols[x][order], panels, xname=xname, xdimension=dimension_of(data, x), title=title)

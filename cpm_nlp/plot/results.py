@@ -201,6 +201,17 @@ def mechanism_title(data: ResultData) -> str:
         return str(data.model.get("type") or data.problem)
 
 
+def figure_title(data: ResultData, what: str = "") -> str:
+    """A figure's title: the mechanism's title over what is drawn (``what``; default: the
+    problem kind in words, "inscribed cuboid"), never an internal name."""
+    return f"{mechanism_title(data)}\n{what or problem_words(data)}"
+
+
+def problem_words(data: ResultData) -> str:
+    """The result's problem kind in words ("rpr transmission map")."""
+    return str(data.problem).replace("_", " ")
+
+
 def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None, with_limits: bool = False) -> Any:
     """A model of the result's mechanism (:func:`result_mechanism`) from ``parameters``
     (default: the ones the result records), without registering it; ``with_limits``: with the

@@ -12,7 +12,16 @@ from ..core.errors import InputError, suggest
 from ..problems.registry import kind_names, problem_kind
 from .draw_map import design_map_figure
 from .draw_panels import Panel, panels_figure
-from .results import OUTSIDE, NotApplicable, PlotOptions, ResultData, dimension_of, value_list
+from .results import (
+    OUTSIDE,
+    NotApplicable,
+    PlotOptions,
+    ResultData,
+    dimension_of,
+    figure_title,
+    problem_words,
+    value_list,
+)
 from .style import pretty, value_text
 
 # -- map ---------------------------------------------------------------------------------------------
@@ -103,7 +112,7 @@ def map_plot(data: ResultData, options: PlotOptions) -> Any:
         domain=v.get("domain"),
         best=options.best,
         marks=marks,
-        title=f"{data.problem}, {data.model.get('type') or ''}",
+        title=figure_title(data),
     )
 
 
@@ -139,7 +148,7 @@ def _sweep_map(data: ResultData, options: PlotOptions) -> Any:
         outside=[s in OUTSIDE for s in data.statuses or []] or None,
         best=options.best,
         marks=[(bases.get(xk), bases.get(yk), "base design (the file)")],
-        title=f"sweep of {data.problem}, {data.model.get('type') or ''}",
+        title=figure_title(data, f"sweep of {problem_words(data)}"),
     )
 
 
@@ -163,7 +172,13 @@ def lines_plot(data: ResultData, options: PlotOptions) -> Any:
         Panel(n, dimension_of(data, n), {n: [data.values[n][i] if ok[i] else None for i in order]}) for n in names
     ]
     xs = [data.values[x][i] for i in order]
-    return panels_figure(xs, panels, xname=x, xdimension=dimension_of(data, x), title=f"{data.problem}: sweep of {x}")
+    return panels_figure(
+        xs,
+        panels,
+        xname=x,
+        xdimension=dimension_of(data, x),
+        title=figure_title(data, f"{problem_words(data)}: sweep of {x}"),
+    )
 
 
 def _map_axes(name: str) -> tuple[str | None, str | None, str | None]:

@@ -21,7 +21,7 @@ from .results import (
     PlotOptions,
     ResultData,
     dimension_of,
-    mechanism_title,
+    figure_title,
     pose_name,
     require_lists,
     result_closure,
@@ -38,7 +38,7 @@ def workspace_plot(data: ResultData, options: PlotOptions) -> Any:
     """A point cloud with its cuboid (see the module's naming conventions)."""
     workspace_figure = workspace_html if options.interactive else workspace_figure_png
     v = data.values
-    title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
+    title = figure_title(data)
     if data.problem == "actuator_workspace":
         closure = result_closure(data)
         if len(closure.task) == 2:  # its points are x, y
@@ -184,9 +184,7 @@ def _cuboid_plot(data: ResultData, cuboid: tuple, axes: tuple, workspace_figure:
     """A cuboid (and the paper's box), with the workspace around it where the model is at hand."""
     task, kinds, box_label, hull = axes
     if data.problem == "inscribed_cuboid":
-        title = (
-            f"Maximal inscribed cuboid: {mechanism_title(data)}" + title.partition("\n")[1] + title.partition("\n")[2]
-        )
+        title = figure_title(data, "maximal inscribed cuboid")
     pts, label, slices = np.zeros((0, 3)), "", ()
     if data.live is not None and data.problem == "inscribed_cuboid":
         pts, slices = _workspace_around(data.live, cuboid)
@@ -366,7 +364,7 @@ def _planar_workspace_plot(data: ResultData, options: PlotOptions, closure: Any)
     v = data.values
     task = list(closure.task)
     kinds = [closure.x[i].kind for i in closure.task_index]
-    title = f"Workspace ({data.model.get('type') or data.problem}, {data.problem})"
+    title = figure_title(data)
     cuboid = _task_box(v, task)
     common = {"names": task, "dimensions": kinds, "title": title}
     if data.problem == "actuator_workspace":

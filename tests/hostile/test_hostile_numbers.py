@@ -330,7 +330,8 @@ _values = st.recursive(
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    values=st.dictionaries(st.text(max_size=5), _values, max_size=5),
+    # names without braces: a name with fields in braces declares a family (Output(per=...))
+    values=st.dictionaries(st.text(max_size=5).filter(lambda k: "{" not in k and "}" not in k), _values, max_size=5),
     model=st.dictionaries(st.text(max_size=5), _values, max_size=3),
 )
 def test_result_to_json_never_fails_nor_holds_nan(values, model):
