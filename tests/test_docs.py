@@ -159,9 +159,13 @@ def _extras() -> set[str]:
 
 
 def _check_pip(segment: str, where: str) -> None:
-    m = re.fullmatch(r"pip install -e (?:\.|'\.\[(?P<extras>[\w,]+)\]')", segment)
+    """``pip install -e .``, ``pip install -e '.[EXTRAS]'`` (a checkout) or ``pip install
+    'cpm_nlp[EXTRAS]'`` (a user's install): the extras it names exist."""
+    m = re.fullmatch(
+        r"pip install (?:-e (?:\.|'\.\[(?P<extras>[\w,]+)\]')|'?cpm_nlp(?:\[(?P<user>[\w,]+)\])?'?)", segment
+    )
     assert m, f"{where}: unexpected install command {segment!r}"
-    for extra in (m.group("extras") or "").split(","):
+    for extra in (m.group("extras") or m.group("user") or "").split(","):
         assert not extra or extra in _extras(), f"{where}: no extra {extra!r} in pyproject.toml"
 
 
