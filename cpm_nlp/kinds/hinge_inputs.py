@@ -124,7 +124,7 @@ def mass_node(name: str, description: str, angle: bool = False, default: Any = N
 _STRESS_DESCRIPTION = (
     "hinge stress limits in place of angle limits: true (the mechanism's hinges and material) or a mapping "
     "{sigma_allow, safety_factor, hinges, material}; each hinge's deflection about each axis alone at sigma_allow "
-    "becomes a limit of its joint (generalizing eq 31 of pantograph-3d-elgammal-2016.md); parsed to the model "
+    "becomes a limit of its joint (generalizing eq 31 of Elgammal et al. 2016); parsed to the model "
     "with those limits"
 )
 
