@@ -398,3 +398,25 @@ def test_user_pages_name_no_internal_paths_or_issues():
         for pattern, what in _INTERNAL:
             bad += [f"{name}: {m.group(0)!r} ({what})" for m in pattern.finditer(_user_text(text))]
     assert not bad, "\n".join(bad)
+
+
+_REST_ROLE = re.compile(r":(?:py:)?(?:class|func|meth|attr|data|mod|exc|obj|const|ref):`")
+
+
+def test_docstrings_use_no_rest_roles():
+    """The API reference renders numpy-style docstrings through mkdocstrings, where a reST role
+    (``:class:`X```) shows as raw text: a reference is a cross-reference
+    (``[`X`][cpm_nlp.module.X]``) or inline code.  Every docstring of the package, public or
+    not (a private one becomes public by a rename)."""
+    import ast
+
+    bad = []
+    for path in sorted((ROOT / "cpm_nlp").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            body = getattr(node, "body", None)
+            if not (isinstance(body, list) and body and isinstance(body[0], ast.Expr)):
+                continue
+            doc = body[0].value
+            if isinstance(doc, ast.Constant) and isinstance(doc.value, str) and _REST_ROLE.search(doc.value):
+                bad.append(f"{path.relative_to(ROOT)}:{doc.lineno}")
+    assert not bad, f"{len(bad)} docstrings with reST roles: " + ", ".join(bad[:20])
