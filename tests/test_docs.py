@@ -18,7 +18,9 @@ of the page may read them):
   (a deliberate mistake the page shows) must fail to load as bad input.
 * a ``bash`` block may be followed by ``<!-- output: TEXT -->`` lines: each claim the
   prose makes about that block's output, which must then contain TEXT (runs of
-  whitespace compared as one space).
+  whitespace compared as one space); after an invalid mechanism file, the claims are
+  about its error message.  Values the prose quotes from a result are checked by the
+  page's own ``python`` blocks (``cn.solve``, ``cn.reproduce``), which run here too.
 * ``text`` and ``toml``: illustrative only (usage synopses, a cluster's own commands, an
   error message, an entry-point table tested by tests/mechanisms/test_plugin.py); kept few.
 """
@@ -223,9 +225,10 @@ def _run_yaml(block: Block, k: int) -> None:
     mechanism = isinstance(data, dict) and ("legs" in data or "bodies" in data)  # legs, or bodies and joints
     if mechanism and block.file:  # a mechanism file, used by the blocks after it
         path.write_text(block.body, encoding="utf-8")
-        if block.invalid:  # the page shows its error next; loading must fail as bad input
-            with pytest.raises(cn.InputError):
+        if block.invalid:  # the page shows its error next; loading must fail as bad input, saying what it quotes
+            with pytest.raises(cn.InputError) as error:
                 cn.load_mechanism_file(path, register=False)
+            _check_claims(block, str(error.value))
             return
         cn.load_mechanism_file(path, register=False)
         return
