@@ -98,9 +98,9 @@ def problem_files_by_mechanism() -> dict[str, list[str]]:
     return out
 
 
-def sketch_problem(mechanism: str) -> str:
+def sketch_problem(mechanism: str, by_mechanism: dict[str, list[str]] | None = None) -> str:
     """The problem file a mechanism's sketch is drawn from: its forward kinematics (a pose near home)."""
-    files = problem_files_by_mechanism().get(mechanism, [])
+    files = (problem_files_by_mechanism() if by_mechanism is None else by_mechanism).get(mechanism, [])
     preferred = f"{mechanism}_forward_kinematics.yaml"
     fk = [f for f in files if f.endswith("forward_kinematics.yaml")]
     if preferred in files:
@@ -114,11 +114,12 @@ def sketches() -> tuple[Figure, ...]:
     """One sketch per registered mechanism, drawn at the pose of its forward-kinematics problem file."""
     from cpm_nlp.mechanisms.registry import mechanism_names
 
+    files = problem_files_by_mechanism()
     return tuple(
         Figure(
             f"mechanisms/{name}",
-            _solve(Path(sketch_problem(name)).stem, "--type", "mechanism"),
-            f"{name}, drawn from problems/{sketch_problem(name)}",
+            _solve(Path(sketch_problem(name, files)).stem, "--type", "mechanism"),
+            f"{name}, drawn from problems/{sketch_problem(name, files)}",
         )
         for name in mechanism_names()
     )

@@ -74,13 +74,15 @@ def mechanism_page(name: str, problem_files: dict[str, list[str]] | None = None)
     from cpm_nlp.mechanisms.registry import mechanism_type
 
     mt = mechanism_type(name)
-    files = (problem_files if problem_files is not None else figures.problem_files_by_mechanism()).get(name, [])
+    by_mechanism = problem_files if problem_files is not None else figures.problem_files_by_mechanism()
+    files = by_mechanism.get(name, [])
     out = [f"# `{name}`: {mt.title}", ""]
     sketch = figures.ASSETS / "mechanisms" / f"{name}.png"
+    drawn_from = figures.sketch_problem(name, by_mechanism) if sketch.is_file() else ""
     out += [
         f"![{name} drawn by cpm-nlp](../../assets/mechanisms/{name}.png)",
         "",
-        f"*Drawn by `cpm-nlp solve problems/{figures.sketch_problem(name)} --plot {name}.png --type mechanism`: "
+        f"*Drawn by `cpm-nlp solve problems/{drawn_from} --plot {name}.png --type mechanism`: "
         "the pose of that file, the home pose dashed.*"
         if sketch.is_file()
         else "",

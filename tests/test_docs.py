@@ -326,7 +326,7 @@ def test_every_shipped_mechanism_has_its_page_and_sketch():
         )
         assert all(f"`{o.name}`" in page for o in mechanism_type(name).parameters), name
         assert all(f"`{f}`" in page for f in by_mechanism[name]), name  # its shipped problem files
-        assert f"problems/{figures.sketch_problem(name)}" in page
+        assert f"problems/{figures.sketch_problem(name, by_mechanism)}" in page
 
 
 def test_overview_pictures_are_drawn_by_the_commands_under_them():
@@ -386,7 +386,8 @@ def _generated_pages() -> dict[str, str]:
     names = list(mechanism_names())
     pages = {"reference/kinds.md": reference_markdown(), "reference/solver-options.md": solver_options_markdown()}
     pages["reference/mechanisms.md"] = hooks.mechanisms_index(names)
-    pages.update({hooks.mechanism_page_path(n): hooks.mechanism_page(n) for n in names})
+    by_mechanism = _docs_module("figures").problem_files_by_mechanism()
+    pages.update({hooks.mechanism_page_path(n): hooks.mechanism_page(n, by_mechanism) for n in names})
     return pages
 
 
