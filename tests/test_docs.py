@@ -424,3 +424,36 @@ def test_docstrings_use_no_rest_roles():
             if isinstance(doc, ast.Constant) and isinstance(doc.value, str) and _REST_ROLE.search(doc.value):
                 bad.append(f"{path.relative_to(ROOT)}:{doc.lineno}")
     assert not bad, f"{len(bad)} docstrings with reST roles: " + ", ".join(bad[:20])
+
+
+def _entry(text: str, angles: dict[str, float]) -> float:
+    """A cell of the page's matrix, e.g. ``−cθ sφ + sψ sθ cφ``, at the given angles."""
+    import math
+
+    value = 0.0
+    for sign, term in re.findall(r"([+−-]?)\s*((?:[cs][ψθφ]\s*)+)", text):
+        product = 1.0
+        for fn, angle in re.findall(r"([cs])([ψθφ])", term):
+            product *= (math.cos if fn == "c" else math.sin)(angles[angle])
+        value += -product if sign in ("−", "-") else product
+    return value
+
+
+def test_rotation_page_matrix_is_the_models():
+    """The matrix reference/rotation.md writes for the 3-PRS (eq 4 of Ruiz et al., as a table of
+    cψ, sθ ... products) equals the model's rotation matrix at a sample pose."""
+    import numpy as np
+
+    text = (SITE / "reference" / "rotation.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\| ([xyz]) \| (.+?) \| (.+?) \| (.+?) \|$", text, re.M)
+    assert [r[0] for r in rows] == ["x", "y", "z"]
+    angles = {"ψ": 0.3, "θ": -0.7, "φ": 1.1}
+    written = np.array([[_entry(cell, angles) for cell in row[1:]] for row in rows])
+    model = cn.build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm"})
+    names = [c.name for c in model.closure.x]
+    x = np.array(model.x_home, dtype=float)
+    for name, symbol in (("psi", "ψ"), ("theta", "θ"), ("phi", "φ")):
+        x[names.index(name)] = angles[symbol]
+    R = np.array(model.closure.frame(x, model.p)[0])
+    assert np.allclose(written, R, atol=1e-12), (written, R)
+    assert abs(np.linalg.det(written) - 1) < 1e-12
