@@ -457,3 +457,15 @@ def test_rotation_page_matrix_is_the_models():
     R = np.array(model.closure.frame(x, model.p)[0])
     assert np.allclose(written, R, atol=1e-12), (written, R)
     assert abs(np.linalg.det(written) - 1) < 1e-12
+
+
+def test_quoted_errors_are_output_claims():
+    """An error message a page quotes (a ``> error: ...`` block quote) is one of the page's
+    ``<!-- output: -->`` claims, so the command it follows is checked to print it as quoted."""
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        claims = {" ".join(c.split()) for b in blocks(page) for c in b.outputs}
+        for quote in re.findall(r"(?:^> .*\n?)+", text, re.M):
+            flat = " ".join(line[2:] for line in quote.splitlines())
+            if flat.startswith("error:"):
+                assert " ".join(flat.split()) in claims, f"{_name(page)}: quoted error not checked: {flat}"
