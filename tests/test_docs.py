@@ -469,3 +469,16 @@ def test_quoted_errors_are_output_claims():
             flat = " ".join(line[2:] for line in quote.splitlines())
             if flat.startswith("error:"):
                 assert " ".join(flat.split()) in claims, f"{_name(page)}: quoted error not checked: {flat}"
+
+
+def test_api_page_documents_every_public_name():
+    """reference/api.md renders (``::: path``) the definition of every name of ``cn.__all__``."""
+    import importlib
+
+    text = (SITE / "reference" / "api.md").read_text(encoding="utf-8")
+    shown = set()
+    for path in re.findall(r"^:::\s*(\S+)", text, re.M):
+        module, _, name = path.rpartition(".")
+        shown.add(id(getattr(importlib.import_module(module), name)))
+    public = {n for n in cn.__all__ if n != "__version__"}
+    assert not [n for n in public if id(getattr(cn, n)) not in shown]
