@@ -96,6 +96,11 @@ def mechanism_page(name: str, problem_files: dict[str, list[str]] | None = None)
             "(`cpm-nlp examples DIR` copies it; `cpm-nlp describe` reads it).",
             "",
         ]
+    from cpm_nlp.mechanisms.registry import ALIASES
+
+    old = sorted(alias for alias, target in ALIASES.items() if target == name)
+    if old:
+        out += [f"**Also named** (an older name, still accepted as `type:`): {', '.join(f'`{o}`' for o in old)}.", ""]
     out += [f"**Orientation** ([rotation convention](../rotation.md)): {_rotation_text(mt)}.", ""]
     out += ["## Parameters", "", "| name | meaning | unit | default | range |", "| --- | --- | --- | --- | --- |"]
     for o in mt.parameters:

@@ -327,6 +327,10 @@ def test_every_shipped_mechanism_has_its_page_and_sketch():
         assert all(f"`{o.name}`" in page for o in mechanism_type(name).parameters), name
         assert all(f"`{f}`" in page for f in by_mechanism[name]), name  # its shipped problem files
         assert f"problems/{figures.sketch_problem(name, by_mechanism)}" in page
+    from cpm_nlp.mechanisms.registry import ALIASES  # the older names: 14 names in all today
+
+    for alias, target in ALIASES.items():
+        assert f"`{alias}`" in hooks.mechanism_page(target, by_mechanism), alias
 
 
 def test_overview_pictures_are_drawn_by_the_commands_under_them():
