@@ -18,7 +18,6 @@ import sys
 from pathlib import Path
 
 import yaml
-from mkdocs.structure.files import File
 
 from cpm_nlp.core.solver_options import reference_markdown as solver_options_markdown
 from cpm_nlp.problems.describe import reference_markdown
@@ -181,6 +180,8 @@ def on_config(config):
 
 
 def on_files(files, config):
+    from mkdocs.structure.files import File  # here: the tests import this module without the docs extra
+
     files.append(File.generated(config, "reference/kinds.md", content=reference_markdown()))
     files.append(File.generated(config, "reference/solver-options.md", content=solver_options_markdown()))
     names = _registered()
