@@ -486,3 +486,28 @@ def test_api_page_documents_every_public_name():
         shown.add(id(getattr(importlib.import_module(module), name)))
     public = {n for n in cn.__all__ if n != "__version__"}
     assert not [n for n in public if id(getattr(cn, n)) not in shown]
+
+
+def test_rotation_page_joint_angles_are_the_generators():
+    """The joint-angle convention the rotation page states, M = Rx(a) Ry(b) Rz(c), is the one
+    the generator reads a joint's angles with (its inverse, at a sample rotation)."""
+    import casadi as ca
+    import numpy as np
+
+    from cpm_nlp.mechanisms.described.motions import xyz_angles
+
+    text = " ".join((SITE / "reference" / "rotation.md").read_text(encoding="utf-8").split())
+    assert "M = Rx(a) Ry(b) Rz(c) in the joint's own frame" in text
+    assert "R = Rz(yaw) Ry(pitch) Rx(roll)" in text
+
+    def rot(axis, t):
+        c, s = np.cos(t), np.sin(t)
+        i, j = [(1, 2), (2, 0), (0, 1)]["xyz".index(axis)]
+        m = np.eye(3)
+        m[i, i], m[i, j], m[j, i], m[j, j] = c, -s, s, c
+        return m
+
+    a, b, c = 0.3, -0.4, 0.9
+    M = rot("x", a) @ rot("y", b) @ rot("z", c)
+    got = ca.Function("angles", [], xyz_angles(ca.SX(M)))()
+    assert np.allclose([float(got[k]) for k in sorted(got)], [a, b, c])
