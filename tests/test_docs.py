@@ -511,3 +511,16 @@ def test_rotation_page_joint_angles_are_the_generators():
     M = rot("x", a) @ rot("y", b) @ rot("z", c)
     got = ca.Function("angles", [], xyz_angles(ca.SX(M)))()
     assert np.allclose([float(got[k]) for k in sorted(got)], [a, b, c])
+
+
+def test_status_and_warning_lists_are_the_codes():
+    """The exported status codes the export page lists (in order) are the statuses' order, and
+    the read-status page's warning table has every warning code and no other."""
+    from cpm_nlp.core.result import WARNING_CODES
+
+    export = " ".join((SITE / "howto" / "export-c.md").read_text(encoding="utf-8").split())
+    codes = ", ".join(f"{k} {s.value}" for k, s in enumerate(cn.Status))
+    assert f"in order: {codes})" in export
+    status_page = (SITE / "howto" / "read-status.md").read_text(encoding="utf-8")
+    table = re.findall(r"^\| `(\w+)` \|", status_page.split("## Warnings", 1)[1], re.M)
+    assert table == list(WARNING_CODES)
