@@ -524,3 +524,13 @@ def test_status_and_warning_lists_are_the_codes():
     status_page = (SITE / "howto" / "read-status.md").read_text(encoding="utf-8")
     table = re.findall(r"^\| `(\w+)` \|", status_page.split("## Warnings", 1)[1], re.M)
     assert table == list(WARNING_CODES)
+
+
+def test_plots_guide_has_every_plot_type():
+    """The plots guide's table has a row for every registered plot type (built-in and the
+    mechanisms' own), and no other."""
+    from cpm_nlp.plot.registry import plot_type_names
+
+    guide = (SITE / "guide" / "plots.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\| `(\w+)`", guide, re.M)
+    assert sorted(rows) == sorted(plot_type_names())
