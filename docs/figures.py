@@ -57,7 +57,11 @@ FIGURES: tuple[Figure, ...] = (
     Figure("overview/kinematics", _solve("prs3_forward_kinematics"), "forward kinematics of the 3-PRS stage"),
     Figure("overview/jacobian", _solve("prs3_jacobian"), "the 3-PRS Jacobian: conditioning over a workspace slice"),
     Figure("overview/workspace", _solve("five_bar_inscribed_cuboid"), "the five-bar's workspace and largest rectangle"),
-    Figure("overview/synthesis", _solve("pantograph_synthesis"), "a synthesised pantograph against the paper's"),
+    Figure(
+        "overview/synthesis",
+        _solve("five_bar_synthesis", "--type", "design"),
+        "a synthesised five-bar drawn over the file's design",
+    ),
     Figure("overview/compliance", _solve("rrr3_platform_compliance"), "the 3-RRR's compliance ellipsoid"),
     Figure("overview/forces", _solve("prs3_fem_table2"), "3-PRS actuator forces and stresses"),
     Figure("overview/dynamics", _solve("prc3_dynamics"), "the 3-PRC's natural frequencies and mode shapes"),
