@@ -64,7 +64,7 @@ FIGURES: tuple[Figure, ...] = (
     ),
     Figure("overview/compliance", _solve("rrr3_platform_compliance"), "the 3-RRR's compliance ellipsoid"),
     Figure("overview/forces", _solve("prs3_fem_table2"), "3-PRS actuator forces and stresses"),
-    Figure("overview/dynamics", _solve("prc3_dynamics"), "the 3-PRC's natural frequencies and mode shapes"),
+    Figure("overview/dynamics", _solve("prs3_natural_frequencies"), "the 3-PRS stage's natural frequencies and modes"),
     Figure(
         "overview/sweep",
         ("sweep", "problems/sweep_rpr_transmission.yaml", "-q", "--workers", "1", "--overwrite", "-o", "RESULTS")
