@@ -11,7 +11,7 @@ or, from a problem file::
 
     result = cn.solve(cn.load_problem("problems/prs3_forward_kinematics.yaml"))
 
-The public names are those of :mod:`cpm_nlp.api` (listed once, there), loaded
+The public names are those of `cpm_nlp.api` (listed once, there), loaded
 on first use (PEP 562): ``import cpm_nlp`` and the ``cpm-nlp`` command start
 without loading CasADi and the solvers until a name is used.  The package's
 layers: ``core`` (model, kernels, solvers, units), ``analysis`` (workspace,
@@ -32,7 +32,7 @@ _legacy.install()
 
 
 def __getattr__(name: str) -> object:
-    """A public name of :mod:`cpm_nlp.api` (and ``__all__`` itself), imported on first use."""
+    """A public name of `cpm_nlp.api` (and ``__all__`` itself), imported on first use."""
     api = importlib.import_module(".api", __name__)
     if name == "__all__" or name in api.__all__:
         value = getattr(api, name)

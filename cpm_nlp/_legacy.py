@@ -2,13 +2,13 @@
 
 ``import cpm_nlp.workspace`` (or ``from cpm_nlp import workspace``) still works and
 gives the module at its new place, with a DeprecationWarning that names it.
-``cpm_nlp.prs3``, ``cpm_nlp.prc3``, ``cpm_nlp.rpr`` and ``cpm_nlp.pantograph`` are gone (:data:`REMOVED`):
+``cpm_nlp.prs3``, ``cpm_nlp.prc3``, ``cpm_nlp.rpr`` and ``cpm_nlp.pantograph`` are gone (`REMOVED`):
 they are mechanism files now.
 Three old modules became packages of the same name and are not aliased:
-``cpm_nlp.problems`` (its ``ProblemKind`` is in :mod:`cpm_nlp.core.kind`, its
-``problem_kind`` in :mod:`cpm_nlp.problems.registry`), ``cpm_nlp.mechanisms``
-(now :mod:`cpm_nlp.mechanisms.registry`) and ``cpm_nlp.sweep`` (now
-:mod:`cpm_nlp.sweep.run`).  See docs/changelog.md.
+``cpm_nlp.problems`` (its ``ProblemKind`` is in `cpm_nlp.core.kind`, its
+``problem_kind`` in `cpm_nlp.problems.registry`), ``cpm_nlp.mechanisms``
+(now `cpm_nlp.mechanisms.registry`) and ``cpm_nlp.sweep`` (now
+`cpm_nlp.sweep.run`).  See docs/changelog.md.
 """
 
 from __future__ import annotations

@@ -54,13 +54,19 @@ def functions(
 ) -> ModelFunctions:
     """The CasADi Functions of a model, or of the mechanism of a problem file.
 
-    source: a :class:`Model` (e.g. from :func:`cpm_nlp.build_model`) or the
-    path of a problem file (its mechanism, and its solver unless ``solver`` is given).
-    solver: tolerance and Newton options (abstol, abstolStep, max_iter) built
-    into fk and ik (default: ``SolverConfig("newton")``).
-    backend: what evaluates fk, ik and jacobian called on numbers ("auto": the compiled C
-    where a C compiler is available; "compiled"; "map": CasADi's virtual machine); on
-    CasADi symbols they are CasADi Functions whatever the backend.
+    Parameters
+    ----------
+    source
+        a [`Model`][cpm_nlp.core.model.Model] (e.g. from
+        [`cpm_nlp.build_model`][cpm_nlp.mechanisms.registry.build_model]) or the path of a
+        problem file (its mechanism, and its solver unless ``solver`` is given).
+    solver
+        tolerance and Newton options (abstol, abstolStep, max_iter) built into fk and ik
+        (default: ``SolverConfig("newton")``).
+    backend
+        what evaluates fk, ik and jacobian called on numbers ("auto": the compiled C where a C
+        compiler is available; "compiled"; "map": CasADi's virtual machine); on CasADi symbols
+        they are CasADi Functions whatever the backend.
     """
     if isinstance(source, (str, os.PathLike)):
         problem = load_problem(source)
@@ -69,8 +75,11 @@ def functions(
 
 
 def describe_mechanism(description: Description, *, register: bool = True) -> Mechanism:
-    """A mechanism from a :class:`Description` built in code (the dataclasses of a mechanism
-    file: :class:`Parameter`, :class:`Platform`, :class:`Leg`, :class:`Joint` ...), generated
+    """A mechanism from a [`Description`][cpm_nlp.mechanisms.described.spec.Description] built in code (the dataclasses
+    of a mechanism
+    file: [`Parameter`][cpm_nlp.mechanisms.described.spec.Parameter],
+    [`Platform`][cpm_nlp.mechanisms.described.spec.Platform], [`Leg`][cpm_nlp.mechanisms.described.spec.Leg],
+    [`Joint`][cpm_nlp.mechanisms.described.spec.Joint] ...), generated
     and checked like a file; registered under its name unless ``register`` is false."""
     mech = _described.mechanism(description)
     return register_mechanism(mech, replace=True) if register else mech

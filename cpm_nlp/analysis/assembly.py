@@ -5,22 +5,22 @@ For given actuators q the loop closures Φ(x, q; p) = 0 usually have several
 real solutions x (the assembly modes: up to 40 for a 6-UPS Stewart-Gough
 platform, two for a planar five-bar, several for a 3-PRS whose legs can flip).
 The model designates one of them (its branch indicators, its closed-form IK);
-the FK of a problem file reports only that one.  :func:`assembly_modes` finds
+the FK of a problem file reports only that one.  [`assembly_modes`][cpm_nlp.analysis.assembly.assembly_modes] finds
 the others, so that a designer sees how far the working mode is from them.
 
 Method
 ------
-1. The search region (:func:`search_region`) needs no bounds from the user:
+1. The search region (`search_region`) needs no bounds from the user:
    every angle coordinate takes a full turn (-pi, pi] (the closures are
    periodic in it), every length coordinate the home value ± the reach (the
    largest of the declared half-span, the characteristic length, the
    distances of the home pose and the lengths among the actuators).
    ``starts`` initial poses are drawn there (seeded, uniform); the home pose
    is the first.
-2. From every start at once, :data:`DAMPED_STEPS` Newton steps, each shortened
-   to :data:`STEP_LIMIT` (one radian in an angle, one reach in a length;
-   :func:`damped_newton`), then Newton's method (the FK kernel of
-   :mod:`cpm_nlp.core.batch`, CasADi ``fast_newton``, mapped over threads).
+2. From every start at once, `DAMPED_STEPS` Newton steps, each shortened
+   to `STEP_LIMIT` (one radian in an angle, one reach in a length;
+   `damped_newton`), then Newton's method (the FK kernel of
+   `cpm_nlp.core.batch`, CasADi ``fast_newton``, mapped over threads).
 3. Angle coordinates of the converged poses are reduced to (-pi, pi] (one
    the closures are not periodic in keeps its value).  Every converged real
    solution is a mode, wherever it lies: a solution outside the start box is
@@ -31,11 +31,11 @@ Method
    divided by the reach).  Without a ``frame`` the coordinates are compared
    with angles wrapped (two angle triples of one rotation then stay two
    modes).
-5. Each distinct pose is checked like any FK solution (:func:`~cpm_nlp.core.kinematics.assess`:
+5. Each distinct pose is checked like any FK solution ([`assess`][cpm_nlp.core.kinematics.assess]:
    residual, branch indicators, IK round trip, conditioning, joint limits)
    and reported with its residual, status, branch indicators, whether it lies
    on the designated branch, and how many starts reached it.
-6. The counts give a completeness estimate (:func:`completeness`): Chao1's
+6. The counts give a completeness estimate (`completeness`): Chao1's
    estimate of the modes no start reached, from the modes reached once and
    twice, Good-Turing's probability that one more start finds a new mode, and
    the starts a 99 % chance of reaching the smallest basin seen would take.
@@ -102,12 +102,21 @@ INCOMPLETE_NOTE = (
 class AssemblyMode:
     """One assembly mode: the pose, its check and its branch indicators.
 
-    status: as an FK solution would report it (``wrong_branch`` off the
-    designated branch); message: why, when not solved; residual: max |Φ|;
-    designated: on the branch the model designates (branch indicators > 0
-    and the closed-form IK round trip agrees); branch: the branch indicator
-    values (empty without indicators); basin: the number of starts that
-    converged to it.
+    Attributes
+    ----------
+    status
+        as an FK solution would report it (``wrong_branch`` off the designated branch);
+    message
+        why, when not solved;
+    residual
+        max |Φ|;
+    designated
+        on the branch the model designates (branch indicators > 0 and the closed-form IK round
+        trip agrees);
+    branch
+        the branch indicator values (empty without indicators);
+    basin
+        the number of starts that converged to it.
     """
 
     x: np.ndarray
@@ -152,16 +161,28 @@ class SearchRegion:
 class Completeness:
     """What the counts of starts per mode say about the modes not found.
 
-    hits: starts that reached a mode (the sum of the basins); singletons,
-    doubletons: modes reached by one and by two starts; unseen: Chao1's
-    estimate of the modes no start reached (bias-corrected form when there is
-    no doubleton); estimate: found + unseen; new_mode_probability:
-    Good-Turing's probability that one more converged start finds a new mode
-    (singletons / hits); smallest_basin: the smallest fraction of the starts
-    that reached one mode; starts_needed: starts for a 99 % chance of
-    reaching a basin that small; rare: indices of the modes reached by fewer
-    than :data:`FEW` starts; complete: no rare mode and no unseen mode
-    estimated.
+    Attributes
+    ----------
+    hits
+        starts that reached a mode (the sum of the basins); singletons,
+    doubletons
+        modes reached by one and by two starts;
+    unseen
+        Chao1's estimate of the modes no start reached (bias-corrected form when there is no
+        doubleton);
+    estimate
+        found + unseen;
+    new_mode_probability
+        Good-Turing's probability that one more converged start finds a new mode (singletons /
+        hits);
+    smallest_basin
+        the smallest fraction of the starts that reached one mode;
+    starts_needed
+        starts for a 99 % chance of reaching a basin that small;
+    rare
+        indices of the modes reached by fewer than `FEW` starts;
+    complete
+        no rare mode and no unseen mode estimated.
     """
 
     hits: int
@@ -195,15 +216,25 @@ class Completeness:
 class AssemblyModes:
     """The distinct assembly modes found for one actuator vector.
 
-    modes: found, the working mode (if any) first, then by basin size;
-    working: index of the working mode in ``modes`` (None if the ordinary FK
-    failed: ``working_solution`` says why); nearest: index of the mode
-    nearest to the working one; distance_length (m), distance_angle (rad):
-    Euclidean distances of the length and angle coordinates of the pose
-    between them (angles wrapped); starts, converged: how many starts ran and
-    converged to a real solution; outside_region: modes found outside the
-    start box (kept); region: the search region; completeness: the estimate
-    from the counts.
+    Attributes
+    ----------
+    modes
+        found, the working mode (if any) first, then by basin size;
+    working
+        index of the working mode in ``modes`` (None if the ordinary FK failed:
+        ``working_solution`` says why);
+    nearest
+        index of the mode nearest to the working one; distance_length (m), distance_angle (rad):
+        Euclidean distances of the length and angle coordinates of the pose between them (angles
+        wrapped);
+    starts, converged
+        how many starts ran and converged to a real solution;
+    outside_region
+        modes found outside the start box (kept);
+    region
+        the search region;
+    completeness
+        the estimate from the counts.
     """
 
     q: np.ndarray
@@ -248,7 +279,7 @@ def reach(model: Model) -> float:
 
 def search_region(model: Model) -> SearchRegion:
     """The box the starts are drawn from, without bounds from the user: a full
-    turn for every angle, home ± :func:`reach` for every other coordinate."""
+    turn for every angle, home ± `reach` for every other coordinate."""
     c = model.closure
     r = reach(model)
     lo, hi, src = [], [], []
@@ -324,7 +355,7 @@ def _merge(F: np.ndarray, tol: float) -> tuple[list[int], np.ndarray]:
 
 
 def _merge_block(Y: np.ndarray, k: int, reps: list[int], label: np.ndarray, dist: Any, tol: float) -> int:
-    """Merge the block of rows from ``k`` (see :func:`_merge`); the first row after it."""
+    """Merge the block of rows from ``k`` (see `_merge`); the first row after it."""
     size = max(1, min(MERGE_BLOCK, MERGE_CELLS // max(1, len(reps) * Y.shape[1])))
     block = Y[k : k + size]
     if reps:
@@ -378,7 +409,7 @@ def _mode(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float, basin: i
 
 #: Newton iterations of the search (random starts need more than a solve from a near guess)
 SEARCH_MAX_ITER = 100
-#: Newton steps from every start before that Newton solve, each shortened to :data:`STEP_LIMIT`
+#: Newton steps from every start before that Newton solve, each shortened to `STEP_LIMIT`
 DAMPED_STEPS = 30
 #: longest step of those (max-norm, lengths divided by the reach): one radian, or one reach.
 #: Undamped Newton from a random start often jumps far (|Φ| of 1e37 on Dietmaier's platform):
@@ -390,16 +421,16 @@ STEP_LIMIT = 1.0
 
 def search_solver(config: SolverConfig) -> SolverConfig:
     """The Newton configuration of the search: the given one (or Newton at its
-    tolerance), with at least :data:`SEARCH_MAX_ITER` iterations."""
+    tolerance), with at least `SEARCH_MAX_ITER` iterations."""
     opts = dict(config.options) if config.method == "newton" else {}
     opts["max_iter"] = max(int(opts.get("max_iter", 0)), SEARCH_MAX_ITER)
     return SolverConfig("newton", options=opts, tolerance=config.tolerance)
 
 
 def damped_newton(model: Model) -> ca.Function:
-    """``<name>_search_steps: (x0, w, scale) -> x``: :data:`DAMPED_STEPS` Newton
+    """``<name>_search_steps: (x0, w, scale) -> x``: `DAMPED_STEPS` Newton
     steps on Φ(x; w) = 0 (w = (q, p)), each shortened to max |dx / scale| <=
-    :data:`STEP_LIMIT`; a step that is not finite (Φ_x singular) is not taken.
+    `STEP_LIMIT`; a step that is not finite (Φ_x singular) is not taken.
     Built once per closure."""
     c = model.closure
 

@@ -1,7 +1,7 @@
 """A certificate that a box of task coordinates lies inside the reachable workspace.
 
 For a mechanism with a closed-form IK (``LoopClosure.ik``: t -> x, q, reach)
-every quantity that decides membership (:func:`cpm_nlp.analysis.workspace.membership`)
+every quantity that decides membership (`cpm_nlp.analysis.workspace.membership`)
 is an explicit function of the task point t: the reach margin (>= 0: the
 mechanism assembles), the limited quantities with declared limits (actuator
 strokes, pose coordinates, passive joints), the branch indicators (>= 0) and
@@ -15,7 +15,7 @@ certificate proves, for **every** point of the box (not samples of it), that
 
 by branch and bound over sub-boxes:
 
-1. the interval extension of those functions (:class:`~cpm_nlp.analysis.intervals.IntervalProgram`,
+1. the interval extension of those functions (`IntervalProgram`,
    the CasADi SX graph replayed on intervals with outward rounding) encloses
    their range over each sub-box, vectorised over all sub-boxes of a round;
 2. where that enclosure does not prove a bound, the **monotonicity test**
@@ -79,15 +79,28 @@ _U = np.finfo(float).eps / 2
 class Certificate:
     """Whether every point of a box of task coordinates is in the workspace.
 
-    certified: proven for every point of the box.
-    margin: the smallest proven margin of a bounded quantity over the box (SI
-    of ``binding``; > 0 only if certified, else None); condition: the proven
-    upper bound of cond₂(Φ_x) over the box (None unless certified).
-    boxes: sub-boxes evaluated; depth: deepest split; seconds: wall time.
-    failing_lower, failing_upper: the first sub-box where the proof failed;
-    failing_quantity: the bound that could not be proven there ("reach" for
-    the assembly condition, "singular" for the regularity of Φ_x);
-    counterexample: a point of it proven outside, if one was found.
+    Attributes
+    ----------
+    certified
+        proven for every point of the box.
+    margin
+        the smallest proven margin of a bounded quantity over the box (SI of ``binding``; > 0
+        only if certified, else None);
+    condition
+        the proven upper bound of cond₂(Φ_x) over the box (None unless certified).
+    boxes
+        sub-boxes evaluated;
+    depth
+        deepest split;
+    seconds
+        wall time.
+    failing_lower, failing_upper
+        the first sub-box where the proof failed;
+    failing_quantity
+        the bound that could not be proven there ("reach" for the assembly condition, "singular"
+        for the regularity of Φ_x);
+    counterexample
+        a point of it proven outside, if one was found.
     """
 
     certified: bool
@@ -435,7 +448,7 @@ CERTIFY_OPTION = Option(
     default=True,
 )
 
-#: the values of :func:`certificate_values` and their dimensions
+#: the values of `certificate_values` and their dimensions
 CERTIFICATE_DIMENSIONS: Mapping[str, str] = MappingProxyType(
     {
         "certified": "text",

@@ -27,7 +27,7 @@ x(q) whose derivative is dx/dq = J = -Φ_x⁻¹ Φ_q (implicit function theorem)
 This is a pseudo-rigid-body model: only the joint coordinates the kinematics
 moves store energy, with the hinge's stiffness about that axis.  The other
 five axes of each flexure (the 6-axis compliances of
-:mod:`cpm_nlp.analysis.flexure_compliance`) would need the position and frame
+`cpm_nlp.analysis.flexure_compliance`) would need the position and frame
 of every hinge in space, which a loop closure does not carry; they supply the
 stiffness of an axis only when a coordinate moves about it (e.g. the torsion
 of a spherical flexure).  With the actuators rigidly held the model is a rigid
@@ -35,7 +35,7 @@ structure (no deflection); the platform compliance it gives is that of the
 actuated directions.
 
 Hinge stresses follow from the hinge moments M = k (θ - θ0) by the formulas of
-:data:`HINGE_TYPES` (nominal stresses at the thinnest section, each with its
+`HINGE_TYPES` (nominal stresses at the thinnest section, each with its
 source), combined by von Mises where a hinge carries bending and torsion.
 """
 
@@ -71,7 +71,7 @@ AXIS_TEXT = {
 
 
 def six_axis_stiffness(h: Hinge) -> dict[str, float] | None:
-    """The hinge's stiffness about and along all of :data:`SIX_AXES` (N*m/rad, N/m),
+    """The hinge's stiffness about and along all of `SIX_AXES` (N*m/rad, N/m),
     its given k where it has one; None without a flexure type and a material with E
     and nu (the other axes then cannot be computed)."""
     if h.kind is None or h.material is None or h.material.E is None or h.material.nu is None:
@@ -82,7 +82,7 @@ def six_axis_stiffness(h: Hinge) -> dict[str, float] | None:
 
 
 #: the hinge types a mechanism's or a problem's ``hinges`` may name: those of the one table
-#: (:data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`) that give a stiffness and a stress
+#: (`cpm_nlp.analysis.hinge_types.HINGE_TABLE`) that give a stiffness and a stress
 HINGE_TYPES: Mapping[str, HingeType] = MappingProxyType(
     {name: t for name, t in HINGE_TABLE.items() if t.stiffness is not None}
 )
@@ -153,9 +153,9 @@ HINGES = hinges_node("hinges by name: name -> {joints, type, k, dimensions, Kt, 
 
 @dataclass(frozen=True, kw_only=True)
 class HingeSpec:
-    """One hinge as declared, parsed by :data:`HINGES` (SI): the typed record a mechanism's
+    """One hinge as declared, parsed by `HINGES` (SI): the typed record a mechanism's
     hinge is parsed to once, and a problem file's hinge of the same name is merged over key
-    by key (:meth:`over`).  ``keys``: the keys given (a key given as null clears the one below)."""
+    by key (`over`).  ``keys``: the keys given (a key given as null clears the one below)."""
 
     joints: str | Mapping[str, str] | None = None
     type: str | None = None
@@ -164,13 +164,13 @@ class HingeSpec:
     k: Any = None
     material: Material | None = None
     Kt: float | None = None
-    #: the dimensions given (t, r, w, ... of :data:`~cpm_nlp.analysis.hinge_types.DIM_OPTIONS`)
+    #: the dimensions given (t, r, w, ... of `DIM_OPTIONS`)
     dims: Mapping[str, float | None] = field(default_factory=dict)
     keys: frozenset[str] = frozenset()
 
     @classmethod
     def parsed(cls, values: Mapping[str, Any]) -> HingeSpec:
-        """The record of one hinge as :data:`HINGES` parsed it (only the keys given)."""
+        """The record of one hinge as `HINGES` parsed it (only the keys given)."""
         named = {k: values[k] for k in ("joints", "type", "k", "material", "Kt") if k in values}
         dims = MappingProxyType({d: values[d] for d in DIM_OPTIONS if d in values})
         return cls(**named, dims=dims, keys=frozenset(values))
@@ -190,17 +190,20 @@ class JointStiffness(Part):
     used by the compliance kinds as defaults that a problem file may override hinge by hinge
     (``inputs.hinges``).
 
-    hinges: hinge name -> the same mapping a problem file gives under ``inputs.hinges``:
-        ``joints`` (a coordinate or family name of x, q or the passive joints, or a mapping
-        axis -> name with axes bend, bend2, torsion, axial), ``k`` (N*m/rad on angles, N/m on
-        lengths; one value or one per axis), and optionally a flexure ``type`` with its
-        dimensions (see :data:`HINGE_TYPES`) for the stresses and the stiffness of the axes k
-        does not give.  Kept as written (``cpm-nlp describe`` shows it); parsed once, when
-        declared, to :attr:`records`.
-    material: the hinge material, a name of :data:`cpm_nlp.analysis.flexure.MATERIALS`
-        or an inline mapping ``{name, E, nu, density, yield_strength, allowable}``; parsed
-        once to :attr:`parsed_material`.
-    source: where the paper gives them (file, section, table).
+    Attributes
+    ----------
+    hinges
+        hinge name -> the same mapping a problem file gives under ``inputs.hinges``: ``joints``
+        (a coordinate or family name of x, q or the passive joints, or a mapping axis -> name
+        with axes bend, bend2, torsion, axial), ``k`` (N*m/rad on angles, N/m on lengths; one
+        value or one per axis), and optionally a flexure ``type`` with its dimensions (see
+        `HINGE_TYPES`) for the stresses and the stiffness of the axes k does not give.  Kept as
+        written (``cpm-nlp describe`` shows it); parsed once, when declared, to `records`.
+    material
+        the hinge material, a name of `cpm_nlp.analysis.flexure.MATERIALS` or an inline mapping
+        ``{name, E, nu, density, yield_strength, allowable}``; parsed once to `parsed_material`.
+    source
+        where the paper gives them (file, section, table).
     """
 
     capability: ClassVar[str] = "stiffness"
@@ -208,7 +211,7 @@ class JointStiffness(Part):
     hinges: Mapping[str, Mapping[str, Any]]
     material: Any = None
     source: str = ""
-    #: hinge name -> its record (:class:`HingeSpec`), parsed once from ``hinges``
+    #: hinge name -> its record (`HingeSpec`), parsed once from ``hinges``
     records: Mapping[str, HingeSpec] = field(init=False, repr=False, compare=False)
     #: the material, parsed once (None when not given)
     parsed_material: Material | None = field(init=False, repr=False, compare=False)
@@ -381,7 +384,7 @@ def _given_stiffness(raw_k: Any, axes: Mapping[str, Any], path: tuple) -> dict[s
 def _parse_hinge(
     closure: LoopClosure, gname: str, spec: HingeSpec, default_material: Material | None, path: tuple
 ) -> list[Hinge]:
-    """The hinges of one parsed hinge entry (:class:`HingeSpec`): one per member of its joints."""
+    """The hinges of one parsed hinge entry (`HingeSpec`): one per member of its joints."""
     axes = _hinge_axes(closure, spec.joints, path)
     coords = list(closure.x) + list(closure.q) + list(closure.passive_coords)
     kind = spec.type
@@ -459,7 +462,7 @@ def hinge_set(
 ) -> HingeSet:
     """The hinges of a model: the mechanism's declared defaults (its part ``stiffness``,
     parsed when it was declared) merged, hinge by hinge and key by key, with ``hinges`` from
-    the problem file (as written or parsed by :data:`HINGES`); ``material_spec`` overrides
+    the problem file (as written or parsed by `HINGES`); ``material_spec`` overrides
     the default material."""
     c = model.closure
     mech = model.mechanism
@@ -561,7 +564,7 @@ def energy_function(closure: LoopClosure) -> ca.Function:
     """``("pseudo_rigid_body", [x, q, p, k, theta0, f], [V, F, K_q, J, theta])``: the
     energy V = U - fᵀx, the actuator forces F, the input stiffness K_q, the
     forward Jacobian J and the joint vector θ = (x, q, passive), all symbolic
-    (the reference :func:`static_point` is checked against; slower, as the
+    (the reference `static_point` is checked against; slower, as the
     symbolic Φ_x⁻¹ grows the expression)."""
     c = closure
     x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
@@ -593,7 +596,7 @@ def energy_parts(closure: LoopClosure) -> Any:
     with d2Phi the Hessians of the nx residuals stacked.  With λ = Φ_x⁻ᵀ V_x (adjoint),
     F = V_q - Φ_qᵀ λ and K_q = Zᵀ (∇²V - Σ λ_i ∇²Φ_i) Z, Z = [J; I] (the reduced
     Hessian of V(x(q), q)); the small linear algebra is done in numpy.  Wrapped for
-    fast calls (:class:`~cpm_nlp.core.fast_calls.FastFunction`)."""
+    fast calls (`FastFunction`)."""
     c = closure
     x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
     n = c.nx + c.nq + len(c.passive_coords)

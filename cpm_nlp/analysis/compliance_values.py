@@ -1,9 +1,9 @@
-"""The declared values of the compliance kinds (:mod:`cpm_nlp.kinds.compliance`) and of the
-hinge models that solve them (:mod:`.hinge_models`): each value with its
-:class:`~cpm_nlp.core.outputs.Output`, written once for both.
+"""The declared values of the compliance kinds (`cpm_nlp.kinds.compliance`) and of the
+hinge models that solve them (`hinge_models`): each value with its
+[`Output`][cpm_nlp.core.result.Output], written once for both.
 
 A value of a hinge group (its largest stress) is one member of a declared family
-(:func:`stress_outputs`): the groups are the problem's hinges, known only once its inputs are read.
+(`stress_outputs`): the groups are the problem's hinges, known only once its inputs are read.
 """
 
 from __future__ import annotations
@@ -96,7 +96,7 @@ def largest(stresses: Mapping[str, float | None]) -> float | None:
 
 
 def point_warnings(hs: HingeSet, points: list[StaticPoint | None], sigma: float | None = None) -> list[ResultWarning]:
-    """The hinges' geometry, stresses and deflections at the solved points (:mod:`~cpm_nlp.analysis.validity`)."""
+    """The hinges' geometry, stresses and deflections at the solved points (`validity`)."""
     pts = [
         None if sp is None else (sp.stresses, validity.hinge_deflections(hs.hinges, sp.theta, hs.theta0))
         for sp in points
@@ -111,5 +111,5 @@ def six_axis_warnings(sm: SixAxisModel, zs: list[np.ndarray]) -> list[ResultWarn
 
 
 def linear_range(c: LoopClosure, d: np.ndarray, linear: np.ndarray) -> list[ResultWarning]:
-    """Where the nonlinear and the linear deflection differ (:func:`~.validity.linear_range_warnings`)."""
+    """Where the nonlinear and the linear deflection differ (`linear_range_warnings`)."""
     return validity.linear_range_warnings(d, linear, c.x_names, [x.kind for x in c.x])

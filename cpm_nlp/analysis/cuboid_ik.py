@@ -1,4 +1,5 @@
-"""The cuboid NLP of :func:`cpm_nlp.analysis.workspace.inscribed_cuboid` for a mechanism
+"""The cuboid NLP of
+[`cpm_nlp.analysis.workspace.inscribed_cuboid`][cpm_nlp.analysis.workspace.cuboid.inscribed_cuboid] for a mechanism
 with a closed-form IK: no pose unknowns.
 
 The same discretised semi-infinite program as the general formulation (box
@@ -29,7 +30,7 @@ of the working set across starts), and each start runs from its own initial
 box.  An exchange round adds sample points and continues from the current
 optimum the same way.
 
-The starts after the first are solved together (:meth:`ClosedFormCuboid.start_all`):
+The starts after the first are solved together (`ClosedFormCuboid.start_all`):
 J copies of the working-set NLP, one per start with its own box and rows, as one
 block-separable NLP (no constraint couples two blocks, the objective is the sum),
 whose KKT points are exactly the tuples of the starts' KKT points; IPOPT's fixed
@@ -56,7 +57,7 @@ from ..core.solver import SolverConfig, solvers_of
 
 log = logging.getLogger(__name__)
 
-#: row slots of the smallest working-set NLP (see :func:`slots`)
+#: row slots of the smallest working-set NLP (see `slots`)
 MIN_SLOTS = 16
 #: a row is active (kept for the next starts) when its multiplier exceeds this, relative to the largest
 ACTIVE_MULTIPLIER = 1e-6
@@ -72,7 +73,7 @@ QUIET = {"show_eval_warnings": False, "calc_lam_p": False}
 
 
 def row_key(rows: tuple[int, ...]) -> tuple:
-    """The key of :func:`row_function` in the closure's cache."""
+    """The key of `row_function` in the closure's cache."""
     return ("cuboid_rows", tuple(rows))
 
 
@@ -181,12 +182,21 @@ class SlotNLP:
 class ClosedFormCuboid:
     """The cuboid NLP of one model through its closed-form IK, on working sets of rows.
 
-    rows: indices of the bounded limited quantities in ``limited``'s output;
-    lower, upper: their bounds as the NLP keeps them (inside the declared
-    ones by the caller's margin); reach_lower: the bound of the reach margin;
-    samples: the unit-box sample points (N, d); centre, size: the
-    normalisation of the box; initial: quantities (positions in ``rows``, and
-    len(rows) for the reach margin) whose corner rows start the first solve.
+    Attributes
+    ----------
+    rows
+        indices of the bounded limited quantities in ``limited``'s output;
+    lower, upper
+        their bounds as the NLP keeps them (inside the declared ones by the caller's margin);
+    reach_lower
+        the bound of the reach margin;
+    samples
+        the unit-box sample points (N, d);
+    centre, size
+        the normalisation of the box;
+    initial
+        quantities (positions in ``rows``, and len(rows) for the reach margin) whose corner rows
+        start the first solve.
     """
 
     def __init__(
@@ -245,7 +255,7 @@ class ClosedFormCuboid:
 
     def _solve_blocks(self, z0s: list[np.ndarray], works: list[list[tuple[int, int]]]):
         """Several starts, each on its own working set, as one block-separable NLP
-        (:class:`SlotNLP` with blocks): (Z (J, 2d), ok, status, iterations, multipliers (J, K))."""
+        (`SlotNLP` with blocks): (Z (J, 2d), ok, status, iterations, multipliers (J, K))."""
         J = len(works)
         K = slots(max(len(w) for w in works))
         sel = tuple(sorted({r for w in works for _, r in w}))
@@ -308,7 +318,7 @@ class ClosedFormCuboid:
         return z, False, f"the working set did not settle in {MAX_SETTLE} solves", iterations, set()
 
     def settle_blocks(self, z0s: list[np.ndarray], works: list[set]) -> tuple[list, bool, str, int, list[set]]:
-        """:meth:`settle` for several starts at once (one block-separable NLP per round;
+        """`settle` for several starts at once (one block-separable NLP per round;
         every start solved again from its own z0 while any start's rows grow).
         Returns (the z of each start, ok, status, iterations, the active rows of each)."""
         works = [set(w) for w in works]
@@ -353,7 +363,7 @@ class ClosedFormCuboid:
     def start_all(self, boxes: list[tuple[np.ndarray, np.ndarray]]) -> tuple[list[tuple] | None, int]:
         """Several starts from the boxes (u0, w0) at once, as one block-separable NLP,
         each from the rows of the optima found before (the first start's, run by
-        :meth:`start`): ([(converged, z, status, 0) per start], IPOPT iterations).  The
+        `start`): ([(converged, z, status, 0) per start], IPOPT iterations).  The
         runs are None if the joint solve did not converge: the caller then runs the
         starts one by one (which also retries a start with the corners' rows)."""
         if not self.memory or len(boxes) < 2:

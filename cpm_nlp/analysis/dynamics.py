@@ -1,6 +1,6 @@
 """Lagrange dynamics of a mechanism about its home configuration.
 
-A mechanism that has a dynamic model registers a :class:`DynamicsModel` among its
+A mechanism that has a dynamic model registers a [`DynamicsModel`][cpm_nlp.analysis.dynamics.DynamicsModel] among its
 parts (the part ``dynamics``, read by the ``dynamics`` kind):
 
 * ``lagrangian()`` -- ``ca.Function("lagrangian", [q, qd, p, w], [T, U, ...])``:
@@ -42,14 +42,20 @@ from ..core.units import parse_quantity
 class DynamicsModel(Part):
     """A Lagrange model of the mechanism (the part ``dynamics``), used by the ``dynamics`` kind.
 
-    masses: ``(name, description)`` of each mass input (kg, or a block of the
-        hinge material given by its dimensions).
-    parameters: names, in order, of the vector w the energies take: ``E``,
-        ``g``, the masses and any mechanism parameters by name.
-    lagrangian: ``() -> ca.Function("...", [q, qd, p, w], [T, U, ...])``: the
-        kinetic and potential energies in the actuator coordinates q (nq).
-    values: optional ``(model, w, M, K, G) -> dict`` of named quantities of the
-        paper, with their dimensions in ``dimensions``.
+    Attributes
+    ----------
+    masses
+        ``(name, description)`` of each mass input (kg, or a block of the hinge material given
+        by its dimensions).
+    parameters
+        names, in order, of the vector w the energies take: ``E``, ``g``, the masses and any
+        mechanism parameters by name.
+    lagrangian
+        ``() -> ca.Function("...", [q, qd, p, w], [T, U, ...])``: the kinetic and potential
+        energies in the actuator coordinates q (nq).
+    values
+        optional ``(model, w, M, K, G) -> dict`` of named quantities of the paper, with their
+        dimensions in ``dimensions``.
     """
 
     capability: ClassVar[str] = "dynamics"

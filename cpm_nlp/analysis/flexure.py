@@ -20,7 +20,7 @@ from ..core.errors import InputError
 from ..core.options import REQUIRED, Option
 from ..core.schema import Named, Record
 
-#: properties of a :class:`Material`, in the order the papers list them
+#: properties of a `Material`, in the order the papers list them
 PROPERTIES = {
     "E": "Young's modulus",
     "nu": "Poisson's ratio",
@@ -47,8 +47,8 @@ class Material:
     source: str = ""
 
     def require(self, prop: str, path: tuple = ("material",), why: str = "") -> float:
-        """The property ``prop`` (one of :data:`PROPERTIES`), or an
-        :class:`InputError` saying that this material does not give it."""
+        """The property ``prop`` (one of `PROPERTIES`), or an
+        [`InputError`][cpm_nlp.core.errors.InputError] saying that this material does not give it."""
         value = getattr(self, prop)
         if value is None:
             need = f" ({why})" if why else ""
@@ -115,8 +115,8 @@ MATERIAL_OPTIONS = (
 
 
 def material_node(name: str = "material", description: str = "the hinge material", default=REQUIRED) -> Named:
-    """The declaration of a material input: a name of :data:`MATERIALS` or inline
-    ``{E: 72 GPa, nu: 0.33, ...}`` (parsed to a :class:`Material`)."""
+    """The declaration of a material input: a name of `MATERIALS` or inline
+    ``{E: 72 GPa, nu: 0.33, ...}`` (parsed to a `Material`)."""
     return Named(
         name,
         description,
@@ -134,8 +134,8 @@ MATERIAL = material_node()
 
 
 def material(spec: str | dict | Material, path: tuple = ("material",)) -> Material:
-    """A material by name (see :data:`MATERIALS`) or inline ``{E: 72 GPa, ...}``
-    (a :class:`Material` already parsed is returned as it is)."""
+    """A material by name (see `MATERIALS`) or inline ``{E: 72 GPa, ...}``
+    (a `Material` already parsed is returned as it is)."""
     return MATERIAL.parse(spec, path)
 
 
@@ -176,7 +176,7 @@ def circular_notch_stiffness_exact(E, b, t, r):
 
     obtained from int dphi / (a - c cos phi) = 4 T / sqrt(u) (x = r sin phi)
     by differentiating twice with respect to a.  For t/r -> 0 it tends to
-    :func:`circular_notch_stiffness` (tests/analysis/test_flexure.py checks both the
+    `circular_notch_stiffness` (tests/analysis/test_flexure.py checks both the
     limit and the integral by quadrature).  For the 3-PRC hinge of
     prc3-li-2018.md Table 1 (t/r = 1/6) the simplified formula is 2.1 % softer.
     """
@@ -191,7 +191,7 @@ def circular_notch_stiffness_exact(E, b, t, r):
 def check_circular_notch(t: float, r: float, path: tuple = ()) -> None:
     """Reject a notch the simplified formula k = 2 E b t^2.5 / (9 pi r^0.5)
     does not describe: it needs t > 0, r > 0 and t <= r (it is the t << r
-    limit of :func:`circular_notch_stiffness_exact`; at t = r it is already
+    limit of `circular_notch_stiffness_exact`; at t = r it is already
     12 % too soft).  ``path`` locates t in the problem file."""
     if not (t > 0 and r > 0):
         raise InputError(f"expected a positive notch thickness t and radius r, got t = {t!r}, r = {r!r}", path=path)

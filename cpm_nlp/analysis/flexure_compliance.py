@@ -1,10 +1,10 @@
 """Six-axis compliance matrices of notch flexure joints (companion of
-:mod:`cpm_nlp.analysis.flexure`, which holds the one-axis hinge formulas and materials).
+`cpm_nlp.analysis.flexure`, which holds the one-axis hinge formulas and materials).
 
 Every function works on floats and on CasADi symbols (the integrals are
 evaluated by a fixed Gauss-Legendre rule, so a design optimisation can
 differentiate through them).  All values are SI.  Compliance matrices follow
-:mod:`cpm_nlp.core.screws`: C maps the wrench (f; m) at the hinge centre to the
+`cpm_nlp.core.screws`: C maps the wrench (f; m) at the hinge centre to the
 displacement (δ; φ) of that point.
 
 Notch frame: x along the hinge (the line through the two attached bodies),
@@ -22,7 +22,7 @@ Sources:
   the variable ψ with tan(φ/2) = sqrt(t/(t+4r)) tan ψ (x = r sin φ), which
   makes the integrands smooth, so 32 nodes reproduce the closed forms to
   round-off (tests compare with adaptive quadrature and with the simplified
-  Paros-Weisbord formula of :func:`cpm_nlp.analysis.flexure.circular_notch_stiffness`).
+  Paros-Weisbord formula of `cpm_nlp.analysis.flexure.circular_notch_stiffness`).
 * Torsion constant of a rectangle a x c (a >= c): J = a c³ [1/3 - 0.21 (c/a)
   (1 - c⁴/(12 a⁴))] (W. C. Young, R. G. Budynas, *Roark's Formulas for Stress
   and Strain*, 7th ed., Table 10.7, case 4).
@@ -31,7 +31,7 @@ Sources:
 * Two orthogonal notches in series as a U joint (the notch-type universal
   flexure, e.g. G. Palmieri, M. C. Palpacelli, M. Callegari, J. Mech. Des.
   134(12), 2012): the series compliance is the sum of both notch compliances
-  rotated and transported to the joint centre (:mod:`cpm_nlp.core.screws`).
+  rotated and transported to the joint centre (`cpm_nlp.core.screws`).
 """
 
 from __future__ import annotations
@@ -128,7 +128,7 @@ def _diag(values) -> Any:
 
 def notch_compliance_matrix(E, G, b, t, r) -> Any:
     """6 x 6 compliance of a circular notch at its centre, notch frame,
-    diag(x, y, z, rx, ry, rz) of :func:`circular_notch_compliances`."""
+    diag(x, y, z, rx, ry, rz) of `circular_notch_compliances`."""
     c = circular_notch_compliances(E, G, b, t, r)
     return _diag([c["x"], c["y"], c["z"], c["rx"], c["ry"], c["rz"]])
 

@@ -1,15 +1,15 @@
 """The six-axis hinge model: compliant forward kinematics and platform compliance
 with every flexure a six-degree-of-freedom spring at its joint.
 
-The pseudo-rigid-body model of :mod:`cpm_nlp.analysis.compliance` lets a hinge
+The pseudo-rigid-body model of `cpm_nlp.analysis.compliance` lets a hinge
 turn only about the axes the kinematics moves, so with the actuators held a
 mechanism of rigid links does not deflect at all.  A real flexure also bends
 about its second axis, twists, stretches and shears.  Here each leg is the
 serial chain of its joints at the reference configuration (the part ``chains``,
-:class:`~cpm_nlp.core.chains.LegChains`) and every hinge adds, at its joint and
+[`LegChains`][cpm_nlp.core.chains.LegChains]) and every hinge adds, at its joint and
 in its own frame (length axis t, compliant axis b1, second axis b2 = b1 x t),
 the axes its joint does not move, each with the flexure library's stiffness
-(:data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, each type's ``six_axis``):
+(`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, each type's ``six_axis``):
 
     leg k:  G_k(z) = Π_j [ Π_d exp(ξ_jd θ_jd) · Π_a exp(η_ja ε_ja) ]      (product of exponentials)
     closure: G_k(z) = T_P(x) T_P(x_ref)⁻¹  at the leg's platform point (3 rows) and in rotation (3 rows)
@@ -64,7 +64,7 @@ _ROT_AXES = ("bend", "bend2", "torsion")
 
 
 def _rot(axis: np.ndarray, angle: Any) -> Any:
-    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues: :func:`~cpm_nlp.core.screws.axis_rotation`)."""
+    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues: `axis_rotation`)."""
     return axis_rotation(ca.DM(np.asarray(axis, dtype=float).reshape(3, 1)), angle)
 
 
@@ -81,8 +81,14 @@ def _perpendicular(v: np.ndarray) -> np.ndarray:
 class HingeFrame:
     """One hinge in the chains: where it sits, its frame, and the variable of each axis.
 
-    axes: axis name -> (kind "R" or "P", unit vector); variables: axis name ->
-    (index in z, rest value); k: axis name -> stiffness.
+    Attributes
+    ----------
+    axes
+        axis name -> (kind "R" or "P", unit vector);
+    variables
+        axis name -> (index in z, rest value);
+    k
+        axis name -> stiffness.
     """
 
     name: str

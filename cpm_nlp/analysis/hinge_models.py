@@ -1,13 +1,13 @@
 """The hinge models of the compliance kinds, as objects: ``kinematic`` (the
-pseudo-rigid-body model of :mod:`cpm_nlp.analysis.compliance`: each hinge only
+pseudo-rigid-body model of `cpm_nlp.analysis.compliance`: each hinge only
 about the axes the kinematics moves) and ``all`` (every flexure a six-axis spring
-at its joint, :mod:`cpm_nlp.analysis.hinge_chains`; needs the mechanism's leg
+at its joint, `cpm_nlp.analysis.hinge_chains`; needs the mechanism's leg
 chains).  A problem file names one (``inputs.hinge_axes``); the input's choices
-are the keys of :data:`HINGE_MODELS`.
+are the keys of `HINGE_MODELS`.
 
-Each model is prepared once per problem (:meth:`HingeModel.prepare`: the six-axis
+Each model is prepared once per problem (`HingeModel.prepare`: the six-axis
 springs built, or the default's fallback to ``kinematic`` noted) and then solves the
-platform compliance at a commanded pose (:meth:`HingeModel.solve`): the output
+platform compliance at a commanded pose (`HingeModel.solve`): the output
 compliance C, and the compliant forward kinematics under the load.  The
 ``platform_compliance`` kind only calls the chosen model.
 """
@@ -65,7 +65,7 @@ class Prepared:
         k_actuator: np.ndarray | None,
         info: SolverInfo,
     ) -> HingeSolution:
-        """The chosen model's compliance at ``pose`` (:meth:`HingeModel.solve`)."""
+        """The chosen model's compliance at ``pose`` (`HingeModel.solve`)."""
         return self.hinges.solve(self, model, hs, pose, load, k_actuator, info)
 
 
@@ -83,7 +83,7 @@ class HingeSolution:
 
 @dataclass(frozen=True)
 class HingeModel:
-    """A hinge model of :data:`HINGE_MODELS` (name, description): prepared once per problem,
+    """A hinge model of `HINGE_MODELS` (name, description): prepared once per problem,
     then solved at a pose."""
 
     name: str

@@ -1,9 +1,9 @@
-"""The flexure hinge types: one table (:data:`HINGE_TABLE`), one frozen :class:`HingeType`
-per type, read by the compliance model (:mod:`cpm_nlp.analysis.compliance`: a hinge's
+"""The flexure hinge types: one table (`HINGE_TABLE`), one frozen `HingeType`
+per type, read by the compliance model (`cpm_nlp.analysis.compliance`: a hinge's
 stiffness, six-axis stiffness and stress), the hinge rotation limits of mechanisms and
-files (:func:`hinge_rotation`, a joint's ``flexure``), the file reader, ``describe`` and
+files (`hinge_rotation`, a joint's ``flexure``), the file reader, ``describe`` and
 the docs.  Where a type may sit is said once, by the joint types
-(:attr:`cpm_nlp.core.joints.JointType.hinges`); :attr:`HingeType.joints` reads it there.
+(`cpm_nlp.core.joints.JointType.hinges`); `HingeType.joints` reads it there.
 
 Each type gives what its sources give: a stiffness per axis and a stress (the compliance
 model's types), and/or the largest rotation at the allowable stress (the rotation limits).
@@ -104,7 +104,7 @@ def _beam_shear(E, G, length, inertia, area, alpha_s):
     """Transverse stiffness of a straight beam at its centre, 1/(l³/(12 E I) + α_s l/(G A)):
     the compliance of a cantilever's free end (l³/3EI, coupling l²/2EI, l/EI) transported
     to the mid-point, where the force-moment coupling vanishes (the definition of
-    :func:`~cpm_nlp.analysis.flexure_compliance.circular_notch_compliances`), plus Timoshenko shear."""
+    `circular_notch_compliances`), plus Timoshenko shear."""
     return 1.0 / (length**3 / (12.0 * E * inertia) + alpha_s * length / (G * area))
 
 
@@ -193,18 +193,28 @@ DIM_OPTIONS: Mapping[str, Option] = MappingProxyType(
 class HingeType:
     """A flexure hinge geometry.
 
-    name: its ``type`` (a hinge's) or ``hinge`` (a joint limit's) in a file.
-    dims: the dimensions its stiffness and stress take (:data:`DIM_OPTIONS`).
-    stiffness: ``(E, G, dims) -> {axis: k}`` about the axes of
-        :data:`cpm_nlp.analysis.compliance.AXES` (G None when the material gives no
-        Poisson's ratio), None if no source gives it.
-    six_axis: ``(E, G, dims) -> {axis: k}`` over all of :data:`SIX_AXES`, at its centre.
-    stress: ``(dims, loads) -> σ``, its largest stress for the loads per axis.
-    source: the sources of stiffness, six-axis stiffness and stress.
-    limit_dims: the dimensions its largest rotation takes.
-    rotation: ``(E, σ_allow, dims) -> δ_max`` [rad], the largest rotation at the allowable
-        stress (a joint's rotation limit), None if no source gives it.
-    limit_source: the source of ``rotation``.
+    Attributes
+    ----------
+    name
+        its ``type`` (a hinge's) or ``hinge`` (a joint limit's) in a file.
+    dims
+        the dimensions its stiffness and stress take (`DIM_OPTIONS`).
+    stiffness
+        ``(E, G, dims) -> {axis: k}`` about the axes of `cpm_nlp.analysis.compliance.AXES` (G
+        None when the material gives no Poisson's ratio), None if no source gives it.
+    six_axis
+        ``(E, G, dims) -> {axis: k}`` over all of `SIX_AXES`, at its centre.
+    stress
+        ``(dims, loads) -> σ``, its largest stress for the loads per axis.
+    source
+        the sources of stiffness, six-axis stiffness and stress.
+    limit_dims
+        the dimensions its largest rotation takes.
+    rotation
+        ``(E, σ_allow, dims) -> δ_max`` [rad], the largest rotation at the allowable stress (a
+        joint's rotation limit), None if no source gives it.
+    limit_source
+        the source of ``rotation``.
     """
 
     name: str
@@ -224,7 +234,7 @@ class HingeType:
 
     @property
     def joints(self) -> tuple[str, ...]:
-        """The joint types it can sit at (said by :data:`cpm_nlp.core.joints.JOINT_TYPES`)."""
+        """The joint types it can sit at (said by `cpm_nlp.core.joints.JOINT_TYPES`)."""
         return tuple(n for n, j in JOINT_TYPES.items() if self.name in j.hinges)
 
 
@@ -294,7 +304,7 @@ LIMIT_TYPES = tuple(n for n, t in HINGE_TABLE.items() if t.rotation is not None)
 # -- hinge rotation limits from a problem file --------------------------------------------------
 #
 # A mechanism whose joint limits follow from its flexure hinges declares
-# HINGE_LIMIT_OPTIONS among its LIMITS and calls :func:`hinge_rotation` on the
+# HINGE_LIMIT_OPTIONS among its LIMITS and calls `hinge_rotation` on the
 # validated limits: the hinge type, its dimensions and its material give the
 # largest rotation delta_max at the allowable stress.
 

@@ -1,6 +1,6 @@
 """Interval evaluation of CasADi SX functions, vectorised over many boxes.
 
-:class:`IntervalProgram` walks the algorithm of a ``ca.Function`` (built from
+`IntervalProgram` walks the algorithm of a ``ca.Function`` (built from
 SX) once, op by op (``instruction_id`` / ``instruction_input`` /
 ``instruction_output`` / ``instruction_constant``), and replays it on interval
 operands: every work register holds two numpy arrays (lower and upper ends)
@@ -14,14 +14,14 @@ Rigour (outward rounding):
 * sin, cos, tan, atan, atan2, acos, asin, exp, log, pow come from the C
   library, which is not correctly rounded but accurate to an ulp or two
   (glibc documents at most 1-2 ulp for these); their ends are moved
-  :data:`LIBM_ULPS` ulps outward;
+  `LIBM_ULPS` ulps outward;
 * fmin, fmax, neg, twice, fabs and assignments are exact and not widened;
 * a function undefined somewhere in its interval argument (acos outside
   [-1, 1], sqrt or log of a negative number, division by an interval that
   contains zero) gives NaN or an infinite interval, never a finite interval
   that could be mistaken for a proof; callers treat NaN as "not proven".
 
-The enclosure is the natural interval extension; :mod:`cpm_nlp.analysis.certify`
+The enclosure is the natural interval extension; `cpm_nlp.analysis.certify`
 sharpens it with a monotonicity test (the interval Jacobian).
 """
 
@@ -33,7 +33,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-#: values (nodes × boxes) held at a time by :meth:`IntervalProgram.evaluate`
+#: values (nodes × boxes) held at a time by `IntervalProgram.evaluate`
 MAX_VALUES = 4_000_000
 #: ulps by which the ends of a C-library function value are moved outward
 LIBM_ULPS = 4
@@ -303,7 +303,7 @@ class IntervalProgram:
     ``evaluate(inputs)`` takes, per input of the function, a pair (lo, hi) of
     arrays (B, n_in) and returns per output a pair (lo, hi) of arrays (B, n_out)
     enclosing the output over every point of the boxes.  Raises
-    :class:`UnsupportedOperation` at construction if the function uses an
+    `UnsupportedOperation` at construction if the function uses an
     operation without an interval version.
 
     The instructions are renamed to single-assignment nodes and grouped by

@@ -1,29 +1,29 @@
 """A certificate that an assembly-mode search missed no real mode in its region.
 
-:func:`cpm_nlp.analysis.assembly.assembly_modes` is a multi-start search: its
-completeness is an estimate.  :func:`certify_modes` proves it, where it can,
+[`cpm_nlp.analysis.assembly.assembly_modes`][cpm_nlp.analysis.assembly.assembly_modes] is a multi-start search: its
+completeness is an estimate.  `certify_modes` proves it, where it can,
 by interval branch and bound on the closures Φ(x; q, p) = 0 over the search
 region (angles a full turn, lengths home ± reach), with the interval
-programs of the cuboid certificate (:class:`~cpm_nlp.analysis.intervals.IntervalProgram`,
-outward rounding) and its regularity test (:func:`~cpm_nlp.analysis.certify.regularity`).
+programs of the cuboid certificate (`IntervalProgram`,
+outward rounding) and its regularity test (`regularity`).
 Every sub-box is, in the end, one of
 
 * **excluded**: the interval enclosure of some Φ_i over the sub-box does not
   contain 0, so no pose in it closes the loops; or
 * **one mode**: every matrix of the interval enclosure of Φ_x over the sub-box
-  (widened by :data:`MARGIN`) is regular, so Φ has at most one zero there (the
+  (widened by `MARGIN`) is regular, so Φ has at most one zero there (the
   mean-value form Φ(a) - Φ(b) = M (a - b) with M in that enclosure), and a mode
   the search found lies in it: that zero is the mode.
 
 When every sub-box is settled the certificate holds: the real modes in the
 region are exactly those found.  A sub-box neither excluded nor settled is
 split in two along its widest coordinate (lengths divided by the reach); the
-search stops uncertified at :data:`MAX_BOXES` sub-boxes (or the caller's
-``max_boxes``), or at sub-boxes narrower than :data:`MIN_WIDTH`, and says so.
+search stops uncertified at `MAX_BOXES` sub-boxes (or the caller's
+``max_boxes``), or at sub-boxes narrower than `MIN_WIDTH`, and says so.
 A mode the search missed is never certified away: its sub-boxes are neither
 excluded nor settled, and the budget runs out.
 
-A found mode is taken to be within :data:`MARGIN` (scaled) of its computed
+A found mode is taken to be within `MARGIN` (scaled) of its computed
 pose: its residual is ~1e-13 and Φ_x is regular there, so the true zero is
 far closer.  The sub-boxes are regular in the region's coordinates, which the
 closures are periodic in (angles), so the full turn is covered once.

@@ -30,11 +30,15 @@ _HOME_ZERO = 1e-12
 class RequirementsReport:
     """IK over a grid of task coordinates.
 
-    poses: the grid, shape (N, nq) in the order of closure.task;
-    solutions: one PoseSolution per pose;
-    ranges: ``name -> value`` for ``<family>_min``, ``<family>_max`` (and
-    ``d<family>_min/max`` for families with a non-zero home value).  Empty
-    unless every pose is solved.
+    Attributes
+    ----------
+    poses
+        the grid, shape (N, nq) in the order of closure.task;
+    solutions
+        one PoseSolution per pose;
+    ranges
+        ``name -> value`` for ``<family>_min``, ``<family>_max`` (and ``d<family>_min/max`` for
+        families with a non-zero home value).  Empty unless every pose is solved.
     """
 
     poses: np.ndarray

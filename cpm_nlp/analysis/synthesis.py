@@ -1,7 +1,7 @@
 """Generic dimensional synthesis: geometry parameters as decision variables of
 the cuboid NLP, for any mechanism (no paper formulation needed).
 
-The NLP is the discretised cuboid problem of :mod:`cpm_nlp.analysis.workspace`
+The NLP is the discretised cuboid problem of `cpm_nlp.analysis.workspace`
 (the box [c + D∘u, c + D∘(u + w)] in the task coordinates, sample points s_j on
 its surface, pose unknowns y_j with Φ(t_j, y_j; p) = 0 and every limited
 quantity -- actuators, pose coordinates, passive joints, branch indicators --
@@ -19,10 +19,10 @@ radius b; no footprint: the volume itself), solved as the minimum of
 Multi-start: the first start is the model's own design (clipped into the
 bounds), the others seeded uniform draws in the parameter box; each start
 begins at the largest cuboid of its own design
-(:func:`~cpm_nlp.analysis.workspace.inscribed_cuboid`, the poses of its
+([`inscribed_cuboid`][cpm_nlp.analysis.workspace.cuboid.inscribed_cuboid], the poses of its
 samples from the IK), so every start is feasible.  The best optimum is
 **re-checked**: the model is rebuilt with the optimal parameters and the box is
-tested against :func:`~cpm_nlp.analysis.workspace.check_box` on a dense grid of
+tested against [`check_box`][cpm_nlp.analysis.workspace.cuboid.check_box] on a dense grid of
 its faces, edges and interior.  A box that fails is shrunk about its centre
 until it passes, and the result says by how much; a design with no box that
 passes is reported infeasible, never as a number.
@@ -69,12 +69,20 @@ SHRINK_STEPS = 30
 class SynthesisResult:
     """The best design found and its re-checked box.
 
-    parameters: every parameter (SI) of the optimal design; lower, upper: the
-    box (task coordinates); volume, footprint, objective = volume / footprint;
-    check: the membership check of the box at the optimal parameters; shrink:
-    factor applied about its centre to pass it (1 = none); starts,
-    converged, agreed: the multi-start's counts; start_objectives: of the
-    converged starts.  None/empty unless ``found``.
+    Attributes
+    ----------
+    parameters
+        every parameter (SI) of the optimal design;
+    lower, upper
+        the box (task coordinates); volume, footprint, objective = volume / footprint;
+    check
+        the membership check of the box at the optimal parameters;
+    shrink
+        factor applied about its centre to pass it (1 = none); starts,
+    converged, agreed
+        the multi-start's counts;
+    start_objectives
+        of the converged starts.  None/empty unless ``found``.
     """
 
     found: bool
@@ -282,10 +290,15 @@ def cuboid_synthesis(
     """The design that maximises the inscribed cuboid per unit of footprint (see
     the module docstring).
 
-    design: parameter name -> (low, high) bounds (SI) of the parameters that
-    vary; footprint: parameter name -> exponent (F = Π p^e; None: volume);
-    rebuild: ``parameters -> Model`` for a design (default: the model's closure
-    and limits with the new parameters).
+    Parameters
+    ----------
+    design
+        parameter name -> (low, high) bounds (SI) of the parameters that vary;
+    footprint
+        parameter name -> exponent (F = Π p^e; None: volume);
+    rebuild
+        ``parameters -> Model`` for a design (default: the model's closure and limits with the
+        new parameters).
     """
     t_start = time.perf_counter()
     config = solver or SolverConfig()

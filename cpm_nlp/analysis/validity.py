@@ -3,22 +3,22 @@
 A solve that converged gives numbers; these checks say when those numbers lie
 outside what the model behind them describes, so that the result is printed
 and stored with a warning instead of as if it were clean
-(:class:`~cpm_nlp.core.result.ResultWarning`; docs/site/howto/read-status.md
+([`ResultWarning`][cpm_nlp.core.result.ResultWarning]; docs/site/howto/read-status.md
 and docs/site/reference/flexures.md list the rules and their sources):
 
 * ``stress_above_yield`` / ``stress_above_allowable`` -- a hinge stress above its
   material's yield strength, or above the allowable (design) stress: the linear
   elastic hinge formulas no longer hold (yield), or the design rule is broken;
 * ``deflection_beyond_formula`` -- a hinge deflection beyond the range of its
-  stiffness formula (:data:`DEFLECTION_LIMITS`);
+  stiffness formula (`DEFLECTION_LIMITS`);
 * ``hinge_geometry`` -- a hinge whose dimensions break its formula's premises
-  (:func:`hinge_geometry_warnings`);
+  (`hinge_geometry_warnings`);
 * ``beyond_linear_range`` -- compliant forward kinematics whose nonlinear
   deflection differs from the linearised one (C f) by more than
-  :data:`LINEAR_RANGE` (10 %);
+  `LINEAR_RANGE` (10 %);
 * ``near_singular`` -- a pose whose loop-closure Jacobian Φ_x (or the
   homogenised input-output Jacobian) has a condition number above
-  :data:`NEAR_SINGULAR_CONDITION`.
+  `NEAR_SINGULAR_CONDITION`.
 
 A warning never changes the status or the numbers: the result stays
 ``solved`` (exit status 0) and says, in its ``warnings`` list, what to doubt.
@@ -198,7 +198,7 @@ class Collector:
     # -- deflections ---------------------------------------------------------------------------
     def deflections(self, hinge: Any, deflection: Mapping[str, float]) -> None:
         """A hinge's deflection per axis (rad about bend, bend2, torsion; m along axial,
-        shear, shear2) against :data:`DEFLECTION_LIMITS` of its type."""
+        shear, shear2) against `DEFLECTION_LIMITS` of its type."""
         if hinge.kind not in DEFLECTION_LIMITS:
             return
         rot_limit, length = DEFLECTION_LIMITS[hinge.kind]
@@ -261,7 +261,7 @@ def linear_range_warnings(
 ) -> list[ResultWarning]:
     """Compliant FK: the loaded pose's deflection against C f.  Lengths and angles
     apart, the relative difference of the two deflection vectors,
-    |d - C f| / max(|d|, |C f|) (2-norms), against :data:`LINEAR_RANGE`; the warning
+    |d - C f| / max(|d|, |C f|) (2-norms), against `LINEAR_RANGE`; the warning
     names the coordinate that differs most in the worse group."""
     d, lin = np.asarray(nonlinear, dtype=float), np.asarray(linear, dtype=float)
     worst: tuple[float, int] | None = None
@@ -292,7 +292,7 @@ def linear_range_warnings(
 
 
 def near_singular_warning(cond: float, what: str, where: str, points: str = "") -> ResultWarning | None:
-    """A warning when ``cond`` is above :data:`NEAR_SINGULAR_CONDITION` (None otherwise)."""
+    """A warning when ``cond`` is above `NEAR_SINGULAR_CONDITION` (None otherwise)."""
     if not cond > NEAR_SINGULAR_CONDITION:
         return None
     return ResultWarning(

@@ -1,4 +1,4 @@
-"""Progress bars on a terminal: :mod:`cpm_nlp.core.progress` reports, the CLI draws (tqdm)."""
+"""Progress bars on a terminal: `cpm_nlp.core.progress` reports, the CLI draws (tqdm)."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ _UNITS = {
 
 def progress_bars(args: argparse.Namespace) -> progress.Callback | None:
     """On a terminal (stderr), a tqdm progress bar per long computation
-    (:mod:`cpm_nlp.core.progress` reports, the CLI draws); none with ``-q`` or
+    (`cpm_nlp.core.progress` reports, the CLI draws); none with ``-q`` or
     when stderr is not a terminal (a log, a pipe)."""
     if getattr(args, "quiet", False) or not getattr(args.err, "isatty", lambda: False)():
         return None

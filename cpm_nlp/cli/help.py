@@ -4,7 +4,7 @@ written from a checkout or from a directory made by ``cpm-nlp examples`` (they n
 shipped problem and mechanism files, or files an earlier example wrote).
 
 The commands that plot list the plot types under their help, from the plot registry
-(:mod:`cpm_nlp.plot.registry`: the built-in types, the mechanisms' own, plugins), read only
+(`cpm_nlp.plot.registry`: the built-in types, the mechanisms' own, plugins), read only
 when the help is printed.  This module imports nothing but the standard library: it is
 loaded by every ``cpm-nlp`` run (issue 23, start-up).
 """
@@ -18,10 +18,16 @@ import textwrap
 class CommandHelp:
     """The help of one subcommand.
 
-    summary: one line, listed under ``cpm-nlp --help``.
-    description: one paragraph, at the top of the ``--help`` of each subcommand.
-    examples: ``(command line, what it does)`` pairs, listed under the options.
-    plot_types: list the registered plot types under the examples (commands that plot).
+    Attributes
+    ----------
+    summary
+        one line, listed under ``cpm-nlp --help``.
+    description
+        one paragraph, at the top of the ``--help`` of each subcommand.
+    examples
+        ``(command line, what it does)`` pairs, listed under the options.
+    plot_types
+        list the registered plot types under the examples (commands that plot).
     """
 
     # a plain class: dataclasses (and inspect, which it imports) would cost --help 5 ms

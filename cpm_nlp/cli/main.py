@@ -1,17 +1,17 @@
 """The ``cpm-nlp`` command line: the parser, which wires one module per subcommand
-(:mod:`~cpm_nlp.cli.solve` for ``solve`` and ``check``, :mod:`~cpm_nlp.cli.sweep`,
-:mod:`~cpm_nlp.cli.plot`, :mod:`~cpm_nlp.cli.reproduce`, :mod:`~cpm_nlp.cli.export`,
-:mod:`~cpm_nlp.cli.examples`, :mod:`~cpm_nlp.cli.describe`, :mod:`~cpm_nlp.cli.urdf` for
-``import``; their help texts in :mod:`~cpm_nlp.cli.help`), and the entry point with its
+(`solve` for ``solve`` and ``check``, `sweep`,
+`plot`, `reproduce`, `export`,
+`examples`, `describe`, `urdf` for
+``import``; their help texts in `help`), and the entry point with its
 handling of errors, Ctrl-C and a closed stdout.
 
-Exit status (:mod:`cpm_nlp.cli.exits`): 0 solved, 1 a solve that did not succeed (the result
+Exit status (`cpm_nlp.cli.exits`): 0 solved, 1 a solve that did not succeed (the result
 says why), 2 bad input (one message naming the file, the key path and what was expected), 70
 an internal error (a bug: please report it).
 
 Start-up is kept short on purpose (issue 23): this module imports only argparse and a few
 standard modules; a subcommand's module is imported when that subcommand runs
-(:class:`_Command`), and each subcommand and renderer imports what it needs when it runs
+(`_Command`), and each subcommand and renderer imports what it needs when it runs
 (units, numpy, CasADi, the problem kinds, Matplotlib, Dask, logging), so ``cpm-nlp --help``
 loads none of them, nor any subcommand module.
 """

@@ -4,10 +4,10 @@ Two rules, the same everywhere the CLI prints a quantity:
 
 * **Engineering prefixes, chosen per value.**  A quantity whose SI unit takes a
   prefix is shown with the prefix that puts its number between 1 and 1000, to
-  :data:`DIGITS` significant digits: 0.00348767 mm is ``3.488 µm``, 0.02 N is
+  `DIGITS` significant digits: 0.00348767 mm is ``3.488 µm``, 0.02 N is
   ``20 mN``, 1.7e8 Pa is ``170 MPa``.  An angle is shown in degrees, the papers' unit
   (``0.5579 deg``), and below 1 mrad in µrad or nrad (``-60.13 µrad``).  A compound unit
-  (N/m, m^2, N*m/rad ...) keeps its display unit (:func:`cpm_nlp.core.units.format_quantity`).
+  (N/m, m^2, N*m/rad ...) keeps its display unit (`cpm_nlp.core.units.format_quantity`).
 * **Noise below the solve's tolerance is zero.**  A solve stops when the largest
   loop-closure residual max |Φ| is at most its tolerance ``tol`` (``solver.tolerance``,
   in metres: Φ is a length).  A length is therefore known to about ``tol``, and any
@@ -15,7 +15,7 @@ Two rules, the same everywhere the CLI prints a quantity:
   largest magnitude of that dimension among the values of the result (``L``: the
   mechanism's scale, its largest length parameter; 1 m if it has none).  A
   value below that is rounding noise of the solve and is printed as ``0`` (never
-  ``-0``): ``psi 1.71766e-15 deg`` is ``0 deg``.  See :class:`Noise`.
+  ``-0``): ``psi 1.71766e-15 deg`` is ``0 deg``.  See `Noise`.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 
 def _fmt_scalar(value: Any, dim: str | None, noise: Noise = NO_NOISE) -> tuple[str, str]:
     """(the SI value, the value for people): noise below the solve's tolerance is 0, and the
-    value for people has the prefix that suits it (:mod:`cpm_nlp.cli.numbers`)."""
+    value for people has the prefix that suits it (`cpm_nlp.cli.numbers`)."""
     from ..core.units import DIMENSIONS, si_unit
 
     if value is None:
@@ -143,7 +143,7 @@ def render_result(
 ) -> str:
     """A readable table of a result.  ``tolerance``: the solve's (``solver.tolerance``) and
     ``length``: the mechanism's largest length parameter, which say what is rounding noise
-    (:class:`cpm_nlp.cli.numbers.Noise`); without a tolerance only -0 is.  ``parameter_dims``:
+    (`cpm_nlp.cli.numbers.Noise`); without a tolerance only -0 is.  ``parameter_dims``:
     the dimension of each declared parameter, shown with its unit."""
     from ..core.result import STATUS_TEXT
     from ..core.units import DIMENSIONS

@@ -4,9 +4,9 @@ By default a short summary: per paper, the figures that agree, that differ for
 a stated reason, and that cannot be reproduced, then a total.  ``--full`` prints
 the whole table (grouped by paper and problem file, cells wrapped, reasons
 numbered once per paper); ``--output FILE`` writes it to a file whose suffix
-gives the format (:data:`FORMATS`: ``.md``, ``.csv``, ``.json``), atomically;
+gives the format (`FORMATS`: ``.md``, ``.csv``, ``.json``), atomically;
 ``--json`` prints the JSON document.  Every printed line is at most
-:data:`WIDTH` characters.
+`WIDTH` characters.
 """
 
 from __future__ import annotations

@@ -57,7 +57,7 @@ def library_output_quiet() -> Iterator[None]:
     ``sys.stdout``/``sys.stderr``) is kept off the terminal, so that stderr
     carries only our one message.  CasADi's lines are logged at debug level
     (``-vv`` shows them); ``--debug`` or a solver preset that asks for its log
-    (:func:`solver_log_asked`) shows everything instead."""
+    (`solver_log_asked`) shows everything instead."""
     saved_py = sys.stdout, sys.stderr
     sink = io.StringIO()
     try:
@@ -99,7 +99,7 @@ def solver_log_asked(solver: Any) -> bool:
 
 def solver_output(args: argparse.Namespace, solver: Any = None) -> contextlib.AbstractContextManager[None]:
     """Where the libraries' output goes while ``args``'s command computes: nowhere
-    (:func:`library_output_quiet`), or with ``--debug`` or a solver that asks for
+    (`library_output_quiet`), or with ``--debug`` or a solver that asks for
     its log, on stdout (on stderr with ``--json``, which keeps stdout for the
     JSON document)."""
     if getattr(args, "debug", False) or solver_log_asked(solver):

@@ -7,7 +7,7 @@ across such a singularity from the designated one.  det Φ_x depends on how the
 rotation is parametrized: with three angles it carries the determinant of the
 map from the angles' rates to the angular velocity (e.g. cos θ for Z-Y-X
 angles), which vanishes at a gimbal lock and changes sign between the two angle
-triples of one rotation.  :func:`twist_determinant` divides it out, so the
+triples of one rotation.  `twist_determinant` divides it out, so the
 indicator is a property of the pose, not of its angles.
 
 A negative aspect proves another assembly mode; a positive one does not prove

@@ -6,19 +6,19 @@ call all the same, and on a loaded machine that is most of the time: the six-axi
 compliance took 20-28 ms per pose against 1.1 ms with one BLAS thread
 (benchmarks/bench_compliance.py, ``six_axis_capped`` beside ``six_axis_compliance``).
 
-* :func:`cap_process` -- one BLAS thread for the whole process: the CLI and the
+* `cap_process` -- one BLAS thread for the whole process: the CLI and the
   sweep's worker processes call it (they run nothing but small algebra; parallel
   work is CasADi's thread pool and Dask's processes, not BLAS).  Called before
   any BLAS library is loaded (``cpm-nlp solve`` calls it first), it only sets the
-  libraries' environment variables (:data:`BLAS_THREAD_VARIABLES`), which they
+  libraries' environment variables (`BLAS_THREAD_VARIABLES`), which they
   read when they load: threadpoolctl is not imported and costs nothing (issue 23,
   start-up); processes started from this one inherit the cap.
-* :func:`small_algebra` -- the same for a block of library code, for a program that
+* `small_algebra` -- the same for a block of library code, for a program that
   calls the library (its own BLAS threads are restored after); cheap when the
-  process is already capped; :func:`one_blas_thread` decorates a function with it.
+  process is already capped; `one_blas_thread` decorates a function with it.
 
 The limit is the process's (BLAS has no per-thread setting): two threads that
-enter and leave :func:`small_algebra` at once may leave it capped, which costs
+enter and leave `small_algebra` at once may leave it capped, which costs
 nothing here.
 """
 
@@ -65,7 +65,7 @@ def cap_process() -> None:
     """One BLAS thread from now on, in this process.  Before any BLAS library is loaded:
     their environment variables, read when each loads (nothing imported).  Else, for the
     libraries loaded so far, through threadpoolctl (a solve that needs no scipy loads
-    none; a library loaded later is capped by the next :func:`small_algebra`)."""
+    none; a library loaded later is capped by the next `small_algebra`)."""
     if _STATE["by_environment"]:
         return
     if not _loaded():
@@ -79,7 +79,7 @@ def cap_process() -> None:
 
 @contextlib.contextmanager
 def small_algebra() -> Iterator[None]:
-    """One BLAS thread within the block (a no-op where :func:`cap_process` ran)."""
+    """One BLAS thread within the block (a no-op where `cap_process` ran)."""
     if _STATE["capped"]:
         if not _STATE["by_environment"] and _STATE["seen"] != _loaded():
             cap_process()
@@ -90,7 +90,7 @@ def small_algebra() -> Iterator[None]:
 
 
 def one_blas_thread(fn: F) -> F:
-    """``fn`` run within :func:`small_algebra` (about 50 µs a call where the process
+    """``fn`` run within `small_algebra` (about 50 µs a call where the process
     is not capped: for functions that do many small solves, not for each solve)."""
 
     @functools.wraps(fn)

@@ -6,17 +6,17 @@ the BLAS CPU kernel (the 3-PRS has f2 = f3, and its modes 2 and 3 came out
 mixed differently on a Haswell and a Sandybridge kernel).  The functions here
 return the same answer on every machine, to rounding:
 
-* :func:`eigen_clusters` groups sorted eigenvalues that agree to
-  :data:`CLUSTER_RTOL` (relative) into clusters: a repeated eigenvalue and its
+* `eigen_clusters` groups sorted eigenvalues that agree to
+  `CLUSTER_RTOL` (relative) into clusters: a repeated eigenvalue and its
   multiplicity.
-* :func:`canonical_basis` is the convention for the basis of a subspace (a
+* `canonical_basis` is the convention for the basis of a subspace (a
   cluster's, or a single eigenvector's sign): the reduced row echelon form of
   the subspace with respect to the coordinates in their order, orthonormalised
   in order (in the metric ``M``), each vector's component on its pivot
   coordinate positive.  It depends on the subspace only, never on the basis it
   is given.  For one vector it reads: the first coordinate that carries a
-  significant part of the vector (:data:`PIVOT_FRACTION`) is positive.
-* :func:`canonical_eigh` is ``scipy.linalg.eigh`` with both applied.
+  significant part of the vector (`PIVOT_FRACTION`) is positive.
+* `canonical_eigh` is ``scipy.linalg.eigh`` with both applied.
 
 The general rule of the project (docs/site/design.md): a result that is only
 defined up to a sign, a basis or an order is reported in one documented
@@ -65,7 +65,7 @@ def eigen_clusters(values: np.ndarray, rtol: float = CLUSTER_RTOL) -> list[list[
 def _pivots(Q: np.ndarray) -> list[int]:
     """The pivot coordinates of the echelon form of the span of the orthonormal
     columns of ``Q`` (n x m): coordinate j is a pivot when the m-th singular value
-    of rows 0..j rises above :data:`PIVOT_FRACTION` for the (d+1)-th time, d the
+    of rows 0..j rises above `PIVOT_FRACTION` for the (d+1)-th time, d the
     pivots so far.  Singular values of an orthonormal basis' rows are invariant
     under a change of basis, so the pivots depend on the subspace only."""
     n, m = Q.shape
@@ -91,7 +91,7 @@ def canonical_basis(V: np.ndarray, M: np.ndarray | None = None, T: np.ndarray | 
     when ``T`` (p x n, e.g. the task Jacobian that maps actuator motions to pose
     coordinates) is given and ``T V`` has rank m, else those of ``V``, weighted by
     sqrt(diag M) (so their units do not matter).  The pivots are chosen in
-    coordinate order (:func:`_pivots`); the basis W with W[pivots] = I (the
+    coordinate order (`_pivots`); the basis W with W[pivots] = I (the
     reduced row echelon form) is orthonormalised in order in the metric M
     (identity if None) by Gram-Schmidt, which keeps each vector's pivot
     component positive.  The result is M-orthonormal, and the same for any basis
@@ -136,7 +136,7 @@ def canonical_eigh(K: np.ndarray, M: np.ndarray | None = None, rtol: float = CLU
     """``scipy.linalg.eigh(K, M)`` in canonical form: (eigenvalues, eigenvectors as
     columns, clusters).  The eigenvalues of a cluster are replaced by their mean
     (a repeated eigenvalue is reported once, exactly repeated); the eigenvectors of
-    each cluster are its :func:`canonical_basis` (M-orthonormal, sign fixed), read
+    each cluster are its `canonical_basis` (M-orthonormal, sign fixed), read
     in the coordinates of ``T`` (e.g. the task Jacobian) when it is given."""
     import scipy.linalg  # here: a solve that needs no eigenvalues loads no scipy (start-up time)
 

@@ -2,17 +2,17 @@
 
 A loop closure Φ(x, q; p) = 0 says where the platform can be; it does not say
 where each joint sits in space.  The six-axis hinge model
-(:mod:`cpm_nlp.analysis.hinge_chains`) needs exactly that: every flexure hinge
+(`cpm_nlp.analysis.hinge_chains`) needs exactly that: every flexure hinge
 is a six-degree-of-freedom spring at its own location, so each leg is written
 as a serial chain, base first, at the reference configuration (product of
 exponentials: a joint's variable is its displacement from there).
 
 A mechanism that can give its legs this way registers the part ``chains``,
-:class:`LegChains` (``(model) -> Chains``, numeric at the model's parameters);
+[`LegChains`][cpm_nlp.core.chains.LegChains] (``(model) -> Chains``, numeric at the model's parameters);
 it sits here, beside the data it gives, so that a mechanism file declares it
 without loading the six-axis model (and scipy) at start-up.
 Mechanisms described in files get it from their legs
-(:mod:`cpm_nlp.mechanisms.described.chains`).
+(`cpm_nlp.mechanisms.described.chains`).
 
 Sizes in model terms: a leg has joints j = 1..n_j, joint j has d_j
 degrees of freedom (P, R: 1; C, U: 2; S: 3).
@@ -39,18 +39,27 @@ JOINT_DOF = MappingProxyType({n: t.dof for n, t in JOINT_TYPES.items() if t.spat
 class ChainJoint:
     """One joint of a leg at the reference configuration (base frame, SI).
 
-    type: P, R, C, U or S.
-    at: its location (3,).
-    axes: (3, d) unit vectors, one per degree of freedom: the axis of an R or a
-        P, a C's axis twice (its rotation, then its slide), a U's two axes, an
-        S's three axes (its reported angles turn about them, in this order).
-    motions: "R" or "P" per degree of freedom.
-    coordinates: per degree of freedom, the name of the closure coordinate (pose,
-        actuator or passive) that reports it, or "" where none does.
-    actuated: the actuator that drives it (a 1-dof P or R), with ``gain``
-        (displacement per actuator unit).
-    link: unit direction from this joint to the next one (to the platform point
-        for the last): a hinge's length axis where its declaration gives none.
+    Attributes
+    ----------
+    type
+        P, R, C, U or S.
+    at
+        its location (3,).
+    axes
+        (3, d) unit vectors, one per degree of freedom: the axis of an R or a P, a C's axis
+        twice (its rotation, then its slide), a U's two axes, an S's three axes (its reported
+        angles turn about them, in this order).
+    motions
+        "R" or "P" per degree of freedom.
+    coordinates
+        per degree of freedom, the name of the closure coordinate (pose, actuator or passive)
+        that reports it, or "" where none does.
+    actuated
+        the actuator that drives it (a 1-dof P or R), with ``gain`` (displacement per actuator
+        unit).
+    link
+        unit direction from this joint to the next one (to the platform point for the last): a
+        hinge's length axis where its declaration gives none.
     """
 
     type: str
@@ -81,12 +90,16 @@ class LegChain:
 class Chains:
     """The legs of a mechanism, and its platform frame as a function of the pose.
 
-    platform: ``ca.Function("platform_frame", [x], [P, R])``: the platform's
-        reference point P (3) and rotation R (3 x 3) at the pose x (nx), at the
-        model's parameters.
-    x_reference, q_reference: the pose and actuators of the reference
-        configuration, where every chain variable is zero.
-    note: what the chains leave out (shown with results).
+    Attributes
+    ----------
+    platform
+        ``ca.Function("platform_frame", [x], [P, R])``: the platform's reference point P (3) and
+        rotation R (3 x 3) at the pose x (nx), at the model's parameters.
+    x_reference, q_reference
+        the pose and actuators of the reference configuration, where every chain variable is
+        zero.
+    note
+        what the chains leave out (shown with results).
     """
 
     legs: tuple[LegChain, ...]
@@ -101,7 +114,7 @@ class LegChains(Part):
     """The legs of a mechanism as serial chains of joints at the reference configuration
     (the part ``chains``), for the six-axis hinge model.
 
-    of: ``(model) -> Chains`` (:class:`~cpm_nlp.core.chains.Chains`), numeric at the model's
+    of: ``(model) -> Chains`` (`Chains`), numeric at the model's
         parameters.
     """
 

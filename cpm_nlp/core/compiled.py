@@ -68,7 +68,7 @@ def cache_dir() -> Path:
 
 
 def cache_key() -> tuple[str | None, ...]:
-    """The environment that decides :func:`cache_dir` (``CPM_NLP_CACHE``, ``XDG_CACHE_HOME``,
+    """The environment that decides `cache_dir` (``CPM_NLP_CACHE``, ``XDG_CACHE_HOME``,
     ``HOME``, ``LOCALAPPDATA``), as a key of the per-process memos: a changed variable (a test's
     fresh cache) means other libraries, and no path is built on every call."""
     env = os.environ
@@ -162,10 +162,10 @@ class NativeLoop:
 
     @staticmethod
     def addresses(inputs: list[np.ndarray], outputs: list[np.ndarray]) -> tuple:
-        """Where the arrays of :meth:`run` are: (addresses, steps, number of inputs, buffer to
+        """Where the arrays of `run` are: (addresses, steps, number of inputs, buffer to
         keep alive), inputs then outputs, each address that of row 0 and its step the row length
         (0 for a shared 1-D input).  The shared inputs are copied into one buffer, and outputs
-        made by :func:`packed_outputs` are located through their one buffer: one address
+        made by `packed_outputs` are located through their one buffer: one address
         look-up each (numpy's ``.ctypes.data`` costs about 1.4 µs, 17 of them were a third of
         the fixed cost of a call)."""
         shared = [a for a in inputs if a.ndim != 2]
@@ -190,7 +190,7 @@ class NativeLoop:
         return addr, steps, len(inputs), block
 
     def run_at(self, start: int, stop: int, where: tuple) -> int:
-        """Poses start..stop-1 of the arrays located by :meth:`addresses`."""
+        """Poses start..stop-1 of the arrays located by `addresses`."""
         addr, steps, n_in, _block = where
         moved = [a + 8 * start * s for a, s in zip(addr, steps)]
         ins = (ctypes.c_void_p * self.n_in)(*moved[:n_in])
@@ -202,7 +202,7 @@ class NativeLoop:
 
 def packed_outputs(n: int, widths: list[int]) -> list[np.ndarray]:
     """(n, width) C-contiguous arrays, the consecutive pieces of one buffer (located at once
-    by :meth:`NativeLoop.addresses`)."""
+    by `NativeLoop.addresses`)."""
     block = np.empty(n * sum(widths))
     out, at = [], 0
     for w in widths:
@@ -213,7 +213,7 @@ def packed_outputs(n: int, widths: list[int]) -> list[np.ndarray]:
 
 class BoundNative(BoundCall):
     """A compiled kernel for one model, called on one pose at a time (the
-    single-solve twin of :class:`cpm_nlp.core.fast_calls.BoundCall`, same
+    single-solve twin of `cpm_nlp.core.fast_calls.BoundCall`, same
     interface): straight into the library's loop for one pose, through ctypes."""
 
     def __init__(self, loop: NativeLoop, shared: list[np.ndarray], defaults: list) -> None:
@@ -250,7 +250,7 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
     """Compile ``source`` into a shared library in the cache (once per content).
 
     ``source`` is C that CasADi generated from the model's expressions (numbers and
-    symbols, never text from a file), plus :func:`batch_loop_source`; ``name`` a
+    symbols, never text from a file), plus `batch_loop_source`; ``name`` a
     kernel name (ASCII letters, digits and single underscores; a mechanism file's
     name is checked when it is read).  The command is the user's ``$CC`` or a
     compiler on PATH, never anything from a problem file."""
@@ -360,7 +360,7 @@ def compiled_function(closure: LoopClosure, kern: Kernel) -> ca.Function:
 
 
 def native_loop(closure: LoopClosure, kern: Kernel) -> NativeLoop:
-    """The compiled kernel's loop over poses (:func:`batch_loop_source`), loaded once per process."""
+    """The compiled kernel's loop over poses (`batch_loop_source`), loaded once per process."""
     return solvers_of(closure).memo(
         ("native_loop", *cache_key()) + kern.key,
         lambda: NativeLoop(_library(closure, kern), kern.name, compiled_function(closure, kern)),

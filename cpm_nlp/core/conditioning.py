@@ -1,12 +1,12 @@
 """Certified bounds of the conditioning of a closure at a pose, as symbolic (SX) expressions
 the kernels evaluate without an inverse of Φ_x or a singular value decomposition:
 
-* :func:`cond1_bound`: κ₁(Φ_x) from an approximate inverse (Φ_x⁻¹ at the home pose);
-* :func:`cond1_block_bound`: κ₁(Φ_x) from the inverses of the diagonal blocks of its block
+* `cond1_bound`: κ₁(Φ_x) from an approximate inverse (Φ_x⁻¹ at the home pose);
+* `cond1_block_bound`: κ₁(Φ_x) from the inverses of the diagonal blocks of its block
   triangular (Dulmage-Mendelsohn) form at the pose;
-* :func:`cond2_left_inverse_bound`: κ₂ of the tall Jacobian e_x of every closure equation of a
+* `cond2_left_inverse_bound`: κ₂ of the tall Jacobian e_x of every closure equation of a
   closure solved through normal equations, from a block left inverse
-  (:class:`LeftInverseBlocks`).
+  (`LeftInverseBlocks`).
 
 Each is +inf where nothing is certified (a non-finite value, a structurally singular matrix).
 """
@@ -31,7 +31,7 @@ def robust_max_abs(v: ca.SX) -> ca.SX:
     return ca.if_else(all_finite(v), ca.mmax(ca.fabs(v)), ca.inf)
 
 
-#: the preconditioned residual ‖I - Φ_x B‖₁ must stay below this for :func:`cond1_bound` to certify
+#: the preconditioned residual ‖I - Φ_x B‖₁ must stay below this for `cond1_bound` to certify
 CERTIFY_DELTA = 0.9
 
 
@@ -55,7 +55,7 @@ def cond1_bound(phi_x: ca.SX, b: ca.SX) -> ca.SX:
     With δ = ‖I - Φ_x B‖₁ < 1, Φ_x B is invertible (Neumann series) and
     ‖Φ_x⁻¹‖₁ = ‖B (Φ_x B)⁻¹‖₁ ≤ ‖B‖₁ / (1 - δ), so
     κ₁(Φ_x) ≤ ‖Φ_x‖₁ ‖B‖₁ / (1 - δ) (induced 1-norms).  Where δ >
-    :data:`CERTIFY_DELTA` (far from home) or Φ_x is not finite the bound is
+    `CERTIFY_DELTA` (far from home) or Φ_x is not finite the bound is
     +inf: nothing is certified.  Costs one nx x nx product instead of a
     symbolic inverse.
     """
@@ -83,7 +83,7 @@ def cond1_block_bound(phi_x: ca.SX) -> ca.SX:
     block column j sums at most the blocks' 1-norms).  Permutations keep the 1-norm, so
     κ₁(Φ_x) ≤ ‖Φ_x‖₁ max_j Σ_i β_ij (induced 1-norms).  A structurally singular Φ_x, a
     singular block (its inverse not finite) or a Φ_x that is not finite gives +inf (NaN is
-    read as singular too: :func:`is_singular`).  Costs the inverses of the diagonal blocks only
+    read as singular too: `is_singular`).  Costs the inverses of the diagonal blocks only
     (for a linkage's normal equations: the block of the loops' passive coordinates).
     """
     n = phi_x.size1()
@@ -186,7 +186,7 @@ def _left_inverse_norm(d: ca.SX) -> ca.SX:
 
 
 def closure_blocks(closure: LoopClosure) -> LeftInverseBlocks | None:
-    """:func:`left_inverse_blocks` of a closure's e_x (built once per closure)."""
+    """`left_inverse_blocks` of a closure's e_x (built once per closure)."""
     c = closure
     return solvers_of(c).memo(
         ("left_inverse_blocks",),
@@ -199,10 +199,10 @@ def cond2_left_inverse_bound(e_x: ca.SX, blocks: LeftInverseBlocks | None) -> ca
     of every closure equation, from a block left inverse at the pose: no SVD, no e_xᵀ e_x.
 
     Any left inverse X (X e_x = I) bounds the smallest singular value: |v| = |X e_x v| <=
-    ‖X‖₂ |e_x v|, so σ_min(e_x) >= 1/‖X‖₂.  In the form of :func:`left_inverse_blocks` (block
+    ‖X‖₂ |e_x v|, so σ_min(e_x) >= 1/‖X‖₂.  In the form of `left_inverse_blocks` (block
     upper triangular U, tall diagonal blocks D_i) one left inverse is block upper triangular:
     X_ii = D_i⁺ (the pseudo-inverse) and X_ij = -D_i⁺ Σ_{i<k<=j} U_ik X_kj, so with
-    α_i >= ‖D_i⁺‖₂ (:func:`_left_inverse_norm`) the norms obey ‖X_ij‖₂ <= β_ij = α_i Σ_k ‖U_ik‖_F
+    α_i >= ‖D_i⁺‖₂ (`_left_inverse_norm`) the norms obey ‖X_ij‖₂ <= β_ij = α_i Σ_k ‖U_ik‖_F
     β_kj (‖·‖₂ <= ‖·‖_F), and ‖X‖₂ <= ‖(β_ij)‖₂ <= ‖(β_ij)‖_F (a block matrix's 2-norm is at most
     that of its blocks' norms).  So κ₂(e_x) <= ‖e_x‖_F ‖(β_ij)‖_F.  For a square closure e_x is Φ_x
     itself: this is the same measure the 2-norm check decides on.  +inf where e_x is structurally

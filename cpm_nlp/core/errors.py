@@ -2,11 +2,11 @@
 
 Two kinds of failure are kept apart on purpose:
 
-* :class:`InputError` -- the problem as given cannot be solved as written (a
+* [`InputError`][cpm_nlp.core.errors.InputError] -- the problem as given cannot be solved as written (a
   malformed file, an unknown key, a wrong unit, a negative length ...).  The CLI
   turns it into one line on stderr and exit status 2.
 * A solve that runs but does not reach a trustworthy answer is *not* an
-  exception: it is a :class:`~cpm_nlp.core.result.Result` whose ``status`` says why
+  exception: it is a [`Result`][cpm_nlp.core.result.Result] whose ``status`` says why
   (exit status 1 on the CLI).
 """
 
@@ -70,16 +70,16 @@ class InputError(CpmError):
 
     Parameters
     ----------
-    message:
+    message
         What was expected and what was found, e.g. ``"expected a positive length
         (e.g. '47.91 mm'), got '-3 mm'"``.
-    path:
+    path
         Key path inside the problem file, e.g. ``("mechanism", "parameters", "b")``.
-    file:
+    file
         The problem file, when there is one.
-    suggestions:
+    suggestions
         Candidates for a "did you mean" hint.
-    hint:
+    hint
         What the user can do next, when it is not obvious from the message.
     """
 
@@ -129,7 +129,7 @@ class InputError(CpmError):
 
 
 def unknown_key_error(key: str, allowed: Iterable[str], path: Sequence[str | int], what: str) -> InputError:
-    """An :class:`InputError` for a key that is not allowed, with suggestions."""
+    """An [`InputError`][cpm_nlp.core.errors.InputError] for a key that is not allowed, with suggestions."""
     allowed = sorted(allowed)
     return InputError(
         f"unknown {what} {key!r}; expected one of: {', '.join(allowed)}",

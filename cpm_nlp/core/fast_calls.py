@@ -1,6 +1,6 @@
 """Fast numeric calls of CasADi Functions on numpy arrays: one
-:class:`casadi.FunctionBuffer` per thread (:class:`FastFunction`), or one kernel bound to one
-model's shared inputs (:class:`BoundCall`)."""
+`casadi.FunctionBuffer` per thread (`FastFunction`), or one kernel bound to one
+model's shared inputs (`BoundCall`)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from .solver import solvers_of
 class FastFunction:
     """Call a CasADi Function on numpy arrays with minimal overhead.
 
-    Uses one :class:`casadi.FunctionBuffer` per thread (a few µs per call
+    Uses one `casadi.FunctionBuffer` per thread (a few µs per call
     instead of the ~30 µs of a regular call from Python); safe to call from
     several threads.  Returns the outputs as flat float arrays (dense,
     column-major, as CasADi stores them).
@@ -122,5 +122,5 @@ class BoundCall:
 
 
 def fast(closure: LoopClosure, key: tuple, function: Callable[[], ca.Function]) -> FastFunction:
-    """A :class:`FastFunction` built once per closure and key."""
+    """A `FastFunction` built once per closure and key."""
     return solvers_of(closure).memo(("fast",) + key, lambda: FastFunction(function()))

@@ -1,18 +1,18 @@
 """Every number is finite, or there is a status.
 
 Input files are untrusted: YAML reads a 1500-digit integer as a Python int
-that no float can hold, which :func:`check_numbers` refuses anywhere in a
+that no float can hold, which `check_numbers` refuses anywhere in a
 parsed file, naming the key path, before anything is built from it.  YAML
 reads ``.inf``, ``.nan`` and a 400-digit ``1111...1.5`` as non-finite floats:
-the declared options (:mod:`cpm_nlp.core.options`, :mod:`cpm_nlp.core.units`)
+the declared options (`cpm_nlp.core.options`, `cpm_nlp.core.units`)
 refuse them with what they expect, and the expression language
-(:mod:`cpm_nlp.mechanisms.described.expr`) refuses an operation that makes one.
+(`cpm_nlp.mechanisms.described.expr`) refuses an operation that makes one.
 
-On the way out, :func:`nonfinite_paths` finds the non-finite numbers in the
-values of a result, which :func:`cpm_nlp.problems.file.solve` turns into the
+On the way out, `nonfinite_paths` finds the non-finite numbers in the
+values of a result, which [`cpm_nlp.problems.file.solve`][cpm_nlp.problems.file.solve] turns into the
 failed status ``not_finite`` (never a printed ``inf`` that looks like an
 answer); JSON output writes a non-finite number as ``null``
-(:func:`cpm_nlp.core.result.jsonable`).
+(`cpm_nlp.core.result.jsonable`).
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def too_large(value: int) -> str:
 
 
 def check_numbers(data: Any, path: tuple = ()) -> None:
-    """Refuse (:class:`InputError` naming the key path) an integer too large for a float
+    """Refuse ([`InputError`][cpm_nlp.core.errors.InputError] naming the key path) an integer too large for a float
     anywhere in parsed file data.  A non-finite float (``.inf``, ``.nan``, ``1e999``) is
     refused by the key that reads it, whose message says what it expects there."""
     stack: list[tuple[Any, tuple]] = [(data, path)]

@@ -1,7 +1,7 @@
 """The joint types of mechanism files: one table, read by the file reader
-(:mod:`cpm_nlp.mechanisms.described.read_joint`), the generator of loop closures
-(:mod:`~cpm_nlp.mechanisms.described.generate`), the legs' serial chains
-(:mod:`cpm_nlp.core.chains`) and the ``describe`` text.
+(`cpm_nlp.mechanisms.described.read_joint`), the generator of loop closures
+(`generate`), the legs' serial chains
+(`cpm_nlp.core.chains`) and the ``describe`` text.
 
 A joint's degrees of freedom are its elementary motions, in the order of its
 coordinates: a rotation ("R") about, or a translation ("P") along, one of its
@@ -12,7 +12,7 @@ entry k of its ``axes`` list (``k``; an S without ``axes`` turns about the base
 frame's x, y, z).
 
 The flexure hinges that can sit at a joint are given by name (the hinge types
-of :data:`cpm_nlp.analysis.hinge_types.HINGE_TABLE`, which reads this table for
+of `cpm_nlp.analysis.hinge_types.HINGE_TABLE`, which reads this table for
 where each may sit): where the project's mechanisms put them, and by a hinge's
 geometry where none does.
 
@@ -42,23 +42,39 @@ from .errors import InputError, suggest
 class JointType:
     """One joint type of a mechanism file.
 
-    name: its ``type`` in a file; description: one line.
-    letter: the letter a drawing marks it with (P, R, C, U, S).
-    motion: its elementary motions in coordinate order, ("R" | "P", axis source):
-        "axis" (the joint's ``axis``) or k (entry k of its ``axes``).
-    axis: "given" (the file gives ``axis``), "z" (fixed: a planar revolute) or
-        None (it has no single axis).
-    n_axes: how many vectors its ``axes`` key holds (0: it takes none);
-        default_axes: the base-frame axes used when ``axes`` is not given
-        (empty: ``axes`` is required if ``n_axes``).
-    planar, spatial: whether a planar, a spatial mechanism takes it.
-    actuable: whether an actuator may drive it.
-    point: a point joint (all rotations about its location: S in space, R in
-        the plane), through which a leg reaches its platform point.
-    sphere: it turns about a point, so the link after it sweeps a sphere (a
-        circle in the plane): U, S, planar R.
-    twin: the same joint in the other kind of mechanism (R <-> planar_R).
-    hinges: names of the flexure hinge types that can sit at it (see the module).
+    Attributes
+    ----------
+    name
+        its ``type`` in a file;
+    description
+        one line.
+    letter
+        the letter a drawing marks it with (P, R, C, U, S).
+    motion
+        its elementary motions in coordinate order, ("R" | "P", axis source): "axis" (the
+        joint's ``axis``) or k (entry k of its ``axes``).
+    axis
+        "given" (the file gives ``axis``), "z" (fixed: a planar revolute) or None (it has no
+        single axis).
+    n_axes
+        how many vectors its ``axes`` key holds (0: it takes none);
+    default_axes
+        the base-frame axes used when ``axes`` is not given (empty: ``axes`` is required if
+        ``n_axes``).
+    planar, spatial
+        whether a planar, a spatial mechanism takes it.
+    actuable
+        whether an actuator may drive it.
+    point
+        a point joint (all rotations about its location: S in space, R in the plane), through
+        which a leg reaches its platform point.
+    sphere
+        it turns about a point, so the link after it sweeps a sphere (a circle in the plane): U,
+        S, planar R.
+    twin
+        the same joint in the other kind of mechanism (R <-> planar_R).
+    hinges
+        names of the flexure hinge types that can sit at it (see the module).
     """
 
     name: str
@@ -174,7 +190,7 @@ JOINT_LETTERS = tuple(dict.fromkeys(t.letter for t in JOINT_TYPES.values()))
 
 
 def joint_type(name: object, path: tuple = ()) -> JointType:
-    """The joint type called ``name``, or an :class:`InputError` at ``path`` naming the
+    """The joint type called ``name``, or an [`InputError`][cpm_nlp.core.errors.InputError] at ``path`` naming the
     types and the nearest ones."""
     if isinstance(name, str) and name in JOINT_TYPES:
         return JOINT_TYPES[name]

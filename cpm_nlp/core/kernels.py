@@ -1,7 +1,7 @@
 """Kinematics kernels: CasADi Functions built generically from a
-:class:`~cpm_nlp.core.model.LoopClosure`, for single solves, batches, embedding
+[`LoopClosure`][cpm_nlp.core.model.LoopClosure], for single solves, batches, embedding
 and exported code.  Each ends with the pose checks and status rule of
-:mod:`cpm_nlp.core.pose_checks`, so every kernel -- and exported C code -- reports a status.
+`cpm_nlp.core.pose_checks`, so every kernel -- and exported C code -- reports a status.
 
 * **FK kernel**: Newton's method from a guess, with CasADi's ``fast_newton``
   rootfinder (it generates C code; its derivatives come from the implicit
@@ -12,9 +12,9 @@ and exported code.  Each ends with the pose checks and status rule of
 
 Kernels take the parameters p, the joint limits and the tolerance as inputs,
 so one kernel -- and one compiled library -- serves every model of a
-mechanism type; :func:`bake` substitutes one model's numbers (for export and
+mechanism type; `bake` substitutes one model's numbers (for export and
 for the embedding API).  Status codes are the positions in
-:data:`~cpm_nlp.core.pose_checks.STATUSES`.
+`STATUSES`.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from .solver import DEFAULT_OPTIONS, SolverConfig, solvers_of
 from .solver_options import NEWTON_BATCH, NEWTON_BATCH_IGNORED
 
 #: Newton options the kernels' rootfinder (CasADi ``fast_newton``) accepts (from the one table,
-#: :data:`cpm_nlp.core.solver_options.NEWTON_TABLE`)
+#: `cpm_nlp.core.solver_options.NEWTON_TABLE`)
 NEWTON_OPTIONS = NEWTON_BATCH
 #: options of CasADi's ``newton`` plugin that have no meaning here (fast_newton never raises or prints)
 _IGNORED_NEWTON = NEWTON_BATCH_IGNORED
@@ -59,7 +59,7 @@ def newton_options(config: SolverConfig | None) -> dict[str, Any]:
     """Options of the kernels' rootfinder (``fast_newton``) from a solver config.
 
     The kernels always solve by Newton's method; an IPOPT configuration only
-    contributes its tolerance.  User options outside :data:`NEWTON_OPTIONS`
+    contributes its tolerance.  User options outside `NEWTON_OPTIONS`
     are rejected (they would be silently ignored otherwise).
     """
     opts = {k: v for k, v in DEFAULT_OPTIONS["newton"].items() if k in NEWTON_OPTIONS}
@@ -93,9 +93,13 @@ def _options_key(opts: Mapping[str, Any]) -> tuple:
 class Kernel:
     """A kernel and how to call it.
 
-    function: the CasADi Function; its inputs are ``pose_inputs`` (one row per
-        pose in a batch) followed by ``SHARED_INPUTS``.
-    kind: "fk", "ik" or "jacobian".
+    Attributes
+    ----------
+    function
+        the CasADi Function; its inputs are ``pose_inputs`` (one row per pose in a batch)
+        followed by ``SHARED_INPUTS``.
+    kind
+        "fk", "ik" or "jacobian".
     """
 
     function: ca.Function
@@ -115,9 +119,9 @@ SHARED_INPUTS = ("p", "lower", "upper", "tol")
 #: shared inputs of the FK through the closed-form IK: also the model's linearization at home
 REDUCED_SHARED_INPUTS = SHARED_INPUTS + ("J_home", "Phi_x_home_inv")
 #: ``path`` output of the FK kernel: which formulation answered ("closed": the closed-form FK of a
-#: dyad, :func:`closed_fk_kernel`)
+#: dyad, `closed_fk_kernel`)
 PATHS = ("reduced", "full", "closed")
-#: outputs of the FK as embedded (:func:`cpm_nlp.io.embed.functions`) and exported: without ``path``
+#: outputs of the FK as embedded (`cpm_nlp.io.embed.functions`) and exported: without ``path``
 FK_OUTPUTS = ("x", "passive", "residual", "branch_margin", "round_trip_error", "cond1", "limit_margin", "status")
 _STATUS_OUTPUTS = ("residual", "branch_margin", "round_trip_error", "cond1", "limit_margin", "status")
 
@@ -157,10 +161,10 @@ def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> 
     Newton on Φ(x, q) = 0 (nx unknowns) from x0; a pose whose residual is
     not within ``tol`` after the iterations is ``not_converged``; then the
     checks.  The FK of mechanisms without a closed-form IK, and the fallback
-    of :func:`fk_kernel` for the others.
+    of `fk_kernel` for the others.
 
     A closure solved through normal equations (``loops``): first
-    :func:`gauss_newton_fk_kernel` (first derivatives only); a pose it does not
+    `gauss_newton_fk_kernel` (first derivatives only); a pose it does not
     settle as ``solved`` goes to Newton on the normal equations from x0 exactly
     as before (a CasADi Switch: only that branch is evaluated), so every status
     other than ``solved`` is Newton's.
@@ -181,7 +185,7 @@ def full_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> 
 
 
 def newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
-    """Newton on Φ(x, q) = 0 from x0 (CasADi ``fast_newton``) and the checks: :func:`full_fk_kernel`
+    """Newton on Φ(x, q) = 0 from x0 (CasADi ``fast_newton``) and the checks: `full_fk_kernel`
     itself for a square closure, its fallback for normal equations (named ``..._newton``)."""
     opts = newton_options(config)
 
@@ -226,7 +230,7 @@ GAUSS_NEWTON_STEPS = 5
 
 
 def left_inverse_step(e_x: ca.SX, e: ca.SX, blocks: LeftInverseBlocks) -> ca.SX:
-    """v = X e with X the block left inverse of e_x of :func:`cond2_left_inverse_bound`: block by
+    """v = X e with X the block left inverse of e_x of `cond2_left_inverse_bound`: block by
     block from the last, v_i = D_i⁺ (e_i - Σ_{k>i} U_ik v_k), D_i⁺ by the QR of the diagonal block
     (a single column: dᵀ/‖d‖²).  Where e_x v = e has a solution (every closure equation holds to
     first order) v is it; x - v is then a Gauss-Newton step with the rows grouped as the blocks,
@@ -261,13 +265,13 @@ def gauss_newton_fk_kernel(
     """``<name>_fk_gauss_newton: (q, x0, p, lower, upper, tol) -> (x, passive, residual, ...,
     status)``: the full FK of a closure solved through normal equations (``loops``), by
     ``steps`` Gauss-Newton steps x <- x - X(x) e(x) on every closure equation e
-    (:func:`left_inverse_step`; first derivatives only, where Newton on the normal equations
+    (`left_inverse_step`; first derivatives only, where Newton on the normal equations
     needs their second) from x0: an MX graph of ``steps`` calls of one SX step (its C code
     generated once) and one SX call of the checks.
 
     ``status`` is ``solved`` only where max |e| <= abstol after the steps (as Newton's stopping
     test, on every equation) and every check passes, with a margin of 2 on the singularity
-    screen; any other status means "not settled here": :func:`full_fk_kernel` then runs Newton.
+    screen; any other status means "not settled here": `full_fk_kernel` then runs Newton.
     """
     opts = newton_options(config)
     abstol = float(opts.get("abstol", DEFAULT_OPTIONS["newton"]["abstol"]))
@@ -343,11 +347,11 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
     ``status`` is ``solved`` only where max |g| <= abstol after the steps
     (Newton converged) and every check of the full path passes on (x, q):
     residual of the full Φ, branch, reach and IK round trip, limits, with
-    ``cond1`` the certified bound of :func:`cond1_bound` (no inverse of Φ_x;
+    ``cond1`` the certified bound of `cond1_bound` (no inverse of Φ_x;
     for a closure solved through normal equations, the bound of
-    :func:`cond2_left_inverse_bound` at the pose on κ₂ of every closure
+    `cond2_left_inverse_bound` at the pose on κ₂ of every closure
     equation's Jacobian) and a margin of 2 on the singularity threshold.  Any other status means
-    "not settled here": the full path decides (see :func:`fk_kernel`).
+    "not settled here": the full path decides (see `fk_kernel`).
     """
     opts = newton_options(config)
     abstol = float(opts.get("abstol", DEFAULT_OPTIONS["newton"]["abstol"]))
@@ -402,12 +406,12 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
     """``<name>_fk``: the FK of every path in cpm_nlp (single Newton solves, batches, the
     embedding Functions, exported code).
 
-    A closure with a closed-form FK (``fk_closed``: planar dyads, :mod:`cpm_nlp.mechanisms.described.dyads`
-    and :mod:`~cpm_nlp.mechanisms.described.graph_dyads`): first
-    :func:`closed_fk_kernel`; a pose it does not settle as ``solved`` goes to the Newton FK
+    A closure with a closed-form FK (``fk_closed``: planar dyads, `cpm_nlp.mechanisms.described.dyads`
+    and `graph_dyads`): first
+    `closed_fk_kernel`; a pose it does not settle as ``solved`` goes to the Newton FK
     below from x0 (a CasADi Switch), so every status other than ``solved`` is Newton's,
     exactly as without the closed form; ``path`` 2 ("closed") says it answered.  Others: the
-    Newton FK (:func:`_newton_fk_kernel`).
+    Newton FK (`_newton_fk_kernel`).
     """
     c = closure
     if c.fk_closed is None and c.fk_seed is not None:
@@ -449,13 +453,13 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
     """``<name>_fk_closed: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) -> (x, passive,
     residual, branch_margin, round_trip_error, cond1, limit_margin[, path], status)``: the pose from
     the closure's closed-form FK (``fk_closed``; x0 picks the side and the turn of an angle), one flat
-    SX graph, with the same inputs and outputs as the Newton FK it fronts in :func:`fk_kernel`.
+    SX graph, with the same inputs and outputs as the Newton FK it fronts in `fk_kernel`.
 
     ``status`` is ``solved`` only where the closed form assembles the pose (every dyad's disc >= 0,
     finite), the guess x0 lies on each dyad's side of the pose (side > 0; else the root Newton seeks
     from x0 is another assembly: Newton answers), and every check passes on (x, q): residual of Φ, branch,
     IK round trip, limits, and the conditioning with a margin of 2 on the singularity threshold
-    (``cond1`` the certified bound of :func:`cond1_bound` where there is a closed-form IK, else
+    (``cond1`` the certified bound of `cond1_bound` where there is a closed-form IK, else
     the exact one).  Any other status means "not settled here": Newton decides.
     """
     opts = newton_options(config)
@@ -498,20 +502,20 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
 def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: str) -> Kernel:
     """``name: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) ->
     (x, passive, residual, branch_margin, round_trip_error, cond1,
-    limit_margin[, path], status)``: the Newton FK -- :func:`fk_kernel` itself for a
+    limit_margin[, path], status)``: the Newton FK -- `fk_kernel` itself for a
     closure without a closed-form FK, its fallback for the others.
 
-    Mechanisms with a closed-form IK: first :func:`reduced_fk_kernel` with
-    :data:`REDUCED_STEPS` steps (nq unknowns); where Newton did not converge in
+    Mechanisms with a closed-form IK: first `reduced_fk_kernel` with
+    `REDUCED_STEPS` steps (nq unknowns); where Newton did not converge in
     them, the same kernel again from the pose they reached (the guess about it and
-    :data:`REDUCED_STEPS` more steps: the number of steps adapts to the pose, and the
+    `REDUCED_STEPS` more steps: the number of steps adapts to the pose, and the
     C code has the kernel once); a pose neither settles as ``solved`` -- Newton
     did not converge, a check failed, or the conditioning bound is not certified --
-    goes to :func:`full_fk_kernel` from x0 (each branch evaluated only where taken:
+    goes to `full_fk_kernel` from x0 (each branch evaluated only where taken:
     CasADi Switches), so every status other than ``solved`` comes from the full
     path exactly as it did before the reduced one existed.  ``path`` says
-    which one answered (0 reduced, 1 full; :data:`PATHS`).  Mechanisms without
-    a closed-form IK: :func:`full_fk_kernel` alone (no ``path`` output).
+    which one answered (0 reduced, 1 full; `PATHS`).  Mechanisms without
+    a closed-form IK: `full_fk_kernel` alone (no ``path`` output).
     """
     c = closure
     if c.ik is None:
@@ -671,9 +675,13 @@ def bake(
     """The kernel with one model's parameters, limits and tolerance built in:
     a Function of the per-pose inputs only, same output names.
 
-    function: the Function to wrap (default the kernel's own; the compiled
-    library's twin for the compiled path).  outputs: the outputs to keep, by
-    name (default all, in the kernel's order).
+    Parameters
+    ----------
+    function
+        the Function to wrap (default the kernel's own; the compiled library's twin for the
+        compiled path).
+    outputs
+        the outputs to keep, by name (default all, in the kernel's order).
     """
     fn = kern.function if function is None else function
     syms = [ca.MX.sym(n, fn.size_in(i)) for i, n in enumerate(kern.pose_inputs)]

@@ -1,13 +1,13 @@
 """Problem kinds: what question a problem file asks about a mechanism.
 
-A problem kind declares its inputs (as :class:`~cpm_nlp.core.options.Option` s,
+A problem kind declares its inputs (as `Option` s,
 which may depend on the mechanism), validates them, and runs an algorithm on
-a :class:`~cpm_nlp.core.model.Model` with a :class:`~cpm_nlp.core.solver.SolverConfig`,
-returning a :class:`~cpm_nlp.core.result.Result`.  Problem, method (the algorithm
+a [`Model`][cpm_nlp.core.model.Model] with a [`SolverConfig`][cpm_nlp.core.solver.SolverConfig],
+returning a [`Result`][cpm_nlp.core.result.Result].  Problem, method (the algorithm
 modules) and solver stay separate.
 
-The generic kinds live in :mod:`cpm_nlp.kinds`; a mechanism declares its own
-kinds (``Mechanism.kinds``); :mod:`cpm_nlp.problems.registry` finds them all.
+The generic kinds live in `cpm_nlp.kinds`; a mechanism declares its own
+kinds (``Mechanism.kinds``); `cpm_nlp.problems.registry` finds them all.
 """
 
 from __future__ import annotations
@@ -30,48 +30,51 @@ class ProblemKind:
     """Base class of problem kinds.
 
     Subclasses set ``name`` and ``description`` and implement
-    :meth:`input_options`, :meth:`run` and :meth:`outputs`; they may
-    override :meth:`resolve` for values derived from several inputs (the hinges of
-    ``hinges`` and ``material``) and :meth:`check_inputs` for rules that involve
+    [`input_options`][cpm_nlp.core.kind.ProblemKind.input_options], `run` and
+    [`outputs`][cpm_nlp.core.kind.ProblemKind.outputs]; they may
+    override [`resolve`][cpm_nlp.core.kind.ProblemKind.resolve] for values derived from several inputs (the hinges of
+    ``hinges`` and ``material``) and [`check_inputs`][cpm_nlp.core.kind.ProblemKind.check_inputs] for rules that involve
     several inputs.  The inputs are parsed once, here, by their declaration
-    (options and the nested nodes of :mod:`cpm_nlp.core.schema`): no kind parses
+    (options and the nested nodes of `cpm_nlp.core.schema`): no kind parses
     an input by hand.
     """
 
     name = ""
     description = ""
-    #: plot types that may draw a result of this kind, the default first (see :mod:`cpm_nlp.plot.figures`)
+    #: plot types that may draw a result of this kind, the default first (see `cpm_nlp.plot.figures`)
     plots: tuple[str, ...] = ()
     #: (x, y, value) names of the values a design map of a result shows (plot type "map")
     map_axes: tuple[str, str, str] | None = None
-    #: the mechanism parts this kind reads (:class:`~cpm_nlp.core.mechanism.Part` types,
-    #: declared with the kind), each through :meth:`part`
+    #: the mechanism parts this kind reads (`Part` types,
+    #: declared with the kind), each through `part`
     parts: tuple[type[Part], ...] = ()
 
     def part(self, model: Model, kind: type[P]) -> P | None:
         """The part of type ``kind`` of the model's mechanism (None without one, or for a
-        model built by hand); ``kind`` must be one this kind declares in :attr:`parts`."""
+        model built by hand); ``kind`` must be one this kind declares in `parts`."""
         if kind not in self.parts:
             raise TypeError(f"problem kind {self.name!r} reads {kind.__name__} but does not declare it in parts")
         return model.mechanism.part(kind) if model.mechanism is not None else None
 
     def input_options(self, model: Model) -> list[Option]:
-        """The declared inputs: :class:`Option` s and nodes of :mod:`cpm_nlp.core.schema`."""
+        """The declared inputs: `Option` s and nodes of `cpm_nlp.core.schema`."""
         raise NotImplementedError
 
     def parse_inputs(self, raw: Any, model: Model, path: tuple = ("inputs",)) -> dict[str, Any]:
         """The one parse of a kind's inputs: validated by their declaration, then
-        :meth:`resolve` and :meth:`check_inputs`."""
+        [`resolve`][cpm_nlp.core.kind.ProblemKind.resolve] and
+        [`check_inputs`][cpm_nlp.core.kind.ProblemKind.check_inputs]."""
         inputs = validate_mapping(raw, self.input_options(model), path, what="input")
         self.resolve(inputs, model, path)
         self.check_inputs(inputs, model, path)
         return inputs
 
     def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
-        """Add the values derived from several parsed inputs to ``inputs``; raise :class:`InputError`."""
+        """Add the values derived from several parsed inputs to ``inputs``; raise
+        [`InputError`][cpm_nlp.core.errors.InputError]."""
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
-        """Cross-input validation; raise :class:`InputError`."""
+        """Cross-input validation; raise [`InputError`][cpm_nlp.core.errors.InputError]."""
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         raise NotImplementedError
@@ -79,13 +82,14 @@ class ProblemKind:
     def outputs(self, model: Model) -> list[Output]:
         """The declared outputs on ``model``: name, dimension, role (and the unit text of
         what has no SI unit), every value the kind may return, in order; its results are
-        built from them (:func:`~cpm_nlp.core.outputs.declared_result`).  Values whose
+        built from them (`declared_result`).  Values whose
         names depend on the inputs (one per hinge group of the problem's hinges) are a
         family (``Output(..., per=...)``), of which a result holds members."""
         raise NotImplementedError
 
     def output_names(self, model: Model) -> list[str]:
-        """The names of :meth:`outputs` that a result has by default: not a family's (its members
+        """The names of [`outputs`][cpm_nlp.core.kind.ProblemKind.outputs] that a result has by default: not a family's
+        (its members
         depend on the inputs), nor one that only an input asks for (``Output.when``)."""
         return [o.name for o in self.outputs(model) if not o.family and not o.when]
 
@@ -94,7 +98,7 @@ class ProblemKind:
         return None
 
     def check_solver(self, solver: SolverConfig) -> None:
-        """Raise :class:`InputError` if the kind cannot use this solver
+        """Raise [`InputError`][cpm_nlp.core.errors.InputError] if the kind cannot use this solver
         configuration (e.g. an optimisation needs IPOPT)."""
 
 

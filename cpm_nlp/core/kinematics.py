@@ -1,12 +1,12 @@
-"""Kinematics algorithms: free functions over a :class:`~cpm_nlp.core.model.Model`.
+"""Kinematics algorithms: free functions over a [`Model`][cpm_nlp.core.model.Model].
 
-* :func:`forward_kinematics` -- x from q, by IPOPT (default) or Newton;
-* :func:`inverse_kinematics` -- q (and the dependent pose coordinates) from
+* [`forward_kinematics`][cpm_nlp.core.kinematics.forward_kinematics] -- x from q, by IPOPT (default) or Newton;
+* [`inverse_kinematics`][cpm_nlp.core.kinematics.inverse_kinematics] -- q (and the dependent pose coordinates) from
   the task coordinates, in closed form where the paper gives one, else solved;
-* :func:`jacobians` -- Φ_x, Φ_q, forward and inverse Jacobians and singularity
+* [`jacobians`][cpm_nlp.core.kinematics.jacobians] -- Φ_x, Φ_q, forward and inverse Jacobians and singularity
   measures, all from algorithmic differentiation of Φ;
-* :func:`passive_joints` -- passive joint angles of a pose;
-* :func:`assess` -- the checks every pose passes before it is reported solved.
+* [`passive_joints`][cpm_nlp.core.kinematics.passive_joints] -- passive joint angles of a pose;
+* [`assess`][cpm_nlp.core.kinematics.assess] -- the checks every pose passes before it is reported solved.
 
 Sizes: nx = pose coordinates, nq = actuated joints (= task coordinates).
 """
@@ -52,9 +52,15 @@ log = logging.getLogger(__name__)
 class PoseSolution:
     """Outcome of one FK or IK solve.
 
-    x: pose, size nx; q: actuated joints, size nq; passive: passive joint
-    angles (model.closure.passive_names).  All three are None unless
-    ``status`` is ``solved``.  ``residual`` is max |Φ| at the last iterate.
+    Attributes
+    ----------
+    x
+        pose, size nx;
+    q
+        actuated joints, size nq;
+    passive
+        passive joint angles (model.closure.passive_names).  All three are None unless
+        ``status`` is ``solved``.  ``residual`` is max |Φ| at the last iterate.
     """
 
     status: Status
@@ -114,7 +120,7 @@ def _limit_violations(model: Model, x: np.ndarray, q: np.ndarray, passive: np.nd
 
 
 def pose_checks(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> dict[str, np.ndarray]:
-    """The kernel checks of one pose (see :mod:`cpm_nlp.core.pose_checks`), one fast call."""
+    """The kernel checks of one pose (see `cpm_nlp.core.pose_checks`), one fast call."""
     c = model.closure
     fn = fast(c, ("pose_checks",), lambda: checks_function(c))
     lower, upper = limit_vectors(model)
@@ -200,7 +206,7 @@ def _assess(
 def assess(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tuple[Status, str, dict]:
     """Check a candidate pose: residual, assembly branch, IK round trip,
     singularity, joint limits (in this order; the first failure gives the
-    status, see :func:`cpm_nlp.core.pose_checks.status_rules`).  Returns (status,
+    status, see `cpm_nlp.core.pose_checks.status_rules`).  Returns (status,
     message, details)."""
     status, message, details, _ = _assess(model, x, q, tolerance)
     return status, message, details
@@ -265,9 +271,9 @@ def pose_from_kernel(
     seconds: float,
     solver: str,
 ) -> PoseSolution:
-    """A :class:`PoseSolution` from the outputs of the FK kernel for one pose
-    (``index``: positions of :data:`_FK_FIELDS` among them), exactly as
-    :class:`cpm_nlp.core.batch.BatchResult` turns a batch row into one (the
+    """A [`PoseSolution`][cpm_nlp.core.kinematics.PoseSolution] from the outputs of the FK kernel for one pose
+    (``index``: positions of `_FK_FIELDS` among them), exactly as
+    [`cpm_nlp.core.batch.BatchResult`][cpm_nlp.core.batch.BatchResult] turns a batch row into one (the
     1-norm singularity screen refined by the 2-norm condition number)."""
     c = model.closure
     i_x, i_passive, i_res, i_branch, i_trip, i_limit, i_cond, i_path, i_status = index
@@ -324,13 +330,9 @@ def forward_kinematics(
 ) -> PoseSolution:
     """Solve Φ(x, q; p) = 0 for the pose x on the designated branch.
 
-    q: actuated joints, size nq (SI).  guess: initial pose, size nx (default:
-    the home pose).  The answer is checked (:func:`assess`) before it is
-    reported solved.
-
     Newton (``SolverConfig("newton")``, with the options the kernels take:
     abstol, abstolStep, max_iter): the kernel of the batch,
-    :func:`cpm_nlp.core.kernels.fk_kernel`, so a single solve and a batch
+    `cpm_nlp.core.kernels.fk_kernel`, so a single solve and a batch
     give the same statuses and values.  For a mechanism with a closed-form IK
     it solves for the nq task coordinates through the IK from the first-order
     guess and falls back to Newton on Φ from ``guess`` where that does not
@@ -340,9 +342,17 @@ def forward_kinematics(
 
     continuation: when the solve from the guess fails (no convergence, or a
     pose off the designated branch, as from a pose far from home), FK follows
-    the designated branch from home to q (:func:`continued_forward_kinematics`)
+    the designated branch from home to q (`continued_forward_kinematics`)
     before reporting the failure.  Angles of a solved pose are reduced
-    (:func:`reduce_angles`).
+    (`reduce_angles`).
+
+    Parameters
+    ----------
+    q
+        actuated joints, size nq (SI).
+    guess
+        initial pose, size nx (default: the home pose).  The answer is checked
+        ([`assess`][cpm_nlp.core.kinematics.assess]) before it is reported solved.
     """
     config = solver or SolverConfig()
     c = model.closure
@@ -453,9 +463,9 @@ def reduce_angle(v: float, ranges: Sequence[tuple[float, float] | None]) -> floa
 
 
 def _angle_ranges(model: Model) -> list[tuple[bool, int, tuple, float, float]]:
-    """The angle coordinates :func:`reduce_angles` reduces, with their ranges, in its order (the
+    """The angle coordinates `reduce_angles` reduces, with their ranges, in its order (the
     actuators first): (in x, index, ranges, low, high), [low, high] the first finite range (a value
-    there is kept: :func:`reduce_angle`; (inf, -inf) when none is); built once per model (a single
+    there is kept: `reduce_angle`; (inf, -inf) when none is); built once per model (a single
     FK calls it each time)."""
     cached = model.__dict__.get("_angle_ranges")
     if cached is None:
@@ -480,7 +490,7 @@ def _angle_ranges(model: Model) -> list[tuple[bool, int, tuple, float, float]]:
 
 def reduce_angles(model: Model, x: np.ndarray, q: np.ndarray, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
     """The pose and the actuators with each angle coordinate reduced by whole turns
-    (:func:`reduce_angle`) to its declared range (its joint limits, else, for a pose
+    (`reduce_angle`) to its declared range (its joint limits, else, for a pose
     coordinate, the bounds of the pose coordinates) if a turn of it lies there, else to
     (-pi, pi]; an actuator without a declared range, and a coordinate the closures are not
     periodic in (the residual grows, e.g. an actuator geared to its joint), keep their
@@ -510,10 +520,13 @@ def inverse_kinematics(
 ) -> PoseSolution:
     """Actuated joints (and dependent pose coordinates) for task coordinates t.
 
-    t: the model's task coordinates (closure.task), size nq.
-    method: "closed_form" (the paper's IK), "solve" (Φ = 0 for the
-    dependent coordinates and q, by the configured solver), or "auto"
-    (closed form when the model has one).
+    Parameters
+    ----------
+    t
+        the model's task coordinates (closure.task), size nq.
+    method
+        "closed_form" (the paper's IK), "solve" (Φ = 0 for the dependent coordinates and q, by
+        the configured solver), or "auto" (closed form when the model has one).
     """
     config = solver or SolverConfig()
     c = model.closure
@@ -560,14 +573,22 @@ class JacobianReport:
 
     phi_x (nx x nx), phi_q (nx x nq);
     J = -Φ_x⁻¹ Φ_q (nx x nq): pose rates from actuator rates;
-    J_task (nq x nq): the task rows of J;
-    J_inv (nq x nq): actuator rates from task rates, from Φ with the
-    dependent coordinates and q as unknowns (equals J_task⁻¹);
-    det_phi_x: zero at forward (type II) singularities;
-    det_phi_y: zero at inverse (type I) singularities;
-    cond, manipulability: condition number and Yoshikawa's sqrt(det(J Jᵀ)) of
-    J_task with angle rows multiplied by ``characteristic_length`` so that
-    every row is a length rate (the measures are then dimensionless).
+
+    Attributes
+    ----------
+    J_task
+        (nq x nq) the task rows of J;
+    J_inv
+        (nq x nq) actuator rates from task rates, from Φ with the dependent coordinates and q as
+        unknowns (equals J_task⁻¹);
+    det_phi_x
+        zero at forward (type II) singularities;
+    det_phi_y
+        zero at inverse (type I) singularities;
+    cond, manipulability
+        condition number and Yoshikawa's sqrt(det(J Jᵀ)) of J_task with angle rows multiplied by
+        ``characteristic_length`` so that every row is a length rate (the measures are then
+        dimensionless).
     """
 
     phi_x: np.ndarray

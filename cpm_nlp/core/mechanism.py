@@ -1,27 +1,27 @@
 """The declared interface between a mechanism and the rest of cpm_nlp.
 
-A mechanism type is one :class:`Mechanism` value.  Its required fields say
+A mechanism type is one [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] value.  Its required fields say
 what the mechanism *is*; its optional fields are what every mechanism may
 have (checks, a drawing, kinds of its own, problem files); everything a
-single kind needs from it is a :class:`Part`, declared by that kind (in its
+single kind needs from it is a [`Part`][cpm_nlp.core.mechanism.Part], declared by that kind (in its
 own module, not here) and registered by the mechanism in ``parts``.  A kind
-reads a part by its type (:meth:`Mechanism.part`), never by probing a module
+reads a part by its type ([`Mechanism.part`][cpm_nlp.core.mechanism.Mechanism.part]), never by probing a module
 for an attribute, so core does not change when a kind needs something new.
 A misspelt field or a mistyped part is an error when the mechanism is
-declared (:func:`declare`) or registered, not a silently missing feature.
+declared ([`declare`][cpm_nlp.core.mechanism.declare]) or registered, not a silently missing feature.
 
 Required fields
 ---------------
 ``name``, ``title``
     the type name used in problem files (``mechanism.type``) and a one-line title.
 ``parameters``, ``limits``
-    declared :class:`~cpm_nlp.core.options.Option` s of the geometry (SI, with
+    declared `Option` s of the geometry (SI, with
     dimension, default, bounds, description) and of the joint limits.
 ``closure``
     ``() -> LoopClosure``: the symbolic closure Φ(x, q; p).  Built once per
     process by the registry and shared by every model of the type.  Three
     capabilities live on the closure itself, as optional arguments of
-    :class:`~cpm_nlp.core.model.LoopClosure`: the closed-form IK (``ik``), the
+    [`LoopClosure`][cpm_nlp.core.model.LoopClosure]: the closed-form IK (``ik``), the
     passive joint angles (``passive``, ``passive_coords``) and the
     assembly-branch indicator (``branch``).
 ``build``
@@ -36,12 +36,12 @@ that reproduce its paper's figures.
 
 Parts (each declared with the kind that reads it)
 -------------------------------------------------
-``synthesis`` (:class:`~cpm_nlp.kinds.synthesis.SynthesisFormulation`), ``cuboid``
-(:class:`~cpm_nlp.kinds.workspace.CuboidExtras`), ``paper_membership``
-(:class:`~cpm_nlp.kinds.workspace.PaperMembership`), ``dynamics``
-(:class:`~cpm_nlp.analysis.dynamics.DynamicsModel`), ``stiffness``
-(:class:`~cpm_nlp.analysis.compliance.JointStiffness`) and ``chains``
-(:class:`~cpm_nlp.core.chains.LegChains`, in core beside the chains it gives).
+``synthesis`` ([`SynthesisFormulation`][cpm_nlp.kinds.synthesis.SynthesisFormulation]), ``cuboid``
+([`CuboidExtras`][cpm_nlp.kinds.workspace.CuboidExtras]), ``paper_membership``
+([`PaperMembership`][cpm_nlp.kinds.workspace.PaperMembership]), ``dynamics``
+([`DynamicsModel`][cpm_nlp.analysis.dynamics.DynamicsModel]), ``stiffness``
+([`JointStiffness`][cpm_nlp.analysis.compliance.JointStiffness]) and ``chains``
+([`LegChains`][cpm_nlp.core.chains.LegChains], in core beside the chains it gives).
 """
 
 from __future__ import annotations
@@ -63,9 +63,9 @@ class MechanismDeclarationError(TypeError):
     or registration, with the mechanism's name and the field at fault)."""
 
 
-#: parts a :class:`Drawing` may join or fill, in the order they are drawn
+#: parts a `Drawing` may join or fill, in the order they are drawn
 DRAWING_PARTS = ("base", "actuator", "link", "leg", "platform")
-#: joint letters a :class:`Drawing` may mark (prismatic, revolute, cylindrical, universal, spherical):
+#: joint letters a `Drawing` may mark (prismatic, revolute, cylindrical, universal, spherical):
 #: the letters of the joint table
 JOINT_TYPES = JOINT_LETTERS
 
@@ -75,14 +75,22 @@ class Drawing:
     """The mechanism drawn at one pose, for plots: named 3-D points (SI, fixed
     frame) and what joins them.
 
-    points: name -> (x, y, z).
-    segments: ``(from, to, part)``: a straight link between two points; part
-        is one of :data:`DRAWING_PARTS` (a rail or a lever is ``actuator``).
-    faces: ``(part, (names ...))``: a filled polygon (the base, the platform).
-    joints: point name -> joint letter (:data:`JOINT_TYPES`), marked on the drawing.
-    actuated: the points of the actuated joints (drawn in the actuators' colour, seen
-        even where the actuator's stroke is too short to draw).
-    note: what the drawing leaves out or where it departs from scale (shown with it).
+    Attributes
+    ----------
+    points
+        name -> (x, y, z).
+    segments
+        ``(from, to, part)``: a straight link between two points; part is one of `DRAWING_PARTS`
+        (a rail or a lever is ``actuator``).
+    faces
+        ``(part, (names ...))``: a filled polygon (the base, the platform).
+    joints
+        point name -> joint letter (`JOINT_TYPES`), marked on the drawing.
+    actuated
+        the points of the actuated joints (drawn in the actuators' colour, seen even where the
+        actuator's stroke is too short to draw).
+    note
+        what the drawing leaves out or where it departs from scale (shown with it).
     """
 
     points: Mapping[str, Any]
@@ -111,11 +119,11 @@ class Part:
     """Base of a mechanism's optional parts: what one kind (or analysis) needs from a mechanism
     beyond its closure, declared where that kind lives, never here.
 
-    A kind names the part types it reads (:attr:`ProblemKind.parts
-    <cpm_nlp.core.kind.ProblemKind.parts>`); a mechanism registers its implementations
-    (:attr:`Mechanism.parts`, at most one of each type); :meth:`Mechanism.part` is the one way to
+    A kind names the part types it reads (`ProblemKind.parts`); a mechanism registers its implementations
+    (`Mechanism.parts`, at most one of each type); [`Mechanism.part`][cpm_nlp.core.mechanism.Mechanism.part] is the one
+    way to
     read one.  A subclass names its ``capability`` (listed by ``cpm-nlp describe``) and checks
-    its own fields when made, raising :class:`MechanismDeclarationError`.
+    its own fields when made, raising `MechanismDeclarationError`.
     """
 
     #: the name ``cpm-nlp describe`` lists the part under
@@ -143,7 +151,7 @@ class Mechanism:
     """A mechanism type: what every mechanism has, and its parts.
 
     Sizes in model terms: nx pose coordinates x, nq actuators q, np
-    parameters p (see :class:`~cpm_nlp.core.model.LoopClosure`).
+    parameters p (see [`LoopClosure`][cpm_nlp.core.model.LoopClosure]).
     """
 
     #: type name in problem files (``mechanism.type``)
@@ -167,8 +175,8 @@ class Mechanism:
     #: ``(model, x (nx,), q (nq,)) -> Drawing``: the mechanism at a pose (base, legs,
     #: joints, platform) for the plots, from its kinematic functions
     geometry: Callable[[Any, Any, Any], Drawing] | None = None
-    #: what kinds need beyond the closure, one :class:`Part` of each type (e.g. the extra
-    #: values of the inscribed cuboid, a Lagrange model, its hinges); read by :meth:`part`
+    #: what kinds need beyond the closure, one `Part` of each type (e.g. the extra
+    #: values of the inscribed cuboid, a Lagrange model, its hinges); read by `part`
     parts: tuple[Part, ...] = ()
     #: problem kinds of its own: kind name -> ProblemKind subclass
     kinds: Mapping[str, type] = field(default_factory=dict)
@@ -176,7 +184,7 @@ class Mechanism:
     #: section) its paper's figures; names under the shipped ``problems/`` directory, or
     #: absolute paths for a plugin's own files
     problem_files: tuple[str, ...] = ()
-    #: where the declaration came from (:class:`~cpm_nlp.core.origin.Origin`; a text given in
+    #: where the declaration came from (`Origin`; a text given in
     #: code, e.g. "built-in", is made one)
     origin: Origin | str = "built-in"
 
@@ -202,7 +210,7 @@ class Mechanism:
         return model
 
     def part(self, kind: type[P]) -> P | None:
-        """The mechanism's part of type ``kind`` (a :class:`Part` subclass), or None."""
+        """The mechanism's part of type ``kind`` (a [`Part`][cpm_nlp.core.mechanism.Part] subclass), or None."""
         return next((p for p in self.parts if isinstance(p, kind)), None)
 
     def capabilities(self) -> list[str]:
@@ -306,7 +314,7 @@ def unknown_field_hint(name: str) -> str:
 
 
 def declare(**fields_: Any) -> Mechanism:
-    """A :class:`Mechanism` from keyword fields, with a "did you mean" for a misspelt one
+    """A [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] from keyword fields, with a "did you mean" for a misspelt one
     (``Mechanism(...)`` itself only says "unexpected keyword")."""
     unknown = [k for k in fields_ if k not in PARTS]
     if unknown:
@@ -328,27 +336,36 @@ class Addon:
     """What a mechanism file cannot say, given in Python for the mechanism of one shipped file
     (issue 21, item 5): the file is the mechanism (its closures, IK, passive joints, branch,
     drawing, paper, problem files); the add-on refers to it by the registry's table
-    :data:`cpm_nlp.mechanisms.names.ADDONS` and adds only what is not kinematics.
-
-    parameters: optional parameters the closures do not use (e.g. a dynamics model's lengths
-        and hinge sizes); a value given is kept in the model's ``parameters``, never in p.
-    check_parameters, check_limits: as the :class:`Mechanism` fields of the same names.
-    parts: the paper's parts (:class:`Part`), registered as a mechanism registers its own
-        (the paper's formulations that refer to the file's mechanism).
-    closure_parts: ``(closure) -> Part`` each: a part made from the file's closure (e.g. a
-        Lagrange model that uses the file's loop closures, their Jacobian, never a copy).
-    kinds: problem kinds of the paper's own: kind name -> ProblemKind subclass.
-    limits: the paper's own limit options (e.g. a hinge from which a formula sets the joint
-        limits, or ranges counted from home), beside the file's limit families; one named
-        like a family of the file replaces it (the paper's meaning of that name wins).
-    complete: ``(model, limits) -> None``: completes the file's model with what ``limits``
-        gives (joint limits on the file's coordinates) and the paper's derived quantities
-        (``model.derived``), from the file's closure and model, never a copy of them.
+    `cpm_nlp.mechanisms.names.ADDONS` and adds only what is not kinematics.
 
     The paper's own plot types are not an add-on's field: they are declared, name and one
-    line each, in :data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that ``cpm-nlp plot
+    line each, in `cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that ``cpm-nlp plot
     --help`` lists them without importing the add-on (a plot belongs to the plot layer,
     above the mechanisms).
+
+    Attributes
+    ----------
+    parameters
+        optional parameters the closures do not use (e.g. a dynamics model's lengths and hinge
+        sizes); a value given is kept in the model's ``parameters``, never in p.
+    check_parameters, check_limits
+        as the [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] fields of the same names.
+    parts
+        the paper's parts ([`Part`][cpm_nlp.core.mechanism.Part]), registered as a mechanism
+        registers its own (the paper's formulations that refer to the file's mechanism).
+    closure_parts
+        ``(closure) -> Part`` each: a part made from the file's closure (e.g. a Lagrange model
+        that uses the file's loop closures, their Jacobian, never a copy).
+    kinds
+        problem kinds of the paper's own: kind name -> ProblemKind subclass.
+    limits
+        the paper's own limit options (e.g. a hinge from which a formula sets the joint limits,
+        or ranges counted from home), beside the file's limit families; one named like a family
+        of the file replaces it (the paper's meaning of that name wins).
+    complete
+        ``(model, limits) -> None``: completes the file's model with what ``limits`` gives
+        (joint limits on the file's coordinates) and the paper's derived quantities
+        (``model.derived``), from the file's closure and model, never a copy of them.
     """
 
     parameters: tuple[Option, ...] = ()

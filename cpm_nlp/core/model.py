@@ -1,6 +1,6 @@
 """Mechanisms as symbolic loop closures.
 
-A mechanism type is a :class:`LoopClosure`: the CasADi equations
+A mechanism type is a [`LoopClosure`][cpm_nlp.core.model.LoopClosure]: the CasADi equations
 Φ(x, q; p) = 0 with
 
 * x -- platform pose plus any passive coordinates, size nx,
@@ -12,9 +12,9 @@ and an assembly-branch indicator.  Everything else -- Φ_x, Φ_q, the forward
 and inverse Jacobians -- is derived from Φ by algorithmic differentiation,
 once per mechanism type.
 
-A :class:`Model` is a mechanism type with numbers: parameter values and joint
+A [`Model`][cpm_nlp.core.model.Model] is a mechanism type with numbers: parameter values and joint
 limits (Pinocchio's split: the model holds constants, algorithms in
-:mod:`cpm_nlp.core.kinematics` are free functions over it).
+`cpm_nlp.core.kinematics` are free functions over it).
 """
 
 from __future__ import annotations
@@ -33,8 +33,12 @@ from .solver import SolverConfig, SquareSolver, solvers_of
 class Coordinate:
     """A named scalar coordinate.
 
-    kind: physical dimension ("length" or "angle").
-    family: joints of the same kind share limits (s1, s2, s3 -> "s").
+    Attributes
+    ----------
+    kind
+        physical dimension ("length" or "angle").
+    family
+        joints of the same kind share limits (s1, s2, s3 -> "s").
     """
 
     name: str
@@ -56,48 +60,48 @@ class LoopClosure:
 
     Parameters
     ----------
-    name:
+    name
         mechanism type, e.g. "prs3".
-    x, q:
+    x, q
         coordinates of the pose (nx) and of the actuators (nq).
-    parameters:
+    parameters
         names of the geometry parameters p (np), in order.
-    phi:
+    phi
         ``ca.Function("phi", [x, q, p], [phi], ["x", "q", "p"], ["phi"])``,
         nx residuals, each in ``residual_unit``.
-    task:
+    task
         names (in x) of the nq independent output coordinates.
-    ik:
+    ik
         optional closed form, ``("ik", [t, p], [x, q, reach])``; ``reach < 0``
         when the pose cannot be assembled.
-    passive:
+    passive
         optional ``("passive", [x, q, p], [j])`` with one entry per
         ``passive_coords``.
-    branch:
+    branch
         optional ``("branch", [x, q, p], [g])``: all g > 0 on the assembly
         branch the model designates.
-    home:
+    home
         ``p -> (x_home, q_home)`` (numpy), the reference configuration and the
         default initial guess.
-    bounds:
+    bounds
         ``p -> (x_lower, x_upper)`` (numpy) used by IPOPT to stay on the branch.
-    offsets:
+    offsets
         input/output names for coordinates measured from the home pose,
         e.g. ``{"dz": "pz"}`` (dz = pz - pz_home).
-    branch_names, branch_descriptions:
+    branch_names, branch_descriptions
         optional name and meaning of each branch indicator (a ``wrong_branch``
         message names the one that failed); default ``g[k]``.
-    frame:
+    frame
         optional ``("frame", [x, p], [R, position])``: the platform's rotation
         matrix (3 x 3) and position (3); assembly modes are told apart on it
         (not on angles, which alias).
-    fk_closed:
+    fk_closed
         optional closed-form FK of the whole closure, ``("fk_closed", [q, x0, p], [x, disc, side])``
-        (planar dyads: :mod:`cpm_nlp.mechanisms.described.dyads`, ``graph_dyads``); ``disc < 0``
+        (planar dyads: `cpm_nlp.mechanisms.described.dyads`, ``graph_dyads``); ``disc < 0``
         where it cannot assemble the pose, ``side <= 0`` where the guess x0 lies in another assembly
         than the one it takes (x0 also picks the turn of an angle).  The FK kernel tries it first
-        and keeps it only where the pose checks pass (:func:`cpm_nlp.core.kernels.fk_kernel`).
-    fk_seed:
+        and keeps it only where the pose checks pass (`cpm_nlp.core.kernels.fk_kernel`).
+    fk_seed
         optional ``("fk_seed", [q, x0, p], [x0_seed])``: where only part of the closure is solved
         in closed form (some dyads before a group they cannot place), the guess Newton starts from
         -- those coordinates in closed form, the others x0's (x0 itself where a dyad does not
@@ -133,7 +137,7 @@ class LoopClosure:
         self.fk_seed = fk_seed
         #: every closure equation (m >= nx rows), when phi holds a square combination of them (an
         #: overconstrained linkage's normal equations): a pose is checked against these too, and the
-        #: closure's conditioning is that of their Jacobian (:attr:`cond_matrix`); None: phi's own
+        #: closure's conditioning is that of their Jacobian (`cond_matrix`); None: phi's own
         self.loops = loops
         self.x = tuple(x)
         self.q = tuple(q)
@@ -245,13 +249,19 @@ class LoopClosure:
 class Model:
     """A mechanism with numbers.
 
-    closure: the symbolic mechanism type.
-    parameters: geometry, SI, in the order of ``closure.parameters``.
-    limits: joint limits ``name -> (low, high)`` (SI) for actuators and
-        passive joints; a family name ("s", "alpha") applies to all its members.
-    derived: quantities that follow from the parameters (e.g. the 3-PRS
-        actuator circle radius a), reported with results; a vector (a
-        mechanism file's derived point) is a list of floats under its name.
+    Attributes
+    ----------
+    closure
+        the symbolic mechanism type.
+    parameters
+        geometry, SI, in the order of ``closure.parameters``.
+    limits
+        joint limits ``name -> (low, high)`` (SI) for actuators and passive joints; a family
+        name ("s", "alpha") applies to all its members.
+    derived
+        quantities that follow from the parameters (e.g. the 3-PRS actuator circle radius a),
+        reported with results; a vector (a mechanism file's derived point) is a list of floats
+        under its name.
     """
 
     closure: LoopClosure
@@ -261,8 +271,8 @@ class Model:
     dimensions: Mapping[str, str] = field(default_factory=dict)  # of parameters and derived values
     #: length that converts angle rates to length rates in conditioning measures
     characteristic_length: float = 1.0
-    #: the :class:`~cpm_nlp.core.mechanism.Mechanism` declaration the model was built from (its
-    #: parts), set by :meth:`Mechanism.model <cpm_nlp.core.mechanism.Mechanism.model>`; None for
+    #: the `Mechanism` declaration the model was built from (its
+    #: parts), set by `Mechanism.model`; None for
     #: a model built by hand on its closure
     mechanism: Any = field(default=None, repr=False, compare=False)
 

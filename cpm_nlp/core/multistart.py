@@ -17,7 +17,7 @@ from .options import Option
 #: two objectives agree when they differ by at most this, relative to the best
 AGREEMENT = 1e-4
 
-#: starts of an assembly-mode search (:func:`cpm_nlp.analysis.assembly.assembly_modes`, the
+#: starts of an assembly-mode search (`cpm_nlp.analysis.assembly.assembly_modes`, the
 #: ``mode_starts`` of a forward_kinematics problem): all 40 modes of Dietmaier's platform with
 #: probability 0.999 (estimated from the basins of 100 000 starts; benchmarks/bench_assembly_modes.py
 #: measures it over seeds).  Here, not in the search's module, so that the kind declaring

@@ -29,7 +29,7 @@ TINY = 1e-60
 
 #: Largest number of points a grid may have (keeps a typo from exhausting memory).
 MAX_GRID_POINTS = 1_000_000
-#: Lists at least this long (a data file's columns) are checked column-wise (:meth:`Option._list`).
+#: Lists at least this long (a data file's columns) are checked column-wise (`Option._list`).
 FAST_LIST = 256
 
 
@@ -37,13 +37,15 @@ FAST_LIST = 256
 class Option:
     """One declared option.
 
-    kind:
-        a dimension of :mod:`cpm_nlp.core.units` ("length", "angle", ...), or one of
-        "int", "bool", "str", "choice".
-    shape:
-        "scalar"; "list" (a non-empty list of scalars); "grid" (a list, or a
-        mapping ``{from, to, count}``); "range" (a pair ``[low, high]``).
-    lower, upper:
+    Attributes
+    ----------
+    kind
+        a dimension of `cpm_nlp.core.units` ("length", "angle", ...), or one of "int", "bool",
+        "str", "choice".
+    shape
+        "scalar"; "list" (a non-empty list of scalars); "grid" (a list, or a mapping ``{from,
+        to, count}``); "range" (a pair ``[low, high]``).
+    lower, upper
         bounds on the SI value; ``strict`` makes them exclusive.
     """
 
@@ -60,7 +62,7 @@ class Option:
     #: a validator of the parsed value, ``(value, key path) -> None`` raising InputError
     check: Any = None
 
-    #: a missing essential input is named before unknown keys (see :func:`validate_mapping`)
+    #: a missing essential input is named before unknown keys (see `validate_mapping`)
     essential = False
 
     @property
@@ -147,7 +149,7 @@ class Option:
 
     def _list_of_floats(self, value: list | tuple) -> list[float] | None:
         """A long list of bare floats of a physical dimension (a data file's column, 100 000
-        values), checked column-wise with numpy: the checks of :meth:`_scalar` on every value
+        values), checked column-wise with numpy: the checks of `_scalar` on every value
         at once.  None (check value by value) for a short list, another kind, or any value
         that is no float or fails a check: the per-value path then raises the same error,
         naming the same first value, as it always did."""

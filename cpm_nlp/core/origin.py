@@ -1,6 +1,6 @@
 """Where a mechanism came from, as a typed value (never parsed back from its text).
 
-:class:`Origin` is what :attr:`cpm_nlp.core.mechanism.Mechanism.origin` holds and
+`Origin` is what `cpm_nlp.core.mechanism.Mechanism.origin` holds and
 what a result records (``"origin"`` in its JSON), so that a plot or a new solve
 rebuilds the very mechanism that was solved:
 
@@ -28,11 +28,21 @@ ORIGIN_KINDS = ("built-in", "file", "inline", "plugin", "code")
 class Origin:
     """Where a mechanism came from (see the module's text).
 
-    kind: one of :data:`ORIGIN_KINDS`; name: the mechanism's name (in a result's
-    record); path: a mechanism file's path (``file``), or the folder an inline
-    description's relative paths are read from; sha256: of the file's bytes, or of
-    the inline description's canonical JSON; detail: free text for messages (a
-    plugin's entry point); description: an inline description as written (data).
+    Attributes
+    ----------
+    kind
+        one of `ORIGIN_KINDS`;
+    name
+        the mechanism's name (in a result's record);
+    path
+        a mechanism file's path (``file``), or the folder an inline description's relative paths
+        are read from;
+    sha256
+        of the file's bytes, or of the inline description's canonical JSON;
+    detail
+        free text for messages (a plugin's entry point);
+    description
+        an inline description as written (data).
     """
 
     kind: str
@@ -89,7 +99,7 @@ def data_sha256(data: Any) -> str:
 
 
 def as_origin(value: Any, name: str = "") -> Origin:
-    """An origin given as an :class:`Origin`, or as the text a declaration in code wrote
+    """An origin given as an `Origin`, or as the text a declaration in code wrote
     ("built-in" is the built-in kind; any other text is kept as the ``code`` kind's detail)."""
     if isinstance(value, Origin):
         return value

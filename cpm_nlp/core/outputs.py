@@ -1,11 +1,11 @@
-"""Declared outputs of a problem kind, and the :class:`~cpm_nlp.core.result.Result` built from them.
+"""Declared outputs of a problem kind, and the [`Result`][cpm_nlp.core.result.Result] built from them.
 
-A kind declares each value it returns once, as an :class:`Output` (name, dimension,
-role); :func:`declared_result` then writes the result's units and dimensions from
+A kind declares each value it returns once, as an [`Output`][cpm_nlp.core.result.Output] (name, dimension,
+role); `declared_result` then writes the result's units and dimensions from
 that declaration, so that no kind writes a unit by hand (issue 22, item 2).  The unit
-of a physical dimension is :func:`~cpm_nlp.core.units.result_unit`'s; an output with
+of a physical dimension is `result_unit`'s; an output with
 no SI unit (a matrix, a list of coordinates, a text) carries a text saying what it
-holds (:func:`matrix`, :func:`vector`, :func:`text`).
+holds (`matrix`, `vector`, `text`).
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def outputs_of(dims: Mapping[str, str], *, named: bool = True) -> list[Output]:
     """Outputs of the given dimensions, in their order (a matrix's and a text's role said by
     their dimension, every other one a value).  An output of no physical dimension (a text,
     a matrix) writes its dimension's name as its unit, or with ``named=False`` no unit; a
-    margin (dimension "si") is in the unit of whichever quantity binds (:data:`BINDING_UNIT`)."""
+    margin (dimension "si") is in the unit of whichever quantity binds (`BINDING_UNIT`)."""
     return [
         Output(
             n,
@@ -56,7 +56,7 @@ def outputs_of(dims: Mapping[str, str], *, named: bool = True) -> list[Output]:
 
 def size(name: str, kinds: Iterable[str]) -> Output:
     """The size of a box whose sides are coordinates of ``kinds`` (an area, a volume, a
-    length times an angle ...): dimension and unit by :func:`~cpm_nlp.core.units.size_dimension`."""
+    length times an angle ...): dimension and unit by `size_dimension`."""
     dimension, unit = size_dimension(kinds)
     return Output(name, dimension, unit=unit)
 
@@ -79,7 +79,7 @@ def text(name: str, unit: str = "") -> Output:
 @dataclass
 class Values:
     """Values with their declarations, gathered in the order computed (what
-    :func:`declared_result` takes): a kind adds each value with its :class:`Output`."""
+    `declared_result` takes): a kind adds each value with its [`Output`][cpm_nlp.core.result.Output]."""
 
     outputs: list[Output] = field(default_factory=list)
     values: dict[str, Any] = field(default_factory=dict)
@@ -113,7 +113,7 @@ def output_names(outputs: Sequence[Output]) -> list[str]:
 def declared_for(kind: str, declared: Sequence[Output], names: Iterable[str]) -> list[Output]:
     """The declarations of ``names``, in the declared order, from a kind's declared outputs (a
     result built from them holds what the kind declares, nothing else); a name the kind
-    does not declare is a programming error (ValueError), as :class:`Result` refuses it."""
+    does not declare is a programming error (ValueError), as [`Result`][cpm_nlp.core.result.Result] refuses it."""
     wanted = set(names)
     undeclared = sorted(wanted - {o.name for o in declared if not o.family})
     if undeclared:

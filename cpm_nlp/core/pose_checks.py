@@ -1,11 +1,11 @@
 """The pose checks every solution passes before it is reported solved -- loop-closure
 residual, assembly branch, round trip through the closed-form IK, conditioning of Φ_x, joint
-limits -- and **the status rule** that turns them into a :class:`~cpm_nlp.core.result.Status`.
+limits -- and **the status rule** that turns them into a [`Status`][cpm_nlp.core.result.Status].
 
-The rule is written once (:func:`status_rules`) and evaluated both symbolically (inside every
-kernel of :mod:`cpm_nlp.core.kernels`, so exported C code reports a status) and on numpy arrays
+The rule is written once (`status_rules`) and evaluated both symbolically (inside every
+kernel of `cpm_nlp.core.kernels`, so exported C code reports a status) and on numpy arrays
 (single solves, refinement of batch results).  Status codes are the positions in
-:data:`STATUSES`.
+`STATUSES`.
 
 Conditioning: the single-pose check uses the 2-norm condition number of Φ_x
 (numpy).  A kernel cannot compute singular values, so it uses the 1-norm
@@ -20,9 +20,9 @@ the condition number in Φ_x (≈ e_xᵀ e_x up to scaling where e = 0): its
 conditioning is measured on e_x instead (``LoopClosure.cond_matrix``), the
 2-norm deciding on κ₂(e_x) = σ_max/σ_min and the kernels reporting as
 ``cond1`` the upper bound of κ₂(e_x) of
-:func:`~cpm_nlp.core.conditioning.cond2_left_inverse_bound` (a block left inverse at the pose;
+`cond2_left_inverse_bound` (a block left inverse at the pose;
 first derivatives only), flagged at 10¹⁰/2 (the bound is of κ₂ itself; 2 covers rounding:
-:func:`screen_factor`).
+`screen_factor`).
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def code_of(status: Status) -> int:
 
 
 def status_of(code: Any) -> Status:
-    """The :class:`Status` of a code output by a kernel, an exported function or a batch."""
+    """The [`Status`][cpm_nlp.core.result.Status] of a code output by a kernel, an exported function or a batch."""
     value = code.full() if isinstance(code, ca.DM) else code
     return STATUSES[int(np.asarray(value, dtype=float).reshape(-1)[0])]
 
@@ -85,7 +85,7 @@ def status_rules(checks: Mapping[str, Any], tolerance: Any, singular: Any, ops: 
     """The checks of a candidate pose, in order; the first that fails gives the status.
 
     ``checks`` holds ``finite`` (pose and joints are finite numbers) and the
-    values named in :data:`CHECKS`; ``singular`` is the conditioning verdict.
+    values named in `CHECKS`; ``singular`` is the conditioning verdict.
     Written with ``not (value within bound)`` so that NaN always fails.
     """
     return [
@@ -112,7 +112,7 @@ def is_singular(cond: Any, ops: _Ops, factor: float = 1.0) -> Any:
 
 
 def condition_number(cond_x: np.ndarray, nx: int) -> float:
-    """κ₂ = σ_max/σ_min of a closure's :attr:`~cpm_nlp.core.model.LoopClosure.cond_matrix` at a
+    """κ₂ = σ_max/σ_min of a closure's `cond_matrix` at a
     pose (flat, column-major, as a Function returns it; Φ_x, or the m x nx Jacobian of every
     closure equation of normal equations): the 2-norm that decides a flagged pose; inf where
     σ_min = 0."""
@@ -127,7 +127,7 @@ KAPPA2_SCREEN_MARGIN = 2.0
 
 def screen_factor(closure: LoopClosure) -> float:
     """The kernels flag a pose singular where ``cond1 >= SINGULAR_CONDITION / factor``: n for κ₁ of
-    Φ_x (κ₂ <= n κ₁), :data:`KAPPA2_SCREEN_MARGIN` for a closure solved through normal equations
+    Φ_x (κ₂ <= n κ₁), `KAPPA2_SCREEN_MARGIN` for a closure solved through normal equations
     (cond1 an upper bound of κ₂ of every closure equation's Jacobian)."""
     return float(closure.nx) if closure.loops is None else KAPPA2_SCREEN_MARGIN
 
@@ -145,22 +145,26 @@ def check_expressions(
     phi_x_home_inv: ca.SX | None = None,
     block_bound: bool = False,
 ) -> dict[str, ca.SX]:
-    """Symbolic checks of the pose (x, q): see :data:`CHECKS`.
-
-    lower, upper: limits of :func:`limited_coordinates` (q, x, passive joints),
-    ±inf where none is declared.
-    phi_x_home_inv: if given (a numeric nx x nx input, Φ_x⁻¹ at the home pose),
-    ``cond1`` is the certified upper bound of :func:`cond1_bound` instead of
-    the exact 1-norm condition number (which needs a symbolic inverse of Φ_x).
-    block_bound: ``cond1`` is the upper bound of :func:`cond1_block_bound` (inverses of
-    Φ_x's diagonal blocks at the pose; takes precedence over phi_x_home_inv).
+    """Symbolic checks of the pose (x, q): see `CHECKS`.
 
     A closure solved through normal equations (``closure.loops``): ``cond1`` is instead the upper
-    bound of :func:`cond2_left_inverse_bound` on κ₂ of e_x, the Jacobian of every closure
+    bound of `cond2_left_inverse_bound` on κ₂ of e_x, the Jacobian of every closure
     equation (``cond_matrix``), whatever the flags: the conditioning a square closure's Φ_x
     measures, not the square of it that Φ_x of the normal equations carries.  Since it bounds
-    κ₂ itself, the screen's margin is :data:`KAPPA2_SCREEN_MARGIN` there (:func:`screen_factor`).
+    κ₂ itself, the screen's margin is `KAPPA2_SCREEN_MARGIN` there (`screen_factor`).
     ``cond_matrix``: the matrix the 2-norm check decides on (Φ_x or e_x).
+
+    Parameters
+    ----------
+    lower, upper
+        limits of `limited_coordinates` (q, x, passive joints), ±inf where none is declared.
+    phi_x_home_inv
+        if given (a numeric nx x nx input, Φ_x⁻¹ at the home pose), ``cond1`` is the certified
+        upper bound of `cond1_bound` instead of the exact 1-norm condition number (which needs a
+        symbolic inverse of Φ_x).
+    block_bound
+        ``cond1`` is the upper bound of `cond1_block_bound` (inverses of Φ_x's diagonal blocks
+        at the pose; takes precedence over phi_x_home_inv).
     """
     c = closure
     out: dict[str, ca.SX] = {"finite": all_finite(ca.vertcat(x, q))}
@@ -222,7 +226,7 @@ def check_expressions(
 
 
 def _cond1(phi_x: ca.SX, phi_x_home_inv: ca.SX | None, block_bound: bool) -> ca.SX:
-    """κ₁(Φ_x) of a square closure, or the upper bound :func:`check_expressions` asks for."""
+    """κ₁(Φ_x) of a square closure, or the upper bound `check_expressions` asks for."""
     if block_bound:
         return cond1_block_bound(phi_x)
     if phi_x_home_inv is not None:
@@ -239,11 +243,11 @@ def _turns_off(d: ca.SX) -> ca.SX:
 
 def _into_range(v: ca.SX, low: ca.SX, high: ca.SX) -> ca.SX:
     """A passive joint angle with a finite range [low, high] reduced by whole turns as
-    :func:`cpm_nlp.core.kinematics.reduce_angle` reduces the pose and the actuators: v if
+    `cpm_nlp.core.kinematics.reduce_angle` reduces the pose and the actuators: v if
     it is in the range, else its value in (-pi, pi] if that is, else its lowest turn in the
     range, else (outside) its value in (-pi, pi].  Without a finite range: unchanged.
 
-    On SX arguments, the scalar Function of :func:`_into_range_function` replays the same
+    On SX arguments, the scalar Function of `_into_range_function` replays the same
     operations in CasADi's C++ (the same expression, instruction for instruction) instead of
     each through CasADi's Python operators: 6 of the 9 ms of the 3-PRS's pose checks, which
     every process builds (issue 23, start-up)."""
@@ -254,7 +258,7 @@ def _into_range(v: ca.SX, low: ca.SX, high: ca.SX) -> ca.SX:
 
 @functools.cache
 def _into_range_function() -> ca.Function:
-    """:func:`_into_range` of scalars as one CasADi Function (built once per process)."""
+    """`_into_range` of scalars as one CasADi Function (built once per process)."""
     v, low, high = ca.SX.sym("v"), ca.SX.sym("low"), ca.SX.sym("high")
     return ca.Function(
         "into_range", [v, low, high], [_into_range_expression(v, low, high)], ["v", "low", "high"], ["reduced"]
@@ -262,7 +266,7 @@ def _into_range_function() -> ca.Function:
 
 
 def _into_range_expression(v: ca.SX, low: ca.SX, high: ca.SX) -> ca.SX:
-    """The expression of :func:`_into_range`."""
+    """The expression of `_into_range`."""
     finite = ca.logic_and(low > -ca.inf, high < ca.inf)
     base = ca.if_else(finite, low, 0)
     r = v - 2 * ca.pi * ca.ceil((v - ca.pi) / (2 * ca.pi))  # in (-pi, pi]
@@ -280,7 +284,7 @@ def limited_coordinates(closure: LoopClosure) -> tuple[Coordinate, ...]:
 
 
 def limit_vectors(model: Model) -> tuple[np.ndarray, np.ndarray]:
-    """Declared limits of :func:`limited_coordinates`, ±inf where none is declared."""
+    """Declared limits of `limited_coordinates`, ±inf where none is declared."""
     c = model.closure
     coords = limited_coordinates(c)
     lower = np.full(len(coords), -np.inf)
@@ -301,9 +305,9 @@ def checks_function(closure: LoopClosure) -> ca.Function:
     """``pose_checks: (x, q, p, lower, upper, tol) -> (passive, residual,
     branch_margin, round_trip_error, cond1, limit_margin, cond_matrix, status)``;
     status with the conservative (1-norm) singularity screen; ``cond_matrix`` is
-    :attr:`LoopClosure.cond_matrix` (Φ_x; for a closure solved through normal
+    `LoopClosure.cond_matrix` (Φ_x; for a closure solved through normal
     equations, ``loops``, the Jacobian of every closure equation, and cond1 the
-    upper bound of :func:`cond2_left_inverse_bound` on its κ₂)."""
+    upper bound of `cond2_left_inverse_bound` on its κ₂)."""
 
     def build() -> ca.Function:
         c = closure

@@ -2,13 +2,13 @@
 search, the starts of a synthesis, the boxes of a certificate), for whoever
 shows it.
 
-Library code never prints: a loop calls :func:`track` (or advances a
-:func:`task`) and the caller that wants to show progress (the CLI draws a
-tqdm bar on a terminal) installs a callback with :func:`reporting`.  Without
-one, :func:`track` costs one check per item.
+Library code never prints: a loop calls `track` (or advances a
+`task`) and the caller that wants to show progress (the CLI draws a
+tqdm bar on a terminal) installs a callback with `reporting`.  Without
+one, `track` costs one check per item.
 
 Interruption: a long search returns to Python at least every
-:data:`INTERVAL` seconds in the calling thread (it runs its work in pieces of
+`INTERVAL` seconds in the calling thread (it runs its work in pieces of
 about that size, or waits for worker threads with that timeout), so that a
 Ctrl-C (``KeyboardInterrupt``) is seen at once; the work not yet started is
 then cancelled.
@@ -44,10 +44,10 @@ def reporting(callback: Callback | None) -> Iterator[None]:
 
 
 class Task:
-    """The progress of one long computation: :meth:`update` as it advances,
-    :meth:`close` at the end.  Reports (what, done, total) to the installed
-    callback about every :data:`INTERVAL` seconds, and once at the end if it
-    reported before (a computation shorter than :data:`INTERVAL` shows nothing)."""
+    """The progress of one long computation: `update` as it advances,
+    `close` at the end.  Reports (what, done, total) to the installed
+    callback about every `INTERVAL` seconds, and once at the end if it
+    reported before (a computation shorter than `INTERVAL` shows nothing)."""
 
     def __init__(self, what: str, total: int) -> None:
         self.what, self.total = what, int(total)
@@ -80,13 +80,13 @@ class Task:
 
 
 def task(what: str, total: int) -> Task:
-    """A :class:`Task` reporting to the callback installed here (use as a context manager)."""
+    """A `Task` reporting to the callback installed here (use as a context manager)."""
     return Task(what, total)
 
 
 def track(items: Iterable[T], what: str, total: int | None = None) -> Iterator[T]:
     """Yield ``items``, reporting (what, done, total) to the installed callback
-    about every :data:`INTERVAL` seconds and once at the end (if it reported before)."""
+    about every `INTERVAL` seconds and once at the end (if it reported before)."""
     if _CALLBACK.get() is None:
         yield from items
         return

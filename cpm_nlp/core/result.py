@@ -97,7 +97,8 @@ class SolverInfo:
 
 
 def poses_solver_info(sols: Sequence[Any], fallback: str) -> SolverInfo:
-    """The solver of solved poses (:class:`cpm_nlp.core.kinematics.PoseSolution`): its name,
+    """The solver of solved poses ([`cpm_nlp.core.kinematics.PoseSolution`][cpm_nlp.core.kinematics.PoseSolution]): its
+    name,
     iterations (None where a compiled kernel answered without counting them), the solve time
     and, apart, the time spent building the kernel, and the Newton FK's path."""
     names = sorted({s.solver for s in sols if s.solver}) or [fallback]
@@ -144,7 +145,7 @@ _JSON_CONVERSIONS: tuple[tuple[Any, Any], ...] = (
 
 
 def jsonable(value: Any) -> Any:
-    """A copy of ``value`` that :func:`json.dumps` writes with ``allow_nan=False``, at any
+    """A copy of ``value`` that `json.dumps` writes with ``allow_nan=False``, at any
     depth: numpy arrays and scalars to lists and numbers, non-finite floats (NaN, inf) to
     None (as an integer too large for any float), mapping keys to strings, enums to their
     values, anything else to its text."""
@@ -161,9 +162,16 @@ class ResultWarning:
     yield, a deflection beyond the hinge formula's range, a pose near a
     singularity ...).
 
-    code: a stable identifier (see :data:`WARNING_CODES`); message: one line for
-    a person; where: what it is about (a hinge, a value, a key path); value and
-    limit: the number found and the bound it broke (SI), where there are such.
+    Attributes
+    ----------
+    code
+        a stable identifier (see `WARNING_CODES`);
+    message
+        one line for a person;
+    where
+        what it is about (a hinge, a value, a key path); value and
+    limit
+        the number found and the bound it broke (SI), where there are such.
     """
 
     code: str
@@ -202,7 +210,7 @@ class ResultWarning:
         return self.message
 
 
-#: Codes of :class:`ResultWarning` (docs/site/howto/read-status.md lists them).
+#: Codes of `ResultWarning` (docs/site/howto/read-status.md lists them).
 WARNING_CODES: Mapping[str, str] = MappingProxyType(
     {
         "stress_above_yield": "a hinge stress above its material's yield strength",
@@ -230,19 +238,29 @@ _FIELD = re.compile(r"\{(\w+)\}")
 class Output:
     """One value a kind returns, declared once.
 
-    name: its name in the result (the papers' symbol); dimension: "length", "angle" ...
-    (or "matrix", "vector", "text" for what has no SI unit); role: one of :data:`ROLES`;
-    refers_to: the output a "reference" is taken from (x0 of an offset dx); unit: the
-    unit text where the dimension's SI unit does not say it (a matrix's rows and columns).
-
     per: a **family** of outputs, one per item of what ``per`` names (a hinge group of the
     problem's hinges): its name has fields in braces (``stress_{group}``), and each member
-    (:meth:`member`) is an output of the family's dimension, role and unit.  A kind declares
-    the family; a :class:`Result` declares only its members.
+    ([`member`][cpm_nlp.core.result.Output.member]) is an output of the family's dimension, role and unit.  A kind
+    declares
+    the family; a [`Result`][cpm_nlp.core.result.Result] declares only its members.
 
     when: the input that asks for this output where the kind returns it only then
     ("assembly_modes: all"); such an output is not among the kind's default names (a
-    sweep's columns, :meth:`~cpm_nlp.core.kind.ProblemKind.output_names`).
+    sweep's columns, [`output_names`][cpm_nlp.core.kind.ProblemKind.output_names]).
+
+    Attributes
+    ----------
+    name
+        its name in the result (the papers' symbol);
+    dimension
+        "length", "angle" ... (or "matrix", "vector", "text" for what has no SI unit);
+    role
+        one of `ROLES`;
+    refers_to
+        the output a "reference" is taken from (x0 of an offset dx);
+    unit
+        the unit text where the dimension's SI unit does not say it (a matrix's rows and
+        columns).
     """
 
     name: str
@@ -263,7 +281,7 @@ class Output:
 
     @property
     def si(self) -> str:
-        """The unit the result writes (:func:`~cpm_nlp.core.units.result_unit` unless given)."""
+        """The unit the result writes (`result_unit` unless given)."""
         return self.unit if self.unit is not None else result_unit(self.dimension)
 
     @property
@@ -297,20 +315,22 @@ class Entry:
 class Result:
     """The answer to one problem.
 
-    A result holds the outputs its kind declared (:class:`Output`: name, dimension, role,
+    A result holds the outputs its kind declared ([`Output`][cpm_nlp.core.result.Output]: name, dimension, role,
     in the declared order) and the values computed for them (in the order computed); a
     value is always of a declared output, so its unit and dimension cannot disagree with
     it. ``values``, ``units`` and ``dimensions`` are read-only views of the two:
 
-    values:
-        SI numbers (or lists of them) under the papers' symbols.
-    units:
-        SI unit of each declared output ("m", "rad", "" ...).
-    dimensions:
-        dimension of each declared output ("length", "angle", ...), used for printing.
-
     An output may be declared and have no value (one not computed, or left out by a
     problem's ``outputs``): its unit is still written.
+
+    Attributes
+    ----------
+    values
+        SI numbers (or lists of them) under the papers' symbols.
+    units
+        SI unit of each declared output ("m", "rad", "" ...).
+    dimensions
+        dimension of each declared output ("length", "angle", ...), used for printing.
     """
 
     def __init__(

@@ -1,7 +1,7 @@
 """Declared nested inputs: records, mappings, lists, alternatives and named tables,
-built from :class:`~cpm_nlp.core.options.Option` leaves.
+built from `Option` leaves.
 
-An :class:`Option` declares one value (a quantity with its dimension and bounds, an
+An `Option` declares one value (a quantity with its dimension and bounds, an
 integer, a choice ...); it cannot nest.  The nodes here nest options, so that an input
 such as ``hinges`` (name -> {joints, type, k, t, r, ...}) or ``stress_limit`` (true or
 {sigma_allow, safety_factor, hinges, material}) is declared once and
@@ -11,13 +11,13 @@ such as ``hinges`` (name -> {joints, type, k, t, r, ...}) or ``stress_limit`` (t
 * described by the same declaration (``cpm-nlp describe`` and the documentation's
   reference page print the nested keys, their dimension, unit, default and choices).
 
-Every node has the interface of an :class:`Option` that :func:`validate_mapping` uses
+Every node has the interface of an `Option` that `validate_mapping` uses
 (``name``, ``description``, ``default``, ``required``, ``expectation()``, ``parse()``), so
 a node may stand wherever an option does.  Two hooks, as in OpenMDAO's
 ``options.declare(check_valid=)``:
 
 ``check(value, path)``
-    a validator of the parsed value (raises :class:`~cpm_nlp.core.errors.InputError`);
+    a validator of the parsed value (raises [`InputError`][cpm_nlp.core.errors.InputError]);
 ``convert(value, path)``
     turns the parsed value into what the algorithm consumes (a material, a model with
     limits ...); it runs after ``check``.
@@ -53,7 +53,7 @@ class Node:
     kind = "node"
     #: nodes are single values to the data-file and sweep readers (never a grid)
     shape = "scalar"
-    #: a missing essential node is named before unknown keys (see :func:`validate_mapping`)
+    #: a missing essential node is named before unknown keys (see `validate_mapping`)
     essential = False
 
     @property
@@ -90,7 +90,7 @@ class Node:
         raise NotImplementedError
 
     def accepts(self, _value: Any) -> bool:
-        """Whether ``value`` has the Python shape this node reads (for :class:`Either`)."""
+        """Whether ``value`` has the Python shape this node reads (for `Either`)."""
         return True
 
     def type_text(self) -> str:
@@ -448,7 +448,7 @@ def walk(decls: Sequence[Any], depth: int = 0) -> list[tuple[int, Any]]:
 
 
 def parse_with(decls: Sequence[Any], raw: Any, path: tuple, *, what: str = "input") -> dict[str, Any]:
-    """The shared parse of a kind's inputs: :func:`validate_mapping` over the declarations."""
+    """The shared parse of a kind's inputs: `validate_mapping` over the declarations."""
     return validate_mapping(raw, decls, path, what=what)
 
 

@@ -20,7 +20,7 @@ and the appendix):
   ``wᵀ C w``.
 
 Every function accepts numpy arrays and CasADi symbols (SX/MX) alike, except
-:func:`reciprocal_basis` (numerical: an SVD) and :func:`null_screw`'s
+`reciprocal_basis` (numerical: an SVD) and `null_screw`'s
 numerical branch noted there.
 """
 
@@ -100,7 +100,7 @@ def axis_rotation(axis: Any, angle: Any) -> Any:
 
 def vee(M: Any) -> Any:
     """The axial vector of a 3 x 3 matrix's skew part, (M - Mᵀ)/2 = [v]× (the inverse of
-    :func:`skew`; for a rotation by a small angle about w: the angle times w)."""
+    `skew`; for a rotation by a small angle about w: the angle times w)."""
     return 0.5 * ca.vertcat(M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1])
 
 
@@ -222,7 +222,7 @@ def null_screw(rows: Any) -> Any:
 def reciprocal_basis(screws: Any, tol: float = 1e-9) -> np.ndarray:
     """Columns spanning every screw reciprocal to all columns of ``screws``
     (numerical, by SVD; relative tolerance ``tol``), orthonormal, in the canonical
-    basis of :func:`cpm_nlp.core.canonical.canonical_basis` (the SVD's null space
+    basis of `cpm_nlp.core.canonical.canonical_basis` (the SVD's null space
     is any basis of it, which depends on the BLAS kernel)."""
     A = (DELTA @ np.asarray(screws, dtype=float)).T
     _, sv, vt = np.linalg.svd(A)
@@ -246,7 +246,7 @@ def wrench_transform(d: Any) -> Any:
 def transport_compliance(C: Any, point: Any, new_point: Any) -> Any:
     """A compliance matrix defined at ``point`` (A), for wrenches applied and
     displacements measured at ``new_point`` (B): ``C_B = Tᵀ C_A T`` with
-    T = :func:`wrench_transform` (B - A)."""
+    T = `wrench_transform` (B - A)."""
     T = wrench_transform(_sub(new_point, point))
     return T.T @ C @ T
 

@@ -2,10 +2,10 @@
 
 The method (IPOPT or Newton) is chosen here; problem and mechanism know
 nothing about it.  CasADi options are checked against a declared allow-list
-(:mod:`cpm_nlp.core.solver_options`: type, range, refused options) before
+(`cpm_nlp.core.solver_options`: type, range, refused options) before
 CasADi sees them, then merged over quiet defaults (``{"ipopt.tol": 1e-10}``
 overrides just that key).  CasADi validates them once more; its rejection
-becomes an :class:`InputError` naming the option.
+becomes an [`InputError`][cpm_nlp.core.errors.InputError] naming the option.
 """
 
 from __future__ import annotations
@@ -67,16 +67,18 @@ def run_nlp(solver: ca.Function, what: str, **args: Any) -> tuple[np.ndarray, bo
 class SolverConfig:
     """How to solve.
 
-    method:
-        "ipopt" (default; an NLP with bounds that select the assembly branch)
-        or "newton" (CasADi's Newton rootfinder, the fast path).
-    options:
-        CasADi/IPOPT options, checked against the allow-list
-        (:func:`~cpm_nlp.core.solver_options.check_options`), over :data:`DEFAULT_OPTIONS`.
-    tolerance:
-        largest accepted loop-closure residual (max norm, in the model's
-        residual unit, m for every shipped mechanism).
-    preset:
+    Attributes
+    ----------
+    method
+        "ipopt" (default; an NLP with bounds that select the assembly branch) or "newton"
+        (CasADi's Newton rootfinder, the fast path).
+    options
+        CasADi/IPOPT options, checked against the allow-list (`check_options`), over
+        `DEFAULT_OPTIONS`.
+    tolerance
+        largest accepted loop-closure residual (max norm, in the model's residual unit, m for
+        every shipped mechanism).
+    preset
         name of the preset this came from, for reporting.
     """
 
@@ -103,7 +105,7 @@ class SolverConfig:
         return merged
 
     def validate(self) -> None:
-        """Check the options by type and range (:func:`check_options`), then let
+        """Check the options by type and range (`check_options`), then let
         CasADi check them (on a one-variable problem), so that a bad option is
         reported while the problem file is read."""
         check_options(self.method, self.options)
@@ -160,7 +162,7 @@ def _validate_options(method: str, items: tuple) -> None:
 
 
 def translate_casadi_error(exc: Exception, options: Mapping[str, Any]) -> InputError:
-    """Turn CasADi's rejection of an option into an :class:`InputError`."""
+    """Turn CasADi's rejection of an option into an [`InputError`][cpm_nlp.core.errors.InputError]."""
     text = str(exc)
     m = re.search(r"No such IPOPT option: (\S+)", text)
     if m:
@@ -304,7 +306,7 @@ class SolverCache:
             return built
 
 
-#: each closure's built solvers and kernels (:func:`solvers_of`), held here rather than on the
+#: each closure's built solvers and kernels (`solvers_of`), held here rather than on the
 #: closure, and weakly keyed: freed with the closure.  Code, never problem data.
 _BUILT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _BUILT_LOCK = threading.Lock()

@@ -25,20 +25,20 @@ and run ``tests/hostile/test_hostile_solver.py`` (it checks that the table agree
 the installed IPOPT).  This module is the policy over that table:
 
 * IPOPT (``ipopt.<name>``): every documented option, typed and bounded as
-  IPOPT documents it, except :data:`IPOPT_REFUSED`, the options of linear
+  IPOPT documents it, except `IPOPT_REFUSED`, the options of linear
   solvers that IPOPT loads from a shared library at run time (MA27 ... MA97,
   Pardiso), the derivative checker, and the choices of ``linear_solver`` and
   ``linear_system_scaling`` that load a library: only the linear solvers built
   into the shipped IPOPT (MUMPS, SPRAL) remain.
-* CasADi: only :data:`NLPSOL_ALLOWED` (with IPOPT) and :data:`NEWTON_ALLOWED`
-  (with Newton), plain flags and numbers.  :data:`CASADI_REFUSED` says why the
+* CasADi: only `NLPSOL_ALLOWED` (with IPOPT) and `NEWTON_ALLOWED`
+  (with Newton), plain flags and numbers.  `CASADI_REFUSED` says why the
   dangerous ones are refused.
 
 JIT is refused: CasADi's JIT runs a compiler command and writes its source and
 library into the working directory, a place nobody named on the command line.
 cpm_nlp compiles its own batch kernels (``backend="compiled"``), from C that
 CasADi generates from the model, named by content hash, in the user's cache
-directory (:mod:`cpm_nlp.core.compiled`).
+directory (`cpm_nlp.core.compiled`).
 """
 
 from __future__ import annotations
@@ -143,11 +143,16 @@ NLPSOL_ALLOWED: Mapping[str, str] = MappingProxyType(
 class NewtonOption:
     """One CasADi option of the Newton rootfinder (method ``newton``) a file may set.
 
-    kind: "real" (> 0), "real0" (>= 0), "int" or "bool";
-    default: the value cpm_nlp sets when the file gives none (None: CasADi's own);
-    batch: how the kernels' ``fast_newton`` (batch and exported solvers) treats it:
-        "honoured", "ignored" (no meaning there: it never raises or prints) or
-        "refused" (a file giving it cannot be solved by the kernels).
+    Attributes
+    ----------
+    kind
+        "real" (> 0), "real0" (>= 0), "int" or "bool";
+    default
+        the value cpm_nlp sets when the file gives none (None: CasADi's own);
+    batch
+        how the kernels' ``fast_newton`` (batch and exported solvers) treats it: "honoured",
+        "ignored" (no meaning there: it never raises or prints) or "refused" (a file giving it
+        cannot be solved by the kernels).
     """
 
     name: str
@@ -156,9 +161,9 @@ class NewtonOption:
     batch: str = "refused"
 
 
-#: the Newton options: one table, read by the option check (:data:`NEWTON_ALLOWED`), the
-#: defaults (:data:`cpm_nlp.core.solver.DEFAULT_OPTIONS`) and the kernels
-#: (:data:`cpm_nlp.core.kernels.NEWTON_OPTIONS`)
+#: the Newton options: one table, read by the option check (`NEWTON_ALLOWED`), the
+#: defaults (`cpm_nlp.core.solver.DEFAULT_OPTIONS`) and the kernels
+#: (`cpm_nlp.core.kernels.NEWTON_OPTIONS`)
 NEWTON_TABLE: tuple[NewtonOption, ...] = (
     NewtonOption("abstol", "real", 1e-14, "honoured"),
     NewtonOption("abstolStep", "real0", None, "honoured"),  # 0: no test on the step, iterate to abstol
@@ -229,7 +234,7 @@ CASADI_REFUSED: Mapping[str, tuple[str, ...]] = MappingProxyType(
 
 @dataclass(frozen=True)
 class SolverOption(Option):
-    """An :class:`~cpm_nlp.core.options.Option` whose lower and upper bounds may
+    """An `Option` whose lower and upper bounds may
     differ in strictness, as IPOPT's do (``0 < bound_frac <= 0.5``)."""
 
     lower_strict: bool = False
@@ -405,7 +410,7 @@ def check_options(method: str, options: Mapping[str, Any]) -> dict[str, Any]:
     """The options of ``method`` checked against the allow-list: every name known,
     none refused, every value of its type and in its range; returns the checked
     values (an integer written ``50.0`` becomes ``50``, ``{ipopt: {tol: ..}}``
-    becomes ``ipopt.tol``).  Raises :class:`InputError` naming the key."""
+    becomes ``ipopt.tol``).  Raises [`InputError`][cpm_nlp.core.errors.InputError] naming the key."""
     if not isinstance(options, Mapping) or not all(isinstance(k, str) for k in options):
         raise InputError(f"expected a mapping of option names to values, got {options!r}", path=("solver", "options"))
     out: dict[str, Any] = {}

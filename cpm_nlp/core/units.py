@@ -137,7 +137,7 @@ FAST_UNITS: Mapping[str, tuple[float, str]] = MappingProxyType(
 
 def fast_dimension(value: Any) -> str | None:
     """The dimension of a ``"<number> <unit>"`` string whose unit is in
-    :data:`FAST_UNITS` (else None): where a caller tries dimensions in turn, the
+    `FAST_UNITS` (else None): where a caller tries dimensions in turn, the
     one to try first."""
     if not isinstance(value, str):
         return None
@@ -180,7 +180,7 @@ def parse_quantity(value: Any, dimension: str, path: tuple = ()) -> float:
     """Return the SI value of ``value``, a quantity of the given ``dimension``.
 
     ``value`` is a bare number (already SI) or a string ``"<number> <unit>"``.
-    Raises :class:`InputError` for anything else, naming ``path``.
+    Raises [`InputError`][cpm_nlp.core.errors.InputError] for anything else, naming ``path``.
     """
     dim = DIMENSIONS[dimension]
     expected = f"{_describe(dim)} such as '{dim.example}' or a bare SI number"
@@ -248,7 +248,7 @@ def _pint_factors(value: str, unit_text: str, dim: Dimension, expected: str, pat
 
 
 def si_unit(dimension: str) -> str:
-    """The SI unit of a dimension of :data:`DIMENSIONS` ("length" -> "m"), the one place
+    """The SI unit of a dimension of `DIMENSIONS` ("length" -> "m"), the one place
     that says it.  Fallback: a dimension that is no physical one ("matrix", "vector",
     "text", "bool", a kind's own label) has no SI unit, and gives ""."""
     dim = DIMENSIONS.get(dimension) if isinstance(dimension, str) else None
@@ -257,7 +257,7 @@ def si_unit(dimension: str) -> str:
 
 def result_unit(dimension: str) -> str:
     """The unit a result of the generic kinds writes for a value of ``dimension``:
-    :func:`si_unit`, and for a value with no SI unit (a matrix, a text ...) the name of
+    `si_unit`, and for a value with no SI unit (a matrix, a text ...) the name of
     what it is, as their results have always written it (kept for byte-identical JSON)."""
     return si_unit(dimension) if dimension in DIMENSIONS else dimension
 

@@ -10,7 +10,7 @@ anything is written:
   refused; a symbolic link is followed, and the file it points to is replaced
   (the link stays);
 * a directory that cannot be written (``/proc``, read-only, missing) is an
-  :class:`InputError` naming the file (exit 2), not a traceback.
+  [`InputError`][cpm_nlp.core.errors.InputError] naming the file (exit 2), not a traceback.
 """
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ def replace_atomically(
 ) -> None:
     """Create ``path`` all at once: ``write(temporary path)``, then rename.  The
     file gets the permissions of any new file (the umask), not mkstemp's 0600.
-    Refused (an :class:`InputError`, nothing written) as the module docstring says."""
+    Refused (an [`InputError`][cpm_nlp.core.errors.InputError], nothing written) as the module docstring says."""
     target = _check_target(path, inputs, option)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=target.parent)

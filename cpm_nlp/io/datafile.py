@@ -1,6 +1,6 @@
 """Sidecar data files: a large batch of inputs (100 000 poses) beside the problem file.
 
-A problem file holds at most :data:`~cpm_nlp.io.inputs.MAX_INPUT_BYTES`; a
+A problem file holds at most `MAX_INPUT_BYTES`; a
 batch larger than that comes from a data file that the problem file names
 under ``inputs.data``::
 
@@ -15,7 +15,7 @@ under ``inputs.data``::
   2-D numeric array; ``columns`` names its columns) or Parquet (numeric
   columns; needs pyarrow);
 * read with the bounds of every input: a regular file (no FIFO, no device),
-  at most :data:`MAX_DATA_BYTES`, at most :data:`MAX_DATA_ROWS` rows, every
+  at most `MAX_DATA_BYTES`, at most `MAX_DATA_ROWS` rows, every
   value finite; each column names an input of the problem kind that takes a
   list (the actuators of ``forward_kinematics``, the task coordinates of
   ``inverse_kinematics`` ...), once, and not also given in the file;

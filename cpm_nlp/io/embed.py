@@ -25,7 +25,7 @@ outputs it always had.)  Nothing here prints or keeps global
 state; the Functions may be called from several threads.
 
 Called on numbers (numpy arrays, lists, floats), ``fk``, ``ik`` and ``jacobian``
-go straight to the kernel (:class:`KernelFunction`): the compiled C through
+go straight to the kernel (`KernelFunction`): the compiled C through
 ctypes where a C compiler is available (built once per machine, as
 ``backend="auto"`` of the solvers), else a CasADi FunctionBuffer, with the
 buffers allocated once per thread -- the same numbers, to the bit, as CasADi's
@@ -57,17 +57,25 @@ from ..core.solver import SolverConfig
 class ModelFunctions:
     """The CasADi Functions of one model (its numbers built in).
 
-    phi: ``(x, q) -> phi``, the loop closures Φ (nx residuals);
-    fk: ``(q, x0) -> (x, passive, residual, branch_margin, round_trip_error,
-        cond1, limit_margin, status)``;
-    ik: ``(t) -> (x, q, passive, reach, residual, ..., status)`` (closed form;
-        mechanisms without one take ``(t, y0)`` and solve by Newton);
-    jacobian: ``(x, q) -> (J, J_inv, Phi_x, Phi_q)``;
-    passive: ``(x, q) -> j``, passive joint angles (None if the mechanism has none);
-    x_home, q_home: the home pose and joints (the default Newton guess).
-
-    fk, ik and jacobian are :class:`KernelFunction` s: called on numbers they return numpy
+    fk, ik and jacobian are `KernelFunction` s: called on numbers they return numpy
     arrays, straight from the (compiled) kernel; on CasADi types, CasADi's own call.
+
+    Attributes
+    ----------
+    phi
+        ``(x, q) -> phi``, the loop closures Φ (nx residuals);
+    fk
+        ``(q, x0) -> (x, passive, residual, branch_margin, round_trip_error, cond1,
+        limit_margin, status)``;
+    ik
+        ``(t) -> (x, q, passive, reach, residual, ..., status)`` (closed form; mechanisms
+        without one take ``(t, y0)`` and solve by Newton);
+    jacobian
+        ``(x, q) -> (J, J_inv, Phi_x, Phi_q)``;
+    passive
+        ``(x, q) -> j``, passive joint angles (None if the mechanism has none);
+    x_home, q_home
+        the home pose and joints (the default Newton guess).
     """
 
     model: Model
@@ -85,8 +93,8 @@ _CASADI_TYPES = (ca.MX, ca.SX, ca.DM)
 
 
 class KernelFunction(ca.Function):
-    """A kernel with one model's numbers built in (:func:`~cpm_nlp.core.kernels.bake`): a
-    :class:`casadi.Function` in every respect, whose call on numbers goes straight to the kernel.
+    """A kernel with one model's numbers built in (`bake`): a
+    `casadi.Function` in every respect, whose call on numbers goes straight to the kernel.
 
     A call whose arguments are all numbers (numpy arrays, lists, floats; positional or by
     name, a missing name taking CasADi's default 0) evaluates the unbaked kernel with the
@@ -99,7 +107,7 @@ class KernelFunction(ca.Function):
     vector), a 1 x 1 output as a float64 (``int()`` and ``float()`` work as on the DM).
     Anything else -- an MX, SX or DM argument, a mixed call, a size CasADi would have to
     interpret -- is CasADi's own call.
-    Unpickled, it is a plain :class:`casadi.Function`.
+    Unpickled, it is a plain `casadi.Function`.
     """
 
     def __init__(self, baked: ca.Function, kern: Kernel, model: Model, tolerance: float, backend: str) -> None:
@@ -218,10 +226,14 @@ def _kernel_function(kern: Kernel, model: Model, tolerance: float, backend: str,
 def model_functions(model: Model, solver: SolverConfig | None = None, *, backend: str = "auto") -> ModelFunctions:
     """The CasADi Functions of a model (``cpm_nlp.functions`` also takes a problem file).
 
-    solver: tolerance and Newton options (abstol, abstolStep, max_iter) built
-    into fk and ik (default: ``SolverConfig("newton")``).  backend: what evaluates
-    ``fk``, ``ik`` and ``jacobian`` called on numbers (:class:`KernelFunction`):
-    "auto" (compiled C where a C compiler is available), "compiled" or "map".
+    Parameters
+    ----------
+    solver
+        tolerance and Newton options (abstol, abstolStep, max_iter) built into fk and ik
+        (default: ``SolverConfig("newton")``).
+    backend
+        what evaluates ``fk``, ``ik`` and ``jacobian`` called on numbers (`KernelFunction`):
+        "auto" (compiled C where a C compiler is available), "compiled" or "map".
     """
     if backend not in BACKENDS:
         raise InputError(

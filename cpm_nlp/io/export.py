@@ -17,7 +17,7 @@ tolerance built in:
   CasADi version that wrote the files.
 
 The forward kinematics is the kernel of every Newton FK in cpm_nlp
-(:func:`cpm_nlp.core.kernels.fk_kernel`): for a mechanism with a closed-form
+(`cpm_nlp.core.kernels.fk_kernel`): for a mechanism with a closed-form
 IK, Newton on the task coordinates through the IK from the first-order
 guess about x0, falling back to Newton on all of Φ (CasADi ``fast_newton``,
 which generates C) from x0; then the same checks as every solve in cpm_nlp.

@@ -32,13 +32,13 @@ carries nothing else (a free spin) is dropped; a rod between two S joints is a d
 joint's actuator is named after it, its own coordinate ``<name>_joint``.  All R axes parallel
 (and P axes normal to them): a planar file, in the plane normal to the axes.
 
-The URDF is data: it is parsed with :mod:`xml.etree.ElementTree` after refusing any document
+The URDF is data: it is parsed with `xml.etree.ElementTree` after refusing any document
 type declaration or entity (``<!DOCTYPE``, ``<!ENTITY``), nothing it names (meshes, xacro
 includes, ``package://`` paths) is ever opened, and its size and element count are capped.
-Errors are :class:`~cpm_nlp.core.errors.InputError` naming the file and the element
+Errors are [`InputError`][cpm_nlp.core.errors.InputError] naming the file and the element
 (``joint[mot1].origin.rpy``) or the sidecar's key path (``closed_loop[0][1]``).
 
-The steps live in :mod:`cpm_nlp.io.urdf`: reading the URDF (``read``) and the sidecar
+The steps live in `cpm_nlp.io.urdf`: reading the URDF (``read``) and the sidecar
 (``sidecar``), the drawing with the loops closed (``assembly``), the bodies and joints
 (``graph``) made smaller (``simplify``), and the file written (``write``).
 """
@@ -160,7 +160,7 @@ def import_urdf(
 
 
 def _basis(graph: Graph, planar: bool | None, file: str) -> np.ndarray | None:
-    """The plane the file is written in (:func:`~cpm_nlp.io.urdf.write.plane_basis`), None for a
+    """The plane the file is written in (`plane_basis`), None for a
     spatial file; ``planar`` True where the mechanism is not planar is an error."""
     basis = plane_basis(graph)
     if planar is True and basis is None:

@@ -1,13 +1,13 @@
 """Reading input files defensively, and remembering what was read.
 
 Every file cpm_nlp reads on a user's behalf (problem files, presets, results
-files, JSON results) goes through :func:`read_input_text` or
-:func:`check_input_file`:
+files, JSON results) goes through `read_input_text` or
+`check_input_file`:
 
 * only a regular file is read: a directory, a FIFO, a device (``/dev/zero``,
   ``/dev/stdin``), a socket is refused before it is opened, so nothing blocks
   or reads forever;
-* at most :data:`MAX_INPUT_BYTES` are read; a longer file is refused at once,
+* at most `MAX_INPUT_BYTES` are read; a longer file is refused at once,
   without reading the rest (its size is checked before it is opened, so a
   16 GB sparse file is refused in microseconds).
 
@@ -16,11 +16,11 @@ The file named on the command line (a problem file, a mechanism file given to
 ``<(cat p.yaml)`` (``/dev/fd/63``) or a named FIFO.  A pipe is read up to the
 same limit (``limit + 1`` bytes at most, refused if over), without blocking
 forever: a FIFO that no program writes to is refused at once, and a pipe
-whose writer stays silent for :data:`PIPE_IDLE_SECONDS` is refused then.  A
+whose writer stays silent for `PIPE_IDLE_SECONDS` is refused then.  A
 terminal or a device on standard input is refused like any special file.
 
-The files read inside an :func:`inputs_scope` (one CLI command) are recorded,
-so that :mod:`cpm_nlp.io.atomic` can refuse to write an output over any of
+The files read inside an `inputs_scope` (one CLI command) are recorded,
+so that `cpm_nlp.io.atomic` can refuse to write an output over any of
 them (``cpm-nlp solve p.yaml -o p.yaml``).
 """
 
@@ -39,7 +39,7 @@ from ..core.errors import InputError
 
 #: Largest input file read (bytes).  The largest shipped problem file is about
 #: 3 KB; a results file of a large sweep is read by its own reader (Parquet)
-#: or checked against :data:`MAX_RESULTS_BYTES`.
+#: or checked against `MAX_RESULTS_BYTES`.
 MAX_INPUT_BYTES = 1 << 20  # 1 MiB
 #: Largest CSV/JSON results file read back (``plot``, resume).
 MAX_RESULTS_BYTES = 1 << 30  # 1 GiB
@@ -70,7 +70,7 @@ def file_kind(mode: int) -> str:
 
 @contextlib.contextmanager
 def inputs_scope() -> Iterator[set[tuple[int, int]]]:
-    """Record the files read inside the block (see :func:`was_read`)."""
+    """Record the files read inside the block (see `was_read`)."""
     token = _READ.set(set())
     try:
         yield _READ.get()  # type: ignore[misc]
@@ -79,7 +79,7 @@ def inputs_scope() -> Iterator[set[tuple[int, int]]]:
 
 
 def record_read(path: str | os.PathLike) -> None:
-    """Remember that ``path`` was read (no-op outside an :func:`inputs_scope`)."""
+    """Remember that ``path`` was read (no-op outside an `inputs_scope`)."""
     seen = _READ.get()
     if seen is None:
         return
@@ -123,7 +123,7 @@ def check_input_file(
     path: str | os.PathLike, limit: int | None = MAX_INPUT_BYTES, allow_pipe: bool = False
 ) -> os.stat_result:
     """The ``stat`` of a regular, readable input file no larger than ``limit``
-    (or of a pipe, with ``allow_pipe``); an :class:`InputError` naming the
+    (or of a pipe, with ``allow_pipe``); an [`InputError`][cpm_nlp.core.errors.InputError] naming the
     file otherwise (nothing is opened)."""
     try:
         st = os.stat(path)
@@ -144,7 +144,8 @@ def check_input_file(
 def read_input_bytes(
     path: str | os.PathLike, limit: int = MAX_INPUT_BYTES, record: bool = True, allow_pipe: bool = False
 ) -> bytes:
-    """The bytes of a regular file of at most ``limit`` bytes (an :class:`InputError` otherwise).
+    """The bytes of a regular file of at most ``limit`` bytes (an [`InputError`][cpm_nlp.core.errors.InputError]
+    otherwise).
 
     The size is checked before reading, and again while reading (a file that
     grows, or a special file in /proc that reports size 0), so at most
@@ -222,7 +223,7 @@ def _read_fifo(path: str | os.PathLike, limit: int) -> bytes:
 
 def _read_fd(fd: int, limit: int, name: str, start: bytes = b"") -> bytes:
     """Read ``fd`` to its end, at most ``limit + 1`` bytes, waiting at most
-    :data:`PIPE_IDLE_SECONDS` for each piece (in steps of 0.2 s, so that
+    `PIPE_IDLE_SECONDS` for each piece (in steps of 0.2 s, so that
     Ctrl-C is seen)."""
     data = bytearray(start)
     idle_since = time.monotonic()

@@ -68,7 +68,7 @@ class SweepTable:
         return [r.get(name) for r in self.rows]
 
     def warnings(self) -> list[list[Any]]:
-        """Each row's result warnings (:class:`~cpm_nlp.core.result.ResultWarning`; [] for a
+        """Each row's result warnings ([`ResultWarning`][cpm_nlp.core.result.ResultWarning]; [] for a
         file written before sweeps recorded them)."""
         from ..core.result import ResultWarning
 
@@ -80,7 +80,7 @@ class SweepTable:
 
 
 def results_format(path: str | os.PathLike) -> str:
-    """``.parquet`` or ``.csv`` from the file name (an :class:`InputError` otherwise)."""
+    """``.parquet`` or ``.csv`` from the file name (an [`InputError`][cpm_nlp.core.errors.InputError] otherwise)."""
     suffix = Path(path).suffix.lower()
     if suffix not in FORMATS:
         raise InputError(f"expected a results file ending in .parquet or .csv, got {str(path)!r}", path=("-o",))

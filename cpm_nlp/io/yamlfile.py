@@ -1,7 +1,7 @@
 """Reading YAML input files (problem files, presets, mechanism files).
 
 Input is untrusted: a file is read only if it is a regular file of at most
-:data:`~cpm_nlp.io.inputs.MAX_INPUT_BYTES`, and YAML's aliases and nesting
+`MAX_INPUT_BYTES`, and YAML's aliases and nesting
 are bounded while the file is composed (before anything is built), so a
 "billion laughs" file, a recursive alias or a deeply nested list is refused
 in milliseconds.  A key given twice in one mapping is an error naming both
@@ -36,7 +36,7 @@ _MERGE = "tag:yaml.org,2002:merge"
 
 
 def _at(error: yaml.YAMLError, path: list | tuple) -> yaml.YAMLError:
-    """``error`` with the key path of the value at fault (read by :func:`parse_yaml`)."""
+    """``error`` with the key path of the value at fault (read by `parse_yaml`)."""
     error.key_path = tuple(path)  # type: ignore[attr-defined]
     return error
 
@@ -181,9 +181,9 @@ _CParser = getattr(getattr(yaml, "cyaml", None), "CParser", None)  # LibYAML, wh
 if _CParser is not None:
 
     class _CLoader(_UniqueKeys, _CParser, yaml.constructor.SafeConstructor, yaml.resolver.Resolver):  # type: ignore[misc, valid-type]
-        """The rules of :class:`_Loader` on LibYAML's parser and composer (C: a
+        """The rules of `_Loader` on LibYAML's parser and composer (C: a
         list of 20 000 values composes in milliseconds, not seconds); the limits
-        on the composed graph by :func:`_check_graph`."""
+        on the composed graph by `_check_graph`."""
 
         yaml_implicit_resolvers = _Loader.yaml_implicit_resolvers
 
@@ -201,9 +201,9 @@ def _entry(key: Any, value: Any, path: tuple) -> list[tuple[Any, tuple]]:
 
 
 def _check_graph(root: Any) -> dict[int, tuple]:
-    """The limits of :class:`_Loader` on a composed node graph (shared by aliases):
+    """The limits of `_Loader` on a composed node graph (shared by aliases):
     values and depth with aliases expanded, no alias inside the value it names (the
-    number of aliases is counted by :func:`_precheck`, where each has its position).
+    number of aliases is counted by `_precheck`, where each has its position).
     Returns the key path of every mapping node (for duplicate keys)."""
     sizes: dict[int, tuple[int, int]] = {}
     paths: dict[int, tuple] = {}
@@ -295,7 +295,7 @@ def _precheck(text: str) -> None:
 
 
 def load_yaml_text(text: str) -> Any:
-    """Parse YAML text with the problem-file rules (see :class:`_Loader`)."""
+    """Parse YAML text with the problem-file rules (see `_Loader`)."""
     if _CParser is None:  # PyYAML without LibYAML: the pure-Python composer, limits checked as it composes
         _precheck(text)
         return yaml.load(text, Loader=_Loader)  # noqa: S506 - a SafeLoader subclass
@@ -329,7 +329,7 @@ def _python_error(text: str) -> None:
 def read_yaml(path: str | os.PathLike, *, allow_pipe: bool = False) -> Any:
     """Parse a YAML file; errors name the file, the line and the key path.
     ``allow_pipe``: the file named on the command line may be ``-`` or a pipe
-    (see :mod:`cpm_nlp.io.inputs`)."""
+    (see `cpm_nlp.io.inputs`)."""
     return parse_yaml(read_input_text(path, allow_pipe=allow_pipe), display_name(path))
 
 

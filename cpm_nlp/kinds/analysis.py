@@ -1,9 +1,9 @@
 """Problem kinds beyond pose solving: actuator workspace and dynamics.
 
 * ``actuator_workspace`` -- the reachable workspace under the actuator strokes
-  (:mod:`cpm_nlp.analysis.workspace`);
+  (`cpm_nlp.analysis.workspace`);
 * ``dynamics`` -- M, K, G of Lagrange's equations and the natural
-  frequencies (:mod:`cpm_nlp.analysis.dynamics`), for mechanisms with a dynamic model.
+  frequencies (`cpm_nlp.analysis.dynamics`), for mechanisms with a dynamic model.
 """
 
 from __future__ import annotations
@@ -180,7 +180,7 @@ class Dynamics(ProblemKind):
         return None
 
     def _lagrange(self, model: Model) -> DynamicsModel:
-        """The mechanism's Lagrange model (its part ``dynamics``; :meth:`supports` said it has one)."""
+        """The mechanism's Lagrange model (its part ``dynamics``; `supports` said it has one)."""
         return self.part(model, DynamicsModel)
 
     def input_options(self, model: Model) -> list[Option]:

@@ -1,7 +1,7 @@
 """Problem kinds of compliance, stiffness and strength, for any mechanism whose
 joints carry hinges (declared by the mechanism's part ``stiffness``, a
-:class:`~cpm_nlp.analysis.compliance.JointStiffness`, or given under
-``inputs.hinges``); the method is :mod:`cpm_nlp.analysis.compliance`.
+[`JointStiffness`][cpm_nlp.analysis.compliance.JointStiffness], or given under
+``inputs.hinges``); the method is `cpm_nlp.analysis.compliance`.
 
 * ``actuator_forces`` -- the actuator forces, input stiffness K_q and hinge
   stresses along a motion (actuator inputs, or poses through IK), and the motion
@@ -113,7 +113,7 @@ class _HingeKind(ProblemKind):
     """Shared input handling: pose or actuator inputs, hinges, material, load."""
 
     #: the mechanism's declared hinges, the defaults of ``inputs.hinges`` (read by
-    #: :func:`~cpm_nlp.analysis.compliance.hinge_set`)
+    #: `hinge_set`)
     parts = (cm.JointStiffness,)
 
     def supports(self, model: Model) -> str | None:

@@ -1,5 +1,5 @@
-"""The declared inputs of the hinge kinds (:mod:`cpm_nlp.kinds.compliance`) and of the
-workspace kinds' ``stress_limit``, by the schema of :mod:`cpm_nlp.core.schema`: the hinges
+"""The declared inputs of the hinge kinds (`cpm_nlp.kinds.compliance`) and of the
+workspace kinds' ``stress_limit``, by the schema of `cpm_nlp.core.schema`: the hinges
 and material, the platform load, the actuator stiffness, masses and inertias, and the hinge
 stress limits.  Each is parsed to what the kinds consume (an nx load vector, the model with
 the stress limits ...)."""
@@ -100,7 +100,7 @@ def _stiffness_dimension(kind: str) -> str:
 def mass_node(name: str, description: str, angle: bool = False, default: Any = None) -> Either:
     """A mass (on a length coordinate) or an inertia (``angle``: on an angle coordinate): a
     quantity, or a block of the hinge material.  The value is checked here and read by
-    :func:`~cpm_nlp.analysis.dynamics.parse_mass` / ``parse_inertia`` once the material is known."""
+    `parse_mass` / ``parse_inertia`` once the material is known."""
     block = (*BLOCK, INERTIA_BLOCK[-1]) if angle else BLOCK
     return Either(
         name,

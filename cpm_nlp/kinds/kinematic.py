@@ -129,7 +129,7 @@ def _result(
     extra: Mapping[str, Any] | None = None,
     outputs: Sequence[Output] = (),
 ) -> Result:
-    """The result of solved poses: the pose (:func:`_pose_outputs`), then ``extra`` values
+    """The result of solved poses: the pose (`_pose_outputs`), then ``extra`` values
     (declared by ``outputs``)."""
     status, message, statuses = _summary(sols, batch)
     values = _pose_values(model, sols, batch)
@@ -165,7 +165,7 @@ def _condition(model: Model, s: PoseSolution) -> float:
 
 def _singularity_warning(model: Model, sols: Sequence[PoseSolution]) -> Any:
     """A ``near_singular`` warning for the worst solved pose whose cond(Φ_x) is above
-    :data:`~cpm_nlp.analysis.validity.NEAR_SINGULAR_CONDITION` (None when none is)."""
+    `NEAR_SINGULAR_CONDITION` (None when none is)."""
     conds = [(_condition(model, s), k) for k, s in enumerate(sols) if s.ok]
     near = [ck for ck in conds if ck[0] > NEAR_SINGULAR_CONDITION]
     if not near:
@@ -277,7 +277,7 @@ MODE_OPTIONS = (
 )
 
 
-#: what asks for the values of :func:`mode_outputs`
+#: what asks for the values of `mode_outputs`
 ALL_MODES = "assembly_modes: all"
 
 
@@ -532,7 +532,7 @@ class JointRequirements(ProblemKind):
     def outputs(self, model: Model) -> list[Output]:
         """The pose, then the range of each family of joints (actuators, dependent pose
         coordinates, passive joints) and of its deviation from home
-        (:func:`~cpm_nlp.analysis.requirements.joint_requirements`)."""
+        ([`joint_requirements`][cpm_nlp.analysis.requirements.joint_requirements])."""
         c = model.closure
         dims = {co.group: co.kind for co in (*c.q, *(c.x[i] for i in c.dep_index), *c.passive_coords)}
         fams = sorted(dims)

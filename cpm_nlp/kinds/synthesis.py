@@ -2,14 +2,15 @@
 
 Every paper states its own synthesis (design variables, objective,
 constraints), so the kind dispatches to the mechanism: a mechanism that
-supports it registers its formulation, an instance of a :class:`SynthesisFormulation`
+supports it registers its formulation, an instance of a
+[`SynthesisFormulation`][cpm_nlp.kinds.synthesis.SynthesisFormulation]
 subclass, among its parts (``Mechanism.parts``; the part ``synthesis``).  The kind itself only
 looks the formulation up and hands it the validated model, inputs and solver.
 
 A mechanism that declares none gets the generic formulation,
-:class:`CuboidSynthesis`: the largest inscribed cuboid per unit of a declared
+`CuboidSynthesis`: the largest inscribed cuboid per unit of a declared
 footprint, with the chosen parameters as unknowns of the cuboid NLP
-(:mod:`cpm_nlp.analysis.synthesis`).
+(`cpm_nlp.analysis.synthesis`).
 """
 
 from __future__ import annotations
@@ -243,7 +244,7 @@ class CuboidSynthesis(SynthesisFormulation):
 
 def formulation(model: Model) -> SynthesisFormulation | None:
     """The synthesis formulation of a model's mechanism: its own (the paper's), else
-    the generic :class:`CuboidSynthesis`; None for a model built by hand."""
+    the generic `CuboidSynthesis`; None for a model built by hand."""
     mech = model.mechanism
     if mech is None:
         return None

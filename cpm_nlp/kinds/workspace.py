@@ -1,13 +1,13 @@
 """Workspace problem kinds: ``inscribed_cuboid`` and ``workspace``.
 
 Both work for any mechanism from its loop closures and joint limits (see
-:mod:`cpm_nlp.analysis.workspace`).  A mechanism may add to them through
-two parts declared here (:class:`~cpm_nlp.core.mechanism.Part`), which a
+`cpm_nlp.analysis.workspace`).  A mechanism may add to them through
+two parts declared here ([`Part`][cpm_nlp.core.mechanism.Part]), which a
 mechanism registers in ``Mechanism.parts``:
 
-* ``cuboid`` (:class:`CuboidExtras`): extra inputs and values of the cuboid
+* ``cuboid`` ([`CuboidExtras`][cpm_nlp.kinds.workspace.CuboidExtras]): extra inputs and values of the cuboid
   found, e.g. the paper's names for it and the paper's own formulation;
-* ``paper_membership`` (:class:`PaperMembership`): a closed-form membership
+* ``paper_membership`` ([`PaperMembership`][cpm_nlp.kinds.workspace.PaperMembership]): a closed-form membership
   test from the paper, reported beside the general one.
 """
 
@@ -49,15 +49,21 @@ from .kinematic import _model_info
 class CuboidExtras(Part):
     """What a mechanism adds to the ``inscribed_cuboid`` kind (the part ``cuboid``).
 
-    options: extra inputs of the kind for this mechanism.
-    outputs: the extra values, all of them, declared (:class:`~cpm_nlp.core.outputs.Output`:
-        name, dimension, unit text where the dimension has no SI unit); set to null when
-        no cuboid was found.
-    values: ``(model, lower, upper, inputs, solver) -> values`` for a found box
-        ``lower <= t <= upper`` (SI, task coordinates), each of a declared output.
-    paper_box: optional ``(values) -> (lower, upper, label) | None``: the box of
-        the paper's own formulation read from a result's values, drawn beside
-        the found one by the workspace plot (None when the result has none).
+    Attributes
+    ----------
+    options
+        extra inputs of the kind for this mechanism.
+    outputs
+        the extra values, all of them, declared ([`Output`][cpm_nlp.core.result.Output]: name,
+        dimension, unit text where the dimension has no SI unit); set to null when no cuboid was
+        found.
+    values
+        ``(model, lower, upper, inputs, solver) -> values`` for a found box ``lower <= t <=
+        upper`` (SI, task coordinates), each of a declared output.
+    paper_box
+        optional ``(values) -> (lower, upper, label) | None``: the box of the paper's own
+        formulation read from a result's values, drawn beside the found one by the workspace
+        plot (None when the result has none).
     """
 
     capability: ClassVar[str] = "cuboid"
@@ -77,7 +83,7 @@ class CuboidExtras(Part):
 
     @property
     def value_names(self) -> tuple[str, ...]:
-        """The names of :attr:`outputs`."""
+        """The names of `outputs`."""
         return tuple(o.name for o in self.outputs)
 
 
@@ -133,7 +139,7 @@ def _region(inputs: Mapping[str, Any], model: Model, path: tuple) -> tuple[np.nd
 def _volume_dimension(model: Model) -> tuple[str, str]:
     """Dimension and SI unit of the size of a box in the task coordinates: a length, an
     area or a volume by the number of translational task coordinates, times the angles'
-    (:func:`~cpm_nlp.core.units.size_dimension`)."""
+    (`size_dimension`)."""
     return size_dimension(model.closure.x[i].kind for i in model.closure.task_index)
 
 

@@ -3,13 +3,13 @@ old names, the add-ons, and the plot types each add-on brings (their names and o
 summaries).
 
 These tables import nothing of cpm_nlp: ``cpm-nlp plot --help`` lists the add-ons' plot types
-from :data:`ADDON_PLOTS` alone, and a plot module is imported only when its plot is drawn
+from `ADDON_PLOTS` alone, and a plot module is imported only when its plot is drawn
 (issue 24, item 5; issue 23, start-up).
 """
 
 from __future__ import annotations
 
-#: built-in file mechanism -> "module:attribute" of its :class:`~cpm_nlp.core.mechanism.Addon`:
+#: built-in file mechanism -> "module:attribute" of its `Addon`:
 #: what its file cannot say (the paper's own kinds, a dynamics model, checks over several
 #: parameters), added to the mechanism the file describes
 ADDONS = {
@@ -30,12 +30,17 @@ ALIASES = {
 class AddonPlot:
     """A plot type of a built-in mechanism's add-on, declared without importing it.
 
-    name: what ``--type`` takes.
-    function: ``"module:attribute"`` of the plot function ``(data, options) -> figure``,
-        imported when the plot is first drawn (a module of the plot layer: it imports
-        :mod:`cpm_nlp.plot`).
-    description: one line, listed by ``cpm-nlp plot --help``.
-    kinds, interactive: as :class:`~cpm_nlp.plot.plot_type.PlotType`'s fields.
+    Attributes
+    ----------
+    name
+        what ``--type`` takes.
+    function
+        ``"module:attribute"`` of the plot function ``(data, options) -> figure``, imported when
+        the plot is first drawn (a module of the plot layer: it imports `cpm_nlp.plot`).
+    description
+        one line, listed by ``cpm-nlp plot --help``.
+    kinds, interactive
+        as `PlotType`'s fields.
     """
 
     # a plain class, not a dataclass: every solve imports this table, and a dataclass costs
@@ -55,8 +60,8 @@ class AddonPlot:
         return f"AddonPlot({self.name!r}, {self.function!r})"
 
 
-#: built-in mechanism (a key of :data:`ADDONS`) -> the plot types of its paper, drawn only for
-#: results of that mechanism (:mod:`cpm_nlp.plot.registry`)
+#: built-in mechanism (a key of `ADDONS`) -> the plot types of its paper, drawn only for
+#: results of that mechanism (`cpm_nlp.plot.registry`)
 ADDON_PLOTS: dict[str, tuple[AddonPlot, ...]] = {
     "prc3": (
         AddonPlot(

@@ -1,11 +1,11 @@
 """Where a result's mechanism came from, and the mechanism rebuilt from that record.
 
 A problem's ``mechanism:`` section gives a built-in (or plugin) by name, a mechanism
-file, or a description inline; :func:`section_origin` makes the
-:class:`~cpm_nlp.core.origin.Origin` a result records (a file by its absolute path
+file, or a description inline; `section_origin` makes the
+`Origin` a result records (a file by its absolute path
 and the SHA-256 of its bytes, an inline description as written).
-:func:`recorded_mechanism` reads the mechanism back for a plot: a file only if it is
-still at its path with the same hash, else one clear :class:`InputError` (never a
+`recorded_mechanism` reads the mechanism back for a plot: a file only if it is
+still at its path with the same hash, else one clear [`InputError`][cpm_nlp.core.errors.InputError] (never a
 silently different mechanism).  Nothing read back is registered: the registry keeps
 what it had.
 """
@@ -126,7 +126,7 @@ def recorded_model(
     path: tuple = ("model",),
     limits: Mapping[str, Any] | None = None,
 ) -> Model:
-    """A model of a mechanism :func:`recorded_mechanism` gave: a registered one through the
+    """A model of a mechanism `recorded_mechanism` gave: a registered one through the
     registry (its shared closure), one read back from a file or a description without
     registering it (the registry keeps what it had); ``limits``: its joint limits, if given."""
     if _registered(mech):
@@ -139,7 +139,7 @@ def _registered(mech: Mechanism) -> bool:
 
 
 def recorded_closure(mech: Mechanism) -> LoopClosure:
-    """The closure of a mechanism :func:`recorded_mechanism` gave (not put in the registry)."""
+    """The closure of a mechanism `recorded_mechanism` gave (not put in the registry)."""
     if _registered(mech):
         return closure_of(mech)
     return mech.closure()

@@ -1,7 +1,7 @@
 """The registry of mechanism types: built-in, and added by plugins.
 
-A mechanism type is a :class:`~cpm_nlp.core.mechanism.Mechanism` declaration.
-The built-in ones are listed in :data:`BUILTIN`; a third-party package adds
+A mechanism type is a [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] declaration.
+The built-in ones are listed in `BUILTIN`; a third-party package adds
 its own through the entry-point group ``cpm_nlp.mechanisms``, without editing
 cpm_nlp::
 
@@ -9,7 +9,7 @@ cpm_nlp::
     [project.entry-points."cpm_nlp.mechanisms"]
     delta = "my_package.delta:MECHANISM"
 
-The entry point names a :class:`Mechanism` (or a function without arguments
+The entry point names a [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] (or a function without arguments
 returning one).  Registering validates it: a misspelt or mistyped capability
 is an error that names the plugin, never a silently missing feature.
 
@@ -42,7 +42,7 @@ log = logging.getLogger(__name__)
 ENTRY_POINT_GROUP = "cpm_nlp.mechanisms"
 
 #: built-in mechanism type -> "module:attribute" of its declaration (every seed mechanism is a
-#: file now: :data:`BUILTIN_FILES`)
+#: file now: `BUILTIN_FILES`)
 BUILTIN: dict[str, str] = {}
 
 #: built-in mechanism type -> its shipped mechanism file (in problems/mechanisms/): the
@@ -135,12 +135,12 @@ class _Registry:
         return mech
 
     def entry(self, name: str) -> tuple[Any, Any, Any]:
-        """What the registry holds under ``name`` (to put back with :meth:`restore`)."""
+        """What the registry holds under ``name`` (to put back with `restore`)."""
         with self._lock:
             return self._discover().get(name), self._loaded.get(name), self._closures.get(name)
 
     def restore(self, name: str, entry: tuple[Any, Any, Any]) -> None:
-        """Put back what :meth:`entry` returned (nothing, if it held nothing)."""
+        """Put back what `entry` returned (nothing, if it held nothing)."""
         spec, loaded, closure = entry
         with self._lock:
             for table, value in ((self._discover(), spec), (self._loaded, loaded), (self._closures, closure)):
@@ -209,9 +209,10 @@ class _Registry:
 
 class _LoadedClosures:
     """The closures of described mechanisms a problem file loaded (never registered): one per
-    Mechanism object, which :mod:`~cpm_nlp.mechanisms.described` caches by the content hash of
+    Mechanism object, which `described` caches by the content hash of
     its file (or description), so a file read again reuses its closure and its compiled solvers.
-    Not a registry: :func:`mechanism_names` and :func:`mechanism_type` never see these."""
+    Not a registry: [`mechanism_names`][cpm_nlp.mechanisms.registry.mechanism_names] and
+    [`mechanism_type`][cpm_nlp.mechanisms.registry.mechanism_type] never see these."""
 
     def __init__(self) -> None:
         self._lock = threading.RLock()
@@ -286,7 +287,7 @@ def _load(name: str, target: str, origin: Origin) -> Mechanism:
 
 
 def _load_file(name: str, path: str, origin: Origin) -> Mechanism:
-    """A mechanism file; a built-in one with its add-on (:data:`ADDONS`), if it has one."""
+    """A mechanism file; a built-in one with its add-on (`ADDONS`), if it has one."""
     mech = described.load_file(path)
     if mech.name != name:  # a shipped file is found by its file name: the two must agree
         raise PluginError(
@@ -299,7 +300,7 @@ def _load_file(name: str, path: str, origin: Origin) -> Mechanism:
 
 
 def _addon(name: str, target: str) -> Addon:
-    """The add-on of a built-in file mechanism (``module:attribute`` of an :class:`Addon`)."""
+    """The add-on of a built-in file mechanism (``module:attribute`` of an `Addon`)."""
     module, _, attr = target.partition(":")
     obj = getattr(importlib.import_module(module), attr)
     if not isinstance(obj, Addon):
@@ -333,7 +334,7 @@ def unregister(name: str) -> None:
 
 def mechanism_type(name: Any, path: tuple = ("mechanism", "type")) -> Mechanism:
     """The declaration of a mechanism type (with a "did you mean" if unknown); an old name
-    (:data:`ALIASES`) gives the mechanism it stands for."""
+    (`ALIASES`) gives the mechanism it stands for."""
     mech = REGISTRY.lookup(name) if isinstance(name, str) else None
     if mech is not None:
         return mech
@@ -418,7 +419,8 @@ def _section_described(section: Mapping[str, Any], base_dir: Any, path: tuple) -
 def section_model(section: Mapping[str, Any], base_dir: Any = None, path: tuple = ("mechanism",)) -> Model:
     """The model of a problem file's ``mechanism:`` section.  A mechanism file or inline
     description gives its model directly: no global registry changes (issue 22, item 3), so
-    a later problem in the same process, and :func:`mechanism_names`, see the registry as it was."""
+    a later problem in the same process, and [`mechanism_names`][cpm_nlp.mechanisms.registry.mechanism_names], see the
+    registry as it was."""
     described_mech = _section_described(section, base_dir, path)
     if described_mech is None:
         return build_model(section["type"], section.get("parameters"), section.get("limits"))
@@ -444,7 +446,7 @@ def build_model(
     ``parameters`` and ``limits`` take numbers (SI) or strings with units,
     exactly as in a problem file, e.g.
     ``build_model("prs3", {"b": "47.91 mm", "L": "109.215 mm"})``; ``type_name`` may be a
-    :class:`Mechanism` itself (one a problem file described, not registered).
+    [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] itself (one a problem file described, not registered).
     """
     mech = type_name if isinstance(type_name, Mechanism) else mechanism_type(type_name, path + ("type",))
     return _model(mech, parameters, limits, path)

@@ -1,10 +1,10 @@
 """The built-in plot types: one declaration each, in the order ``--help`` lists them.
 
-Each function is named, not imported (:class:`~cpm_nlp.plot.plot_type.Deferred`): listing the
+Each function is named, not imported (`Deferred`): listing the
 plot types imports no plot module (issue 23, start-up).
 A mechanism adds the plots of its own paper through its add-on
-(:attr:`cpm_nlp.core.mechanism.Addon.plots`), a third-party package through the
-entry-point group ``cpm_nlp.plots`` (:mod:`cpm_nlp.plot.registry`).
+(`cpm_nlp.core.mechanism.Addon.plots`), a third-party package through the
+entry-point group ``cpm_nlp.plots`` (`cpm_nlp.plot.registry`).
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ from .results import NotApplicable, PlotOptions, ResultData, dimension_of, figur
 #: label says what the reference is: a value computed here from a paper's formulas or
 #: formulation is not a number the paper prints (issue 24: eq 38 of prc3-li-2018.md evaluated
 #: with assumed masses, 96.5 Hz, was labelled "paper (printed)"; the paper prints 93.83 Hz).
-#: Numbers a paper prints come from the problem's reproduce rows (:data:`PRINTED`).
+#: Numbers a paper prints come from the problem's reproduce rows (`PRINTED`).
 REFERENCES = (
     ("reference_", "", "reference design"),
     ("paper_", "", "paper's formulation (solved here)"),

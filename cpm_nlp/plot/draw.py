@@ -2,22 +2,22 @@
 drawing functions, one module per concept, gathered here for one import.
 
 Every function takes SI numbers and the dimension of each axis ("length",
-"angle", ...), converts them for display (:mod:`.style`) and returns a
+"angle", ...), converts them for display (`style`) and returns a
 ``matplotlib.figure.Figure`` (no pyplot, no global state, no display: the
-Agg and SVG renderers write files); :func:`save` writes PNG, SVG or PDF
-atomically (:mod:`.output`).
+Agg and SVG renderers write files); `save` writes PNG, SVG or PDF
+atomically (`output`).
 
-* :mod:`.draw_workspace` -- a reachable workspace as a 3-D point cloud with
+* `draw_workspace` -- a reachable workspace as a 3-D point cloud with
   its inscribed cuboid, and the three projections (pantograph paper, Fig. 9-14);
-* :mod:`.draw_map` -- a value over two design parameters, on a grid or on
+* `draw_map` -- a value over two design parameters, on a grid or on
   scattered points of any domain (RPR paper, Fig. 4);
-* :mod:`.draw_panels` -- curves against one abscissa, one panel per quantity
+* `draw_panels` -- curves against one abscissa, one panel per quantity
   (3-PRS paper, Fig. 6-7; pantograph paper, Fig. 20-22);
-* :mod:`.draw_mechanism` -- the mechanism at a pose, arrows and mode shapes on it;
-* :mod:`.draw_compliance` -- the compliance ellipsoid, natural frequencies, mode shapes;
-* :mod:`.draw_tables` -- values beside references, matrices as heat maps.
+* `draw_mechanism` -- the mechanism at a pose, arrows and mode shapes on it;
+* `draw_compliance` -- the compliance ellipsoid, natural frequencies, mode shapes;
+* `draw_tables` -- values beside references, matrices as heat maps.
 
-:mod:`cpm_nlp.plot.figures` chooses and feeds these from results.
+`cpm_nlp.plot.figures` chooses and feeds these from results.
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ from .style import (
 
 def principal_axes(S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Principal compliances (ascending) and axes (columns) of a symmetric block S, in
-    the canonical form of :func:`cpm_nlp.core.canonical.canonical_eigh`: each axis'
+    the canonical form of `cpm_nlp.core.canonical.canonical_eigh`: each axis'
     first significant component positive, and equal compliances (a circle, a sphere)
     with axes along the coordinates in their order, on every BLAS kernel."""
     w, V, _ = canonical_eigh(np.asarray(S, dtype=float))

@@ -74,7 +74,7 @@ OUTSIDE_COLOUR = "0.86"
 
 def _colour_scale(zpos: np.ndarray) -> tuple[Any, Any]:
     """The colour norm and contour levels: logarithmic for values over decades, else linear;
-    the levels round numbers inside the values' range (:func:`contour_levels`)."""
+    the levels round numbers inside the values' range (`contour_levels`)."""
     lo, hi = float(zpos.min()), float(zpos.max())
     if lo > 0 and hi / lo > 1000:  # values over decades: a log scale shows them all
         from matplotlib.colors import LogNorm

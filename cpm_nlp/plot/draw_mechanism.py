@@ -1,4 +1,4 @@
-"""The mechanism at a pose, from its :class:`~cpm_nlp.core.mechanism.Drawing`:
+"""The mechanism at a pose, from its `Drawing`:
 links, joints and faces in 3-D (a planar mechanism in its plane), arrows on it,
 mode shapes on it, and the Jacobian figure (the pose beside cond and
 manipulability over a workspace slice).
@@ -79,10 +79,10 @@ def draw_mechanism(
     label_points: bool = True,
     arrows: Sequence[Arrow] = (),
 ) -> None:
-    """Draw a :class:`~cpm_nlp.core.mechanism.Drawing` (SI) into a 3-D axes,
+    """Draw a `Drawing` (SI) into a 3-D axes,
     shown = SI * factor; ``faint``: a reference pose (thin, grey, no labels; a text: its legend,
     else "home pose").
-    The layers are drawn in a fixed order (:data:`ZORDER`), faces translucent."""
+    The layers are drawn in a fixed order (`ZORDER`), faces translucent."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     ax.computed_zorder = False
@@ -186,7 +186,7 @@ def draw_mechanism_2d(
     label_points: bool = True,
     arrows: Sequence[Arrow] = (),
 ) -> None:
-    """:func:`draw_mechanism` for a planar mechanism, in a 2-D axes (its plane z = 0)."""
+    """`draw_mechanism` for a planar mechanism, in a 2-D axes (its plane z = 0)."""
     from matplotlib.patches import Polygon
 
     pts = {k: np.asarray(v, dtype=float).ravel()[:2] * factor for k, v in drawing.points.items()}
@@ -272,9 +272,9 @@ def readable_names(names: Sequence[str], joints: Mapping[str, str]) -> dict[str,
 def point_labels(pts: Mapping[str, np.ndarray], joints: Mapping[str, str]) -> Any:
     """The names of a drawing's points as one Matplotlib artist, placed when drawn (the view
     and the layout are then final): points that coincide share one label ("E = P"), points
-    closer on the page than :data:`LABEL_NEAR` and in space than :data:`LABEL_NEAR_SPACE` one
+    closer on the page than `LABEL_NEAR` and in space than `LABEL_NEAR_SPACE` one
     label ("$P_{1}$, $R_{1}$"); each label goes
-    to the first place around its point (:data:`LABEL_OFFSETS`) where it overlaps no other
+    to the first place around its point (`LABEL_OFFSETS`) where it overlaps no other
     label and no other point."""
     return _point_labels_class()(pts, joints)
 
@@ -329,7 +329,7 @@ def _place_label(text: Any, p: np.ndarray, renderer: Any, scale: float, placed: 
 
 @functools.cache
 def _point_labels_class() -> Any:
-    """The artist class of :func:`point_labels` (made on first use: Matplotlib is imported
+    """The artist class of `point_labels` (made on first use: Matplotlib is imported
     only when a figure is drawn)."""
     from matplotlib.artist import Artist
     from matplotlib.text import Text
@@ -506,7 +506,7 @@ def mechanism_figure(
 
 
 def drawing_factor(drawing: Any) -> tuple[float, str]:
-    """The length unit :func:`mechanism_axes` shows a drawing in (factor from SI, unit)."""
+    """The length unit `mechanism_axes` shows a drawing in (factor from SI, unit)."""
     allpts = np.array([np.asarray(v, dtype=float).ravel()[:3] for v in drawing.points.values()])
     return display_unit("length", allpts)
 

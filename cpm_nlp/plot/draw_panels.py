@@ -27,11 +27,14 @@ from .style import (
 
 @dataclass
 class Panel:
-    """One panel of :func:`panels_figure`: curves of one quantity.
+    """One panel of `panels_figure`: curves of one quantity.
 
-    series: label -> values (SI, one per abscissa point; None/NaN = not
-    solved, a gap); annotate_range: write the range of the values in the
-    panel's title (for requirements).
+    Attributes
+    ----------
+    series
+        label -> values (SI, one per abscissa point; None/NaN = not solved, a gap);
+    annotate_range
+        write the range of the values in the panel's title (for requirements).
     """
 
     name: str

@@ -92,7 +92,7 @@ def matrix_axes(ax: Any, M: Any, *, title: str = "", rows: Sequence[str] = (), c
 def comparison_figure(
     groups: Sequence[tuple[str, Sequence[Comparison]]], spread: Mapping[str, Any] | None = None, *, title: str = ""
 ) -> Any:
-    """One panel per kind of reference (:func:`comparison_axes`), and the
+    """One panel per kind of reference (`comparison_axes`), and the
     multi-start record (starts, converged, agreed; distinct optima) if given."""
     Figure = figure_class()
     spread = dict(spread or {})
@@ -122,7 +122,7 @@ def comparison_figure(
 
 
 def matrices_figure(mats: Sequence[tuple[str, Any]], units: Mapping[str, str] | None = None, *, title: str = "") -> Any:
-    """Matrices as annotated heat maps (:func:`matrix_axes`), the unit text of each below it."""
+    """Matrices as annotated heat maps (`matrix_axes`), the unit text of each below it."""
     Figure = figure_class()
     units = units or {}
     n = len(mats)

@@ -27,12 +27,16 @@ from .style import (
 
 @dataclass
 class BoundarySlice:
-    """A plane slice of the workspace for :func:`workspace_figure`: membership of
+    """A plane slice of the workspace for `workspace_figure`: membership of
     a grid in the plane of task axes ``axes`` (i, j) with the third at ``at`` (SI).
 
-    x, y: the grid lines (SI) along axes i and j; inside: (len(y), len(x)):
-    bools, or the signed margin of the membership test (> 0 inside), whose
-    zero level places the boundary between the grid lines.
+    Attributes
+    ----------
+    x, y
+        the grid lines (SI) along axes i and j;
+    inside
+        (len(y), len(x)): bools, or the signed margin of the membership test (> 0 inside), whose
+        zero level places the boundary between the grid lines.
     """
 
     axes: tuple[int, int]

@@ -1,16 +1,16 @@
 """Which figure a result makes.
 
-A result is the JSON of ``cpm-nlp solve -o`` (or a :class:`~cpm_nlp.core.result.Result`)
-or a sweep results file; :func:`load` reads either into :class:`ResultData`
-(:mod:`cpm_nlp.plot.results`).  The figure is chosen from the result's problem kind
-(its ``plots``, see :class:`~cpm_nlp.core.kind.ProblemKind`: the first plot type
+A result is the JSON of ``cpm-nlp solve -o`` (or a [`Result`][cpm_nlp.core.result.Result])
+or a sweep results file; `load` reads either into `ResultData`
+(`cpm_nlp.plot.results`).  The figure is chosen from the result's problem kind
+(its ``plots``, see [`ProblemKind`][cpm_nlp.core.kind.ProblemKind]: the first plot type
 that applies to the values wins) or named (``--type``).
 
-Extending: a plot type is a :class:`~cpm_nlp.plot.plot_type.PlotType` in the
-registry (:mod:`cpm_nlp.plot.registry`: built-in, a mechanism's add-on, or a plugin
+Extending: a plot type is a `PlotType` in the
+registry (`cpm_nlp.plot.registry`: built-in, a mechanism's add-on, or a plugin
 of the entry-point group ``cpm_nlp.plots``), its function taking ``(data, options)``
 and returning a Matplotlib figure made from arrays (the ``draw_*`` modules), or
-raising :class:`NotApplicable`; a problem kind lists its plot types in its ``plots``
+raising `NotApplicable`; a problem kind lists its plot types in its ``plots``
 attribute.  A kind needs no plotting code of its own when its values use the names
 the built-in plot types read (SI values, units in the result):
 
@@ -69,7 +69,7 @@ def figure(
 ) -> tuple[Any, str]:
     """The figure of a result: ``(figure, plot type)``; ``interactive``: a Plotly
     figure (for ``.html``) of a 3-D plot type (declared ``interactive``).  Raises
-    :class:`NothingSolved` for a result without a solved point."""
+    `NothingSolved` for a result without a solved point."""
     options = replace(
         options or PlotOptions(), interactive=interactive or (options is not None and options.interactive)
     )
@@ -93,7 +93,7 @@ def figure(
 
 
 def check_plot_type(plot_type: str | None) -> None:
-    """An :class:`InputError` (``--type``, with "did you mean") unless ``plot_type``
+    """An [`InputError`][cpm_nlp.core.errors.InputError] (``--type``, with "did you mean") unless ``plot_type``
     is None or a registered plot type (checked before anything is solved)."""
     if plot_type is None or REGISTRY.has(plot_type):
         return

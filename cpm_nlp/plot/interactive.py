@@ -1,5 +1,5 @@
 """Interactive 3-D figures (Plotly): the same content as the 3-D views of
-:mod:`cpm_nlp.plot.draw` -- a workspace cloud with its boundary slices and
+`cpm_nlp.plot.draw` -- a workspace cloud with its boundary slices and
 boxes, a mechanism drawing -- in a self-contained HTML file a designer can
 rotate (``--plot FILE.html``).  Plotly is an optional extra (``plot``), imported
 only here and only when an HTML figure is asked for; the file embeds
@@ -107,7 +107,7 @@ def workspace_html(
     slices_label: str = "workspace boundary (slices through the box centre)",
     colour_by_height: bool = False,
 ) -> Any:
-    """The 3-D view of :func:`~cpm_nlp.plot.draw.workspace_figure` as a Plotly figure."""
+    """The 3-D view of `workspace_figure` as a Plotly figure."""
     go = _go()
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     pts = pts[np.all(np.isfinite(pts), axis=1)]

@@ -1,5 +1,5 @@
 """Writing figures: the file types, early checks of the path and the plotting
-library it needs, and :func:`save` (atomic; PNG, SVG, PDF, or a Plotly HTML file).
+library it needs, and `save` (atomic; PNG, SVG, PDF, or a Plotly HTML file).
 """
 
 from __future__ import annotations
@@ -12,14 +12,14 @@ from typing import Any
 from ..core.errors import InputError
 from ..io.atomic import check_output_path, replace_atomically
 
-#: file types :func:`save` writes (.html: an interactive Plotly figure, :mod:`cpm_nlp.plot.interactive`)
+#: file types `save` writes (.html: an interactive Plotly figure, `cpm_nlp.plot.interactive`)
 FIGURE_FORMATS = (".png", ".svg", ".pdf", ".html")
 
 # -- saving -----------------------------------------------------------------------------------
 
 
 def check_figure_path(path: str | os.PathLike, option: str = "-o", inputs: Sequence[str | os.PathLike] = ()) -> None:
-    """Fail early (an :class:`InputError`) if a figure cannot be written there
+    """Fail early (an [`InputError`][cpm_nlp.core.errors.InputError]) if a figure cannot be written there
     (or would replace one of ``inputs``)."""
     if Path(path).suffix.lower() not in FIGURE_FORMATS:
         raise InputError(
@@ -29,7 +29,7 @@ def check_figure_path(path: str | os.PathLike, option: str = "-o", inputs: Seque
 
 
 def require_backend(path: str | os.PathLike) -> None:
-    """The plotting library a figure file needs is installed (an :class:`InputError` saying
+    """The plotting library a figure file needs is installed (an [`InputError`][cpm_nlp.core.errors.InputError] saying
     which extra installs it if not): Plotly for .html, Matplotlib for the others."""
     from ..core.extras import require
 

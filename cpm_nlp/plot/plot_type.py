@@ -51,18 +51,24 @@ class Deferred:
 class PlotType:
     """One plot type.
 
-    name: what ``--type`` takes (lower case, digits, underscores).
-    function: ``(data, options) -> figure``: ``data`` a
-        :class:`~cpm_nlp.plot.results.ResultData`, ``options`` a
-        :class:`~cpm_nlp.plot.results.PlotOptions`; returns a Matplotlib figure (a
-        Plotly one when ``options.interactive``), or raises
-        :class:`~cpm_nlp.plot.results.NotApplicable` saying why the result does not fit.
-    description: one line, listed by ``cpm-nlp plot --help``.
-    kinds: the problem kinds whose results it draws ("sweep": a sweep results file);
-        empty: any result it finds its values in.
-    interactive: it draws an interactive (.html) 3-D figure too.
-    origin: who declared it ("built-in", "add-on of mechanism 'x'", "plugin 'y' (...)"),
-        set by the registry.
+    Attributes
+    ----------
+    name
+        what ``--type`` takes (lower case, digits, underscores).
+    function
+        ``(data, options) -> figure``: ``data`` a `ResultData`, ``options`` a `PlotOptions`;
+        returns a Matplotlib figure (a Plotly one when ``options.interactive``), or raises
+        `NotApplicable` saying why the result does not fit.
+    description
+        one line, listed by ``cpm-nlp plot --help``.
+    kinds
+        the problem kinds whose results it draws ("sweep": a sweep results file); empty: any
+        result it finds its values in.
+    interactive
+        it draws an interactive (.html) 3-D figure too.
+    origin
+        who declared it ("built-in", "add-on of mechanism 'x'", "plugin 'y' (...)"), set by the
+        registry.
     """
 
     name: str
@@ -78,7 +84,7 @@ class PlotType:
 
 
 def validate(plot: Any, where: str) -> PlotType:
-    """``plot`` if it is a well-formed :class:`PlotType`; else a :class:`PlotDeclarationError`
+    """``plot`` if it is a well-formed `PlotType`; else a `PlotDeclarationError`
     naming ``where`` it was declared."""
     if not isinstance(plot, PlotType):
         raise PlotDeclarationError(f"{where} must name a PlotType declaration, got {type(plot).__name__}")

@@ -95,7 +95,7 @@ TITLE_NOISE = 1e-9
 
 def model_title(model: Any) -> str:
     """The title of the model's mechanism ("3-PRS compliant stage (Ruiz et al.)"), else its name
-    (:func:`.results.mechanism_title` gives it from a result)."""
+    (`results.mechanism_title` gives it from a result)."""
     mech = model.mechanism
     return str(mech.title) if mech is not None and mech.title else str(model.name)
 
@@ -104,7 +104,7 @@ def pose_title(model: Any, x: np.ndarray, k: float, size: float = 0.0, how: str 
     """The mechanism's title over its pose, e.g. "planar five-bar linkage (2-RRR), elbows out" /
     "forward kinematics: x = 0 mm, y = 203.8 mm": the task coordinates of the pose (symbols, each
     value in its own unit) after ``how`` the pose was found (a problem kind, "_" read as " ").  A
-    value below :data:`TITLE_NOISE` of the mechanism's ``size`` (SI: the span of its drawing;
+    value below `TITLE_NOISE` of the mechanism's ``size`` (SI: the span of its drawing;
     lengths) or of a degree (angles) is rounding noise, shown as 0 in the unit of the size (not
     "x = -7.939e-12 nm")."""
     c = model.closure

@@ -1,10 +1,10 @@
 """The registry of plot types: built-in, a mechanism's own, and added by plugins.
 
-A plot type is a :class:`~cpm_nlp.plot.plot_type.PlotType` declaration.  Three
+A plot type is a `PlotType` declaration.  Three
 sources extend the registry, none by editing cpm_nlp:
 
-* the built-in plot types (:data:`cpm_nlp.plot.builtin.BUILTIN`);
-* a built-in mechanism's add-on (:data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`): the plots
+* the built-in plot types (`cpm_nlp.plot.builtin.BUILTIN`);
+* a built-in mechanism's add-on (`cpm_nlp.mechanisms.names.ADDON_PLOTS`): the plots
   of its paper, each declared by name, function ("module:attribute") and one line, drawn
   only for results of that mechanism; listing them imports neither the add-on nor its
   plot module (the function is imported when the plot is drawn);
@@ -14,14 +14,14 @@ sources extend the registry, none by editing cpm_nlp:
       [project.entry-points."cpm_nlp.plots"]
       radar = "my_package.plots:RADAR"
 
-  The entry point names a :class:`PlotType` (or a function without arguments returning
+  The entry point names a `PlotType` (or a function without arguments returning
   one) of the entry point's name.  Loading validates it: a plugin that fails to import,
   names something else or declares another name is an error naming the plugin, never a
   silently missing plot.
 
 Nothing registers a plot type as a side effect: loading a problem file or a result
 leaves the registry as it is; a mechanism's plots are looked up from the result's
-mechanism when a figure is drawn.  :func:`register` adds one in code (a script, a test).
+mechanism when a figure is drawn.  `register` adds one in code (a script, a test).
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ def _load_target(target: str, where: str) -> Any:
 
 
 def _from_addon(declared: AddonPlot, mechanism: str, where: str) -> PlotType:
-    """The :class:`PlotType` of an add-on's declaration, its function imported when drawn."""
+    """The `PlotType` of an add-on's declaration, its function imported when drawn."""
     if not isinstance(declared, AddonPlot):
         raise PlotDeclarationError(f"{where} must be an AddonPlot declaration, got {type(declared).__name__}")
     try:
@@ -125,7 +125,7 @@ class _Registry:
 
     def mechanism_plots(self, mechanism: str) -> dict[str, PlotType]:
         """The plot types of a built-in mechanism's add-on (none for another mechanism),
-        from their declarations (:data:`~cpm_nlp.mechanisms.names.ADDON_PLOTS`): nothing is
+        from their declarations (`ADDON_PLOTS`): nothing is
         imported until a plot is drawn."""
         with self._lock:
             if mechanism not in self._mechanism_plots:

@@ -1,6 +1,6 @@
 """The results a plot reads: a JSON result (``cpm-nlp solve -o``, or a
-:class:`~cpm_nlp.core.result.Result`) or a sweep results file, read into
-:class:`ResultData`; the options of a plot; and the small readers of values every
+[`Result`][cpm_nlp.core.result.Result]) or a sweep results file, read into
+`ResultData`; the options of a plot; and the small readers of values every
 plot type shares.
 """
 
@@ -53,9 +53,15 @@ class PlotOptions:
 class ResultData:
     """A result to plot.
 
-    problem: the problem kind; sweep: True for a sweep results file, whose
-    ``values`` are its columns (lists, one entry per point) and ``parameters``
-    its swept keys; dimensions: of every value ("length", "angle" ...).
+    Attributes
+    ----------
+    problem
+        the problem kind;
+    sweep
+        True for a sweep results file, whose ``values`` are its columns (lists, one entry per
+        point) and ``parameters`` its swept keys;
+    dimensions
+        of every value ("length", "angle" ...).
     """
 
     source: str
@@ -74,7 +80,7 @@ class ResultData:
     )  # as the result writes them (matrices: what rows and columns are)
     #: published figures to draw beside the values: (value expression "dz[2]", published SI, label)
     published: list[tuple[str, float, str]] = field(default_factory=list)
-    #: the result's warnings (:class:`~cpm_nlp.core.result.ResultWarning`), read back from its JSON
+    #: the result's warnings (`ResultWarning`), read back from its JSON
     warnings: list[Any] = field(default_factory=list)
     #: where the mechanism came from, as the result records it (``origin``; None in older results)
     origin: Any = None
@@ -98,7 +104,7 @@ def _dimension_of_unit(unit: Any) -> str | None:
 
 
 def from_result(result: Any, source: str = "") -> ResultData:
-    """A :class:`~cpm_nlp.core.result.Result` or its JSON dict."""
+    """A [`Result`][cpm_nlp.core.result.Result] or its JSON dict."""
     d = result if isinstance(result, Mapping) or not hasattr(result, "to_dict") else result.to_dict()
     if not isinstance(d, Mapping) or not isinstance(d.get("values"), Mapping) or not isinstance(d.get("problem"), str):
         raise InputError("expected a cpm-nlp result (JSON with problem, status, values, units)", file=source or None)
@@ -133,7 +139,7 @@ def from_solved(result: Any, problem: Any) -> ResultData:
 
 
 def from_table(table: Any) -> ResultData:
-    """A sweep results file read by :func:`cpm_nlp.io.results.read_results`."""
+    """A sweep results file read by `cpm_nlp.io.results.read_results`."""
     meta = table.meta
     names = ["point", *(p["key"] for p in table.parameters), "status", "message", "seconds", "warnings"]
     names += table.values
@@ -183,7 +189,7 @@ def result_closure(data: ResultData) -> Any:
 
 def result_mechanism(data: ResultData) -> Any:
     """The mechanism of the result: the one its ``origin`` records (a mechanism file only
-    if it is unchanged at its path, see :mod:`cpm_nlp.mechanisms.provenance`), else the
+    if it is unchanged at its path, see `cpm_nlp.mechanisms.provenance`), else the
     registered type ``model.type`` (a result written before results recorded their origin)."""
     if data.live is not None and data.live.mechanism is not None:
         return data.live.mechanism
@@ -213,7 +219,7 @@ def problem_words(data: ResultData) -> str:
 
 
 def result_model(data: ResultData, parameters: Mapping[str, Any] | None = None, with_limits: bool = False) -> Any:
-    """A model of the result's mechanism (:func:`result_mechanism`) from ``parameters``
+    """A model of the result's mechanism (`result_mechanism`) from ``parameters``
     (default: the ones the result records), without registering it; ``with_limits``: with the
     joint limits the result records too (its workspace is then the one solved)."""
     mech = result_mechanism(data)

@@ -1,7 +1,7 @@
 """What a problem kind takes and gives, for one mechanism, from the declared options.
 
-``cpm-nlp describe KIND --mechanism NAME`` prints :func:`kind_text`; the documentation's
-reference page is :func:`reference_markdown` (generated when the site is built), so the two
+``cpm-nlp describe KIND --mechanism NAME`` prints `kind_text`; the documentation's
+reference page is `reference_markdown` (generated when the site is built), so the two
 say the same and neither can drift from the code.  A kind's inputs may depend on the
 mechanism (``input_options(model)``), so a model is built: from the mechanism section of
 its first shipped problem file (``Mechanism.problem_files``), else from its defaults.
@@ -57,7 +57,7 @@ class InputRow:
 
 @dataclass(frozen=True)
 class ValueRow:
-    """One value a kind declares (:class:`~cpm_nlp.core.outputs.Output`): name, the unit a
+    """One value a kind declares ([`Output`][cpm_nlp.core.result.Output]): name, the unit a
     result writes for it (SI, or what a matrix's rows and columns are), dimension, and what it
     is where that is not the value itself ("pz relative to home": an offset)."""
 

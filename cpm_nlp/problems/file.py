@@ -57,7 +57,7 @@ TOP_LEVEL = {
 
 @dataclass
 class Problem:
-    """A validated problem: ready to :func:`solve`."""
+    """A validated problem: ready to [`solve`][cpm_nlp.problems.file.solve]."""
 
     kind: ProblemKind
     model: Model
@@ -74,7 +74,7 @@ class Problem:
 
 
 def problem_from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Problem:
-    """Validate a parsed problem mapping into a :class:`Problem`."""
+    """Validate a parsed problem mapping into a [`Problem`][cpm_nlp.problems.file.Problem]."""
     try:
         return _problem_from_dict(data, file, base_dir)
     except InputError as exc:

@@ -34,11 +34,11 @@ independent an agreement with it is, each row says:
   number (an approximation taken as exact: 0, "lies inside": 0 points
   outside); ``not_printed`` the paper prints no such number (a plot, an
   assumed input).  Only a ``published`` row that agrees and does not
-  echo an input is an independent agreement (:func:`summarize`).
+  echo an input is an independent agreement (`summarize`).
 * ``echoes``: the computed value is an input given back (an active bound, a
   parameter held fixed), named by this text.
 * ``tolerance_reason``: required when the tolerance is wider than half a unit
-  of the last digit of the published text (:func:`printed_half_unit`).
+  of the last digit of the published text (`printed_half_unit`).
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ ROW_KEYS = (
     "expect",
 )
 VERDICTS = ("agrees", "differs", "not reproducible", "solve failed")
-#: what a row comes to (:attr:`Comparison.outcome`), each row exactly one of these
+#: what a row comes to (`Comparison.outcome`), each row exactly one of these
 OUTCOMES = ("agrees", "differs", "not reproducible", "unexpected")
 
 #: what a row's "published" value is (its ``category``), as shown beside it
@@ -130,7 +130,7 @@ class Comparison:
 
     @property
     def outcome(self) -> str:
-        """The row in one word of :data:`OUTCOMES`: ``agrees`` and ``differs`` as the file
+        """The row in one word of `OUTCOMES`: ``agrees`` and ``differs`` as the file
         expects (a figure that differs says why), ``not reproducible`` (the model does not
         compute it, and says why), else ``unexpected`` (a regression, or a failed solve)."""
         if not self.expected:
@@ -193,7 +193,7 @@ def summarize(rows: Iterable[Comparison]) -> dict[str, Any]:
 
 def by_paper(rows: Iterable[Comparison]) -> dict[str, dict[str, int]]:
     """Per paper (in the order they first come), the rows of each outcome
-    (:data:`OUTCOMES`), and how many of those that agree are independent."""
+    (`OUTCOMES`), and how many of those that agree are independent."""
     out: dict[str, dict[str, int]] = {}
     for r in rows:
         counts = out.setdefault(r.paper, {**{o: 0 for o in OUTCOMES}, "independent": 0})

@@ -1,4 +1,4 @@
-"""Reading YAML input files: see :mod:`cpm_nlp.io.yamlfile` (shared with mechanism files)."""
+"""Reading YAML input files: see `cpm_nlp.io.yamlfile` (shared with mechanism files)."""
 
 from ..io.yamlfile import MAX_ALIASES, MAX_DEPTH, MAX_NODES, load_yaml_text, parse_yaml, read_yaml
 

@@ -2,7 +2,7 @@
 
 Three sources, one namespace:
 
-* the generic kinds of :mod:`cpm_nlp.kinds` (:data:`GENERIC`), which apply to
+* the generic kinds of `cpm_nlp.kinds` (`GENERIC`), which apply to
   any mechanism that has what they need;
 * the kinds each registered mechanism declares (``Mechanism.kinds``), e.g. the
   RPR's ``rpr_twists``;

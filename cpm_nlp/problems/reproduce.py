@@ -1,6 +1,6 @@
 """``cpm-nlp reproduce``: solve the problem files that carry a ``reproduce``
 section and compare each published figure with the computed value (the
-section's format and the comparison are in :mod:`cpm_nlp.problems.published`)."""
+section's format and the comparison are in `cpm_nlp.problems.published`)."""
 
 from __future__ import annotations
 
@@ -63,7 +63,7 @@ def _unique(files: Iterable[Path]) -> list[Path]:
 def reproduce(paths: Iterable[str | Path] | None = None) -> list[Comparison]:
     """Solve every problem file with a ``reproduce`` section; all rows.  Without
     paths: the shipped problem files, and those of mechanism plugins.  Comparing
-    nothing is bad input (:class:`InputError`, naming what was given): no
+    nothing is bad input ([`InputError`][cpm_nlp.core.errors.InputError], naming what was given): no
     problem files, or none with a ``reproduce`` section."""
     given = [str(p) for p in paths] if paths is not None else None
     if given is not None:

@@ -51,7 +51,7 @@ def example_files() -> list[tuple[Path, Path]]:
 def copy_examples(dest: str | os.PathLike, force: bool = False) -> list[Path]:
     """Copy the shipped problem files and presets into ``dest/problems`` and
     ``dest/configs`` (the layout ``cpm-nlp`` looks in) for the user to edit.
-    Refuses (:class:`InputError`, nothing copied) to overwrite an existing file
+    Refuses ([`InputError`][cpm_nlp.core.errors.InputError], nothing copied) to overwrite an existing file
     unless ``force``, or to write anything but a regular file; returns the paths
     written."""
     target = Path(dest)

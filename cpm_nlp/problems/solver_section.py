@@ -8,7 +8,7 @@ problem file's own folder, from which it also reads its mechanism files), then
 among the presets shipped with cpm_nlp.  The working directory is not searched:
 a ``configs/ipopt.yaml`` that happens to be there must not change what
 ``solver: ipopt`` means.  A preset is data like the problem file: its options
-pass the same allow-list (:mod:`cpm_nlp.core.solver_options`), and a refusal
+pass the same allow-list (`cpm_nlp.core.solver_options`), and a refusal
 names the preset file."""
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The ``sweep`` section of a problem file: the values ``cpm-nlp sweep`` varies
 (grids, lists or seeded random samples over dotted keys), validated against
 the problem's declarations when the file is loaded.  Running a sweep is
-:mod:`cpm_nlp.sweep`'s job."""
+`cpm_nlp.sweep`'s job."""
 
 from __future__ import annotations
 
@@ -37,10 +37,18 @@ SWEEPABLE = ("mechanism", "inputs", "solver")
 class Axis:
     """One swept value.
 
-    key: dotted key of the problem file; mode: "grid", "list" or "random";
-    values: the SI values of a grid or list; low, high, distribution: the
-    range of a random parameter; dimension: of a numeric value ("length",
-    "angle", ...), None for other values.
+    Attributes
+    ----------
+    key
+        dotted key of the problem file;
+    mode
+        "grid", "list" or "random";
+    values
+        the SI values of a grid or list;
+    low, high, distribution
+        the range of a random parameter;
+    dimension
+        of a numeric value ("length", "angle", ...), None for other values.
     """
 
     key: str

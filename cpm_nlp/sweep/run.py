@@ -29,8 +29,8 @@ mechanism's ``check_parameters``) are checked per point: a point that breaks
 one is recorded with status ``invalid_input`` and the message, like a
 point that does not solve.
 
-Running a sweep (:func:`run_sweep`, Dask) and its results files
-(:mod:`cpm_nlp.io.results`) build on this module; parsing needs neither
+Running a sweep (`run_sweep`, Dask) and its results files
+(`cpm_nlp.io.results`) build on this module; parsing needs neither
 Dask nor pyarrow.
 """
 
@@ -58,7 +58,7 @@ from ..problems.sweep_section import SweepSpec, override
 
 log = logging.getLogger(__name__)
 
-#: statuses a sweep records besides those of :class:`~cpm_nlp.core.result.Status`
+#: statuses a sweep records besides those of `Status`
 INVALID_INPUT = "invalid_input"  # the point's values break a rule of the problem (message says which)
 ERROR = "error"  # the point raised an internal error or killed its worker repeatedly (message says what)
 
@@ -70,9 +70,13 @@ ERROR = "error"  # the point raised an internal error or killed its worker repea
 class Job:
     """What a worker needs to solve points of a sweep (small; pickled per task).
 
-    data: the problem file without its ``sweep`` and ``reproduce`` sections
-    (solving them is what ``cpm-nlp solve`` does with the file); values: the
-    result values recorded for each point.
+    Attributes
+    ----------
+    data
+        the problem file without its ``sweep`` and ``reproduce`` sections (solving them is what
+        ``cpm-nlp solve`` does with the file);
+    values
+        the result values recorded for each point.
     """
 
     data: dict
@@ -132,7 +136,7 @@ def solve_points(job: Job, ids: Sequence[int]) -> dict[str, Any]:
 
 
 def job_of(problem: Any) -> Job:
-    """The :class:`Job` of a validated problem that has a sweep section."""
+    """The `Job` of a validated problem that has a sweep section."""
     if problem.sweep is None:
         raise InputError(
             "the file has no 'sweep' section; add one naming the values to sweep, e.g. "
@@ -187,11 +191,20 @@ def columns(job: Job) -> list[str]:
 
 @dataclass
 class SweepSummary:
-    """Outcome of :func:`run_sweep`.
+    """Outcome of `run_sweep`.
 
-    total: points of the sweep; statuses: status -> number of points in the
-    results file; solved_now: points solved in this run; seconds: wall time
-    of this run; workers: worker threads used (0 if nothing was left to do).
+    Attributes
+    ----------
+    total
+        points of the sweep;
+    statuses
+        status -> number of points in the results file;
+    solved_now
+        points solved in this run;
+    seconds
+        wall time of this run;
+    workers
+        worker threads used (0 if nothing was left to do).
     """
 
     output: str
@@ -345,15 +358,21 @@ def run_sweep(
 ) -> SweepSummary:
     """Solve every point of ``problem.sweep`` on Dask, streaming records to ``output``.
 
-    output: ``.parquet`` or ``.csv``.  If it already holds points of this
-    sweep, only the missing ones are solved (resume); a file of another sweep
-    is an :class:`InputError` unless ``overwrite``.
-    scheduler: address of an existing Dask scheduler (``tcp://host:port``);
-    client: an existing ``distributed.Client``; neither: a local cluster of
-    ``workers`` processes (default: one per core).
-    chunk_size: points per Dask task (default: adapted so a task takes about
-    half a second).
-    progress: called with (points done, total) as points finish.
+    Parameters
+    ----------
+    output
+        ``.parquet`` or ``.csv``.  If it already holds points of this sweep, only the missing
+        ones are solved (resume); a file of another sweep is an
+        [`InputError`][cpm_nlp.core.errors.InputError] unless ``overwrite``.
+    scheduler
+        address of an existing Dask scheduler (``tcp://host:port``);
+    client
+        an existing ``distributed.Client``; neither: a local cluster of ``workers`` processes
+        (default: one per core).
+    chunk_size
+        points per Dask task (default: adapted so a task takes about half a second).
+    progress
+        called with (points done, total) as points finish.
     """
     from ..io.results import open_store
 
@@ -418,7 +437,7 @@ def _execute(
 
 
 class _Scheduling:
-    """The state of the scheduling loop of :func:`_execute`: the points still to submit, the
+    """The state of the scheduling loop of `_execute`: the points still to submit, the
     chunks to retry one point at a time, the tasks in flight and the measured time per point."""
 
     def __init__(self, client: Any, job: Job, pending: list[int], store: Any, chunk_size: int | None) -> None:

@@ -4,13 +4,13 @@ A point t of the task coordinates belongs to the workspace when the mechanism
 assembles there on the branch the model designates and every actuator, pose
 coordinate and passive joint with declared limits lies within them:
 
-* :func:`membership` -- that test for many points at once (the closed-form
+* [`membership`][cpm_nlp.analysis.workspace.membership.membership] -- that test for many points at once (the closed-form
   IK of the model when it has one, with the limited quantities, residuals
   and Φ_x of all points in one mapped CasADi call; else the IK solved point
   by point);
-* :func:`probe_region` and :func:`sample_workspace` -- a box around the home
+* `probe_region` and [`sample_workspace`][cpm_nlp.analysis.workspace.sampling.sample_workspace] -- a box around the home
   pose found by probing along the task axes, and a seeded point cloud;
-* :func:`inscribed_cuboid` -- the largest axis-aligned box in the task
+* [`inscribed_cuboid`][cpm_nlp.analysis.workspace.cuboid.inscribed_cuboid] -- the largest axis-aligned box in the task
   coordinates inside the workspace, by IPOPT, seeded multi-start, verified
   afterwards on a dense sample of its faces, edges and interior.
 
@@ -23,7 +23,7 @@ actuators) with Φ(t_j, y_j) = 0 and the limits as bounds on the limited
 quantities; the objective is -Σ log w_i (the log of the volume).  With a
 closed-form IK the same NLP is solved without pose unknowns, the limited
 quantities being functions of the sample points through the IK, on working
-sets of its rows (:mod:`cpm_nlp.analysis.cuboid_ik`; ``formulation`` chooses).  The dense
+sets of its rows (`cpm_nlp.analysis.cuboid_ik`; ``formulation`` chooses).  The dense
 check afterwards finds any point of the box that is outside (between the
 samples, or a hole inside); its worst points become extra samples and the
 NLP is solved again (an exchange method), a few rounds at most.  If points
@@ -34,10 +34,10 @@ The image of the actuator-stroke box under the forward kinematics (the
 "hexahedron" of prc3-li-2018.md, eq 27, Fig. 5) is a second view of the same
 set when the strokes are the binding limits:
 
-* :func:`reachable_workspace` -- FK on a grid over the box (faces included),
+* `reachable_workspace` -- FK on a grid over the box (faces included),
   the vertices, the axis-aligned bounding box, the volume, and how far the
   kinematics strays from its linearization at home over the workspace;
-* :func:`joint_box` -- the actuator strokes of a model.
+* `joint_box` -- the actuator strokes of a model.
 """
 
 from __future__ import annotations

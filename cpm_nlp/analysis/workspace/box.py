@@ -20,7 +20,7 @@ from ..requirements import full_factorial
 log = logging.getLogger(__name__)
 
 #: FK statuses of an actuator value where no pose was found: taken as not assembling
-#: (see :func:`_partial`); any other failure (a branch change, a singularity) is reported as such
+#: (see `_partial`); any other failure (a branch change, a singularity) is reported as such
 NOT_ASSEMBLED = (Status.NOT_CONVERGED, Status.INFEASIBLE)
 
 # -- the image of the actuator-stroke box (FK) ----------------------------------------------------
@@ -28,7 +28,7 @@ NOT_ASSEMBLED = (Status.NOT_CONVERGED, Status.INFEASIBLE)
 
 def joint_box(model: Model) -> tuple[np.ndarray, np.ndarray]:
     """(low, high) of every actuator from the model's limits; an
-    :class:`InputError` naming the missing ``mechanism.limits`` key if one has none."""
+    [`InputError`][cpm_nlp.core.errors.InputError] naming the missing ``mechanism.limits`` key if one has none."""
     c = model.closure
     missing = [q for q in c.q if model.limit_of(q) is None]
     if missing:
@@ -51,7 +51,7 @@ def box_grid(low: Sequence[float], high: Sequence[float], count: int) -> np.ndar
 
 
 def box_corners(low: Sequence[float], high: Sequence[float]) -> np.ndarray:
-    """The 2^n corners of a box, in the order of :func:`box_grid` with count 2."""
+    """The 2^n corners of a box, in the order of `box_grid` with count 2."""
     return box_grid(low, high, 2)
 
 
@@ -70,22 +70,31 @@ def gauss_box(low: Sequence[float], high: Sequence[float], order: int) -> tuple[
 class WorkspaceReport:
     """The reachable workspace (task coordinates, SI).
 
-    q, t: the grid over the stroke box and its images, shape (N, nq) (rows of
-    t are NaN where FK failed); solutions: the FK of every grid point.
-    vertices: images of the box corners, shape (2^nq, nq).
-    lower, upper: axis-aligned bounding box of the grid images.
-    volume: the integral of |det(dt/dq)| over the box (Gauss-Legendre), i.e.
-    the volume of the workspace if FK is one-to-one on the box, which holds
-    when det(dt/dq) keeps its sign (checked at every grid and quadrature point).
-    linear_volume: |det J_task(home)| times the volume of the stroke box: the
-    volume of the linearized workspace (for the 3-PRC the cube (A2 q_max)^3
-    of eq 26).
-    jacobian_deviation: the largest entry of |J_inv - J_inv(home)| over the
-    grid, each column scaled by its largest entry at home (dimensionless;
-    zero for a linear mechanism).
-    linear_error: per task coordinate, the largest |t - t_lin| over the grid,
-    t_lin = t_home + J_task(home) (q - q_home) the linearization at home.
-    None (or empty) unless ``status`` is solved.
+    Attributes
+    ----------
+    q, t
+        the grid over the stroke box and its images, shape (N, nq) (rows of t are NaN where FK
+        failed);
+    solutions
+        the FK of every grid point.
+    vertices
+        images of the box corners, shape (2^nq, nq).
+    lower, upper
+        axis-aligned bounding box of the grid images.
+    volume
+        the integral of |det(dt/dq)| over the box (Gauss-Legendre), i.e. the volume of the
+        workspace if FK is one-to-one on the box, which holds when det(dt/dq) keeps its sign
+        (checked at every grid and quadrature point).
+    linear_volume
+        |det J_task(home)| times the volume of the stroke box: the volume of the linearized
+        workspace (for the 3-PRC the cube (A2 q_max)^3 of eq 26).
+    jacobian_deviation
+        the largest entry of |J_inv - J_inv(home)| over the grid, each column scaled by its
+        largest entry at home (dimensionless; zero for a linear mechanism).
+    linear_error
+        per task coordinate, the largest |t - t_lin| over the grid, t_lin = t_home +
+        J_task(home) (q - q_home) the linearization at home. None (or empty) unless ``status``
+        is solved.
     """
 
     q: np.ndarray
@@ -113,8 +122,8 @@ def reachable_workspace(
     model: Model, samples: int = 11, quadrature: int = 4, solver: SolverConfig | None = None
 ) -> WorkspaceReport:
     """Sample the reachable workspace: FK on a ``samples``^nq grid over the
-    stroke box (:func:`joint_box`), and the volume by ``quadrature``^nq
-    Gauss-Legendre points (see :class:`WorkspaceReport`)."""
+    stroke box (`joint_box`), and the volume by ``quadrature``^nq
+    Gauss-Legendre points (see `WorkspaceReport`)."""
     config = solver or SolverConfig()
     c = model.closure
     t0 = time.perf_counter()

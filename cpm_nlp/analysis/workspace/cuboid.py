@@ -1,5 +1,5 @@
 """The largest axis-aligned box in the task coordinates inside the workspace (see
-:mod:`cpm_nlp.analysis.workspace`)."""
+`cpm_nlp.analysis.workspace`)."""
 
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ ADDED_PER_ROUND = 4
 
 @functools.lru_cache(maxsize=32)
 def _grid(d: int, n: int, interior: int | None) -> np.ndarray:
-    """:func:`surface_grid` (interior None) or :func:`check_grid`, computed once (read-only)."""
+    """`surface_grid` (interior None) or `check_grid`, computed once (read-only)."""
     g = np.linspace(0.0, 1.0, n)
     pts = np.array(list(itertools.product(g, repeat=d)))
     pts = pts[np.any((pts == 0.0) | (pts == 1.0), axis=1)]
@@ -79,7 +79,7 @@ MAX_CHECK_POINTS = 200_000
 
 
 def surface_count(d: int, n: int) -> int:
-    """Points of :func:`surface_grid` (d, n): n^d - (n - 2)^d."""
+    """Points of `surface_grid` (d, n): n^d - (n - 2)^d."""
     return n**d - max(n - 2, 0) ** d
 
 
@@ -95,7 +95,7 @@ def default_per_edge(d: int, largest: int, budget: int) -> int:
 
 def check_interior(d: int) -> int:
     """Interior points per edge of the membership check: 5, fewer where 5^d would pass
-    :data:`DEFAULT_CHECK_POINTS`."""
+    `DEFAULT_CHECK_POINTS`."""
     n = 5
     while n > 1 and n**d > DEFAULT_CHECK_POINTS:
         n -= 1
@@ -126,7 +126,7 @@ CHECK_OPTION = check_per_edge_option(17)
 def check_grid(d: int, per_edge: int, interior: int | None = None) -> np.ndarray:
     """Dense check sample of the unit box: its surface on a grid of ``per_edge``
     points per edge, plus the interior points of a grid of ``interior + 2``
-    (default: :func:`check_interior`)."""
+    (default: `check_interior`)."""
     return _grid(d, per_edge, check_interior(d) if interior is None else interior).copy()
 
 
@@ -219,7 +219,8 @@ class CuboidCheck:
 def check_box(
     model: Model, lower, upper, per_edge: int | None = None, solver: SolverConfig | None = None
 ) -> tuple[CuboidCheck, np.ndarray, Membership]:
-    """Check a box against :func:`membership` on :func:`check_grid`; also returns
+    """Check a box against [`membership`][cpm_nlp.analysis.workspace.membership.membership] on `check_grid`; also
+    returns
     the unit-box positions checked and the membership report."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     S = check_grid(lower.size, check_per_edge_of(lower.size, per_edge))
@@ -232,11 +233,22 @@ def check_box(
 class CuboidResult:
     """The largest box found, with how it was found and checked.
 
-    lower, upper: corners in the task coordinates (SI); None unless ``found``.
-    starts: number of starts; converged: how many converged; agreed: how
-    many converged to the best volume (within AGREEMENT); refinements:
-    exchange rounds used; shrink: factor applied about the centre after
-    them (1 = none); check: the dense membership check of the reported box.
+    Attributes
+    ----------
+    lower, upper
+        corners in the task coordinates (SI); None unless ``found``.
+    starts
+        number of starts;
+    converged
+        how many converged;
+    agreed
+        how many converged to the best volume (within AGREEMENT);
+    refinements
+        exchange rounds used;
+    shrink
+        factor applied about the centre after them (1 = none);
+    check
+        the dense membership check of the reported box.
     """
 
     found: bool
@@ -285,7 +297,7 @@ def _layout(nlp: CuboidNLP, model: Model, S: np.ndarray, centre, size):
 
 class _PoseCuboid:
     """The general cuboid NLP (pose unknowns y_j with Φ(t_j, y_j) = 0 at every sample,
-    see :class:`CuboidNLP`), with EXTRA_SLOTS sample slots for the exchange rounds."""
+    see `CuboidNLP`), with EXTRA_SLOTS sample slots for the exchange rounds."""
 
     def __init__(self, model: Model, config: SolverConfig, base: np.ndarray, centre, size):
         d = model.closure.nq
@@ -319,7 +331,7 @@ class _PoseCuboid:
 def _closed_form_cuboid(
     model: Model, config: SolverConfig, base: np.ndarray, centre, size, cloud: Membership
 ) -> ClosedFormCuboid:
-    """The working-set NLP through the closed-form IK (:mod:`cpm_nlp.analysis.cuboid_ik`)."""
+    """The working-set NLP through the closed-form IK (`cpm_nlp.analysis.cuboid_ik`)."""
     fn, names = limited_function(model.closure)
     lo, hi = limit_bounds(model)
     rows = tuple(int(r) for r in np.flatnonzero(np.isfinite(lo) | np.isfinite(hi)))
@@ -348,7 +360,7 @@ def _start_box(model: Model, t_c: np.ndarray, S: np.ndarray, centre, size, confi
 
 
 def _start_boxes(model: Model, seeds: list, S: np.ndarray, centre, size, config: SolverConfig) -> list:
-    """:func:`_start_box` of every seed; with a closed-form IK the poses of all seeds'
+    """`_start_box` of every seed; with a closed-form IK the poses of all seeds'
     samples in one call per shrink step (the same boxes)."""
     if model.closure.ik is None:
         return [_start_box(model, t_c, S, centre, size, config) for t_c in seeds]
@@ -378,7 +390,7 @@ def _start_boxes(model: Model, seeds: list, S: np.ndarray, centre, size, config:
 class CuboidFormulation:
     """How the cuboid NLP is written (both ways solve the same NLP): ``poses``, pose unknowns
     at every sample (any mechanism); ``closed_form``, the limited quantities through the
-    mechanism's closed-form IK (:mod:`cpm_nlp.analysis.cuboid_ik`); ``auto``, the closed form
+    mechanism's closed-form IK (`cpm_nlp.analysis.cuboid_ik`); ``auto``, the closed form
     where the mechanism has one and every point of the cloud drawn for the starts assembles
     (where the IK's reach margin bounds the workspace its derivatives grow without bound, and
     IPOPT converges there less reliably than with pose unknowns).
@@ -391,7 +403,7 @@ class CuboidFormulation:
     through_ik: bool | None
 
     def check(self, model: Model) -> None:
-        """Raise :class:`InputError` if the formulation cannot be used for ``model``."""
+        """Raise [`InputError`][cpm_nlp.core.errors.InputError] if the formulation cannot be used for ``model``."""
         if self.through_ik and model.closure.ik is None:
             raise InputError(
                 f"the {self.name} cuboid formulation needs a closed-form IK; {model.name} has none (use 'poses')",
@@ -417,7 +429,7 @@ FORMULATIONS: Mapping[str, CuboidFormulation] = MappingProxyType(
 
 
 def cuboid_formulation(formulation: str | CuboidFormulation) -> CuboidFormulation:
-    """A formulation by its name in :data:`FORMULATIONS` (or as given), with "did you mean"."""
+    """A formulation by its name in `FORMULATIONS` (or as given), with "did you mean"."""
     if isinstance(formulation, CuboidFormulation):
         return formulation
     if formulation not in FORMULATIONS:
@@ -482,7 +494,7 @@ def _exchange_rounds(
 ) -> tuple[np.ndarray, CuboidCheck, int, int]:
     """The exchange method: while the box fails its dense check, its worst outside points
     join the NLP's samples and it is solved again (at most ``rounds`` rounds and
-    :data:`EXTRA_SLOTS` points); the last solution, its check, the rounds and iterations."""
+    `EXTRA_SLOTS` points); the last solution, its check, the rounds and iterations."""
     centre, size = frame
     d = model.closure.nq
 
@@ -551,13 +563,22 @@ def inscribed_cuboid(
     """The largest axis-aligned box in the task coordinates inside the reachable
     workspace (see the module docstring for the method).
 
-    starts: IPOPT starts (the first at the home pose, the others at points of
-    a seeded point cloud of ``region``); samples_per_edge: the NLP's surface
-    grid (default 5, fewer in more than 3 task coordinates, see :func:`default_per_edge`);
-    check_per_edge: the dense check's surface grid (:func:`check_per_edge_of`); refinements: the
-    largest number of exchange rounds; region: the box the starts are drawn
-    from (default: probed around home); formulation: a :class:`CuboidFormulation` or its
-    name in :data:`FORMULATIONS` ("auto", "closed_form", "poses").
+    Parameters
+    ----------
+    starts
+        IPOPT starts (the first at the home pose, the others at points of a seeded point cloud
+        of ``region``);
+    samples_per_edge
+        the NLP's surface grid (default 5, fewer in more than 3 task coordinates, see
+        `default_per_edge`);
+    check_per_edge
+        the dense check's surface grid (`check_per_edge_of`);
+    refinements
+        the largest number of exchange rounds;
+    region
+        the box the starts are drawn from (default: probed around home);
+    formulation
+        a `CuboidFormulation` or its name in `FORMULATIONS` ("auto", "closed_form", "poses").
     """
     form = cuboid_formulation(formulation)
     form.check(model)

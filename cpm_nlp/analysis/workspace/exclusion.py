@@ -1,17 +1,17 @@
 """A proof that a task point is outside the workspace of a mechanism without a closed-form IK.
 
 A point t is inside when some pose y = (dependent pose coordinates, actuators) in the
-box of the unknowns (:func:`~cpm_nlp.analysis.workspace.point_ik.unknown_box`: the
+box of the unknowns (`unknown_box`: the
 actuator strokes, the declared pose limits and the closure's bounds) satisfies
 Φ(t, y) = 0 with every limited quantity within its limits and every branch indicator
 >= 0 (all to the membership tolerance).  The proof covers the whole box by branch and
 bound: a sub-box is excluded when the interval enclosure
-(:class:`~cpm_nlp.analysis.intervals.IntervalProgram`, outward rounding) of one
+(`IntervalProgram`, outward rounding) of one
 closure row does not contain 0, or that of one limited quantity lies wholly beyond
 its limit; a sub-box not excluded is split in two along the unknown with the largest
 width × Σ|∂Φ/∂y| at its centre over the rows not yet excluded.  The point is proven
 outside when no sub-box is left; the search gives up (no proof) beyond
-:data:`PROOF_BOXES` live sub-boxes or :data:`PROOF_ROUNDS` rounds.  All points are
+`PROOF_BOXES` live sub-boxes or `PROOF_ROUNDS` rounds.  All points are
 searched together, one vectorised interval evaluation per round; each point's search
 depends on that point alone.  A box with an unbounded side is never proven.
 """

@@ -68,11 +68,19 @@ def limit_bounds(model: Model) -> tuple[np.ndarray, np.ndarray]:
 class Membership:
     """Membership of N task points.
 
-    inside: bool (N,); margin: (N,) the worst signed margin (SI, of the
-    quantity named in ``binding``; >= -CHECK_TOLERANCE inside; -inf where the
-    mechanism does not assemble, is singular or the point is undecided); X (N, nx),
-    Q (N, nq): the poses (NaN where none was found); status: per point "inside",
-    "outside" or "undecided" (no pose on the designated branch found; not inside).
+    Attributes
+    ----------
+    inside
+        bool (N,);
+    margin
+        (N,) the worst signed margin (SI, of the quantity named in ``binding``; >=
+        -CHECK_TOLERANCE inside; -inf where the mechanism does not assemble, is singular or the
+        point is undecided); X (N, nx),
+    Q
+        (N, nq) the poses (NaN where none was found);
+    status
+        per point "inside", "outside" or "undecided" (no pose on the designated branch found;
+        not inside).
     """
 
     inside: np.ndarray
@@ -108,7 +116,7 @@ TASK_POINT_KEY = ("workspace", "task_point")
 def _pose_values(c: LoopClosure, x, q, p) -> list:
     """Symbolic values the membership test needs at a pose: the limited
     quantities, the loop-closure residuals and the matrix whose condition number
-    decides a singularity, :attr:`LoopClosure.cond_matrix` (dense, column-major;
+    decides a singularity, `LoopClosure.cond_matrix` (dense, column-major;
     Φ_x, or for normal equations the Jacobian of every closure equation, whose
     rows then join the residuals), common subexpressions shared."""
     fn, _names = limited_function(c)
@@ -118,7 +126,7 @@ def _pose_values(c: LoopClosure, x, q, p) -> list:
 
 def pose_check_function(closure: LoopClosure) -> ca.Function:
     """``<name>_pose_values: (x, q, p) -> (v, phi, phi_x)`` (built once per mechanism type; see
-    :func:`_pose_values`: for normal equations ``phi`` also holds every closure equation and
+    `_pose_values`: for normal equations ``phi`` also holds every closure equation and
     ``phi_x`` is their Jacobian)."""
 
     def build() -> ca.Function:
@@ -133,7 +141,7 @@ def pose_check_function(closure: LoopClosure) -> ca.Function:
 
 def task_point_function(closure: LoopClosure) -> ca.Function:
     """``<name>_task_point: (t, p) -> (x, q, reach, v, phi, phi_x)``: the closed-form
-    IK at a task point and the values of :func:`pose_check_function` there (one
+    IK at a task point and the values of `pose_check_function` there (one
     flat SX graph, built once per mechanism type)."""
 
     def build() -> ca.Function:
@@ -278,7 +286,7 @@ def _decide(points: _Points, model, T, todo: np.ndarray, Y: np.ndarray, j: _Judg
 
 
 def _solved_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float) -> _Points:
-    """Every point from its own start set (:mod:`.point_ik`), never from another point."""
+    """Every point from its own start set (`point_ik`), never from another point."""
     c = model.closure
     N = T.shape[0]
     starts = start_set(model, T)
@@ -341,7 +349,7 @@ def poses(model: Model, T: np.ndarray, solver: SolverConfig | None = None) -> tu
     designated branch (inside or outside the limits).
 
     With a closed-form IK all points are evaluated at once (one mapped CasADi call);
-    otherwise each point's IK is solved from its own start set (:mod:`.point_ik`).
+    otherwise each point's IK is solved from its own start set (`point_ik`).
     """
     got = _points(model, T, solver, CHECK_TOLERANCE)
     ok = np.all(np.isfinite(got.X), axis=1) & np.all(np.isfinite(got.Q), axis=1)
@@ -350,7 +358,7 @@ def poses(model: Model, T: np.ndarray, solver: SolverConfig | None = None) -> tu
 
 def condition_numbers(PX: np.ndarray) -> np.ndarray:
     """2-norm condition numbers of N square matrices (N, n, n), computed by SVD only
-    where they may reach :data:`SINGULAR_CONDITION`; elsewhere the returned value is the
+    where they may reach `SINGULAR_CONDITION`; elsewhere the returned value is the
     upper bound κ₂ ≤ ‖A‖_F ‖A⁻¹‖_F (σ_max ≤ ‖A‖_F and 1/σ_min = ‖A⁻¹‖₂ ≤ ‖A⁻¹‖_F; at
     most n κ₂) from one batched inverse (about 40 % of the cost of the SVD), below half
     the threshold, so the verdict is the same (there the computed inverse is accurate to

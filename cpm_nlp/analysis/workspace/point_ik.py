@@ -7,8 +7,8 @@ model alone (never of another point or of the order of the points):
 
 1. the linearisation at home, y_home + (dy/dt)(home) (t - t_home);
 2. home, y_home;
-3. :data:`HALTON_STARTS` points of the unlimited Halton sequence (bases 2, 3, 5, ...,
-   unscrambled) in the box of the unknowns (:func:`unknown_box`: the actuator strokes,
+3. `HALTON_STARTS` points of the unlimited Halton sequence (bases 2, 3, 5, ...,
+   unscrambled) in the box of the unknowns (`unknown_box`: the actuator strokes,
    the declared pose limits and the closure's bounds; home ± a span where nothing bounds a
    coordinate).
 
@@ -21,7 +21,7 @@ the unknowns as bounds (the actuator strokes among them), from each start in tur
 
 Each converged pose is reduced (angles by whole turns, to the turn nearest the middle
 of the box, kept only if Φ still vanishes there) and judged by
-:func:`cpm_nlp.analysis.workspace.membership.judge`; the caller takes a point's first
+`cpm_nlp.analysis.workspace.membership.judge`; the caller takes a point's first
 witness in the order of its start set.
 """
 

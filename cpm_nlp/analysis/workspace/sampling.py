@@ -17,7 +17,7 @@ log = logging.getLogger(__name__)
 # -- sampling ------------------------------------------------------------------------------------
 
 
-#: bisection steps of :func:`probe_region` along each direction
+#: bisection steps of `probe_region` along each direction
 PROBE_BISECTIONS = 40
 #: bisection levels decided per membership call (membership is one vectorised call, each
 #: point decided on its own): the 2^k - 1 midpoints of the next k levels are tested at once
@@ -26,7 +26,7 @@ PROBE_LEVELS = 4
 
 def _double(model: Model, solver: SolverConfig | None, t0: np.ndarray, dirs: np.ndarray) -> tuple:
     """Along each direction, the last doubling step inside and the first outside (1e4 where
-    none is): every step of the doubling tested in one call where :data:`PROBE_LEVELS` > 1."""
+    none is): every step of the doubling tested in one call where `PROBE_LEVELS` > 1."""
     d = t0.size
     inside_step = np.zeros(len(dirs))
     outside_step = np.full(len(dirs), np.nan)
@@ -83,7 +83,7 @@ def probe_region(
     is outside.
 
     The steps of the doubling are tested in one call and the bisection decides
-    :data:`PROBE_LEVELS` levels per call (all midpoints those levels could visit);
+    `PROBE_LEVELS` levels per call (all midpoints those levels could visit);
     the result is the same as one level per call.
     """
     t0 = model.task_of(model.x_home) if centre is None else np.asarray(centre, dtype=float)
@@ -106,12 +106,22 @@ def probe_region(
 class Cloud:
     """A seeded point cloud of the workspace.
 
-    points: the points inside (M, nq); region: the box they were drawn from (None if
-    the home pose is outside and no region was given); drawn, inside, undecided:
-    counts; volume: the Monte-Carlo estimate (region volume × inside / drawn), with its
-    standard error ``volume_error``;
-    volume_upper: the same with the undecided points counted inside (equal to
-    ``volume`` when none is undecided); undecided_points: those points (U, nq).
+    Attributes
+    ----------
+    points
+        the points inside (M, nq);
+    region
+        the box they were drawn from (None if the home pose is outside and no region was given);
+    drawn, inside, undecided
+        counts;
+    volume
+        the Monte-Carlo estimate (region volume × inside / drawn), with its standard error
+        ``volume_error``;
+    volume_upper
+        the same with the undecided points counted inside (equal to ``volume`` when none is
+        undecided);
+    undecided_points
+        those points (U, nq).
     """
 
     points: np.ndarray
@@ -140,8 +150,9 @@ def workspace_cloud(
     region: tuple[np.ndarray, np.ndarray] | None = None,
     solver: SolverConfig | None = None,
 ) -> Cloud:
-    """``count`` points drawn uniformly in ``region`` (default: :func:`probe_region`)
-    with a seeded generator, each decided by :func:`membership` (see :class:`Cloud`)."""
+    """``count`` points drawn uniformly in ``region`` (default: `probe_region`)
+    with a seeded generator, each decided by [`membership`][cpm_nlp.analysis.workspace.membership.membership] (see
+    `Cloud`)."""
     nq = model.closure.nq
     if region is None:
         region = probe_region(model, solver)
@@ -174,8 +185,8 @@ def sample_workspace(
     solver: SolverConfig | None = None,
 ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray] | None, float]:
     """A seeded point cloud of the workspace: ``count`` points drawn uniformly
-    in ``region`` (default: :func:`probe_region`), those inside kept.  Returns
+    in ``region`` (default: `probe_region`), those inside kept.  Returns
     (points inside (M, nq), the region, the Monte-Carlo volume estimate); see
-    :func:`workspace_cloud` for the counts of undecided points."""
+    `workspace_cloud` for the counts of undecided points."""
     cloud = workspace_cloud(model, count, seed, region, solver)
     return cloud.points, cloud.region, cloud.volume

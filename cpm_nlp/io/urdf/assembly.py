@@ -22,7 +22,7 @@ def _dof(kind: str) -> int:
 
 
 def _rot(axis: Any, angle: Any) -> ca.SX:
-    """Rodrigues: the rotation by ``angle`` about the unit ``axis`` (:func:`~cpm_nlp.core.screws.axis_rotation`)."""
+    """Rodrigues: the rotation by ``angle`` about the unit ``axis`` (`axis_rotation`)."""
     return ca.SX(axis_rotation(ca.SX(ca.DM(np.asarray(axis, dtype=float).reshape(3, 1))), angle))
 
 

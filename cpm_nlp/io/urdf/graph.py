@@ -213,7 +213,7 @@ class _Builder:
             )
 
     def link_of(self, name: str, path: tuple) -> str:
-        """The link of a sidecar frame name (:func:`frame_link`)."""
+        """The link of a sidecar frame name (`frame_link`)."""
         return frame_link(name, self.links, self.by_name, self.side, path)
 
     def bodies(self, order: list[str]) -> None:

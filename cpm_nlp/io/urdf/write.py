@@ -70,7 +70,7 @@ def mechanism_name(raw: str) -> str:
 @dataclass(frozen=True)
 class Layout:
     """How a graph is written: in the plane of ``basis`` (e1, e2, n; None: spatial), numbers
-    below :data:`ZERO` times ``scale`` written as 0."""
+    below `ZERO` times ``scale`` written as 0."""
 
     basis: np.ndarray | None
     scale: float

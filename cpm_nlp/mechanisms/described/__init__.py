@@ -1,9 +1,9 @@
 """Mechanisms described in files (or built in code from the same dataclasses).
 
-:func:`load_file` reads a mechanism file, :func:`from_dict` a parsed mapping
-(inline under ``mechanism:`` in a problem file) and :func:`mechanism` a
-:class:`~.spec.Description` built in code; each returns a
-:class:`~cpm_nlp.core.mechanism.Mechanism` with its symbolic closure, ready to
+`load_file` reads a mechanism file, `from_dict` a parsed mapping
+(inline under ``mechanism:`` in a problem file) and `mechanism` a
+[`Description`][cpm_nlp.mechanisms.described.spec.Description] built in code; each returns a
+[`Mechanism`][cpm_nlp.core.mechanism.Mechanism] with its symbolic closure, ready to
 register.  A description is generated once per content (SHA-256 of the file's
 text, or of the description) and kept in memory; compiled kernels are cached
 on disk by their source like the built-ins'.
@@ -75,7 +75,7 @@ def shipped_files() -> list[Path]:
 def load_file(path: str | Path, *, allow_pipe: bool = False) -> Mechanism:
     """The mechanism a file describes (errors name the file and the key path).
 
-    The file is read once, through :func:`cpm_nlp.io.inputs.read_input_text`
+    The file is read once, through `cpm_nlp.io.inputs.read_input_text`
     (its type and size checked before it is opened); ``allow_pipe``: a file
     named on the command line may be ``-`` or a pipe."""
     return load_file_description(path, allow_pipe=allow_pipe)[0]
@@ -104,7 +104,7 @@ def same_text(a: Mechanism, b: Mechanism) -> bool:
 
 def with_same_text(mech: Mechanism, read: Mechanism) -> Mechanism:
     """``mech`` (a mechanism made from ``read``, e.g. with an add-on) counted as read from the
-    same text as ``read``, for :func:`same_text`."""
+    same text as ``read``, for `same_text`."""
     with _LOCK:
         if id(read) in _TEXT_HASH:
             _TEXT_HASH[id(mech)] = _TEXT_HASH[id(read)]
@@ -132,7 +132,7 @@ def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = Non
 
 
 def mechanism(d: Description, *, base_dir: Path | None = None) -> Mechanism:
-    """A :class:`Mechanism` from a description built in code or read from a file."""
+    """A [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] from a description built in code or read from a file."""
     try:
         return _mechanism(d, base_dir)
     except InputError as exc:

@@ -1,6 +1,6 @@
 """The reference configuration of a graph of bodies and joints, assembled from its drawing:
 Gauss-Newton on the loops with the actuators at their ``home`` values, for any parameter
-values; at the parameters' defaults, the loop rows independent there (:mod:`.mobility`) and
+values; at the parameters' defaults, the loop rows independent there (`mobility`) and
 the signs the branch indicators take there."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ class Assembler:
 
     ``assembler(p) -> (x_home, q_home)``: Gauss-Newton (minimum-norm steps, halved until the
     residual falls) on every loop row and the platform rows, from the drawing, with the actuators
-    at their drawing values; an :class:`InputError` when it does not assemble."""
+    at their drawing values; an [`InputError`][cpm_nlp.core.errors.InputError] when it does not assemble."""
 
     def __init__(self, gen: Any, q: ca.SX, span: ca.SX) -> None:
         self.gen = gen

@@ -34,7 +34,7 @@ WORKING_P = "working mode: e·(B - c) of the P joint before it (axis e) and the 
 
 
 def elimination_indicators(gen: ClosureBuilder, q: ca.SX) -> None:
-    """The indicator of each eliminated link (recorded by :meth:`.generate.Generator.eliminated`), a mode invariant.
+    """The indicator of each eliminated link (recorded by `generate.Generator.eliminated`), a mode invariant.
 
     If the link's rows make a diagonal block of Φ_x (block-triangular form, Dulmage-Mendelsohn)
     holding no other elimination, the link closes a sub-chain of its own (a four-bar's coupler
@@ -136,7 +136,7 @@ def select_branch(gen: ClosureBuilder, added: list[tuple[ca.SX, str, str]]) -> N
 
 
 def aspect(gen: ClosureBuilder, q: ca.SX) -> None:
-    """The aspect indicator (:mod:`cpm_nlp.core.aspect`): negative in an assembly mode across a
+    """The aspect indicator (`cpm_nlp.core.aspect`): negative in an assembly mode across a
     forward singularity from the reference configuration."""
     if gen.x.numel() > ASPECT_MAX_NX:
         return
@@ -146,7 +146,7 @@ def aspect(gen: ClosureBuilder, q: ca.SX) -> None:
 
 
 def graph_indicators(gen: Any, q: ca.SX) -> None:
-    """A graph's indicators (``gen``: its :class:`~.graph.GraphGenerator`): one indicator per
+    """A graph's indicators (``gen``: its `GraphGenerator`): one indicator per
     diagonal block of Φ_x (block-triangular form) that holds loop rows: the sign of the block's
     determinant is the assembly mode of the loops it holds; it is taken as the reference
     configuration's, and scaled by the determinant's size at the drawing."""

@@ -1,5 +1,5 @@
-"""What every generator of a loop closure shares (the legs' :class:`~.generate.Generator`, the
-graph's :class:`~.graph.GraphGenerator`): the parameters and derived values, expressions read
+"""What every generator of a loop closure shares (the legs' `Generator`, the
+graph's `GraphGenerator`): the parameters and derived values, expressions read
 in an environment of symbols, the platform's pose coordinates, the actuators, the joint values
 made unknowns or reported, their names and their limits (the declared joint-limit options)."""
 

@@ -1,4 +1,4 @@
-"""The legs of a described mechanism as serial chains (:class:`~cpm_nlp.core.chains.Chains`),
+"""The legs of a described mechanism as serial chains (`Chains`),
 the ``chains`` capability the six-axis hinge model needs.
 
 The description already gives each leg as a chain at the reference

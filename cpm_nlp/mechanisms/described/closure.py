@@ -1,8 +1,8 @@
-"""The closure of a description: its generator -- the legs' (:class:`~.generate.Generator`,
-each leg's passive joints eliminated) or the graph's (:class:`~.graph.GraphGenerator`, a
+"""The closure of a description: its generator -- the legs' (`Generator`,
+each leg's passive joints eliminated) or the graph's (`GraphGenerator`, a
 mixed file's legs expanded into bodies and joints) -- and the functions it built; a legs file
 whose drawing need not close gets its reference configuration by the assembly of the graph
-its legs expand into (:class:`LegsAssembler`)."""
+its legs expand into (`LegsAssembler`)."""
 
 from __future__ import annotations
 
@@ -18,10 +18,10 @@ from .spec import Description
 
 
 def closure_parts(d: Description) -> tuple[ClosureBuilder, dict[str, Any]]:
-    """The generator of a description -- its legs (:class:`Generator`) or its bodies and joints
-    (:class:`GraphGenerator`) -- and the functions it built.  A legs file whose drawing need not
-    close (:func:`assembled_from_drawing`) gets its reference configuration by the assembly of
-    the graph its legs expand into (:class:`LegsAssembler`); its closures stay the legs'."""
+    """The generator of a description -- its legs (`Generator`) or its bodies and joints
+    (`GraphGenerator`) -- and the functions it built.  A legs file whose drawing need not
+    close (`assembled_from_drawing`) gets its reference configuration by the assembly of
+    the graph its legs expand into (`LegsAssembler`); its closures stay the legs'."""
     if d.is_graph:
         # the graph's generator and its assembly are imported for a graph file only: a legs
         # file (the 3-PRS) never loads them (issue 23, start-up)
@@ -49,8 +49,8 @@ def assembled_from_drawing(d: Description) -> bool:
 
 
 class LegsAssembler:
-    """The reference configuration of a legs file from a rough drawing: the :class:`.assembly.Assembler` of
-    the graph its legs expand into (:func:`.expand.expand_legs`; Gauss-Newton on its loops with the
+    """The reference configuration of a legs file from a rough drawing: the `assembly.Assembler` of
+    the graph its legs expand into (`expand.expand_legs`; Gauss-Newton on its loops with the
     actuators at their drawn values), its pose coordinates read by name into the legs' (the
     platform's, then each proximal chain's passive joints')."""
 

@@ -6,7 +6,7 @@ The generator locates every joint of every leg at a pose symbolically (the
 by the joints before them, the eliminated joint by the whole proximal chain, a
 passive P along the leg at its reference distance from there, and the last
 joint where the platform puts it.  This module turns those points into a
-:class:`~cpm_nlp.core.mechanism.Drawing`: the base through the legs' first
+`Drawing`: the base through the legs' first
 joints, each leg's joints and links, the platform through the legs' last joints.
 """
 
@@ -159,7 +159,7 @@ def _strokes(pts: dict, strokes: list[tuple[str, str]], tol: float) -> list[tupl
 
 
 def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any], Drawing]:
-    """The ``geometry`` capability of a graph (``gen``: its :class:`~.graph.GraphGenerator`; ``fn``:
+    """The ``geometry`` capability of a graph (``gen``: its `GraphGenerator`; ``fn``:
     its ``drawing_points`` of (x, q, p), ``layout`` the body and name of each point): every body's
     points, each body a segment (two points) or a face (three or more); the ground as the base,
     the platform body as the platform."""
@@ -219,7 +219,7 @@ def graph_geometry(fn: Any, layout: list, gen: Any) -> Callable[[Any, Any, Any],
 
 
 def graph_drawing_points(gen: Any, q: Any) -> tuple[Any, list]:
-    """A graph's drawing (``gen``: its :class:`~.graph.GraphGenerator`): every body's points at
+    """A graph's drawing (``gen``: its `GraphGenerator`): every body's points at
     the pose (x, q, p), and what to draw: the layout."""
     # a point name on several bodies is one drawn point where a joint keeps them together
     # (R, U, S, planar R at that point); across a P or C joint, or unjoined, a point of its own

@@ -13,12 +13,12 @@ an RRR dyad):
 with the branch sign s = sign(e⊥·(x - o1)) at the reference configuration (the file's assembly
 mode), an expression of the parameters.  h² < 0: the circles do not meet (the pose is out of
 reach); a guess x0 with s e⊥·(x0 - o1) <= 0 lies in the other assembly (Newton from it seeks that
-one).  The kernel (:func:`cpm_nlp.core.kernels.fk_kernel`) then leaves the pose to Newton, whose
+one).  The kernel (`cpm_nlp.core.kernels.fk_kernel`) then leaves the pose to Newton, whose
 status it reports, so the closed form never answers with a number for a pose it cannot assemble.
 
 An actuated P between two point joints (an R-P-R leg: |B - c| = r + s) is a circle of radius
 r + s(q): the same intersection.  Files of bodies and joints have their own decomposition into
-dyads (RRR, RRP, RPR; :mod:`.graph_dyads`).
+dyads (RRR, RRP, RPR; `graph_dyads`).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Legs as a shorthand: a legs file expanded into the bodies and joints it stands for (issue 21).
 
-:func:`expand_legs` turns a :class:`~.spec.Description` with ``legs`` into the equivalent
-description of bodies and joints, read by :class:`~.graph.GraphGenerator`:
+`expand_legs` turns a [`Description`][cpm_nlp.mechanisms.described.spec.Description] with ``legs`` into the equivalent
+description of bodies and joints, read by `GraphGenerator`:
 
 * the ground, one body per link of each leg (``{leg}_link{n}``, or the leg's ``body:`` names) and
   the platform; joint ``n`` of a leg joins the body before it to the body after it, with its type,
@@ -21,7 +21,7 @@ description of bodies and joints, read by :class:`~.graph.GraphGenerator`:
   joint and refuses coordinates on it, so nothing it reports is lost.
 
 Every expression keeps its text; it is evaluated in its leg's frame -- the leg's ``let``
-definitions, its index and its rotation -- through :class:`InLeg` (the key paths of errors stay
+definitions, its index and its rotation -- through `InLeg` (the key paths of errors stay
 the legs file's).
 
 The expansion serves ``describe`` (the body graph, loops and both mobility counts), the
@@ -30,12 +30,12 @@ bodies and joints (``legs`` and ``bodies``/``joints`` in one file: a lever betwe
 and a leg's slider): their bodies join the legs' by name and the whole is read as one graph.
 
 **A pure legs file keeps the elimination generator for its closures**
-(:class:`~.generate.Generator`): it eliminates each leg's passive joints, so Φ has one to three
+(`Generator`): it eliminates each leg's passive joints, so Φ has one to three
 rows per leg in the platform coordinates alone, and its FK and batch run within 1.1x of the
 hand-written modules (benchmarks/bench_described.py); the expanded graph has every passive joint
 as an unknown and would be slower.
 
-What has no bodies-and-joints equivalent yet (:func:`expansion_gap`): ``closures`` and
+What has no bodies-and-joints equivalent yet (`expansion_gap`): ``closures`` and
 ``actuators`` written as expressions (a graph's loops come from its joints).  A closed-form
 ``ik`` is dropped (it names only the legs' coordinates; the expanded graph solves its IK), and
 so are the legs' generated branch indicators (the graph generates its own; the declared
@@ -103,8 +103,9 @@ def expand_legs(d: Description, defaults: dict[str, float] | None = None) -> Des
 
     ``defaults``: parameter values (SI) that replace the file's defaults -- the graph's loops are
     ranked at the reference configuration with them, and a parameter without a default needs one
-    (e.g. the parameters of the problem being described).  An :class:`InputError` names what has no
-    equivalent yet (:func:`expansion_gap`)."""
+    (e.g. the parameters of the problem being described).  An [`InputError`][cpm_nlp.core.errors.InputError] names what
+    has no
+    equivalent yet (`expansion_gap`)."""
     gap = expansion_gap(d)
     if gap is not None:
         raise InputError(

@@ -3,9 +3,9 @@
 An expression is a string such as ``"b + L*cos(alpha0)"`` or
 ``"[a*cos(g), a*sin(g), 0]"`` over declared symbols (parameters, derived
 values, pose and actuator coordinates).  It is parsed with Python's
-:mod:`ast` and walked with a strict whitelist -- numbers, names, ``+ - * / **``
+`ast` and walked with a strict whitelist -- numbers, names, ``+ - * / **``
 (``^`` is read as a power), unary minus, calls of the functions in
-:data:`FUNCTIONS`, ``[a, b, c]`` vectors and ``v[0]`` indexing -- and never
+`FUNCTIONS`, ``[a, b, c]`` vectors and ``v[0]`` indexing -- and never
 evaluated by Python: every other construct (attributes, comparisons,
 lambdas, keywords, strings ...) is an error that names its column.
 
@@ -206,7 +206,7 @@ class _Evaluator:
         self.cols = cols
         #: the expression as written (for quoting a part of it in a message)
         self.text = text
-        #: placeholder name -> the value of a number with its unit (see :func:`_units`)
+        #: placeholder name -> the value of a number with its unit (see `_units`)
         self.units = units or {}
 
     def col(self, node: ast.AST) -> int:
@@ -261,7 +261,7 @@ class _Evaluator:
     def finite(self, node: ast.AST, result: Value, args: list[Value], what: str) -> Value:
         """``result``, or an error naming the operation when it is a known number that is
         not finite (``1/0``, ``b/0``, ``sqrt(-1)``, ``exp(1000)``; with every symbol a
-        number, as :func:`diagnose` evaluates, any operation on them)."""
+        number, as `diagnose` evaluates, any operation on them)."""
         # the structural non-zeros in one call (a structural zero is finite): indexing each
         # entry costs CasADi's Python overloads a few microseconds apiece (issue 23, start-up)
         for e in result.sx.nonzeros():
@@ -421,7 +421,7 @@ def _adapts(v: Value) -> bool:
 
 
 def adapts(v: Value) -> bool:
-    """Whether a whole value takes the dimension its key declares (see :func:`_adapts`)."""
+    """Whether a whole value takes the dimension its key declares (see `_adapts`)."""
     return _adapts(v) or (v.dim == NUMBER and all(v.sx[i].is_constant() for i in range(v.size)))
 
 
@@ -631,7 +631,7 @@ def _units(source: str, cols: list[int]) -> tuple[str, list[int], dict[str, Valu
 
 
 def _check_nesting(text: str) -> None:
-    """Brackets nested at most :data:`MAX_NESTING` deep (before Python's parser sees the text)."""
+    """Brackets nested at most `MAX_NESTING` deep (before Python's parser sees the text)."""
     depth = 0
     for col, ch in enumerate(text, 1):
         if ch in "([{":

@@ -1,5 +1,6 @@
-"""From a :class:`~.spec.Description` to a :class:`~cpm_nlp.core.model.LoopClosure`
-and a :class:`~cpm_nlp.core.mechanism.Mechanism`, symbolically in CasADi.
+"""From a [`Description`][cpm_nlp.mechanisms.described.spec.Description] to a
+[`LoopClosure`][cpm_nlp.core.model.LoopClosure]
+and a [`Mechanism`][cpm_nlp.core.mechanism.Mechanism], symbolically in CasADi.
 
 Each leg is a serial chain given at the reference configuration (product of
 exponentials: a joint's variable is its displacement from there).  Its closure
@@ -22,7 +23,7 @@ The eliminated joints' values (the passive joint angles) are recovered from
 the chain afterwards, and each elimination gives a branch indicator, an
 invariant of a mode (it changes sign only at a singularity of the sub-chain
 it separates, never because a link turned far), positive at the reference
-configuration (:func:`.branches.elimination_indicators`):
+configuration (`branches.elimination_indicators`):
 
 * the link closes a sub-chain of its own (its rows make a diagonal block of
   Φ_x in block-triangular form with no other elimination: a four-bar's
@@ -43,7 +44,7 @@ configuration (:func:`.branches.elimination_indicators`):
 A pure legs file keeps this generator for its closures: with each leg's passive joints
 eliminated, Φ has one to three rows per leg in the platform coordinates alone, and its FK and
 batch run within 1.1x of the hand-written modules (benchmarks/bench_described.py).  The same
-file expanded into bodies and joints (:mod:`.expand`, every passive joint an unknown of a
+file expanded into bodies and joints (`expand`, every passive joint an unknown of a
 spanning tree) serves ``describe``, the assembly of a rough drawing and files that mix legs
 with bodies; it would be the slower closure.
 """
@@ -113,7 +114,7 @@ class Generator(ClosureBuilder):
 
     def __init__(self, d: Description) -> None:
         super().__init__(d)
-        #: Φ's circle rows (planar): (row, centre c, platform point B, radius), for :mod:`.dyads`
+        #: Φ's circle rows (planar): (row, centre c, platform point B, radius), for `dyads`
         self.circles: list[tuple[int, ca.SX, ca.SX, ca.SX]] = []
 
     # -- legs ------------------------------------------------------------------------------
@@ -329,7 +330,7 @@ class Generator(ClosureBuilder):
             # a turned leg whose proximal chain only slides: its angle and its link's rotation in
             # the leg's own frame (v_l = turnᵀ v), where the file's axes are (0, 1, 0) and the
             # like -- the rotation about w_l keeps a U or S axis along w_l exactly, and the tip's
-            # angles need no turned constant (:meth:`report_tip`)
+            # angles need no turned constant (`report_tip`)
             v_l, w_l = turn.T @ v, axis_l
             # w·(up × vp) = v·(w × u) and up·vp = u·v - (u·w)(v·w), with u·w = h
             theta = ca.atan2(ca.dot(v_l, ca.cross(w_l, u0_l)), ca.dot(u0_l, v_l) - h * ca.dot(v_l, w_l))
@@ -365,7 +366,7 @@ class Generator(ClosureBuilder):
 
     def indicator(self, value: ca.SX | None, leg: Leg, j: ResolvedJoint, what: str) -> None:
         """A generated branch indicator, named after its leg and joint (``a1.U1``: leg a1, its
-        first joint, a U); value None: filled in by :func:`.branches.elimination_indicators`."""
+        first joint, a U); value None: filled in by `branches.elimination_indicators`."""
         n = j.spec.path[-1] + 1 if j.spec.path and isinstance(j.spec.path[-1], int) else 0
         name = f"{leg.name}.{JOINT_TYPES[j.type].letter}{n}"
         self.branch.append((value, name, f"leg {leg.name}, joint {n} ({j.type}): {what}"))
@@ -384,7 +385,7 @@ class Generator(ClosureBuilder):
         normal to the axis ``along`` of an eliminated R or C, else v) and its working-mode expression:
         the closure's rate with respect to the joint before it, w·((c - a) × vp) for a revolute (axis
         w at a), e·vp for a P along e (None: no joint before it, or one with several motions).  The
-        indicator itself is chosen once Φ_x is known (:func:`.branches.elimination_indicators`)."""
+        indicator itself is chosen once Φ_x is known (`branches.elimination_indicators`)."""
         vp = v if along is None else v - ca.dot(v, along) * along
         working, what = None, ""
         if before and JOINT_TYPES[before[-1].type].dof == 1:

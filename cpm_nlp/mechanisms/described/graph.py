@@ -9,18 +9,18 @@ The formulation (relative coordinates with cut joints, as multibody codes write 
   a ``distance`` joint is a rod, never a tree edge), places every body by the product of the
   exponentials of the tree joints' displacements from the drawing.  A tree joint brings its point
   on the distal body onto its point on the proximal one, so a rough drawing (the two points apart)
-  costs nothing (:mod:`.graph_tree`).
+  costs nothing (`graph_tree`).
 * Each joint left out of the tree closes one loop (the fundamental cycles of the tree: a cycle
   basis).  Its rows say that the two bodies' relative motion is one the joint allows: a point joint
   (S; planar R) keeps its two points together, an R also keeps the axes parallel, a P keeps the
   relative rotation and the offset along the axis, a distance joint the rod's length
-  (:mod:`.graph_rows`).
+  (`graph_rows`).
 * Mobility is the number of tree coordinates less the rank of the loops' Jacobian at the reference
   configuration (so an overconstrained linkage such as the Bennett linkage loads); the rows are
   kept that are independent there, in file order.  Grübler-Kutzbach is counted beside it
-  (:mod:`.mobility`).
+  (`mobility`).
 * The reference configuration is assembled from the drawing: a Gauss-Newton solve on the loops
-  with the actuators at their ``home`` values, for any parameter values (:class:`.assembly.Assembler`).
+  with the actuators at their ``home`` values, for any parameter values (`assembly.Assembler`).
 * The pose coordinates are the platform's (``platform.body``, ``platform.point``): rows that say
   the platform coordinates locate that body, then the passive tree coordinates.
 
@@ -78,7 +78,7 @@ class GraphGenerator(ClosureBuilder):
         self.actuated_coords: set[str] = set()
         self.info: GraphInfo | None = None
         self.assembler: Assembler | None = None
-        #: what ``describe`` says of the closed-form FK by dyads (:mod:`.graph_dyads`), if any
+        #: what ``describe`` says of the closed-form FK by dyads (`graph_dyads`), if any
         self.closed_form_summary: str | None = None
         #: an expanded legs file: each leg's environment and rotation (id of the leg -> (env, turn))
         self._frames: dict[int, tuple[dict, ca.SX]] = {}
@@ -86,7 +86,7 @@ class GraphGenerator(ClosureBuilder):
     # -- expressions of an expanded legs file (in a leg's frame: its let, index and rotation) ----
     def _leg_frame(self, leg: Any) -> tuple[dict, ca.SX]:
         """A leg's environment (parameters, derived values, its index and ``let``) and its rotation,
-        as the legs generator resolves them (:meth:`.generate.Generator.leg`)."""
+        as the legs generator resolves them (`generate.Generator.leg`)."""
         frames = self._frames
         if id(leg) not in frames:
             env = dict(self.env)
@@ -118,7 +118,7 @@ class GraphGenerator(ClosureBuilder):
         u = turn @ (b - a) / ca.norm_2(b - a)
         if text.normal == 0:  # the point at a length from `from` towards `to`
             return turn @ a + self.scalar(text.text, path, lenv, "length") * u
-        # two unit vectors across u, as a joint's normals (:func:`.graph_rows.axis_normals`)
+        # two unit vectors across u, as a joint's normals (`graph_rows.axis_normals`)
         n1, n2 = axis_normals(u, self.p, self.p_default)
         return n1 if text.normal == 1 else n2
 
@@ -231,14 +231,14 @@ class GraphGenerator(ClosureBuilder):
 
     # -- the tree and its loops ----------------------------------------------------------------
     def spanning_tree(self) -> None:
-        """The spanning tree and its loops (:func:`.graph_tree.spanning_tree`): each body's parent."""
+        """The spanning tree and its loops (`graph_tree.spanning_tree`): each body's parent."""
         bodies = [b.name for b in self.d.bodies]
         self.parent = spanning_tree(self.gjoints, bodies, self.ground, set(self.d.platform.task))
 
     # -- coordinates and poses -------------------------------------------------------------------
     def tree_coordinates(self) -> None:
         """Each tree joint's values become pose coordinates (unknowns); an actuated joint's also
-        gets its actuator (q) and a row that ties the two (:attr:`actuation_rows`), so that every
+        gets its actuator (q) and a row that ties the two (`actuation_rows`), so that every
         body's pose is a function of the pose coordinates alone."""
         for g in self.gjoints:
             if g.type == "pose":  # its values are the platform coordinates
@@ -322,7 +322,7 @@ class GraphGenerator(ClosureBuilder):
 
     # -- rows --------------------------------------------------------------------------------
     def cut(self, g: GraphJoint, scale: ca.SX) -> Cut:
-        """A cut joint at the pose (:class:`.graph_rows.Cut`)."""
+        """A cut joint at the pose (`graph_rows.Cut`)."""
         return Cut(
             g,
             self.pose[g.a][0],
@@ -456,7 +456,7 @@ class GraphGenerator(ClosureBuilder):
         return fns
 
     def loops(self, scale: ca.SX) -> None:
-        """Each cut joint's loop rows (:mod:`.graph_rows`) and its reported values."""
+        """Each cut joint's loop rows (`graph_rows`) and its reported values."""
         for g in self.gjoints:
             if not g.tree:
                 self.loop_rows += [
@@ -502,7 +502,7 @@ class GraphGenerator(ClosureBuilder):
             )
 
     def select_rows(self, scale: ca.SX) -> None:
-        """Φ's rows: the loop rows (overconstrained: their normal equations, :meth:`normal_rows`),
+        """Φ's rows: the loop rows (overconstrained: their normal equations, `normal_rows`),
         the actuation rows and the platform's; the mobility checked against the actuators."""
         keep = self.assembler.select_rows()
         if self.assembler.info.mobility != len(self.q_coords):
@@ -539,7 +539,7 @@ class GraphGenerator(ClosureBuilder):
                 )
 
     def graph_functions(self, q: ca.SX) -> dict[str, Any]:
-        """The closure's functions (:func:`.emit.closure_functions`), the assembly, every loop row
+        """The closure's functions (`emit.closure_functions`), the assembly, every loop row
         of an overconstrained graph and the drawing's points."""
         fns = closure_functions(self, q)
         fns["assemble"] = self.assembler
@@ -571,7 +571,7 @@ class GraphGenerator(ClosureBuilder):
         Jacobian in the passive tree coordinates -- square, zero on the mechanism's motion, and
         regular wherever the loops' Jacobian keeps its rank (any fixed choice of rows loses rank
         somewhere along the motion, where the rows it left out would not).  The passive tree
-        coordinates are :meth:`tree_columns` less the actuated joints': with a placed platform (an
+        coordinates are `tree_columns` less the actuated joints': with a placed platform (an
         expanded legs file) the platform coordinates too, which then have no rows of their own."""
         r = ca.vertcat(*[row[0] for row in self.loop_rows])
         tree = [k for k in self.tree_columns() if self.x_names[k] not in self.actuated_coords]

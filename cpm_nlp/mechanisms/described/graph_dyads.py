@@ -5,7 +5,7 @@ Once the actuators are set, a planar linkage of R and P joints (and rods, ``dist
 solved in closed form where it decomposes into Assur groups of class II -- dyads -- each placed by
 bodies already placed (the ground first, then the actuated joints' bodies), as Pyslvs and pylinkage
 assemble a linkage.  A body's pose is its rotation (cos, sin) and translation from the drawing (the
-graph's body frames are the world at the drawing, :mod:`.graph`); derived here:
+graph's body frames are the world at the drawing, `graph`); derived here:
 
 * **actuated joint** (R or P) to a placed body: its value is the actuator's, the body follows;
 * **RRR** -- bodies b1, b2 pinned (R) to placed bodies at A and B and to each other at C, or one
@@ -21,16 +21,16 @@ graph's body frames are the world at the drawing, :mod:`.graph`); derived here:
 
 Each dyad has two assemblies; its sign s is the reference configuration's (the graph's assembled
 reference, with the parameters' defaults, as the graph's branch indicators are signed:
-:func:`.branches.graph_indicators`).
+`branches.graph_indicators`).
 ``disc`` (the least over the dyads, negative where one does not assemble) and ``side`` (the least of
 each dyad's side at the guess x0 times its sign: positive where x0 is on the assembly taken) let the
-FK kernel (:func:`cpm_nlp.core.kernels.fk_kernel`) leave any other pose to Newton.  The pose
+FK kernel (`cpm_nlp.core.kernels.fk_kernel`) leave any other pose to Newton.  The pose
 coordinates follow from the bodies' poses: a tree R joint's value is its home plus the turn between
 its bodies, each body's turn the one nearest its turn at the guess x0 (as Newton from x0 finds it),
 a body driven by an actuated R joint turning with it exactly (a crank keeps its whole turns), a
 tree P joint's the slide between its points, the platform's coordinates by their rows (linear in
 them).  A graph that decomposes only in part (a class III group after some dyads) gets a seed
-instead (:meth:`Decomposition.seed`): the dyads' closed form places the bodies it can, and Newton,
+instead (`Decomposition.seed`): the dyads' closed form places the bodies it can, and Newton,
 started there, moves only the rest (the placed coordinates' rows are already solved, and Φ_x is
 block-triangular in them); Newton's status stands.  A spatial or overconstrained graph, or one
 whose platform is placed by its coordinates, gets neither.
@@ -93,8 +93,8 @@ class Dyad:
 
 
 class Decomposition:
-    """The dyads of a planar graph (``gen``: its :class:`~.graph.GraphGenerator`, built), placed in
-    order from the ground; :meth:`function` is its ``fk_closed``."""
+    """The dyads of a planar graph (``gen``: its `GraphGenerator`, built), placed in
+    order from the ground; `function` is its ``fk_closed``."""
 
     def __init__(self, gen: Any, q: ca.SX) -> None:
         self.gen, self.q = gen, q
@@ -338,7 +338,7 @@ class Decomposition:
         return turns
 
     def _coordinates(self, x0: ca.SX) -> ca.SX | None:
-        """The pose coordinates from the bodies' poses and turns (:meth:`_turns`) (None: a
+        """The pose coordinates from the bodies' poses and turns (`_turns`) (None: a
         coordinate it cannot give); a partial decomposition keeps x0's where the bodies are not placed."""
         gen = self.gen
         where = {n: k for k, n in enumerate(gen.x_names)}
@@ -417,7 +417,7 @@ class Decomposition:
         return ca.Function("fk_seed", [self.q, x0, self.gen.p], [guess], ["q", "x0", "p"], ["x0_seed"])
 
     def _parts(self, x_ref: np.ndarray, q_ref: np.ndarray, p_ref: np.ndarray) -> tuple | None:
-        """(x0, x, disc, side) of the dyads placed, each its reference sign (None: see :meth:`function`)."""
+        """(x0, x, disc, side) of the dyads placed, each its reference sign (None: see `function`)."""
         gen = self.gen
         x0 = ca.SX.sym("x0", gen.x.numel())
         signs = []

@@ -36,7 +36,7 @@ class GraphInfo:
 
 
 def independent_rows(J: np.ndarray) -> list[int]:
-    """The rows of J independent of the rows before them (Gram-Schmidt in row order, :data:`RANK_TOL`)."""
+    """The rows of J independent of the rows before them (Gram-Schmidt in row order, `RANK_TOL`)."""
     keep, basis = [], np.zeros((0, J.shape[1]))
     for k in range(J.shape[0]):
         row = J[k]

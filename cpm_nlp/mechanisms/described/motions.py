@@ -1,6 +1,6 @@
 """Joints resolved to CasADi: their location, axes and values, their elementary motions
 (product of exponentials about their reference axes), the rotations they are written with,
-and the aliases of the joint table (:data:`cpm_nlp.core.joints.JOINT_TYPES`) the generators
+and the aliases of the joint table (`cpm_nlp.core.joints.JOINT_TYPES`) the generators
 use."""
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ BASE_AXES = {"x": ca.DM([1.0, 0, 0]), "y": ca.DM([0, 1.0, 0]), "z": ca.DM([0, 0,
 
 def rot(axis: Any, angle: Any) -> ca.SX:
     """Rotation by ``angle`` about a unit axis k, or about "x", "y", "z" (Rodrigues,
-    :func:`~cpm_nlp.core.screws.axis_rotation`: R = cos I + sin [k]x + (1 - cos) k kᵀ, whose
+    `axis_rotation`: R = cos I + sin [k]x + (1 - cos) k kᵀ, whose
     zero entries of k drop out about a base axis)."""
     if isinstance(axis, str):
         axis = ca.DM([1.0 if axis == a else 0.0 for a in "xyz"])
@@ -76,7 +76,7 @@ class ResolvedJoint:
 def elementary_motions(j: ResolvedJoint) -> list[tuple[str, Any]]:
     """A joint's degrees of freedom as elementary motions ("P" | "R", axis), in the order
     of its coordinates (product of exponentials about its reference axes): the joint table's
-    motions (:data:`cpm_nlp.core.joints.JOINT_TYPES`) with the joint's axes."""
+    motions (`cpm_nlp.core.joints.JOINT_TYPES`) with the joint's axes."""
     t = JOINT_TYPES[j.type]
     axes = j.axes or [BASE_AXES[a] for a in t.default_axes]
     return [(kind, j.axis if source == "axis" else axes[source]) for kind, source in t.motion]

@@ -1,9 +1,10 @@
-"""Reading a mechanism file (a parsed mapping) into a :class:`~.spec.Description`: its
+"""Reading a mechanism file (a parsed mapping) into a [`Description`][cpm_nlp.mechanisms.described.spec.Description]:
+its
 top-level keys, each read in turn by its section's reader (the errors carry key paths), and
 the small sections -- parameters, derived and passive values, actuators, the closed-form
 inverse kinematics, joint-limit descriptions, stiffness and branch indicators.  The larger
-sections have modules of their own: :mod:`.read_platform`, :mod:`.read_legs`,
-:mod:`.read_graph`."""
+sections have modules of their own: `read_platform`, `read_legs`,
+`read_graph`."""
 
 from __future__ import annotations
 

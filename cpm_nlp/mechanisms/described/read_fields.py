@@ -1,6 +1,6 @@
 """The checks every section of a mechanism file is read with: a mapping (with its allowed
 keys), a list, a name, free text, a dimension, the type name, a size limit.  Each raises an
-:class:`~cpm_nlp.core.errors.InputError` at the key path of the value it was given."""
+[`InputError`][cpm_nlp.core.errors.InputError] at the key path of the value it was given."""
 
 from __future__ import annotations
 

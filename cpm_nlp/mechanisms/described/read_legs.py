@@ -122,7 +122,7 @@ def _check_link(leg: Leg, n: int, body: str, prev: str, seen: set, owner: str) -
 def leg_bodies(legs: list[Leg]) -> list[str]:
     """The bodies the legs run through: the ground, each leg's links (its joints' ``body``, else
     ``{leg}_link{n}``; a rod ``{leg}_rod`` for a last distance joint) and the platform (see
-    :mod:`.expand`)."""
+    `expand`)."""
     if not legs:
         return []
     out = ["ground"]

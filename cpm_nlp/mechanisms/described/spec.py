@@ -1,5 +1,5 @@
 """The description of a mechanism: dataclasses (the Python builder API); a mechanism
-file is read into them by :func:`.read.description_from_dict`.
+file is read into them by `read.description_from_dict`.
 
 A mechanism file::
 
@@ -73,7 +73,7 @@ class Quantity:
 @dataclass
 class Flexure:
     """A flexure hinge that sets a joint's limits: hinge type, dimensions, material
-    (the keys of :data:`cpm_nlp.analysis.hinge_types.HINGE_LIMIT_OPTIONS`)."""
+    (the keys of `cpm_nlp.analysis.hinge_types.HINGE_LIMIT_OPTIONS`)."""
 
     values: dict[str, Any]
 
@@ -82,16 +82,23 @@ class Flexure:
 class Joint:
     """One joint of a leg, base side first.
 
-    at: its location (vector expression, base frame, reference configuration);
-    for ``distance`` the point on the proximal body, ``to`` the one on the distal.
-    axis: its axis (R, P, C, planar_P); axes: the two axes of a U, the three
-    axes an S reports its angles about (default x, y, z).
-    actuated: the actuator coordinate driving it (a name), with ``gain``
-    (displacement per actuator unit) and ``home`` (the actuator value at the
-    reference configuration).
-    coordinates: names of its reported joint values (one per degree of freedom),
-    ``home`` their values at the reference configuration.
-    limit: the limit family of its coordinates (default: the name without digits).
+    Attributes
+    ----------
+    at
+        its location (vector expression, base frame, reference configuration); for ``distance``
+        the point on the proximal body, ``to`` the one on the distal.
+    axis
+        its axis (R, P, C, planar_P);
+    axes
+        the two axes of a U, the three axes an S reports its angles about (default x, y, z).
+    actuated
+        the actuator coordinate driving it (a name), with ``gain`` (displacement per actuator
+        unit) and ``home`` (the actuator value at the reference configuration).
+    coordinates
+        names of its reported joint values (one per degree of freedom), ``home`` their values at
+        the reference configuration.
+    limit
+        the limit family of its coordinates (default: the name without digits).
     """
 
     type: str
@@ -149,7 +156,7 @@ class Platform:
     body: str | None = None
     point: str | None = None
     #: the platform coordinates place the platform body (a legs file expanded into bodies and
-    #: joints, :mod:`.expand`): its pose is P(x), R(x) R_home^T, the legs close on it
+    #: joints, `expand`): its pose is P(x), R(x) R_home^T, the legs close on it
     placed: bool = False
 
 
@@ -191,7 +198,7 @@ class Description:
     closures: list[Expr] = field(default_factory=list)
     #: the branch indicators: None (absent) the generated ones; a list: exactly these (an item is a
     #: generated indicator's name, an expression, or {name: expression}; [] none); a mapping
-    #: {keep, remove, add}: the generated ones filtered and extended (see :func:`.read._branch`)
+    #: {keep, remove, add}: the generated ones filtered and extended (see `read._branch`)
     branch: list[Any] | dict[str, Any] | None = None
     passive: list[Quantity] = field(default_factory=list)
     ik: ClosedFormIK | None = None
@@ -203,7 +210,7 @@ class Description:
     #: the compliant joints (hinges, material, source): the compliance kinds' defaults
     stiffness: JointStiffness | None = None
     file: str | None = None
-    #: a bodies-and-joints file (see :mod:`.graph`): the drawing's named points, the bodies, the
+    #: a bodies-and-joints file (see `graph`): the drawing's named points, the bodies, the
     #: joints between any two of them, and points of any body reported as outputs (name -> (body, point))
     points: dict[str, Expr] = field(default_factory=dict)
     bodies: list[Body] = field(default_factory=list)

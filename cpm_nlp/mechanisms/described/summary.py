@@ -1,5 +1,5 @@
 """A mechanism file as text, for ``cpm-nlp describe FILE``: its derived values, its bodies and
-joints (a legs file: the graph its legs expand into, :mod:`.expand`), loops and mobility, and a
+joints (a legs file: the graph its legs expand into, `expand`), loops and mobility, and a
 legs file's legs (type, location, coordinates, actuated, hinge) and generated closures.
 
 The text is built from the description and its generated closure (the same the solvers use),

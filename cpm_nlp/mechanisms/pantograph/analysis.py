@@ -4,7 +4,7 @@ Micromanipulation", J. Intell. Robot. Syst. 2016), on the model of its mechanism
 problems/mechanisms/pantograph.yaml (the kinematics, eq 1-8, written once, there).
 
 Every formula here is in the parameters a, b, the joint limits and the magnification factors
-the model reads off the AD Jacobian of the file's loops (:func:`complete`); none uses a copy of
+the model reads off the AD Jacobian of the file's loops (`complete`); none uses a copy of
 the loop closures (the hand-written ones are the independent reference
 tests/reference/pantograph_closures.py).
 
@@ -13,8 +13,8 @@ tests/reference/pantograph_closures.py).
   by eq 31 (ψ = π/2 ∓ δ_max, φ_max = δ_max, δ_max of the flexure by eq 30 or 38); ranges
   counted from home for θ1, θ2 (the hinges at A and B, which the paper does not limit) and
   the actuators (``stroke``, centred on dx0 = √2 a, dy0 = dz0 = 0);
-* the reachable workspace in closed form (eq 17-29, :func:`paper_membership`), the actuator
-  ranges (eq 20-22), the paper's cuboid (eq 32-34, :func:`paper_cuboid`).
+* the reachable workspace in closed form (eq 17-29, `paper_membership`), the actuator
+  ranges (eq 20-22), the paper's cuboid (eq 32-34, `paper_cuboid`).
 
 Readings of the paper chosen here (documented, not tuned):
 
@@ -27,7 +27,7 @@ Readings of the paper chosen here (documented, not tuned):
   belongs to the guiding parallelograms, which eq 1-8 do not contain; it enters as the branch
   condition cos θ_i > 0 (the file's ``branch``), and with it, sin(θ1 - θ2) > 0 and cos φ > 0
   the loop model's workspace is exactly the region bounded by eq 24-29 (proof in
-  :func:`paper_membership`).
+  `paper_membership`).
 * **Magnification factors** Mx, My, Mz are read off the AD Jacobian of the file's loops at the
   home configuration (Model.derived), not typed in; the closed form Mx = 1 + b/a, My = Mz = b/a
   (eq 9-10) is checked against them in the tests.
@@ -41,7 +41,7 @@ Readings of the paper chosen here (documented, not tuned):
   then leave the φ planes (eq 18: |pz| <= (Mz/Mx) px tan φ_max).  The paper's
   own optimum (ẑ = 0.0054 m) satisfies the bound at the near face,
   ẑ <= (Mz/Mx) k tan φ_max, which is also what membership requires.  See
-  :func:`paper_cuboid` (``reading``).
+  `paper_cuboid` (``reading``).
 """
 
 from __future__ import annotations
@@ -380,7 +380,7 @@ CUBOID_OPTIONS = (
 )
 
 
-#: the values the pantograph adds to ``inscribed_cuboid`` (:data:`~.addon.CUBOID`): the cuboid under
+#: the values the pantograph adds to ``inscribed_cuboid`` (`CUBOID`): the cuboid under
 #: the paper's names, the parameters and derived quantities it depends on, and the paper's own
 #: formulation (eq 32-34) solved, checked and certified beside the general one
 CUBOID_DIMENSIONS: Mapping[str, str] = MappingProxyType(

@@ -1,13 +1,13 @@
 """The 3-PRC's add-on: what its mechanism file (problems/mechanisms/prc3.yaml) cannot say.
 
 The kinematics -- loop closures, IK, passive joints, branch, drawing -- is the file.  This
-add-on (named by :data:`cpm_nlp.mechanisms.registry.ADDONS`) gives the paper's own parts:
+add-on (named by `cpm_nlp.mechanisms.registry.ADDONS`) gives the paper's own parts:
 
 * the parameters only the dynamics uses (Table 1: L5, L6, L8, the hinge's r, t, b, and h),
   optional, never in the closures' p;
-* the hinge check of eq 28 (:func:`check_parameters`);
-* the Lagrange model of eq 28-41 (:mod:`.dynamics`), on the file's closures;
-* the paper's kind ``amplifier`` (eq 1-2, :mod:`.kinds`).
+* the hinge check of eq 28 (`check_parameters`);
+* the Lagrange model of eq 28-41 (`dynamics`), on the file's closures;
+* the paper's kind ``amplifier`` (eq 1-2, `kinds`).
 """
 
 from __future__ import annotations

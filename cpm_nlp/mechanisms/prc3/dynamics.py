@@ -69,12 +69,12 @@ def _gravity_coefficient(v: dict, A1, A2):
 def lagrangian(closure: LoopClosure) -> ca.Function:
     """Kinetic energy T(q, qd) and potential energy U(q) of the 3-PRC
     (eq 28-36), symbolic in the kinematic parameters p (those of ``closure``, the file's)
-    and the dynamic ones w (:data:`DYNAMIC_PARAMETERS`).  :mod:`cpm_nlp.analysis.dynamics`
+    and the dynamic ones w (`DYNAMIC_PARAMETERS`).  `cpm_nlp.analysis.dynamics`
     derives M = d2T/dqd2, K = d2U/dq2 and G = dU/dq at q = 0 (eq 37-38).
 
     Each energy is typed in as the first line of its equation (the sum over
     bodies and hinges); the collected second lines and eq 38 are
-    :func:`printed_coefficients`.  Readings (documented, not tuned):
+    `printed_coefficients`.  Readings (documented, not tuned):
 
     * Hinges: k = 2 E b t^2.5 / (9 pi r^0.5) for every hinge (after eq 28).
       Per limb, 2 x (4 hinges turning theta_1 = A1 q/L2 and 3 turning

@@ -1,8 +1,8 @@
 """The 3-PRC paper's own plot: the lever amplifier's output against its input (eq 1-2).
 
-Declared, name and one line, in :data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that
+Declared, name and one line, in `cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that
 ``cpm-nlp plot --help`` lists it without importing this module; drawn only for results of
-the 3-PRC.  This module belongs to the plot layer (it imports :mod:`cpm_nlp.plot`; nothing
+the 3-PRC.  This module belongs to the plot layer (it imports `cpm_nlp.plot`; nothing
 in the mechanisms layer imports it).
 """
 

@@ -1,11 +1,11 @@
 """Flexure-joint design and the pseudo-rigid-body compliance model of the RPR
 compliant mechanism (rpr-2rpu-upr-zhang-2022.md, sections 3-4, eq 27-44).
 
-* :func:`joint_design` -- the R and U flexure joints of one leg minimising the
+* `joint_design` -- the R and U flexure joints of one leg minimising the
   energy of eq 27 under unit constraint wrenches, with the rotation capability
   of eq 32, the 12 mm size box and the thinnest section (section 3.1), by IPOPT
   from several starts;
-* :func:`compliance_model` -- the bridge amplifier (eq 33-36), the mechanism
+* `compliance_model` -- the bridge amplifier (eq 33-36), the mechanism
   stiffness K' = G_pᵀ K_J G_p (eq 39-40) and the compliances C and C_in
   (eq 41-44).
 
@@ -15,7 +15,7 @@ Readings and inputs the paper leaves out (documented, not tuned):
   right-circular notch (notch radius r, thinnest section t, width b); U joint:
   two orthogonal circular notches (r, t) cut next to each other in a square rod
   of side h (Table 1 gives no width for U).  Compliances:
-  :mod:`cpm_nlp.analysis.flexure_compliance` (Lobontiu 2002).  The block height of the
+  `cpm_nlp.analysis.flexure_compliance` (Lobontiu 2002).  The block height of the
   R joint (Table 1: h = 12 mm) does not enter a notch's compliance; the design
   reports the smallest block that holds the notch, t + 2r.
 * **Objective (eq 27, 30, 31).**  The wrenches are the appendix's constraint
@@ -316,7 +316,7 @@ def joint_design(model: Model, joint: str, spec: JointSpec, config: SolverConfig
 
 def leaf_compliances(material: Material, length: float, thickness: float, width: float) -> tuple[float, float]:
     """(c_r, c_t) of a leaf hinge of the amplifier: rotation 12 L/(E w t³)
-    (= 1 / :func:`cpm_nlp.analysis.flexure.leaf_spring_stiffness`) and stretch along the
+    (= 1 / `cpm_nlp.analysis.flexure.leaf_spring_stiffness`) and stretch along the
     leaf L/(E w t)."""
     c_r = 1.0 / flexure.leaf_spring_stiffness(material.E, width, thickness, length)
     c_t = length / (material.E * width * thickness)
@@ -369,7 +369,7 @@ def passive_rates(model: Model, x: Sequence[float]) -> tuple[np.ndarray, np.ndar
 
 def mechanism_stiffness(model: Model, x: Sequence[float], k_J: Sequence[float]) -> np.ndarray:
     """K' of eq 40 as an instance of the generic pseudo-rigid-body method
-    (:mod:`cpm_nlp.analysis.compliance`): hinges of stiffness k_J on the passive
+    (`cpm_nlp.analysis.compliance`): hinges of stiffness k_J on the passive
     joints, undeflected at the home pose, give the input stiffness K_q, the Hessian of
     the strain energy along the loop closures.  At the home pose (the paper's initial
     pose, where eq 40 is evaluated) it equals G_pᵀ K_J G_p exactly; away from it K_q

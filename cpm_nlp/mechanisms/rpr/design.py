@@ -1,17 +1,17 @@
 """Motion/force transmission and dimensional synthesis of the 2-RPU-UPR
 (rpr-2rpu-upr-zhang-2022.md, section 2.3, eq 1 and 14-26).
 
-* :func:`transmission_screws` -- the locked-leg twist systems (eq 14-15), the
+* `transmission_screws` -- the locked-leg twist systems (eq 14-15), the
   constraint wrenches H1..H5 (eq 16), the output twist S_O (eq 17) and the
   transmission wrench S_T of leg A1B1 (eq 18) at the initial pose, referred to
   the fixed origin o as in the paper;
-* :func:`eta_expression` -- the output transmission index η (eq 19), symbolic in
+* `eta_expression` -- the output transmission index η (eq 19), symbolic in
   (r1, r2, P) so that IPOPT can optimise it;
 * design space: D and the normalized l1, l2, l3 (eq 20-21), the constraints of
-  eq 22 (:func:`design_space_violation`), the (s, t) plane (eq 23);
-* :func:`transmission_map` -- η over a grid of the (s, t) triangle (Fig. 4),
+  eq 22 (`design_space_violation`), the (s, t) plane (eq 23);
+* `transmission_map` -- η over a grid of the (s, t) triangle (Fig. 4),
   ``nan`` outside eq 22;
-* :func:`synthesis` -- maximise η under eq 22 by IPOPT from several starts.
+* `synthesis` -- maximise η under eq 22 by IPOPT from several starts.
 
 Readings (documented, not tuned):
 
@@ -157,7 +157,7 @@ def design_space_violation(l1: float, l2: float, l3: float, tol: float = 1e-9) -
 
 
 def check_design_space(l1: float, l2: float, l3: float, path: tuple) -> None:
-    """Raise :class:`InputError` for normalized parameters outside eq 22."""
+    """Raise [`InputError`][cpm_nlp.core.errors.InputError] for normalized parameters outside eq 22."""
     why = design_space_violation(l1, l2, l3)
     if why:
         raise InputError(
@@ -190,9 +190,20 @@ def transmission_map(s: Sequence[float], t: Sequence[float], eta_max: str = "dis
 class SynthesisResult:
     """Best design found by the multi-start IPOPT synthesis.
 
-    l: (l1, l2, l3); eta: its η; starts: number of starts; converged: how many
-    converged; at_best: how many of those reached the best η (within 1e-8);
-    optima: the distinct local optima (l1, l2, l3, η), best first.
+    Attributes
+    ----------
+    l
+        (l1, l2, l3);
+    eta
+        its η;
+    starts
+        number of starts;
+    converged
+        how many converged;
+    at_best
+        how many of those reached the best η (within 1e-8);
+    optima
+        the distinct local optima (l1, l2, l3, η), best first.
     """
 
     status: Status

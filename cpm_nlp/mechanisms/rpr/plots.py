@@ -1,8 +1,8 @@
 """The RPR paper's own plot: the displacement twists of the platform on the mechanism (eq 45).
 
-Declared, name and one line, in :data:`cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that
+Declared, name and one line, in `cpm_nlp.mechanisms.names.ADDON_PLOTS`, so that
 ``cpm-nlp plot --help`` lists it without importing this module; drawn only for results of
-the RPR.  This module belongs to the plot layer (it imports :mod:`cpm_nlp.plot`; nothing
+the RPR.  This module belongs to the plot layer (it imports `cpm_nlp.plot`; nothing
 in the mechanisms layer imports it).
 """
 

@@ -21,7 +21,7 @@ Readings of the paper chosen here (documented, not tuned):
   (-cθ, 0, sθ).  Differentiating eq 2 and o' gives, at the reference point o'
   of the appendix, ω = θ̇ y + α̇ x' and v_o' = θ̇ P (cθ, 0, -sθ) + Ṗ (sθ, 0, cθ):
   the first column is (0, 1, 0; P cθ, 0, -P sθ) and the second (cθ, 0, -sθ; 0).
-  The derived columns are used (:func:`motion_screws`); only then does the
+  The derived columns are used (`motion_screws`); only then does the
   screw-theory Jacobian of eq 9-11 agree with the loop closures (it does, to
   round-off; see the tests).
 * **Displacement twists (eq 45).**  Rotational rows and the translation along
@@ -31,7 +31,7 @@ Readings of the paper chosen here (documented, not tuned):
   (o'A_i × s) and the velocity of o' give o'o × y, the opposite sign of that
   contribution (row 4 of eq 45: +5e-6 printed, -5e-6 as velocity of o').
   Eq 49 is printed with the velocity convention.  Both conventions are
-  available (:func:`motion_screws`, ``convention``), with any reference point.
+  available (`motion_screws`, ``convention``), with any reference point.
 """
 
 from __future__ import annotations
@@ -108,12 +108,16 @@ def paper_parameters(model: Model) -> np.ndarray:
 def motion_screws(x, p, reference=None, convention: str = "velocity"):  # noqa: ARG001 - same (x, p) signature as the other screw functions
     """S_t (6 x 3): the platform twist is S_t (θ̇, α̇, Ṗ) (eq 7).
 
-    reference: point (fixed frame) the linear rows refer to; default o'.
-    convention: "velocity" -- the linear rows are the velocity of the body
-    point at the reference (Plücker (s; (a - c) × s), as in the appendix);
-    "eq45" -- the moment of each rotation is taken with the position vector
-    from the axis point a to the reference c, (s; (c - a) × s), which is how
-    the translational rows of eq 45 and 47 are printed (see the module notes).
+    Parameters
+    ----------
+    reference
+        point (fixed frame) the linear rows refer to; default o'.
+    convention
+        "velocity" -- the linear rows are the velocity of the body point at the reference
+        (Plücker (s; (a - c) × s), as in the appendix); "eq45" -- the moment of each rotation is
+        taken with the position vector from the axis point a to the reference c, (s; (c - a) ×
+        s), which is how the translational rows of eq 45 and 47 are printed (see the module
+        notes).
     """
     if convention not in CONVENTIONS:
         raise ValueError(f"unknown twist convention {convention!r}")
@@ -174,11 +178,17 @@ def screw_function() -> ca.Function:
 class ScrewJacobian:
     """The screw-theory route of eq 7-13 at one pose (reference o').
 
-    S_t: motion screw system (6 x 3, eq 7, derived columns);
-    J_a, J_b: eq 9; J = J_b⁻¹ J_a (q̇ = J V, eq 10); G = J⁻¹ (V = G q̇, eq 11);
-    G_p: passive joint rates per actuator rate (9 x 3, eq 12-13), rows in the
-    order of the file's passive joints (theta_a11, ..., eq 13); branch_rates: J_i⁻¹ S_t G per leg (6 x 3, eq 12),
-    whose constrained-twist rows must vanish.
+    Attributes
+    ----------
+    S_t
+        motion screw system (6 x 3, eq 7, derived columns);
+    J_a, J_b
+        eq 9; J = J_b⁻¹ J_a (q̇ = J V, eq 10); G = J⁻¹ (V = G q̇, eq 11);
+    G_p
+        passive joint rates per actuator rate (9 x 3, eq 12-13), rows in the order of the file's
+        passive joints (theta_a11, ..., eq 13);
+    branch_rates
+        J_i⁻¹ S_t G per leg (6 x 3, eq 12), whose constrained-twist rows must vanish.
     """
 
     S_t: np.ndarray

@@ -7,7 +7,7 @@
 * ``rpr_joint_design`` -- the R and U flexure joints (eq 27-32, Table 1);
 * ``rpr_compliance`` -- the pseudo-rigid-body compliance model (eq 33-44).
 
-Every kind applies to the ``rpr`` mechanism only (:meth:`supports`), the mechanism of the file
+Every kind applies to the ``rpr`` mechanism only (`supports`), the mechanism of the file
 problems/mechanisms/rpr.yaml, and runs on its closures (pose, passive joints, Jacobians).  One
 module per kind; the classes are named here as well, as ``cpm_nlp.mechanisms.rpr.kinds`` (the
 home of 0.1's ``cpm_nlp.rpr_problems``) has always named them.

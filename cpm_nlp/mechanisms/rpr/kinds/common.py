@@ -54,7 +54,7 @@ def _finish(
     message: str = "",
 ) -> Result:
     """The result of an RPR kind: its values (none unless solved), each of an output the kind
-    declares (:meth:`~cpm_nlp.core.kind.ProblemKind.outputs`)."""
+    declares ([`outputs`][cpm_nlp.core.kind.ProblemKind.outputs])."""
     if not status.ok:
         values = {}
     return declared_result(

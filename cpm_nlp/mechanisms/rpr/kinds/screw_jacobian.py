@@ -54,7 +54,7 @@ class ScrewJacobian(RprKind, Jacobian):
         return res.declare(extra.outputs).set(extra.values)
 
     def outputs(self, model: Model) -> list[Output]:
-        """The AD Jacobians (:class:`~cpm_nlp.kinds.kinematic.Jacobian`), then eq 7-13 by screw theory."""
+        """The AD Jacobians (`Jacobian`), then eq 7-13 by screw theory."""
         return super().outputs(model) + _screw_outputs(model)
 
 

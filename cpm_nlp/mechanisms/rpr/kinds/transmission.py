@@ -37,7 +37,7 @@ def _eta_max_option() -> Option:
 DESIGN_NAMES = ("l1_design", "l2_design", "l3_design", "s_design", "t_design", "eta_design", "design_in_space")
 
 
-#: the dimensions of :data:`DESIGN_NAMES`
+#: the dimensions of `DESIGN_NAMES`
 DESIGN_DIMENSIONS = MappingProxyType({k: ("bool" if k == "design_in_space" else "dimensionless") for k in DESIGN_NAMES})
 
 
