@@ -131,7 +131,13 @@ def _model_text(model: Mapping[str, Any], dims: Mapping[str, str]) -> str:
             plain.append(f"{k} = {_plain(v)}" if isinstance(v, float) else f"{k} = {v}")
     if not named and not plain:
         return " (no parameters)"
+    if named and len(plain) > DERIVED_SHOWN:  # a file's many derived values: in the JSON, not on one line
+        return ": " + ", ".join(named) + f"; {len(plain)} derived values (in the JSON result, --json)"
     return ": " + "; ".join(x for x in (", ".join(named), ", ".join(plain) + "  (SI)" if plain else "") if x)
+
+
+#: derived model values printed on the model line at most (more are counted, not listed)
+DERIVED_SHOWN = 4
 
 
 def render_result(

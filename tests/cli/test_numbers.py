@@ -146,3 +146,16 @@ def test_the_model_line_shows_declared_parameters_with_their_units(cli):
     model = next(line for line in text.splitlines() if line.startswith("model"))
     assert model.startswith("model   : prs3: b = 47.91 mm, L = 109.215 mm, alpha0 = 45 deg; a = ")
     assert model.endswith("(SI)")
+
+
+def test_many_derived_values_are_counted_not_listed(cli):
+    """jansen.yaml derives 22 values (the reference configuration's points): the model line
+    gives its 13 declared lengths and the count of the derived ones, which the JSON holds."""
+    import json
+
+    text = cli("solve", str(PROBLEMS / "jansen_forward_kinematics.yaml")).out
+    model = next(line for line in text.splitlines() if line.startswith("model"))
+    assert model.startswith("model   : jansen: a = 38 mm, b = 41.5 mm,") and "m = 15 mm;" in model
+    data = json.loads(cli("solve", str(PROBLEMS / "jansen_forward_kinematics.yaml"), "--json").out)
+    derived = [k for k in data["model"] if k != "type" and k not in set("abcdefghijklm")]
+    assert model.endswith(f"; {len(derived)} derived values (in the JSON result, --json)") and len(derived) > 4
