@@ -123,7 +123,7 @@ def render_summary(rows: Sequence[Any], summary: dict[str, Any], hint: bool = Tr
         f"Independent agreements ({independent}): a number the paper prints, computed from other inputs.", WIDTH
     )
     if hint:
-        out.append("Every figure and reason: cpm-nlp reproduce --full, or --output table.md (.csv, .json)")
+        out.append("Every figure and reason: cpm-nlp reproduce --full, or --output FILE (.md, .csv, .json)")
     return "\n".join(out)
 
 
