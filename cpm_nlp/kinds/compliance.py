@@ -27,6 +27,7 @@ from ..analysis.compliance_values import (
     coordinate_list,
     diagonal_output,
     force_output,
+    peak_outputs,
     point_warnings,
     stress_groups,
     stress_outputs,
@@ -164,9 +165,15 @@ def _declared_hinges(kind: ProblemKind, model: Model) -> cm.HingeSet | None:
 
 
 def _stress_outputs(hs: cm.HingeSet | None, suffix: str = "") -> list[Output]:
-    """The largest stress, that of each of the mechanism's hinge groups, and the family of all groups."""
+    """The largest stress, that of each of the mechanism's hinge groups, and the family of all
+    groups: the nominal stresses, then the peak stresses K_t × nominal and each group's K_t."""
+    groups = stress_groups(hs) if hs is not None else ()
+    out: list[Output] = []
     largest, family = stress_outputs(suffix)
-    return [largest, *(family.member(group=g) for g in (stress_groups(hs) if hs is not None else ())), family]
+    peak_largest, peak_family, kt_family = peak_outputs(suffix)
+    for one, fam in ((largest, family), (peak_largest, peak_family)):
+        out += [one, *(fam.member(group=g) for g in groups), fam]
+    return [*out, *(kt_family.member(group=g) for g in groups), kt_family]
 
 
 def _k_q_output(c: Any) -> Output:
