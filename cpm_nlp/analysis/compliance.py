@@ -313,6 +313,16 @@ class HingeSet:
         dev = np.asarray(theta, dtype=float) - self.theta0
         return {h.name: h.stress({a: float(dev[i]) for a, i in h.axes.items()}) for h in self.hinges}
 
+    def peaks(self, stresses: Mapping[str, float | None]) -> dict[str, float | None]:
+        """The peak stress K_t × nominal of each hinge (:attr:`Hinge.kt`), from its nominal stress."""
+        kts = {h.name: h.kt for h in self.hinges}
+        return {n: None if s is None else kts[n] * s for n, s in stresses.items()}
+
+    def checked(self, stresses: Mapping[str, float | None], peak: bool) -> float | None:
+        """The largest stress a stress limit checks: the nominal one (the papers'), or the peak."""
+        vals = self.peaks(stresses) if peak else stresses
+        return max((v for v in vals.values() if v is not None), default=None)
+
 
 def joint_names(closure: LoopClosure) -> list[str]:
     return closure.x_names + closure.q_names + closure.passive_names

@@ -62,7 +62,7 @@ def stress_values(hs: HingeSet, points: list[StaticPoint | None], batch: bool, s
                 v.append(None)
             continue
         cols[largest].append(sp.stress_max)
-        peaks = [None if s is None else h.kt * s for h, s in zip(hs.hinges, sp.stresses.values())]
+        peaks = list(hs.peaks(sp.stresses).values())
         cols[peak_largest].append(max((p for p in peaks if p is not None), default=None))
         for g in groups:
             vals = [s for h, s in zip(hs.hinges, sp.stresses.values()) if h.group == g and s is not None]
