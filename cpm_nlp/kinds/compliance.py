@@ -472,6 +472,7 @@ class PlatformCompliance(_HingeKind):
             *(Output(f"d_{x.name}", x.kind) for x in c.x),
             text("hinge_model"),
             Output("stress_max_unloaded", "stress"),
+            Output("stress_peak_max_unloaded", "stress"),
             *(force_output(f"F{j + 1}_loaded", q) for j, q in enumerate(c.q)),
         ]
 

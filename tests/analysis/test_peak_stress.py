@@ -138,3 +138,13 @@ def test_hinge_peaks_of_a_hinge_set():
         assert peaks[h.name] == pytest.approx(h.kt * 1e8)
     assert hs.checked(stresses, peak=False) == 1e8
     assert hs.checked(stresses, peak=True) == pytest.approx(1e8 * ht.circular_notch_kt(2e-3, 8e-3))
+
+
+def test_six_axis_model_reports_the_peak():
+    """The six-axis hinge model (prs3_cutting_force.yaml): the largest peak stress lies between
+    the largest nominal one and K_t of the notch times it (the spherical necks have K_t = 1)."""
+    v = solve(load_problem(ROOT / "problems" / "prs3_cutting_force.yaml")).values
+    kt = ht.circular_notch_kt(2e-3, 8e-3)
+    assert v["stress_max_loaded"] > 0
+    assert v["stress_max_loaded"] <= v["stress_peak_max_loaded"] <= kt * v["stress_max_loaded"] * (1 + 1e-12)
+    assert v["Kt_revolute"] == pytest.approx(kt, rel=1e-12)
