@@ -33,6 +33,46 @@ def _roark_case_2b(h_over_r: float, x: float) -> float:
     return float(np.polyval(c[::-1], x))
 
 
+def _roark_shoulder(h_over_r: float, x: float) -> float:
+    """Roark's Table 17.1 (7th ed.), square shoulder with fillet in a circular shaft, bending,
+    0.25 <= h/r <= 2.0 (as transcribed on eng-calculations.com); x = 2h/D."""
+    s, hr = math.sqrt(h_over_r), h_over_r
+    c = [
+        0.927 + 1.149 * s - 0.086 * hr,
+        0.015 - 3.281 * s + 0.837 * hr,
+        0.847 + 1.716 * s - 0.506 * hr,
+        -0.790 + 0.417 * s - 0.246 * hr,
+    ]
+    return float(np.polyval(c[::-1], x))
+
+
+def _roark_u_groove(h_over_r: float, x: float) -> float:
+    """Roark's Table 17.1 (7th ed.), U-notch in a circular shaft, bending, 0.25 <= h/r <= 2.0
+    (as transcribed on eng-calculations.com); x = 2h/D."""
+    s, hr = math.sqrt(h_over_r), h_over_r
+    c = [
+        0.455 + 3.354 * s - 0.769 * hr,
+        0.891 - 12.721 * s + 4.593 * hr,
+        0.286 + 15.481 * s - 6.392 * hr,
+        -0.632 - 6.115 * s + 2.568 * hr,
+    ]
+    return float(np.polyval(c[::-1], x))
+
+
+def test_filleted_rod_kt_shoulder_fit_and_limits():
+    """The filleted neck's K_t is Roark's shoulder fit at h/r = 1; K_t -> 1 as d/r -> 0, it
+    grows with d/r, and a groove (the neck with no straight length) has more: the shoulder fit
+    is for a neck whose fillets do not interact (3-PRS neck: 1.073 against 1.128)."""
+    for d_over_r in (0.1, 0.75, 2.0):
+        x = 2 / (d_over_r + 2)
+        assert ht.filleted_rod_kt(d_over_r, 1.0) == pytest.approx(_roark_shoulder(1.0, x), rel=1e-12)
+    assert ht.filleted_rod_kt(1e-9, 1.0) == pytest.approx(1.0, abs=2e-3)
+    kts = [ht.filleted_rod_kt(dr, 1.0) for dr in np.linspace(1e-4, 2.0, 50)]
+    assert all(b > a for a, b in zip(kts, kts[1:]))
+    assert ht.filleted_rod_kt(3e-3, 4e-3) == pytest.approx(1.073, abs=5e-4)
+    assert _roark_u_groove(1.0, 8 / 11) == pytest.approx(1.128, abs=5e-4)
+
+
 def _peterson_chart_2_24(x: float) -> float:
     """An independent published fit of the same geometry: W. D. Pilkey, D. F. Pilkey,
     Peterson's Stress Concentration Factors, 3rd ed. (2008), Chart 2.24, bending of a flat
@@ -81,16 +121,16 @@ def test_circular_notch_kt_near_the_issue_3d_fe_ratios():
 
 def test_table2_reports_peak_beside_nominal():
     """The 3-PRS Table 2 solve: nominal stresses unchanged (177.6 MPa, the paper's check), the
-    revolute notch (t 2, r 8 mm) at peak = K_t x nominal with K_t of Roark's fit, and the
-    filleted rod (no fit shipped) at K_t = 1."""
+    revolute notch (t 2, r 8 mm) and the spherical neck (filleted rod, d 3, r 4 mm) at
+    peak = K_t x nominal with K_t of Roark's fits."""
     v = solve(load_problem(TABLE2)).values
     kt = ht.circular_notch_kt(2e-3, 8e-3)
     assert v["Kt_revolute"] == pytest.approx(kt, rel=1e-12)
     assert v["Kt_revolute"] == pytest.approx(_roark_case_2b(1.0, 16 / 18), rel=1e-12)
     assert v["stress_revolute"] == pytest.approx(177.58e6, rel=1e-4)
     assert v["stress_peak_revolute"] == pytest.approx(kt * v["stress_revolute"], rel=1e-12)
-    assert v["Kt_spherical"] == 1.0
-    assert v["stress_peak_spherical"] == pytest.approx(v["stress_spherical"], rel=1e-12)
+    assert v["Kt_spherical"] == pytest.approx(_roark_shoulder(1.0, 8 / 11), rel=1e-12)
+    assert v["stress_peak_spherical"] == pytest.approx(v["Kt_spherical"] * v["stress_spherical"], rel=1e-12)
     assert v["stress_peak_max"] == pytest.approx(max(v["stress_peak_revolute"], v["stress_peak_spherical"]))
     assert v["stress_max"] == pytest.approx(max(v["stress_revolute"], v["stress_spherical"]))
 
@@ -137,14 +177,14 @@ def test_hinge_peaks_of_a_hinge_set():
     for h in hs.hinges:
         assert peaks[h.name] == pytest.approx(h.kt * 1e8)
     assert hs.checked(stresses, peak=False) == 1e8
-    assert hs.checked(stresses, peak=True) == pytest.approx(1e8 * ht.circular_notch_kt(2e-3, 8e-3))
+    assert hs.checked(stresses, peak=True) == pytest.approx(1e8 * ht.filleted_rod_kt(3e-3, 4e-3))  # the largest
 
 
 def test_six_axis_model_reports_the_peak():
     """The six-axis hinge model (prs3_cutting_force.yaml): the largest peak stress lies between
-    the largest nominal one and K_t of the notch times it (the spherical necks have K_t = 1)."""
+    the largest nominal one and the largest K_t times it (the necks' 1.073, the notches' 1.061)."""
     v = solve(load_problem(ROOT / "problems" / "prs3_cutting_force.yaml")).values
-    kt = ht.circular_notch_kt(2e-3, 8e-3)
+    kt = max(ht.circular_notch_kt(2e-3, 8e-3), ht.filleted_rod_kt(3e-3, 4e-3))
     assert v["stress_max_loaded"] > 0
     assert v["stress_max_loaded"] <= v["stress_peak_max_loaded"] <= kt * v["stress_max_loaded"] * (1 + 1e-12)
     assert v["stress_peak_max_unloaded"] == v["stress_max_unloaded"] == 0.0  # no load, no deflection
