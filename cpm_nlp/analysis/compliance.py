@@ -35,8 +35,10 @@ structure (no deflection); the platform compliance it gives is that of the
 actuated directions.
 
 Hinge stresses follow from the hinge moments M = k (θ - θ0) by the formulas of
-`HINGE_TYPES` (nominal stresses at the thinnest section, each with its
-source), combined by von Mises where a hinge carries bending and torsion.
+:data:`HINGE_TYPES` (nominal stresses at the thinnest section, each with its
+source), combined by von Mises where a hinge carries bending and torsion.  The peak
+stress is K_t times the nominal one (:attr:`Hinge.kt`: a hinge's ``Kt``, else its
+type's published fit, else 1).
 """
 
 from __future__ import annotations
@@ -118,7 +120,14 @@ def _hinge_fields() -> tuple:
             default=None,
         ),
         material_node("material", "the hinge's own material (default: the problem's or the mechanism's)", None),
-        Option("Kt", "dimensionless", "stress concentration factor (default 1)", default=None, lower=1.0),
+        Option(
+            "Kt",
+            "dimensionless",
+            "stress-concentration factor on the nominal stress, for the peak stress (default: the type's "
+            "published fit, circular_notch; else 1)",
+            default=None,
+            lower=1.0,
+        ),
         Option("r_fillet", "length", "accepted for older files; not used (a filleted rod's fillet is r)", default=None),
         *(dataclasses.replace(o, default=None) for o in DIM_OPTIONS.values()),
     )
@@ -258,11 +267,23 @@ class Hinge:
     k_formula: dict[str, float] = field(default_factory=dict)
 
     def stress(self, deflection: Mapping[str, float]) -> float | None:
-        """Largest stress for the axis deflections (θ - θ0); None without geometry."""
+        """Largest nominal stress for the axis deflections (θ - θ0); None without geometry."""
         if self.kind is None:
             return None
         loads = {a: self.k[a] * deflection[a] for a in self.axes}
         return float(HINGE_TYPES[self.kind].stress(self.dims, loads))
+
+    @property
+    def kt(self) -> float | None:
+        """The stress-concentration factor K_t on the nominal stress (peak = K_t × nominal):
+        the hinge's ``Kt`` where given, else its type's published fit
+        (:attr:`~cpm_nlp.analysis.hinge_types.HingeType.kt`), else 1; None without geometry."""
+        if self.kind is None:
+            return None
+        if self.dims.get("Kt") is not None:
+            return float(self.dims["Kt"])
+        fit = HINGE_TYPES[self.kind].kt
+        return 1.0 if fit is None else float(fit(self.dims))
 
     def angle_limit(self, axis: str, sigma_allow: float) -> float | None:
         """The deflection about one axis alone at which the hinge reaches sigma_allow."""
@@ -294,6 +315,16 @@ class HingeSet:
     def stresses(self, theta: np.ndarray) -> dict[str, float | None]:
         dev = np.asarray(theta, dtype=float) - self.theta0
         return {h.name: h.stress({a: float(dev[i]) for a, i in h.axes.items()}) for h in self.hinges}
+
+    def peaks(self, stresses: Mapping[str, float | None]) -> dict[str, float | None]:
+        """The peak stress K_t × nominal of each hinge (:attr:`Hinge.kt`), from its nominal stress."""
+        kts = {h.name: h.kt for h in self.hinges}
+        return {n: None if s is None else kts[n] * s for n, s in stresses.items()}
+
+    def checked(self, stresses: Mapping[str, float | None], peak: bool) -> float | None:
+        """The largest stress a stress limit checks: the nominal one (the papers'), or the peak."""
+        vals = self.peaks(stresses) if peak else stresses
+        return max((v for v in vals.values() if v is not None), default=None)
 
 
 def joint_names(closure: LoopClosure) -> list[str]:
@@ -357,7 +388,8 @@ def _hinge_dims(kind: str | None, spec: HingeSpec, path: tuple) -> dict[str, flo
         {d: spec.dims.get(d) for d in need}, [DIM_OPTIONS[d] for d in need], path, what="hinge dimension"
     )
     check_geometry(kind, dims, path)
-    dims["Kt"] = 1.0 if spec.Kt is None else float(spec.Kt)
+    if spec.Kt is not None:  # else the type's published fit (Hinge.kt)
+        dims["Kt"] = float(spec.Kt)
     return dims
 
 

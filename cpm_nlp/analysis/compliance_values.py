@@ -30,27 +30,48 @@ def stress_outputs(suffix: str = "") -> list[Output]:
     ]
 
 
+def peak_outputs(suffix: str = "") -> list[Output]:
+    """The largest peak stress (K_t × nominal) over every hinge, that of each hinge group, and
+    each group's stress-concentration factor K_t (:attr:`~.compliance.Hinge.kt`): two families."""
+    per = "hinge group with a flexure type"
+    return [
+        Output("stress_peak_max" + suffix, "stress"),
+        Output(f"stress_peak_{{group}}{suffix}", "stress", per=per),
+        Output("Kt_{group}", "dimensionless", per=per),
+    ]
+
+
 def stress_groups(hs: HingeSet) -> list[str]:
     """The hinge groups with a stress: those of a flexure type, in name order."""
     return sorted({h.group for h in hs.hinges if h.kind is not None})
 
 
 def stress_values(hs: HingeSet, points: list[StaticPoint | None], batch: bool, suffix: str = "") -> Values:
-    """The largest stress (and each hinge group's) per point."""
+    """The largest nominal stress (and each hinge group's) per point, beside the peak stress
+    K_t × nominal (and each group's), and each group's K_t (the largest of its hinges')."""
     groups = stress_groups(hs)
     largest, family = stress_outputs(suffix)
+    peak_largest, peak_family, kt_family = peak_outputs(suffix)
     cols: dict[Output, list] = {largest: []}
     cols.update({family.member(group=g): [] for g in groups})
+    cols[peak_largest] = []
+    cols.update({peak_family.member(group=g): [] for g in groups})
     for sp in points:
         if sp is None:
             for v in cols.values():
                 v.append(None)
             continue
         cols[largest].append(sp.stress_max)
+        peaks = list(hs.peaks(sp.stresses).values())
+        cols[peak_largest].append(max((p for p in peaks if p is not None), default=None))
         for g in groups:
             vals = [s for h, s in zip(hs.hinges, sp.stresses.values()) if h.group == g and s is not None]
             cols[family.member(group=g)].append(max(vals) if vals else None)
-    return Values().add_all((o, v if batch else v[0]) for o, v in cols.items())
+            pk = [p for h, p in zip(hs.hinges, peaks) if h.group == g and p is not None]
+            cols[peak_family.member(group=g)].append(max(pk) if pk else None)
+    out = Values().add_all((o, v if batch else v[0]) for o, v in cols.items())
+    kts = {g: max(h.kt for h in hs.hinges if h.group == g and h.kind is not None) for g in groups}
+    return out.add_all((kt_family.member(group=g), kts[g]) for g in groups)
 
 
 def coordinate_list(coords: Sequence[Coordinate]) -> str:

@@ -229,6 +229,7 @@ class SixAxisHinges(HingeModel):
         out.extend(compliance_matrix(c, C, C @ f)).add(text("hinge_model"), "all")
         out.extend(diagonal_compliance(c, C))
         out.add(Output("stress_max_unloaded", "stress"), largest(sm.stresses(z_u)))
+        out.add(Output("stress_peak_max_unloaded", "stress"), largest(sm.hs.peaks(sm.stresses(z_u))))
         note = f"six-axis hinges: {', '.join(sm.six_axis_hinges) or 'none'}; {sm.chains.note}"
         if not np.any(f):
             info = SolverInfo("newton-kkt", pose.iterations + it_u, pose.seconds)
@@ -243,6 +244,7 @@ class SixAxisHinges(HingeModel):
         out.extend(deflection_values(c, d))
         out.add(vector("q_loaded", coordinate_list(c.q)), z_l[c.nx : c.nx + c.nq].tolist())
         out.add(Output("stress_max_loaded", "stress"), largest(sm.stresses(z_l)))
+        out.add(Output("stress_peak_max_loaded", "stress"), largest(sm.hs.peaks(sm.stresses(z_l))))
         if ka is None:
             F = sm.actuator_reactions(z_l, lam_l, f)
             out.add_all((force_output(f"F{j + 1}_loaded", q), float(F[j])) for j, q in enumerate(c.q))

@@ -43,30 +43,79 @@ def rectangle_torsion_stress(T, a, c):
     return 3.0 * T / (8.0 * A * B**2) * (1 + 0.6095 * ratio + 0.8865 * ratio**2 - 1.8023 * ratio**3 + 0.91 * ratio**4)
 
 
+def circular_notch_kt(t, r):
+    """Stress-concentration factor K_t of a circular notch hinge in bending about its compliant
+    axis, on the nominal stress 6M/(w t²) of its thinnest section: the hinge is a bar of height
+    H = t + 2r with two opposite U-notches of depth h = r and radius r (h/r = 1), whose fit is
+    W. C. Young, R. G. Budynas, Roark's Formulas for Stress and Strain, 7th ed. (2002),
+    Table 17.1, case 2b (two U-notches in a member of rectangular section, in-plane bending),
+    for 0.25 <= h/r <= 2.0:
+        K_t = C1 + C2 (2h/H) + C3 (2h/H)² + C4 (2h/H)³,
+        C1 = 0.723 + 2.845 √(h/r) - 0.504 h/r,   C2 = -1.836 - 5.746 √(h/r) + 1.314 h/r,
+        C3 = 7.254 - 1.885 √(h/r) + 1.646 h/r,   C4 = -5.140 + 4.785 √(h/r) - 2.456 h/r.
+    Coefficients as read in a transcription of that table (eng-calculations.com, "Two U-notches
+    in a member of rectangular section for elastic stress, in-plane bending"), not in the book.
+    At h/r = 1 the coefficients sum to 1.000: K_t -> 1 as t/r -> 0 (2h/H -> 1), and
+    K_t -> C1 = 3.064 for a shallow notch in a wide bar (2h/H -> 0)."""
+    h_over_r = 1.0
+    s = math.sqrt(h_over_r)
+    c1 = 0.723 + 2.845 * s - 0.504 * h_over_r
+    c2 = -1.836 - 5.746 * s + 1.314 * h_over_r
+    c3 = 7.254 - 1.885 * s + 1.646 * h_over_r
+    c4 = -5.140 + 4.785 * s - 2.456 * h_over_r
+    x = 2.0 * r / (t + 2.0 * r)  # 2h/H
+    return c1 + c2 * x + c3 * x**2 + c4 * x**3
+
+
+def filleted_rod_kt(d, r):
+    """Stress-concentration factor K_t of a filleted round neck (diameter d, fillets of radius r
+    rising to D = d + 2r) in bending, on the nominal 32M/(π d³): each end is a square shoulder
+    with a fillet of height h = r (h/r = 1) in a circular shaft, whose fit is W. C. Young,
+    R. G. Budynas, Roark's Formulas for Stress and Strain, 7th ed. (2002), Table 17.1 (square
+    shoulder with fillet in a circular shaft, bending), for 0.25 <= h/r <= 2.0:
+        K_t = C1 + C2 (2h/D) + C3 (2h/D)² + C4 (2h/D)³,
+        C1 = 0.927 + 1.149 √(h/r) - 0.086 h/r,   C2 = 0.015 - 3.281 √(h/r) + 0.837 h/r,
+        C3 = 0.847 + 1.716 √(h/r) - 0.506 h/r,   C4 = -0.790 + 0.417 √(h/r) - 0.246 h/r
+    (coefficients as read in a transcription of that table, eng-calculations.com, "Square
+    shoulder with fillet in circular shaft for elastic stress, bending", not in the book).
+    A shoulder fit: it assumes the neck long enough that its two fillets do not interact; a
+    neck of no straight length is a U-groove, for which the same table's fit gives more
+    (1.128 against 1.073 for the 3-PRS neck, d 3 mm, r 4 mm).  At h/r = 1 the coefficients
+    sum to 0.999: K_t -> 1 as d/r -> 0."""
+    h_over_r = 1.0
+    s = math.sqrt(h_over_r)
+    c1 = 0.927 + 1.149 * s - 0.086 * h_over_r
+    c2 = 0.015 - 3.281 * s + 0.837 * h_over_r
+    c3 = 0.847 + 1.716 * s - 0.506 * h_over_r
+    c4 = -0.790 + 0.417 * s - 0.246 * h_over_r
+    x = 2.0 * r / (d + 2.0 * r)  # 2h/D
+    return c1 + c2 * x + c3 * x**2 + c4 * x**3
+
+
 def _von_mises(sigma: float, tau: float) -> float:
     return math.sqrt(sigma**2 + 3.0 * tau**2)
 
 
 def _rect_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
     """Nominal stress at the thinnest section t x w of a rectangular hinge:
-    σ = K_t (6|M_bend|/(w t²) + 6|M_bend2|/(t w²) + |F|/(w t)), τ from Roark's
+    σ = (6|M_bend|/(w t²) + 6|M_bend2|/(t w²) + |F|/(w t)), τ from Roark's
     rectangle torsion, combined by von Mises."""
     t, w = d["t"], d["w"]
     sigma = 6.0 * abs(loads.get("bend", 0.0)) / (w * t**2) + 6.0 * abs(loads.get("bend2", 0.0)) / (t * w**2)
     sigma += abs(loads.get("axial", 0.0)) / (w * t)
     tau = rectangle_torsion_stress(abs(loads.get("torsion", 0.0)), w, t)
-    return d.get("Kt", 1.0) * _von_mises(sigma, tau)
+    return _von_mises(sigma, tau)
 
 
 def _rod_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
-    """Round neck of diameter d: σ = K_t (32 |M|/(π d³) + 4|F|/(π d²)) with M the
+    """Round neck of diameter d: σ = (32 |M|/(π d³) + 4|F|/(π d²)) with M the
     resultant of both bending moments, τ = 16 T/(π d³), von Mises (Euler-Bernoulli
     and Saint-Venant torsion of a circular section)."""
     dia = d["d"]
     m = math.hypot(loads.get("bend", 0.0), loads.get("bend2", 0.0))
     sigma = 32.0 * m / (math.pi * dia**3) + 4.0 * abs(loads.get("axial", 0.0)) / (math.pi * dia**2)
     tau = 16.0 * abs(loads.get("torsion", 0.0)) / (math.pi * dia**3)
-    return d.get("Kt", 1.0) * _von_mises(sigma, tau)
+    return _von_mises(sigma, tau)
 
 
 def _notch_stiffness(E, G, d) -> dict[str, float]:
@@ -193,28 +242,21 @@ DIM_OPTIONS: Mapping[str, Option] = MappingProxyType(
 class HingeType:
     """A flexure hinge geometry.
 
-    Attributes
-    ----------
-    name
-        its ``type`` (a hinge's) or ``hinge`` (a joint limit's) in a file.
-    dims
-        the dimensions its stiffness and stress take (`DIM_OPTIONS`).
-    stiffness
-        ``(E, G, dims) -> {axis: k}`` about the axes of `cpm_nlp.analysis.compliance.AXES` (G
-        None when the material gives no Poisson's ratio), None if no source gives it.
-    six_axis
-        ``(E, G, dims) -> {axis: k}`` over all of `SIX_AXES`, at its centre.
-    stress
-        ``(dims, loads) -> σ``, its largest stress for the loads per axis.
-    source
-        the sources of stiffness, six-axis stiffness and stress.
-    limit_dims
-        the dimensions its largest rotation takes.
-    rotation
-        ``(E, σ_allow, dims) -> δ_max`` [rad], the largest rotation at the allowable stress (a
-        joint's rotation limit), None if no source gives it.
-    limit_source
-        the source of ``rotation``.
+    name: its ``type`` (a hinge's) or ``hinge`` (a joint limit's) in a file.
+    dims: the dimensions its stiffness and stress take (:data:`DIM_OPTIONS`).
+    stiffness: ``(E, G, dims) -> {axis: k}`` about the axes of
+        :data:`cpm_nlp.analysis.compliance.AXES` (G None when the material gives no
+        Poisson's ratio), None if no source gives it.
+    six_axis: ``(E, G, dims) -> {axis: k}`` over all of :data:`SIX_AXES`, at its centre.
+    stress: ``(dims, loads) -> σ``, its largest nominal stress for the loads per axis.
+    kt: ``(dims) -> K_t``, its stress-concentration factor on that nominal stress (peak =
+        K_t × nominal), None where no published fit is shipped (a hinge's ``Kt``, else 1).
+    kt_source: the source of ``kt``.
+    source: the sources of stiffness, six-axis stiffness and stress.
+    limit_dims: the dimensions its largest rotation takes.
+    rotation: ``(E, σ_allow, dims) -> δ_max`` [rad], the largest rotation at the allowable
+        stress (a joint's rotation limit), None if no source gives it.
+    limit_source: the source of ``rotation``.
     """
 
     name: str
@@ -223,6 +265,8 @@ class HingeType:
     six_axis: Callable[..., dict[str, float]] | None = None
     stress: Callable[..., float] | None = None
     source: str = ""
+    kt: Callable[..., float] | None = None
+    kt_source: str = ""
     limit_dims: tuple[str, ...] = ()
     rotation: Callable[..., float] | None = None
     limit_source: str = ""
@@ -257,10 +301,13 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _rect_stress,
                 "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance), Paros-Weisbord exact without nu; "
                 "stress: nominal 6M/(w t^2) at the thinnest section (the stress of Elgammal et al. 2016 "
-                "eq 38), times Kt (default 1)",
-                ("t", "r"),
-                lambda E, sigma, d: circular_notch_max_rotation(E, d["t"], d["r"], sigma),
-                "Elgammal et al. 2016, eq 38",
+                "eq 38); peak: K_t x nominal",
+                kt=lambda d: circular_notch_kt(d["t"], d["r"]),
+                kt_source="Roark's Formulas for Stress and Strain, 7th ed., Table 17.1 case 2b (two U-notches, "
+                "in-plane bending), h/r = 1",
+                limit_dims=("t", "r"),
+                rotation=lambda E, sigma, d: circular_notch_max_rotation(E, d["t"], d["r"], sigma),
+                limit_source="Elgammal et al. 2016, eq 38",
             ),
             HingeType(
                 "circular_rod",
@@ -269,7 +316,7 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _rod_six,
                 _rod_stress,
                 "stiffness: E I/l, G J/l, E A/l of a round neck of diameter d and length l (fillets ignored: "
-                "stiffer); stress: 32M/(pi d^3), 16T/(pi d^3), von Mises, times Kt (default 1)",
+                "stiffer); stress: 32M/(pi d^3), 16T/(pi d^3), von Mises; peak: Kt x nominal (Kt given, default 1)",
             ),
             HingeType(
                 "filleted_rod",
@@ -279,7 +326,10 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _rod_stress,
                 "stiffness: Euler-Bernoulli integrals over a round neck of diameter d and straight length l with "
                 "circular fillets of radius r at both ends (a revolved corner-filleted hinge, Lobontiu 2002 ch. 2); "
-                "stress: 32M/(pi d^3), 16T/(pi d^3) at the neck, von Mises, times Kt (default 1)",
+                "stress: 32M/(pi d^3), 16T/(pi d^3) at the neck, von Mises; peak: K_t x nominal",
+                kt=lambda d: filleted_rod_kt(d["d"], d["r"]),
+                kt_source="Roark's Formulas for Stress and Strain, 7th ed., Table 17.1 (square shoulder with fillet "
+                "in a circular shaft, bending), h/r = 1",
             ),
             HingeType(
                 "leaf_spring",
@@ -288,10 +338,10 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _leaf_six,
                 _rect_stress,
                 "stiffness: E w t^3/(12 l) (Euler-Bernoulli), G J/l with Roark's rectangle J; "
-                "stress: 6M/(w t^2), Roark Table 10.7 torsion, von Mises",
-                ("l", "t"),
-                lambda E, sigma, d: leaf_spring_max_rotation(E, d["t"], d["l"], sigma),
-                "Euler-Bernoulli leaf spring under a pure moment",
+                "stress: 6M/(w t^2), Roark Table 10.7 torsion, von Mises; peak: Kt x nominal (Kt given, default 1)",
+                limit_dims=("l", "t"),
+                rotation=lambda E, sigma, d: leaf_spring_max_rotation(E, d["t"], d["l"], sigma),
+                limit_source="Euler-Bernoulli leaf spring under a pure moment",
             ),
         )
     }

@@ -27,6 +27,7 @@ from ..analysis.compliance_values import (
     coordinate_list,
     diagonal_output,
     force_output,
+    peak_outputs,
     point_warnings,
     stress_groups,
     stress_outputs,
@@ -164,9 +165,15 @@ def _declared_hinges(kind: ProblemKind, model: Model) -> cm.HingeSet | None:
 
 
 def _stress_outputs(hs: cm.HingeSet | None, suffix: str = "") -> list[Output]:
-    """The largest stress, that of each of the mechanism's hinge groups, and the family of all groups."""
+    """The largest stress, that of each of the mechanism's hinge groups, and the family of all
+    groups: the nominal stresses, then the peak stresses K_t × nominal and each group's K_t."""
+    groups = stress_groups(hs) if hs is not None else ()
+    out: list[Output] = []
     largest, family = stress_outputs(suffix)
-    return [largest, *(family.member(group=g) for g in (stress_groups(hs) if hs is not None else ())), family]
+    peak_largest, peak_family, kt_family = peak_outputs(suffix)
+    for one, fam in ((largest, family), (peak_largest, peak_family)):
+        out += [one, *(fam.member(group=g) for g in groups), fam]
+    return [*out, *(kt_family.member(group=g) for g in groups), kt_family]
 
 
 def _k_q_output(c: Any) -> Output:
@@ -221,6 +228,14 @@ class ActuatorForces(_HingeKind):
                 strict=True,
             ),
             Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
+            Option(
+                "stress_check",
+                "choice",
+                "the stress the stress limit checks: nominal (at the thinnest section, as the papers do) or peak "
+                "(K_t x nominal, the hinges' stress-concentration factors)",
+                default="nominal",
+                choices=("nominal", "peak"),
+            ),
         ]
 
     def check_inputs(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
@@ -277,7 +292,7 @@ class ActuatorForces(_HingeKind):
             if not sol.ok:
                 raise _OutOfReach(lam, sol)
             sp = cm.static_point(model, hs, sol.x, sol.q, inputs["load"])
-            return (sp.stress_max or 0.0) - sigma
+            return (hs.checked(sp.stresses, inputs["stress_check"] == "peak") or 0.0) - sigma
 
         s_end = excess(1.0) + sigma
         lam_lin = sigma / s_end if s_end > 0 else None
@@ -292,7 +307,10 @@ class ActuatorForces(_HingeKind):
         if lam is None:
             return Values(), "the stresses never reach sigma_allow along this motion"
         values = _limit_values(model, ray, ray.pose(lam), lam, lam_lin, sigma)
-        return values, f"first hinge at sigma_allow = {sigma / 1e6:.6g} MPa at scale {lam:.6g} of the motion"
+        which = "peak" if inputs["stress_check"] == "peak" else "nominal"
+        return values, (
+            f"first hinge at sigma_allow = {sigma / 1e6:.6g} MPa ({which} stress) at scale {lam:.6g} of the motion"
+        )
 
     def _root(
         self, excess: Any, sigma: float, s_end: float, inputs: Mapping[str, Any], hs: cm.HingeSet
@@ -454,6 +472,7 @@ class PlatformCompliance(_HingeKind):
             *(Output(f"d_{x.name}", x.kind) for x in c.x),
             text("hinge_model"),
             Output("stress_max_unloaded", "stress"),
+            Output("stress_peak_max_unloaded", "stress"),
             *(force_output(f"F{j + 1}_loaded", q) for j, q in enumerate(c.q)),
         ]
 
