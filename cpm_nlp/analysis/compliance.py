@@ -35,9 +35,9 @@ structure (no deflection); the platform compliance it gives is that of the
 actuated directions.
 
 Hinge stresses follow from the hinge moments M = k (θ - θ0) by the formulas of
-:data:`HINGE_TYPES` (nominal stresses at the thinnest section, each with its
+`HINGE_TYPES` (nominal stresses at the thinnest section, each with its
 source), combined by von Mises where a hinge carries bending and torsion.  The peak
-stress is K_t times the nominal one (:attr:`Hinge.kt`: a hinge's ``Kt``, else its
+stress is K_t times the nominal one (`Hinge.kt`: a hinge's ``Kt``, else its
 type's published fit, else 1).
 """
 
@@ -277,7 +277,7 @@ class Hinge:
     def kt(self) -> float | None:
         """The stress-concentration factor K_t on the nominal stress (peak = K_t × nominal):
         the hinge's ``Kt`` where given, else its type's published fit
-        (:attr:`~cpm_nlp.analysis.hinge_types.HingeType.kt`), else 1; None without geometry."""
+        (`kt`), else 1; None without geometry."""
         if self.kind is None:
             return None
         if self.dims.get("Kt") is not None:
@@ -317,7 +317,7 @@ class HingeSet:
         return {h.name: h.stress({a: float(dev[i]) for a, i in h.axes.items()}) for h in self.hinges}
 
     def peaks(self, stresses: Mapping[str, float | None]) -> dict[str, float | None]:
-        """The peak stress K_t × nominal of each hinge (:attr:`Hinge.kt`), from its nominal stress."""
+        """The peak stress K_t × nominal of each hinge (`Hinge.kt`), from its nominal stress."""
         kts = {h.name: h.kt for h in self.hinges}
         return {n: None if s is None else kts[n] * s for n, s in stresses.items()}
 

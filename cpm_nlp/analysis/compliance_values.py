@@ -32,7 +32,7 @@ def stress_outputs(suffix: str = "") -> list[Output]:
 
 def peak_outputs(suffix: str = "") -> list[Output]:
     """The largest peak stress (K_t × nominal) over every hinge, that of each hinge group, and
-    each group's stress-concentration factor K_t (:attr:`~.compliance.Hinge.kt`): two families."""
+    each group's stress-concentration factor K_t (`kt`): two families."""
     per = "hinge group with a flexure type"
     return [
         Output("stress_peak_max" + suffix, "stress"),

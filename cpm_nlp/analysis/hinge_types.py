@@ -242,21 +242,33 @@ DIM_OPTIONS: Mapping[str, Option] = MappingProxyType(
 class HingeType:
     """A flexure hinge geometry.
 
-    name: its ``type`` (a hinge's) or ``hinge`` (a joint limit's) in a file.
-    dims: the dimensions its stiffness and stress take (:data:`DIM_OPTIONS`).
-    stiffness: ``(E, G, dims) -> {axis: k}`` about the axes of
-        :data:`cpm_nlp.analysis.compliance.AXES` (G None when the material gives no
-        Poisson's ratio), None if no source gives it.
-    six_axis: ``(E, G, dims) -> {axis: k}`` over all of :data:`SIX_AXES`, at its centre.
-    stress: ``(dims, loads) -> σ``, its largest nominal stress for the loads per axis.
-    kt: ``(dims) -> K_t``, its stress-concentration factor on that nominal stress (peak =
-        K_t × nominal), None where no published fit is shipped (a hinge's ``Kt``, else 1).
-    kt_source: the source of ``kt``.
-    source: the sources of stiffness, six-axis stiffness and stress.
-    limit_dims: the dimensions its largest rotation takes.
-    rotation: ``(E, σ_allow, dims) -> δ_max`` [rad], the largest rotation at the allowable
-        stress (a joint's rotation limit), None if no source gives it.
-    limit_source: the source of ``rotation``.
+    Attributes
+    ----------
+    name
+        its ``type`` (a hinge's) or ``hinge`` (a joint limit's) in a file.
+    dims
+        the dimensions its stiffness and stress take (`DIM_OPTIONS`).
+    stiffness
+        ``(E, G, dims) -> {axis: k}`` about the axes of `cpm_nlp.analysis.compliance.AXES` (G
+        None when the material gives no Poisson's ratio), None if no source gives it.
+    six_axis
+        ``(E, G, dims) -> {axis: k}`` over all of `SIX_AXES`, at its centre.
+    stress
+        ``(dims, loads) -> σ``, its largest nominal stress for the loads per axis.
+    kt
+        ``(dims) -> K_t``, its stress-concentration factor on that nominal stress (peak = K_t ×
+        nominal), None where no published fit is shipped (a hinge's ``Kt``, else 1).
+    kt_source
+        the source of ``kt``.
+    source
+        the sources of stiffness, six-axis stiffness and stress.
+    limit_dims
+        the dimensions its largest rotation takes.
+    rotation
+        ``(E, σ_allow, dims) -> δ_max`` [rad], the largest rotation at the allowable stress (a
+        joint's rotation limit), None if no source gives it.
+    limit_source
+        the source of ``rotation``.
     """
 
     name: str
