@@ -203,15 +203,22 @@ def _force_panel(values: dict, forces: list[str], order: np.ndarray, published: 
 
 
 def _stress_panel(data: ResultData, values: dict, order: np.ndarray, published: dict, x: str) -> ForcePanel | None:
-    """Each hinge group's largest stress (the largest of all, stress_max, is their upper
-    envelope: drawn only without groups), the allowable stress and where it is reached."""
-    groups = sorted(k for k in values if k.startswith("stress_") and k not in ("stress_max",) and "_loaded" not in k)
+    """Each hinge group's largest nominal stress (the largest of all, stress_max, is their upper
+    envelope: drawn only without groups), the largest peak stress (K_t times the nominal one,
+    where the result gives it), the allowable stress and where it is reached."""
+    groups = sorted(
+        k
+        for k in values
+        if k.startswith("stress_") and k != "stress_max" and not k.startswith("stress_peak_") and "_loaded" not in k
+    )
     groups = [g for g in groups if isinstance(values[g], list)]
     if not groups and not isinstance(values.get("stress_max"), list):
         return None
     curves = [Quantity(readable_group(g.removeprefix("stress_")), as_floats(values[g])[order]) for g in groups]
     if not curves:
         curves = [Quantity("largest hinge stress", as_floats(values["stress_max"])[order])]
+    if isinstance(values.get("stress_peak_max"), list):  # the notch's stress concentration
+        curves.append(Quantity("largest peak stress ($K_t$ × nominal)", as_floats(values["stress_peak_max"])[order]))
     points = [(px, py, f"{text}: largest joint stress") for px, py, text in published.get("stress_max", ())]
     for g in groups:
         name = readable_group(g.removeprefix("stress_"))
