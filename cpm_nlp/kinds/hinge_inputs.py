@@ -13,6 +13,7 @@ import numpy as np
 from ..analysis import compliance as cm
 from ..analysis.dynamics import BLOCK, INERTIA_BLOCK
 from ..analysis.flexure import material_node
+from ..analysis.stress_limits import stress_angle_limits, with_limits
 from ..core.errors import InputError
 from ..core.model import Model
 from ..core.options import Option
@@ -151,7 +152,7 @@ def stress_limit_option(model: Model) -> Either:
         if not any(h.kind is not None for h in hs.hinges):
             raise InputError("a stress limit needs hinges with a flexure type and dimensions", path=path + ("hinges",))
         sigma = cm.allowable(hs, vals["sigma_allow"], vals["safety_factor"], path)
-        return cm.with_limits(model, cm.stress_angle_limits(hs, sigma))
+        return with_limits(model, stress_angle_limits(hs, sigma))
 
     return Either(
         "stress_limit",
