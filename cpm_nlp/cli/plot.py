@@ -62,6 +62,19 @@ def save_figure(args: argparse.Namespace, fig_and_type: tuple[Any, str], out: Te
         out.write(f"plot    : {args.plot} ({kind})\n")
 
 
+def _check_axes_used(args: argparse.Namespace, kind: str) -> None:
+    """--x and --y choose a map's axes; given to any other plot they would be
+    ignored without a word, so they are refused (exit 2, nothing written)."""
+    given = [flag for flag, v in (("--x", args.x), ("--y", args.y)) if v is not None]
+    if given and kind != "map":
+        verb, them = ("choose", "them") if len(given) > 1 else ("chooses", "it")
+        raise InputError(
+            f"{' and '.join(given)} {verb} the axes of a map plot; {args.result} was drawn as a {kind} plot, "
+            f"which has its own axes: leave {them} out, or ask for the map with --type map",
+            path=(given[0],),
+        )
+
+
 def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
     from ..plot.draw import check_figure_path, require_backend, save
     from ..plot.figures import check_plot_type, figure, load
@@ -75,6 +88,7 @@ def cmd_plot(args: argparse.Namespace, out: TextIO) -> int:
     except InputError as exc:  # every message about the result names the file plotted
         about_a_flag = bool(exc.path) and str(exc.path[0]).startswith("-")
         raise (exc if exc.file or about_a_flag else exc.at(file=args.result)) from None
+    _check_axes_used(args, kind)
     save(fig, args.output, inputs=[args.result])
     out.write(f"{args.output}: {kind} plot of {args.result}\n")
     return EXIT_OK

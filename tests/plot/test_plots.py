@@ -263,6 +263,11 @@ def test_plot_bad_input(cli, tmp_path):
     assert run.err == (
         f"error: -o: expected a figure file ending in .png, .svg, .pdf, .html, got '{tmp_path / 'x.jpg'}'\n"
     )
+    run = cli("plot", str(out), "-o", str(tmp_path / "x.png"), "--x", "px")  # an FK result draws no map
+    assert run.code == 2 and run.err.startswith(
+        f"error: --x: --x chooses the axes of a map plot; {out} was drawn as a "
+    ), run.err
+    assert run.err.endswith("leave it out, or ask for the map with --type map\n")
     run = cli("plot", fk, "-o", str(tmp_path / "x.png"))
     assert run.code == 2 and run.err == (
         f"error: {fk}: expected a JSON result written by 'cpm-nlp solve -o' or a sweep results file (.parquet, .csv)\n"
