@@ -73,6 +73,9 @@ class JointType:
         S, planar R.
     twin
         the same joint in the other kind of mechanism (R <-> planar_R).
+    in_plane
+        the type a planar mechanism file gives it (a planar type is its own; R and S turn
+        about z in the plane, planar_R; P slides in it, planar_P; None: no planar form).
     hinges
         names of the flexure hinge types that can sit at it (see the module).
     """
@@ -90,6 +93,7 @@ class JointType:
     point: bool = False
     sphere: bool = False
     twin: str | None = None
+    in_plane: str | None = None
     hinges: tuple[str, ...] = ()
 
     @property
@@ -111,7 +115,16 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
     {
         t.name: t
         for t in (
-            JointType("P", "prismatic (spatial)", "P", (("P", "axis"),), axis="given", actuable=True, twin="planar_P"),
+            JointType(
+                "P",
+                "prismatic (spatial)",
+                "P",
+                (("P", "axis"),),
+                axis="given",
+                actuable=True,
+                twin="planar_P",
+                in_plane="planar_P",
+            ),
             JointType(
                 "R",
                 "revolute (spatial)",
@@ -120,6 +133,7 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
                 axis="given",
                 actuable=True,
                 twin="planar_R",
+                in_plane="planar_R",
                 hinges=_REVOLUTE_HINGES,
             ),
             JointType(
@@ -147,6 +161,7 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
                 default_axes=("x", "y", "z"),
                 point=True,
                 sphere=True,
+                in_plane="planar_R",
                 hinges=("circular_rod", "filleted_rod"),
             ),
             JointType(
@@ -161,6 +176,7 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
                 point=True,
                 sphere=True,
                 twin="R",
+                in_plane="planar_R",
                 hinges=_REVOLUTE_HINGES,
             ),
             JointType(
@@ -173,6 +189,7 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
                 spatial=False,
                 actuable=True,
                 twin="P",
+                in_plane="planar_P",
             ),
             JointType(
                 "distance",
@@ -180,6 +197,7 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
                 "S",
                 (),
                 planar=True,
+                in_plane="distance",
             ),
         )
     }
@@ -187,6 +205,11 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
 
 #: the letters a drawing marks joints with
 JOINT_LETTERS = tuple(dict.fromkeys(t.letter for t in JOINT_TYPES.values()))
+
+#: what each letter is called in a drawing's legend
+LETTER_NAMES: Mapping[str, str] = MappingProxyType(
+    {"P": "prismatic", "R": "revolute", "C": "cylindrical", "U": "universal", "S": "spherical"}
+)
 
 
 def joint_type(name: object, path: tuple = ()) -> JointType:

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import InputError
+from ..core.joints import LETTER_NAMES
 from .draw_tables import matrix_axes
 from .style import (
     axis_label,
@@ -46,7 +47,6 @@ _FACE_COLOUR = {
 }
 #: marker of each joint letter (prismatic, revolute, universal, spherical, cylindrical)
 JOINT_MARKER = {"P": "s", "R": "o", "U": "D", "S": "o", "C": "^"}
-JOINT_NAME = {"P": "prismatic", "R": "revolute", "U": "universal", "S": "spherical", "C": "cylindrical"}
 
 
 @dataclass
@@ -148,7 +148,7 @@ def _links_and_joints(ax: Any, drawing: Any, pts: dict, seen: set[str], faint: A
     for name, letter in drawing.joints.items():  # every marker named (the legend names each kind once)
         act = name in driven
         face = ACTUATED_FACE if act else "white" if letter == "S" else "k"
-        what = f"{JOINT_NAME[letter]} joint ({letter})"
+        what = f"{LETTER_NAMES[letter]} joint ({letter})"
         label = f"actuated {what}" if act else what
         ax.scatter(
             *pts[name],

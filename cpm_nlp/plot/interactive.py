@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from .draw_mechanism import JOINT_NAME, PART_STYLE, Arrow
+from ..core.joints import LETTER_NAMES
+from .draw_mechanism import PART_STYLE, Arrow
 from .draw_workspace import (
     BOX_EDGES,
     BOX_FACES,
@@ -287,7 +288,7 @@ def mechanism_html(
                         mode="markers+text",
                         text=names,
                         marker={"size": 5, "color": "black", "symbol": _JOINT_SYMBOL[letter]},
-                        name=f"{JOINT_NAME[letter]} joint ({letter})",
+                        name=f"{LETTER_NAMES[letter]} joint ({letter})",
                     )
                 )
     for arrow in arrows:

@@ -23,7 +23,7 @@ import yaml
 import cpm_nlp as cn
 from cpm_nlp.analysis import compliance, hinge_types
 from cpm_nlp.core.chains import JOINT_DOF
-from cpm_nlp.core.joints import JOINT_LETTERS, JOINT_TYPES, joint_type, joint_types
+from cpm_nlp.core.joints import JOINT_LETTERS, JOINT_TYPES, LETTER_NAMES, joint_type, joint_types
 from cpm_nlp.mechanisms import described
 from cpm_nlp.mechanisms.described import builder, generate, motions, read_joint, spec
 from cpm_nlp.plot import draw_mechanism, interactive
@@ -124,9 +124,22 @@ def test_letters_and_the_drawings():
         "planar_P": "P",
         "distance": "S",  # an S-S strut
     }
-    drawn = (draw_mechanism.JOINT_MARKER, draw_mechanism.JOINT_NAME, interactive._JOINT_SYMBOL)
+    drawn = (draw_mechanism.JOINT_MARKER, LETTER_NAMES, interactive._JOINT_SYMBOL)
     assert set(JOINT_LETTERS) == set(drawn[0]) == set(drawn[1]) == set(drawn[2])
     assert motions.LETTER == {n: t.letter for n, t in JOINT_TYPES.items()}
+    # a planar file's type of each joint (the URDF writer's planar layout reads it)
+    assert {n: t.in_plane for n, t in JOINT_TYPES.items()} == {
+        "P": "planar_P",
+        "R": "planar_R",
+        "C": None,
+        "U": None,
+        "S": "planar_R",  # a point joint: it turns about z in the plane
+        "planar_R": "planar_R",
+        "planar_P": "planar_P",
+        "distance": "distance",
+    }
+    for t in JOINT_TYPES.values():
+        assert t.in_plane is None or (JOINT_TYPES[t.in_plane].planar and JOINT_TYPES[t.in_plane].letter in "RPS")
 
 
 def test_generate_aliases_are_the_table():

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ...core.errors import InputError, suggest
+from ...core.joints import JOINT_TYPES
 from .graph import TOL, YAML_WORDS, ZERO, GJoint, Graph
 
 NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9]){0,63}")
@@ -79,10 +80,6 @@ class Layout:
         return self.basis[:2] @ v if self.basis is not None else v
 
 
-#: a planar file's joint types
-_PLANAR_TYPES = {"R": "planar_R", "S": "planar_R", "P": "planar_P", "distance": "distance"}
-
-
 def drawing_points(graph: Graph, layout: Layout) -> tuple[dict[str, np.ndarray], dict[str, dict]]:
     """The drawing's points: a point's global value is its first body's; a body that differs says
     its own (each body's points: None where the global value holds)."""
@@ -105,7 +102,7 @@ def joint_entry(g: GJoint, graph: Graph, layout: Layout, flipped: list[str]) -> 
     is minus the URDF's: their URDF axis is -n)."""
     kind, flip = g.kind, 1.0
     if layout.basis is not None:
-        kind = _PLANAR_TYPES[kind]
+        kind = JOINT_TYPES[kind].in_plane
         if g.kind == "R" and float(np.dot(g.axis, layout.basis[2])) < 0:
             flip = -1.0
             if g.actuated or g.limits is not None or " and " not in g.source:
