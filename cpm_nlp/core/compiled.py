@@ -25,6 +25,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -101,16 +103,103 @@ def _compiler_identity(cmd: list[str]) -> str:
         return " ".join(cmd)
 
 
-def generate_source(function: ca.Function, name: str) -> str:
-    """CasADi-generated C source of one Function (no header, no main)."""
+def generate_source(function: ca.Function, name: str, extra: Sequence[ca.Function] = ()) -> str:
+    """CasADi-generated C source of one Function (no header, no main), and of ``extra``
+    Functions in the same file (each under its own name)."""
     with tempfile.TemporaryDirectory(prefix="cpm_nlp_cg_") as tmp:
         cg = ca.CodeGenerator(f"{name}.c", {"with_header": False})
         cg.add(function)
+        for f in extra:
+            cg.add(f)
         cg.generate(tmp + os.sep)
         return Path(tmp, f"{name}.c").read_text()
 
 
-def batch_loop_source(function: ca.Function, name: str) -> str:
+@dataclass(frozen=True)
+class FirstPass:
+    """The first kernel of a kernel (`Kernel.first`) as the compiled loop runs it for a model
+    without joint limits: ``pre`` (the shared inputs but the limits -> w, every part of the
+    first kernel that depends on nothing else, computed once per call) and ``per`` (the pose
+    inputs, w and those shared inputs -> the first kernel's outputs), the limits built in as
+    ±inf.  The same operations on the same numbers as the first kernel, moved or folded away:
+    its outputs, as numbers (the sign of a zero aside), on every pose.
+
+    Attributes
+    ----------
+    shared
+        positions in the kernel's inputs of ``pre``'s inputs (and of ``per``'s after w).
+    outputs
+        for each output of ``per``, its position in the kernel's outputs.
+    fills
+        (position in the kernel's outputs, value) written where the first kernel settles.
+    lower, upper
+        positions of the limits in the kernel's inputs; n_limits their length.
+    status
+        position of ``status`` in the kernel's outputs.
+    """
+
+    pre: ca.Function
+    per: ca.Function
+    pose: tuple[int, ...]
+    shared: tuple[int, ...]
+    outputs: tuple[int, ...]
+    fills: tuple[tuple[int, float], ...]
+    lower: int
+    upper: int
+    n_limits: int
+    status: int
+
+
+def first_pass(kern: Kernel) -> FirstPass | None:
+    """The `FirstPass` of a kernel with a flat SX first kernel (None: none)."""
+    first = kern.first
+    if first is None or not first.function.is_a("SXFunction"):
+        return None
+    fn, f = kern.function, first.function
+    names_in, names_out = list(fn.name_in()), list(fn.name_out())
+    if list(f.name_in()) != names_in or any(f.sparsity_in(k) != fn.sparsity_in(k) for k in range(f.n_in())):
+        return None
+    fills = dict(kern.first_fills)
+    if sorted([*f.name_out(), *fills]) != sorted(names_out):
+        return None
+    if any(f.sparsity_out(k) != fn.sparsity_out(names_out.index(n)) for k, n in enumerate(f.name_out())):
+        return None
+    if "lower" not in names_in or "upper" not in names_in or "status" not in names_out:
+        return None
+    n_pose = len(kern.pose_inputs)
+    ins = [ca.SX.sym(n, f.sparsity_in(k)) for k, n in enumerate(names_in)]
+    lo, up = names_in.index("lower"), names_in.index("upper")
+    nl = f.nnz_in(lo)
+    fixed = list(ins)
+    fixed[lo], fixed[up] = ca.SX(ca.DM.ones(nl) * -ca.inf), ca.SX(ca.DM.ones(nl) * ca.inf)
+    outs = f(*fixed)
+    shared = [k for k in range(n_pose, len(ins)) if k not in (lo, up)]
+    # every part depending on the shared numbers alone, once per call (same operations, same order)
+    per_outs, w_syms, w_values = ca.extract_parametric(list(outs), [ca.vec(ins[k]) for k in shared])
+    per_outs = [ca.densify(o) if f.sparsity_out(k).is_dense() else o for k, o in enumerate(per_outs)]
+    if any(o.sparsity() != f.sparsity_out(k) for k, o in enumerate(per_outs)):
+        return None
+    w = ca.vertcat(*w_syms) if w_syms else ca.SX(0, 1)
+    name = kern.name
+    pre = ca.Function(
+        f"{name}_first_pre", [ins[k] for k in shared], [ca.vertcat(*w_values) if w_values else ca.SX(0, 1)]
+    )
+    per = ca.Function(f"{name}_first_per", [*ins[:n_pose], w, *[ins[k] for k in shared]], list(per_outs))
+    return FirstPass(
+        pre,
+        per,
+        tuple(range(n_pose)),
+        tuple(shared),
+        tuple(names_out.index(n) for n in f.name_out()),
+        tuple((names_out.index(n), float(v)) for n, v in kern.first_fills),
+        lo,
+        up,
+        nl,
+        names_out.index("status"),
+    )
+
+
+def batch_loop_source(function: ca.Function, name: str, fast: FirstPass | None = None) -> str:
     """C of ``<name>_batch``: the kernel over n poses in one call, with no
     per-pose overhead of CasADi's ``map`` of an external function.
 
@@ -119,18 +208,65 @@ def batch_loop_source(function: ca.Function, name: str) -> str:
     ``in[k] + i * in_step[k]`` (step 0 for a value shared by every pose),
     output k ``out[k] + i * out_step[k]``.  Work memory on the stack:
     reentrant, so threads may run it on disjoint ranges.  Returns 0 on
-    success."""
+    success.
+
+    With ``fast`` (`first_pass`), where the shared inputs are one value for every pose and
+    every joint limit is infinite: ``pre`` once, then per pose ``per`` (the first kernel) and
+    the whole kernel only where its status is not solved (``solved`` is code 0) -- the
+    kernel's Switch, without its copies, and the first kernel without the work on the shared
+    numbers and the limits."""
     n_in, n_out = function.n_in(), function.n_out()
+    funcs = [function] + ([fast.pre, fast.per] if fast is not None else [])
+    sz_arg, sz_res = max(f.sz_arg() for f in funcs), max(f.sz_res() for f in funcs)
+    sz_iw, sz_w = max(f.sz_iw() for f in funcs), max(f.sz_w() for f in funcs)
+    first = ""
+    if fast is not None:
+        shared_steps = " || ".join(f"in_step[{k}]" for k in (*fast.shared, fast.lower, fast.upper))
+        pre_args = "\n".join(f"    arg[{j}] = in[{k}];" for j, k in enumerate(fast.shared))
+        per_args = "\n".join(
+            [f"      arg[{j}] = in[{k}] + i * in_step[{k}];" for j, k in enumerate(fast.pose)]
+            + [f"      arg[{len(fast.pose)}] = wp;"]
+            + [f"      arg[{len(fast.pose) + 1 + j}] = in[{k}];" for j, k in enumerate(fast.shared)]
+        )
+        per_res = "\n".join(f"      res[{j}] = out[{k}] + i * out_step[{k}];" for j, k in enumerate(fast.outputs))
+        fills = "\n".join(f"        out[{k}][i * out_step[{k}]] = {v!r};" for k, v in fast.fills)
+        first = f"""
+  /* the first kernel alone where it settles (shared inputs, no joint limit) */
+  if (!({shared_steps})) {{
+    const casadi_real* lo = in[{fast.lower}];
+    const casadi_real* up = in[{fast.upper}];
+    int unlimited = 1;
+    for (k = 0; k < {fast.n_limits}; ++k) unlimited = unlimited && lo[k] == -HUGE_VAL && up[k] == HUGE_VAL;
+    if (unlimited) {{
+      casadi_real wp[{fast.pre.nnz_out(0) + 1}];
+{pre_args}
+      res[0] = wp;
+      if ({fast.pre.name()}(arg, res, iw, w, 0)) return 1;
+      for (i = 0; i < n; ++i) {{
+{per_args}
+{per_res}
+        if ({fast.per.name()}(arg, res, iw, w, 0)) return 1;
+        if (out[{fast.status}][i * out_step[{fast.status}]] == 0) {{
+{fills}
+          continue;
+        }}
+        for (k = 0; k < {n_in}; ++k) arg[k] = in[k] + i * in_step[k];
+        for (k = 0; k < {n_out}; ++k) res[k] = out[k] + i * out_step[k];
+        if ({name}(arg, res, iw, w, 0)) return 1;
+      }}
+      return 0;
+    }}
+  }}"""
     return f"""
 /* cpm_nlp: the kernel over n poses (arrays of structures, one row per pose) */
 CASADI_SYMBOL_EXPORT int {name}_batch(long n, const casadi_real* const* in, const long* in_step,
                                       casadi_real* const* out, const long* out_step) {{
-  const casadi_real* arg[{function.sz_arg()}];
-  casadi_real* res[{function.sz_res()}];
-  casadi_int iw[{function.sz_iw() + 1}];
-  casadi_real w[{function.sz_w() + 1}];
+  const casadi_real* arg[{sz_arg}];
+  casadi_real* res[{sz_res}];
+  casadi_int iw[{sz_iw + 1}];
+  casadi_real w[{sz_w + 1}];
   long i;
-  int k;
+  int k;{first}
   for (i = 0; i < n; ++i) {{
     for (k = 0; k < {n_in}; ++k) arg[k] = in[k] + i * in_step[k];
     for (k = 0; k < {n_out}; ++k) res[k] = out[k] + i * out_step[k];
@@ -337,11 +473,19 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
     return kern.function, "map"
 
 
+def kernel_source(kern: Kernel) -> str:
+    """The C of a kernel's library: CasADi's C of the kernel (and of its `first_pass`) and the
+    loop over poses."""
+    fast = first_pass(kern)
+    extra = [fast.pre, fast.per] if fast is not None else []
+    return generate_source(kern.function, kern.name, extra) + batch_loop_source(kern.function, kern.name, fast)
+
+
 def _source(closure: LoopClosure, kern: Kernel) -> str:
     """The kernel's C source (its function and the loop over poses), generated once per process."""
     return solvers_of(closure).memo(
         ("source",) + kern.key,
-        lambda: generate_source(kern.function, kern.name) + batch_loop_source(kern.function, kern.name),
+        lambda: kernel_source(kern),
     )
 
 

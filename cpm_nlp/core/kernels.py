@@ -109,6 +109,14 @@ class Kernel:
     key: tuple = ()  # identity in the closure's cache
     #: inputs shared by every pose (numbers of one model), after ``pose_inputs``
     shared_inputs: tuple[str, ...] = ()
+    #: the kernel this one tries first (a flat SX kernel: the closed form, or the reduced Newton),
+    #: whose outputs it returns unchanged where that one's status is ``solved`` (a CasADi Switch);
+    #: the compiled loop over poses runs it directly and the whole kernel only where it does not
+    #: settle (`cpm_nlp.core.compiled.batch_loop_source`).  None: no such first kernel
+    first: Kernel | None = None
+    #: outputs of this kernel that ``first`` does not give, with their values where it settles
+    #: (the reduced kernel's ``path``, 0)
+    first_fills: tuple[tuple[str, float], ...] = ()
 
     @property
     def name(self) -> str:
@@ -422,9 +430,9 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
 
     def build() -> Kernel:
         newton = _newton_fk_kernel(c, config, f"{c.name}_fk_newton_paths" if c.ik is not None else f"{c.name}_fk")
-        first = closed_fk_kernel(c, config).function
-        fn = _settled_or(first, newton.function, f"{c.name}_fk", newton.outputs)
-        return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
+        first = closed_fk_kernel(c, config)
+        fn = _settled_or(first.function, newton.function, f"{c.name}_fk", newton.outputs)
+        return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs, first)
 
     key = ("fk_kernel_closed", _options_key(opts))
     return solvers_of(c).memo(key, build)
@@ -523,7 +531,8 @@ def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: s
     opts = newton_options(config)
 
     def build() -> Kernel:
-        reduced = reduced_fk_kernel(c, config).function
+        first = reduced_fk_kernel(c, config)
+        reduced = first.function
         full = full_fk_kernel(c, config).function
         names = ("x", "passive", *_STATUS_OUTPUTS)
         # outputs: (x, passive, checks..., path, status): status stays last
@@ -555,7 +564,8 @@ def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: s
         r = reduced(*ins)
         outs = switch(r[-1] == solved, *ins, *r)
         fn = ca.Function(name, ins, list(outs), in_names, out_names)
-        return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS)
+        fills = (("path", float(PATHS.index("reduced"))),)
+        return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS, first, fills)
 
     key = ("fk_kernel", _options_key(opts), name)
     return solvers_of(c).memo(key, build)
