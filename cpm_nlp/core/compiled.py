@@ -121,13 +121,18 @@ class FirstPass:
     without joint limits: ``pre`` (the shared inputs but the limits -> w, every part of the
     first kernel that depends on nothing else, computed once per call) and ``per`` (the pose
     inputs, w and those shared inputs -> the first kernel's outputs), the limits built in as
-    ±inf.  The same operations on the same numbers as the first kernel, moved or folded away:
-    its outputs, as numbers (the sign of a zero aside), on every pose.
+    ±inf (CasADi folds the comparisons with them and the angle reductions they switch off).
+    The same operations on the same numbers as the first kernel, moved or folded away: its
+    outputs, as numbers, on every pose (bit for bit in the tests; folding x + 0 into x where a
+    limit is infinite could only turn a -0 into a +0 or back).
 
     Attributes
     ----------
+    pose
+        positions in the kernel's inputs of ``per``'s inputs before w (one value per pose).
     shared
-        positions in the kernel's inputs of ``pre``'s inputs (and of ``per``'s after w).
+        positions in the kernel's inputs of ``pre``'s inputs (and of ``per``'s after w): the
+        shared inputs but the limits, and the guess x0 where it is hoisted too (`X0_HOISTED_MIN`).
     outputs
         for each output of ``per``, its position in the kernel's outputs.
     fills
@@ -148,6 +153,11 @@ class FirstPass:
     upper: int
     n_limits: int
     status: int
+
+
+#: the guess x0 is hoisted with the shared inputs (`first_pass`) where that takes at least this
+#: share of the first kernel's instructions per pose away (the 3-PRS's reduced Newton: 3 %)
+X0_HOISTED_MIN = 0.02
 
 
 def first_pass(kern: Kernel) -> FirstPass | None:
@@ -174,22 +184,33 @@ def first_pass(kern: Kernel) -> FirstPass | None:
     fixed[lo], fixed[up] = ca.SX(ca.DM.ones(nl) * -ca.inf), ca.SX(ca.DM.ones(nl) * ca.inf)
     outs = f(*fixed)
     shared = [k for k in range(n_pose, len(ins)) if k not in (lo, up)]
-    # every part depending on the shared numbers alone, once per call (same operations, same order)
-    per_outs, w_syms, w_values = ca.extract_parametric(list(outs), [ca.vec(ins[k]) for k in shared])
-    per_outs = [ca.densify(o) if f.sparsity_out(k).is_dense() else o for k, o in enumerate(per_outs)]
-    if any(o.sparsity() != f.sparsity_out(k) for k, o in enumerate(per_outs)):
+
+    def extract(hoisted: list[int]) -> tuple:
+        # every part depending on the hoisted inputs alone, once per call (same operations, same order)
+        per_outs, w_syms, w_values = ca.extract_parametric(list(outs), [ca.vec(ins[k]) for k in hoisted])
+        per_outs = [ca.densify(o) if f.sparsity_out(k).is_dense() else o for k, o in enumerate(per_outs)]
+        w = ca.vertcat(*w_syms) if w_syms else ca.SX(0, 1)
+        pose = [k for k in range(n_pose) if k not in hoisted]
+        per = ca.Function(f"{kern.name}_first_per", [*[ins[k] for k in pose], w, *[ins[k] for k in hoisted]], per_outs)
+        pre = ca.Function(
+            f"{kern.name}_first_pre", [ins[k] for k in hoisted], [ca.vertcat(*w_values) if w_values else w]
+        )
+        return hoisted, pose, pre, per
+
+    plain = extract(shared)
+    # the guess too where one guess serves every pose (a batch without guesses: the reduced
+    # Newton's first-order guess about it), if that takes at least X0_HOISTED_MIN of the work
+    # per pose away; a batch with a guess per pose then runs the whole kernel
+    with_x0 = extract(sorted(shared + [k for k in range(n_pose) if names_in[k] == "x0"]))
+    better = with_x0[3].n_instructions() <= (1 - X0_HOISTED_MIN) * plain[3].n_instructions()
+    hoisted, pose, pre, per = with_x0 if better else plain
+    if any(per.sparsity_out(k) != f.sparsity_out(k) for k in range(f.n_out())):
         return None
-    w = ca.vertcat(*w_syms) if w_syms else ca.SX(0, 1)
-    name = kern.name
-    pre = ca.Function(
-        f"{name}_first_pre", [ins[k] for k in shared], [ca.vertcat(*w_values) if w_values else ca.SX(0, 1)]
-    )
-    per = ca.Function(f"{name}_first_per", [*ins[:n_pose], w, *[ins[k] for k in shared]], list(per_outs))
     return FirstPass(
         pre,
         per,
-        tuple(range(n_pose)),
-        tuple(shared),
+        tuple(pose),
+        tuple(hoisted),
         tuple(names_out.index(n) for n in f.name_out()),
         tuple((names_out.index(n), float(v)) for n, v in kern.first_fills),
         lo,

@@ -119,9 +119,13 @@ def test_jansen_turn_and_guesses():
     q = rng.uniform(-4 * np.pi, 4 * np.pi, (2000, 1))
     x0 = np.tile(model.x_home, (2000, 1))
     x0[::2] += rng.uniform(-0.05, 0.05, (1000, model.closure.nx))
-    kern, vm, c = reference_and_compiled(model, q, x0)
-    assert first_pass(kern) is not None
+    kern, vm, c = reference_and_compiled(model, q, x0)  # a guess per pose: the whole kernel
     assert_same_outputs(kern, vm, c)
+    fast = first_pass(kern)
+    assert fast is not None and 1 in fast.shared  # the guess is hoisted: one guess, the first pass
+    kern, vm, c = reference_and_compiled(model, q, model.x_home)
+    assert_same_outputs(kern, vm, c)
+    assert set(vm["status"].ravel().tolist()) == {code_of(Status.SOLVED)}
 
 
 def test_single_solve_takes_the_same_path(five_bar):
@@ -131,3 +135,40 @@ def test_single_solve_takes_the_same_path(five_bar):
     batch = cn.batch_forward_kinematics(five_bar, q[None, :], backend="compiled")
     assert one.ok and batch.ok[0] and one.path == batch.path(0) == "closed"
     np.testing.assert_array_equal(one.x, batch.x[0])
+
+
+def test_the_round_trip_is_not_redundant_on_the_closed_path(five_bar):
+    """The IK round trip stays in the closed form's checks: next to a leg singularity (crank and
+    distal link in line) the closed form's pose passes the residual and the branch indicators,
+    but the file's IK (acos near +-1) does not give the actuators back within 100 tol -- or finds
+    the pose out of reach -- so the pose is left to Newton (dropping the check would call these
+    poses solved by the closed form)."""
+    c = five_bar.closure
+    kern = fk_kernel(c, NEWTON).first
+    shared = shared_values(kern, five_bar, NEWTON.tolerance)
+    tol = NEWTON.tolerance
+
+    def outputs(q):
+        return dict(zip(kern.outputs, evaluate(kern.function, [q, five_bar.x_home, *shared], 1)))
+
+    def label(q):
+        o = outputs(q)
+        ok = [o["residual"] <= tol, o["branch_margin"] > 0, o["round_trip_error"] <= 100 * tol]
+        return sum(k * v.ravel() for k, v in zip((1, 2, 4), ok))
+
+    rng = np.random.default_rng(2)
+    a = five_bar.q_home + rng.uniform(-0.3, 0.3, (1000, 2))
+    b = five_bar.q_home + rng.uniform(-2.5, 2.5, (1000, 2))
+    la = label(a)
+    keep = la != label(b)
+    a, b, la = a[keep], b[keep], la[keep]
+    for _ in range(60):
+        m = 0.5 * (a + b)
+        same = label(m) == la
+        a, b = np.where(same[:, None], m, a), np.where(same[:, None], b, m)
+    o = outputs(np.vstack([a, b]))
+    passes = (o["residual"] <= tol) & (o["branch_margin"] > 0)
+    fails = passes & ~(o["round_trip_error"] <= 100 * tol)
+    assert fails.sum() > 10
+    assert np.all(o["status"][fails] == code_of(Status.WRONG_BRANCH))
+    assert np.all(o["branch_margin"][fails] < 1e-6)  # at a leg singularity
