@@ -25,7 +25,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -220,7 +220,7 @@ def first_pass(kern: Kernel) -> FirstPass | None:
     )
 
 
-def batch_loop_source(function: ca.Function, name: str, fast: FirstPass | None = None) -> str:
+def batch_loop_source(function: ca.Function, name: str) -> str:
     """C of ``<name>_batch``: the kernel over n poses in one call, with no
     per-pose overhead of CasADi's ``map`` of an external function.
 
@@ -229,66 +229,93 @@ def batch_loop_source(function: ca.Function, name: str, fast: FirstPass | None =
     ``in[k] + i * in_step[k]`` (step 0 for a value shared by every pose),
     output k ``out[k] + i * out_step[k]``.  Work memory on the stack:
     reentrant, so threads may run it on disjoint ranges.  Returns 0 on
-    success.
-
-    With ``fast`` (`first_pass`), where the shared inputs are one value for every pose and
-    every joint limit is infinite: ``pre`` once, then per pose ``per`` (the first kernel) and
-    the whole kernel only where its status is not solved (``solved`` is code 0) -- the
-    kernel's Switch, without its copies, and the first kernel without the work on the shared
-    numbers and the limits."""
+    success."""
     n_in, n_out = function.n_in(), function.n_out()
-    funcs = [function] + ([fast.pre, fast.per] if fast is not None else [])
-    sz_arg, sz_res = max(f.sz_arg() for f in funcs), max(f.sz_res() for f in funcs)
-    sz_iw, sz_w = max(f.sz_iw() for f in funcs), max(f.sz_w() for f in funcs)
-    first = ""
-    if fast is not None:
-        shared_steps = " || ".join(f"in_step[{k}]" for k in (*fast.shared, fast.lower, fast.upper))
-        pre_args = "\n".join(f"    arg[{j}] = in[{k}];" for j, k in enumerate(fast.shared))
-        per_args = "\n".join(
-            [f"      arg[{j}] = in[{k}] + i * in_step[{k}];" for j, k in enumerate(fast.pose)]
-            + [f"      arg[{len(fast.pose)}] = wp;"]
-            + [f"      arg[{len(fast.pose) + 1 + j}] = in[{k}];" for j, k in enumerate(fast.shared)]
-        )
-        per_res = "\n".join(f"      res[{j}] = out[{k}] + i * out_step[{k}];" for j, k in enumerate(fast.outputs))
-        fills = "\n".join(f"        out[{k}][i * out_step[{k}]] = {v!r};" for k, v in fast.fills)
-        first = f"""
-  /* the first kernel alone where it settles (shared inputs, no joint limit) */
-  if (!({shared_steps})) {{
-    const casadi_real* lo = in[{fast.lower}];
-    const casadi_real* up = in[{fast.upper}];
-    int unlimited = 1;
-    for (k = 0; k < {fast.n_limits}; ++k) unlimited = unlimited && lo[k] == -HUGE_VAL && up[k] == HUGE_VAL;
-    if (unlimited) {{
-      casadi_real wp[{fast.pre.nnz_out(0) + 1}];
-{pre_args}
-      res[0] = wp;
-      if ({fast.pre.name()}(arg, res, iw, w, 0)) return 1;
-      for (i = 0; i < n; ++i) {{
-{per_args}
-{per_res}
-        if ({fast.per.name()}(arg, res, iw, w, 0)) return 1;
-        if (out[{fast.status}][i * out_step[{fast.status}]] == 0) {{
-{fills}
-          continue;
-        }}
-        for (k = 0; k < {n_in}; ++k) arg[k] = in[k] + i * in_step[k];
-        for (k = 0; k < {n_out}; ++k) res[k] = out[k] + i * out_step[k];
-        if ({name}(arg, res, iw, w, 0)) return 1;
-      }}
-      return 0;
-    }}
-  }}"""
     return f"""
 /* cpm_nlp: the kernel over n poses (arrays of structures, one row per pose) */
 CASADI_SYMBOL_EXPORT int {name}_batch(long n, const casadi_real* const* in, const long* in_step,
                                       casadi_real* const* out, const long* out_step) {{
+  const casadi_real* arg[{function.sz_arg()}];
+  casadi_real* res[{function.sz_res()}];
+  casadi_int iw[{function.sz_iw() + 1}];
+  casadi_real w[{function.sz_w() + 1}];
+  long i;
+  int k;
+  for (i = 0; i < n; ++i) {{
+    for (k = 0; k < {n_in}; ++k) arg[k] = in[k] + i * in_step[k];
+    for (k = 0; k < {n_out}; ++k) res[k] = out[k] + i * out_step[k];
+    if ({name}(arg, res, iw, w, 0)) return 1;
+  }}
+  return 0;
+}}
+"""
+
+
+#: the generator of a library's first pass (`first_pass`, `first_pass_source`): it keys the
+#: library in place of that C, which is generated only to compile it (change it with either)
+FIRST_PASS_GENERATOR = "first pass 1"
+
+
+def first_pass_source(kern: Kernel) -> str:
+    """C of ``<name>_batch_first`` (a second file of the kernel's library, beside CasADi's C of
+    the kernel and `batch_loop_source`; empty where the kernel has no `first_pass`): the
+    signature and the results of ``<name>_batch``, which it calls where its own path does not
+    apply.
+
+    Where the shared inputs (and the guess, where `first_pass` hoists it) are one value for
+    every pose and every joint limit is infinite: ``pre`` once, then per pose ``per`` (the
+    first kernel) and the whole kernel only where that status is not solved (code 0) -- the
+    kernel's Switch without its copies, and the first kernel without the work on the shared
+    numbers and on the limits."""
+    fast = first_pass(kern)
+    if fast is None:
+        return ""
+    function, name = kern.function, kern.name
+    n_in, n_out = function.n_in(), function.n_out()
+    funcs = [function, fast.pre, fast.per]
+    sz_arg, sz_res = max(f.sz_arg() for f in funcs), max(f.sz_res() for f in funcs)
+    sz_iw, sz_w = max(f.sz_iw() for f in funcs), max(f.sz_w() for f in funcs)
+    shared_steps = " || ".join(f"in_step[{k}]" for k in (*fast.shared, fast.lower, fast.upper))
+    pre_args = "\n".join(f"  arg[{j}] = in[{k}];" for j, k in enumerate(fast.shared))
+    per_args = "\n".join(
+        [f"    arg[{j}] = in[{k}] + i * in_step[{k}];" for j, k in enumerate(fast.pose)]
+        + [f"    arg[{len(fast.pose)}] = wp;"]
+        + [f"    arg[{len(fast.pose) + 1 + j}] = in[{k}];" for j, k in enumerate(fast.shared)]
+    )
+    per_res = "\n".join(f"    res[{j}] = out[{k}] + i * out_step[{k}];" for j, k in enumerate(fast.outputs))
+    fills = "\n".join(f"      out[{k}][i * out_step[{k}]] = {v!r};" for k, v in fast.fills)
+    casadi = generate_source(fast.pre, f"{name}_first", [fast.per])
+    return f"""{casadi}
+/* cpm_nlp: the kernel over n poses, its first kernel alone where that settles */
+int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int {name}_batch(long n, const casadi_real* const* in, const long* in_step,
+                 casadi_real* const* out, const long* out_step);
+
+CASADI_SYMBOL_EXPORT int {name}_batch_first(long n, const casadi_real* const* in, const long* in_step,
+                                            casadi_real* const* out, const long* out_step) {{
   const casadi_real* arg[{sz_arg}];
   casadi_real* res[{sz_res}];
   casadi_int iw[{sz_iw + 1}];
   casadi_real w[{sz_w + 1}];
+  casadi_real wp[{fast.pre.nnz_out(0) + 1}];
+  const casadi_real* lo = in[{fast.lower}];
+  const casadi_real* up = in[{fast.upper}];
   long i;
-  int k;{first}
+  int k;
+  if ({shared_steps}) return {name}_batch(n, in, in_step, out, out_step);
+  for (k = 0; k < {fast.n_limits}; ++k)
+    if (!(lo[k] == -HUGE_VAL && up[k] == HUGE_VAL)) return {name}_batch(n, in, in_step, out, out_step);
+{pre_args}
+  res[0] = wp;
+  if ({fast.pre.name()}(arg, res, iw, w, 0)) return 1;
   for (i = 0; i < n; ++i) {{
+{per_args}
+{per_res}
+    if ({fast.per.name()}(arg, res, iw, w, 0)) return 1;
+    if (out[{fast.status}][i * out_step[{fast.status}]] == 0) {{
+{fills}
+      continue;
+    }}
     for (k = 0; k < {n_in}; ++k) arg[k] = in[k] + i * in_step[k];
     for (k = 0; k < {n_out}; ++k) res[k] = out[k] + i * out_step[k];
     if ({name}(arg, res, iw, w, 0)) return 1;
@@ -305,7 +332,10 @@ class NativeLoop:
     def __init__(self, library: Path, name: str, function: ca.Function) -> None:
         self.function = function
         self._lib = ctypes.CDLL(str(library))
-        self.call = getattr(self._lib, f"{name}_batch")
+        try:  # the loop with the kernel's first pass (first_pass_source), where the library has one
+            self.call = getattr(self._lib, f"{name}_batch_first")
+        except AttributeError:
+            self.call = getattr(self._lib, f"{name}_batch")
         self.call.restype = ctypes.c_int
         self.call.argtypes = [ctypes.c_long, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
         self.n_in, self.n_out = function.n_in(), function.n_out()
@@ -403,11 +433,19 @@ class BoundNative(BoundCall):
 _KERNEL_NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9]){0,127}")
 
 
-def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Path:
+def build_library(
+    source: str,
+    name: str,
+    flags: tuple[str, ...] = CFLAGS,
+    second: Callable[[], str] | None = None,
+    second_key: str = "",
+) -> Path:
     """Compile ``source`` into a shared library in the cache (once per content).
 
     ``source`` is C that CasADi generated from the model's expressions (numbers and
-    symbols, never text from a file), plus `batch_loop_source`; ``name`` a
+    symbols, never text from a file), plus `batch_loop_source`; ``second``, if given, makes
+    the C of a second file of the library (`first_pass_source`), only when it is compiled: the
+    library is keyed by ``second_key`` in its place; ``name`` a
     kernel name (ASCII letters, digits and single underscores; a mechanism file's
     name is checked when it is read).  The command is the user's ``$CC`` or a
     compiler on PATH, never anything from a problem file."""
@@ -419,30 +457,29 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
             "no C compiler found for the compiled backend (set CC, or install gcc or clang); "
             "use backend='map', which needs none"
         )
-    digest = hashlib.sha256(
-        "\0".join([source, _compiler_identity(cmd), " ".join(flags), ca.__version__]).encode()
-    ).hexdigest()[:20]
+    key = [source, _compiler_identity(cmd), " ".join(flags), ca.__version__] + ([second_key] if second else [])
+    digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:20]
     folder = cache_dir() / "compiled" / digest
     lib = folder / f"{name}.so"
     if lib.exists():
         return lib
     folder.mkdir(parents=True, exist_ok=True)
-    src = folder / f"{name}.c"
-    if not src.exists():
-        fd, tmp_src = tempfile.mkstemp(dir=folder, suffix=".c")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(source)
-        os.replace(tmp_src, src)
+    sources = [_written(folder / f"{name}.c", source)]
+    if second is not None:
+        sources.append(_written(folder / f"{name}_first.c", second()))
     fd, tmp_lib = tempfile.mkstemp(dir=folder, suffix=".so")
     os.close(fd)
     try:
         run = subprocess.run(
-            cmd + list(flags) + [str(src), "-o", tmp_lib, "-lm"], capture_output=True, text=True, check=False
+            cmd + list(flags) + [str(f) for f in sources] + ["-o", tmp_lib, "-lm"],
+            capture_output=True,
+            text=True,
+            check=False,
         )
         if run.returncode != 0:
             detail = (run.stderr or run.stdout).strip().splitlines()
             raise CompilerError(
-                f"the C compiler failed on {src}: " + (detail[-1] if detail else f"exit {run.returncode}")
+                f"the C compiler failed on {sources[-1]}: " + (detail[-1] if detail else f"exit {run.returncode}")
             )
         os.replace(tmp_lib, lib)
     finally:
@@ -450,6 +487,16 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
             os.unlink(tmp_lib)
     log.info("compiled %s into %s", name, lib)
     return lib
+
+
+def _written(path: Path, text: str) -> Path:
+    """``text`` in the file ``path`` (written once, renamed into place: never half-written)."""
+    if not path.exists():
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".c")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    return path
 
 
 BACKENDS = ("map", "compiled", "auto")
@@ -494,25 +541,19 @@ def backend_function(closure: LoopClosure, kern: Kernel, backend: str) -> tuple[
     return kern.function, "map"
 
 
-def kernel_source(kern: Kernel) -> str:
-    """The C of a kernel's library: CasADi's C of the kernel (and of its `first_pass`) and the
-    loop over poses."""
-    fast = first_pass(kern)
-    extra = [fast.pre, fast.per] if fast is not None else []
-    return generate_source(kern.function, kern.name, extra) + batch_loop_source(kern.function, kern.name, fast)
-
-
 def _source(closure: LoopClosure, kern: Kernel) -> str:
     """The kernel's C source (its function and the loop over poses), generated once per process."""
     return solvers_of(closure).memo(
         ("source",) + kern.key,
-        lambda: kernel_source(kern),
+        lambda: generate_source(kern.function, kern.name) + batch_loop_source(kern.function, kern.name),
     )
 
 
 def _library(closure: LoopClosure, kern: Kernel) -> Path:
     def build() -> Path:
-        return build_library(_source(closure, kern), kern.name)
+        first = kern.first is not None and kern.first.function.is_a("SXFunction")
+        second = (lambda: first_pass_source(kern)) if first else None
+        return build_library(_source(closure, kern), kern.name, second=second, second_key=FIRST_PASS_GENERATOR)
 
     return solvers_of(closure).memo(("library", *cache_key()) + kern.key, build)
 

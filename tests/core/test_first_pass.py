@@ -64,8 +64,10 @@ def five_bar():
 
 
 def test_five_bar_has_a_first_pass(five_bar):
-    fast = first_pass(fk_kernel(five_bar.closure, NEWTON))
+    kern = fk_kernel(five_bar.closure, NEWTON)
+    fast = first_pass(kern)
     assert fast is not None
+    assert native_loop(five_bar.closure, kern).call.__name__ == "five_bar_fk_batch_first"
     # the shared parts (the crank's home angle's sine and cosine, limit flags) leave the pose loop
     assert fast.per.n_instructions() < 0.75 * fk_kernel(five_bar.closure, NEWTON).first.function.n_instructions()
 
