@@ -166,6 +166,8 @@ def first_pass(kern: Kernel) -> FirstPass | None:
     if first is None or not first.function.is_a("SXFunction"):
         return None
     fn, f = kern.function, first.function
+    # the checks written for a model without limits (same numbers, fewer operations)
+    f = kern.first_unlimited().function if kern.first_unlimited is not None else f
     names_in, names_out = list(fn.name_in()), list(fn.name_out())
     if list(f.name_in()) != names_in or any(f.sparsity_in(k) != fn.sparsity_in(k) for k in range(f.n_in())):
         return None

@@ -174,3 +174,36 @@ def test_the_round_trip_is_not_redundant_on_the_closed_path(five_bar):
     assert fails.sum() > 10
     assert np.all(o["status"][fails] == code_of(Status.WRONG_BRANCH))
     assert np.all(o["branch_margin"][fails] < 1e-6)  # at a leg singularity
+
+
+@pytest.mark.parametrize("name", ["five_bar", "prs3", "jansen"])
+def test_unlimited_checks_are_the_checks_at_infinite_limits(name, prs3):
+    """check_expressions(unlimited=True) gives the numbers of the checks with every limit
+    infinite, also where a joint is NaN or infinite (the limit margin, the passive joints)."""
+    import casadi as ca
+
+    from cpm_nlp.core.pose_checks import check_expressions, n_joints
+
+    model = prs3 if name == "prs3" else cn.build_model(name)
+    c = model.closure
+    x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
+    nl = n_joints(c)
+    inf = ca.DM.ones(nl) * ca.inf
+    names = ["passive", "limit_margin", "residual", "branch_margin", "round_trip_error"]
+
+    def outputs(**kw):
+        chk = check_expressions(c, x, q, p, -inf, inf, **kw)
+        return ca.Function("f", [x, q, p], [ca.densify(chk[n]) for n in names])
+
+    limited, unlimited = outputs(), outputs(unlimited=True)
+    assert unlimited.n_instructions() < limited.n_instructions()
+    rng = np.random.default_rng(8)
+    for k in range(300):
+        xv = model.x_home + rng.normal(0, 0.02, c.nx)
+        qv = model.q_home + rng.normal(0, 0.05, c.nq)
+        if k % 3 == 1:
+            xv[rng.integers(c.nx)] = [np.nan, np.inf, -np.inf][k % 9 // 3]
+        if k % 3 == 2:
+            qv[rng.integers(c.nq)] = [np.nan, np.inf, -np.inf][k % 9 // 3]
+        for a, b, n in zip(limited(xv, qv, model.p), unlimited(xv, qv, model.p), names):
+            np.testing.assert_array_equal(np.asarray(b), np.asarray(a), err_msg=f"{n} at {xv}, {qv}")
