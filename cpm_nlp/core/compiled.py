@@ -16,6 +16,7 @@ a mechanism type (a design sweep does not recompile).
 from __future__ import annotations
 
 import ctypes
+import functools
 import hashlib
 import logging
 import os
@@ -253,9 +254,23 @@ CASADI_SYMBOL_EXPORT int {name}_batch(long n, const casadi_real* const* in, cons
 """
 
 
-#: the generator of a library's first pass (`first_pass`, `first_pass_source`): it keys the
-#: library in place of that C, which is generated only to compile it (change it with either)
-FIRST_PASS_GENERATOR = "first pass 1"
+#: the generator of a library's first pass (`first_pass`, `first_pass_source`): with the source of
+#: the modules that write that C (`first_pass_key`) it keys the library in place of the C, which
+#: is generated only to compile it
+FIRST_PASS_GENERATOR = "first pass 2"
+#: the modules whose code makes the first pass's C (besides the kernel's own C, in the key anyway)
+_FIRST_PASS_MODULES = ("compiled.py", "kernels.py", "pose_checks.py", "conditioning.py")
+
+
+@functools.cache
+def first_pass_key() -> str:
+    """`FIRST_PASS_GENERATOR` and a digest of the code of the modules that generate the first
+    pass (read once per process): a changed generator means another library, never a stale one."""
+    here = Path(__file__).resolve().parent
+    digest = hashlib.sha256()
+    for name in _FIRST_PASS_MODULES:
+        digest.update((here / name).read_bytes())
+    return f"{FIRST_PASS_GENERATOR} {digest.hexdigest()[:20]}"
 
 
 def first_pass_source(kern: Kernel) -> str:
@@ -555,7 +570,7 @@ def _library(closure: LoopClosure, kern: Kernel) -> Path:
     def build() -> Path:
         first = kern.first is not None and kern.first.function.is_a("SXFunction")
         second = (lambda: first_pass_source(kern)) if first else None
-        return build_library(_source(closure, kern), kern.name, second=second, second_key=FIRST_PASS_GENERATOR)
+        return build_library(_source(closure, kern), kern.name, second=second, second_key=first_pass_key())
 
     return solvers_of(closure).memo(("library", *cache_key()) + kern.key, build)
 
