@@ -121,11 +121,12 @@ class FirstPass:
     """The first kernel of a kernel (`Kernel.first`) as the compiled loop runs it for a model
     without joint limits: ``pre`` (the shared inputs but the limits -> w, every part of the
     first kernel that depends on nothing else, computed once per call) and ``per`` (the pose
-    inputs, w and those shared inputs -> the first kernel's outputs), the limits built in as
-    ±inf (CasADi folds the comparisons with them and the angle reductions they switch off).
-    The same operations on the same numbers as the first kernel, moved or folded away: its
-    outputs, as numbers, on every pose (bit for bit in the tests; folding x + 0 into x where a
-    limit is infinite could only turn a -0 into a +0 or back).
+    inputs, w and those shared inputs -> the first kernel's outputs).  The first kernel is the
+    one built for a model without limits (`Kernel.first_unlimited`, ±inf put in for the limits
+    it no longer reads).  The same operations on the same numbers as the first kernel, some moved
+    out of the pose loop, the limit check shorter: its outputs, as numbers, on every pose (bit
+    for bit in the tests; an angle the kernel reduces as ``0 + v`` where no limit is finite is
+    ``v`` here, so a passive angle of -0 keeps its sign).
 
     Attributes
     ----------

@@ -112,7 +112,7 @@ class Kernel:
     #: the kernel this one tries first (a flat SX kernel: the closed form, or the reduced Newton),
     #: whose outputs it returns unchanged where that one's status is ``solved`` (a CasADi Switch);
     #: the compiled loop over poses runs it directly and the whole kernel only where it does not
-    #: settle (`cpm_nlp.core.compiled.batch_loop_source`).  None: no such first kernel
+    #: settle (`cpm_nlp.core.compiled.first_pass_source`).  None: no such first kernel
     first: Kernel | None = None
     #: outputs of this kernel that ``first`` does not give, with their values where it settles
     #: (the reduced kernel's ``path``, 0)
