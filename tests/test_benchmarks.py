@@ -129,7 +129,8 @@ def test_peer_benchmark_without_peers(tmp_path, capsys, monkeypatch):
 
 def test_batch_speed_benchmark_smoke(tmp_path, capsys):
     """benchmarks/bench_batch_speed.py runs end to end (small sizes; no timing is asserted, only
-    the same bits before and after the flags, and the five-bar fallback share, a count)."""
+    the same bits before and after the flags and the first pass, and the five-bar fallback share,
+    a count)."""
     spec = importlib.util.spec_from_file_location("bench_batch_speed", ROOT / "benchmarks" / "bench_batch_speed.py")
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
@@ -138,7 +139,10 @@ def test_batch_speed_benchmark_smoke(tmp_path, capsys):
     data = json.loads(out.read_text())
     if "kernel" in data:  # a C compiler is there
         assert data["kernel"]["kernel_before_same_bits_as_vm"] and data["kernel"]["kernel_now_same_bits_as_vm"]
+        assert data["kernel"]["kernel_whole_same_bits_as_vm"]  # the loop before the first pass
         assert data["batch"]["statuses"] == {"solved": 2000}
+        same = {k: v for part in ("fivebar", "jansen") for k, v in data[part].items() if k.endswith("same_bits_as_vm")}
+        assert len(same) == 7 and all(same.values()), same
     assert data["fivebar"]["fallback_share_now"] < 0.05 < data["fivebar"]["fallback_share_3_steps"]
     assert data["fivebar"]["closed_share"] == 1.0  # every five-bar pose by the closed-form dyad (a count)
     assert data["single"]["single_fk_function_us"] > 0 and "load" in data["single"]

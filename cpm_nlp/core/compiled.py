@@ -16,6 +16,7 @@ a mechanism type (a design sweep does not recompile).
 from __future__ import annotations
 
 import ctypes
+import functools
 import hashlib
 import logging
 import os
@@ -25,6 +26,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -101,13 +104,124 @@ def _compiler_identity(cmd: list[str]) -> str:
         return " ".join(cmd)
 
 
-def generate_source(function: ca.Function, name: str) -> str:
-    """CasADi-generated C source of one Function (no header, no main)."""
+def generate_source(function: ca.Function, name: str, extra: Sequence[ca.Function] = ()) -> str:
+    """CasADi-generated C source of one Function (no header, no main), and of ``extra``
+    Functions in the same file (each under its own name)."""
     with tempfile.TemporaryDirectory(prefix="cpm_nlp_cg_") as tmp:
         cg = ca.CodeGenerator(f"{name}.c", {"with_header": False})
         cg.add(function)
+        for f in extra:
+            cg.add(f)
         cg.generate(tmp + os.sep)
         return Path(tmp, f"{name}.c").read_text()
+
+
+@dataclass(frozen=True)
+class FirstPass:
+    """The first kernel of a kernel (`Kernel.first`) as the compiled loop runs it for a model
+    without joint limits: ``pre`` (the shared inputs but the limits -> w, every part of the
+    first kernel that depends on nothing else, computed once per call) and ``per`` (the pose
+    inputs, w and those shared inputs -> the first kernel's outputs).  The first kernel is the
+    one built for a model without limits (`Kernel.first_unlimited`, ±inf put in for the limits
+    it no longer reads).  The same operations on the same numbers as the first kernel, some moved
+    out of the pose loop, the limit check shorter: its outputs, as numbers, on every pose (bit
+    for bit in the tests; an angle the kernel reduces as ``0 + v`` where no limit is finite is
+    ``v`` here, so a passive angle of -0 keeps its sign).
+
+    Attributes
+    ----------
+    pose
+        positions in the kernel's inputs of ``per``'s inputs before w (one value per pose).
+    shared
+        positions in the kernel's inputs of ``pre``'s inputs (and of ``per``'s after w): the
+        shared inputs but the limits, and the guess x0 where it is hoisted too (`X0_HOISTED_MIN`).
+    outputs
+        for each output of ``per``, its position in the kernel's outputs.
+    fills
+        (position in the kernel's outputs, value) written where the first kernel settles.
+    lower, upper
+        positions of the limits in the kernel's inputs; n_limits their length.
+    status
+        position of ``status`` in the kernel's outputs.
+    """
+
+    pre: ca.Function
+    per: ca.Function
+    pose: tuple[int, ...]
+    shared: tuple[int, ...]
+    outputs: tuple[int, ...]
+    fills: tuple[tuple[int, float], ...]
+    lower: int
+    upper: int
+    n_limits: int
+    status: int
+
+
+#: the guess x0 is hoisted with the shared inputs (`first_pass`) where that takes at least this
+#: share of the first kernel's instructions per pose away (the 3-PRS's reduced Newton: 3 %)
+X0_HOISTED_MIN = 0.02
+
+
+def first_pass(kern: Kernel) -> FirstPass | None:
+    """The `FirstPass` of a kernel with a flat SX first kernel (None: none)."""
+    first = kern.first
+    if first is None or not first.function.is_a("SXFunction"):
+        return None
+    fn, f = kern.function, first.function
+    # the checks written for a model without limits (same numbers, fewer operations)
+    f = kern.first_unlimited().function if kern.first_unlimited is not None else f
+    names_in, names_out = list(fn.name_in()), list(fn.name_out())
+    if list(f.name_in()) != names_in or any(f.sparsity_in(k) != fn.sparsity_in(k) for k in range(f.n_in())):
+        return None
+    fills = dict(kern.first_fills)
+    if sorted([*f.name_out(), *fills]) != sorted(names_out):
+        return None
+    if any(f.sparsity_out(k) != fn.sparsity_out(names_out.index(n)) for k, n in enumerate(f.name_out())):
+        return None
+    if "lower" not in names_in or "upper" not in names_in or "status" not in names_out:
+        return None
+    n_pose = len(kern.pose_inputs)
+    ins = [ca.SX.sym(n, f.sparsity_in(k)) for k, n in enumerate(names_in)]
+    lo, up = names_in.index("lower"), names_in.index("upper")
+    nl = f.nnz_in(lo)
+    fixed = list(ins)
+    fixed[lo], fixed[up] = ca.SX(ca.DM.ones(nl) * -ca.inf), ca.SX(ca.DM.ones(nl) * ca.inf)
+    outs = f(*fixed)
+    shared = [k for k in range(n_pose, len(ins)) if k not in (lo, up)]
+
+    def extract(hoisted: list[int]) -> tuple:
+        # every part depending on the hoisted inputs alone, once per call (same operations, same order)
+        per_outs, w_syms, w_values = ca.extract_parametric(list(outs), [ca.vec(ins[k]) for k in hoisted])
+        per_outs = [ca.densify(o) if f.sparsity_out(k).is_dense() else o for k, o in enumerate(per_outs)]
+        w = ca.vertcat(*w_syms) if w_syms else ca.SX(0, 1)
+        pose = [k for k in range(n_pose) if k not in hoisted]
+        per = ca.Function(f"{kern.name}_first_per", [*[ins[k] for k in pose], w, *[ins[k] for k in hoisted]], per_outs)
+        pre = ca.Function(
+            f"{kern.name}_first_pre", [ins[k] for k in hoisted], [ca.vertcat(*w_values) if w_values else w]
+        )
+        return hoisted, pose, pre, per
+
+    plain = extract(shared)
+    # the guess too where one guess serves every pose (a batch without guesses: the reduced
+    # Newton's first-order guess about it), if that takes at least X0_HOISTED_MIN of the work
+    # per pose away; a batch with a guess per pose then runs the whole kernel
+    with_x0 = extract(sorted(shared + [k for k in range(n_pose) if names_in[k] == "x0"]))
+    better = with_x0[3].n_instructions() <= (1 - X0_HOISTED_MIN) * plain[3].n_instructions()
+    hoisted, pose, pre, per = with_x0 if better else plain
+    if any(per.sparsity_out(k) != f.sparsity_out(k) for k in range(f.n_out())):
+        return None
+    return FirstPass(
+        pre,
+        per,
+        tuple(pose),
+        tuple(hoisted),
+        tuple(names_out.index(n) for n in f.name_out()),
+        tuple((names_out.index(n), float(v)) for n, v in kern.first_fills),
+        lo,
+        up,
+        nl,
+        names_out.index("status"),
+    )
 
 
 def batch_loop_source(function: ca.Function, name: str) -> str:
@@ -141,6 +255,94 @@ CASADI_SYMBOL_EXPORT int {name}_batch(long n, const casadi_real* const* in, cons
 """
 
 
+#: the generator of a library's first pass (`first_pass`, `first_pass_source`): with the source of
+#: the modules that write that C (`first_pass_key`) it keys the library in place of the C, which
+#: is generated only to compile it
+FIRST_PASS_GENERATOR = "first pass 2"
+#: the modules whose code makes the first pass's C (besides the kernel's own C, in the key anyway)
+_FIRST_PASS_MODULES = ("compiled.py", "kernels.py", "pose_checks.py", "conditioning.py")
+
+
+@functools.cache
+def first_pass_key() -> str:
+    """`FIRST_PASS_GENERATOR` and a digest of the code of the modules that generate the first
+    pass (read once per process): a changed generator means another library, never a stale one."""
+    here = Path(__file__).resolve().parent
+    digest = hashlib.sha256()
+    for name in _FIRST_PASS_MODULES:
+        digest.update((here / name).read_bytes())
+    return f"{FIRST_PASS_GENERATOR} {digest.hexdigest()[:20]}"
+
+
+def first_pass_source(kern: Kernel) -> str:
+    """C of ``<name>_batch_first`` (a second file of the kernel's library, beside CasADi's C of
+    the kernel and `batch_loop_source`; empty where the kernel has no `first_pass`): the
+    signature and the results of ``<name>_batch``, which it calls where its own path does not
+    apply.
+
+    Where the shared inputs (and the guess, where `first_pass` hoists it) are one value for
+    every pose and every joint limit is infinite: ``pre`` once, then per pose ``per`` (the
+    first kernel) and the whole kernel only where that status is not solved (code 0) -- the
+    kernel's Switch without its copies, and the first kernel without the work on the shared
+    numbers and on the limits."""
+    fast = first_pass(kern)
+    if fast is None:
+        return ""
+    function, name = kern.function, kern.name
+    n_in, n_out = function.n_in(), function.n_out()
+    funcs = [function, fast.pre, fast.per]
+    sz_arg, sz_res = max(f.sz_arg() for f in funcs), max(f.sz_res() for f in funcs)
+    sz_iw, sz_w = max(f.sz_iw() for f in funcs), max(f.sz_w() for f in funcs)
+    shared_steps = " || ".join(f"in_step[{k}]" for k in (*fast.shared, fast.lower, fast.upper))
+    pre_args = "\n".join(f"  arg[{j}] = in[{k}];" for j, k in enumerate(fast.shared))
+    per_args = "\n".join(
+        [f"    arg[{j}] = in[{k}] + i * in_step[{k}];" for j, k in enumerate(fast.pose)]
+        + [f"    arg[{len(fast.pose)}] = wp;"]
+        + [f"    arg[{len(fast.pose) + 1 + j}] = in[{k}];" for j, k in enumerate(fast.shared)]
+    )
+    per_res = "\n".join(f"    res[{j}] = out[{k}] + i * out_step[{k}];" for j, k in enumerate(fast.outputs))
+    fills = "\n".join(f"      out[{k}][i * out_step[{k}]] = {v!r};" for k, v in fast.fills)
+    casadi = generate_source(fast.pre, f"{name}_first", [fast.per])
+    return f"""{casadi}
+/* cpm_nlp: the kernel over n poses, its first kernel alone where that settles */
+int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int {name}_batch(long n, const casadi_real* const* in, const long* in_step,
+                 casadi_real* const* out, const long* out_step);
+
+CASADI_SYMBOL_EXPORT int {name}_batch_first(long n, const casadi_real* const* in, const long* in_step,
+                                            casadi_real* const* out, const long* out_step) {{
+  const casadi_real* arg[{sz_arg}];
+  casadi_real* res[{sz_res}];
+  casadi_int iw[{sz_iw + 1}];
+  casadi_real w[{sz_w + 1}];
+  casadi_real wp[{fast.pre.nnz_out(0) + 1}];
+  const casadi_real* lo = in[{fast.lower}];
+  const casadi_real* up = in[{fast.upper}];
+  long i;
+  int k;
+  if ({shared_steps}) return {name}_batch(n, in, in_step, out, out_step);
+  for (k = 0; k < {fast.n_limits}; ++k)
+    if (!(lo[k] == -HUGE_VAL && up[k] == HUGE_VAL)) return {name}_batch(n, in, in_step, out, out_step);
+{pre_args}
+  res[0] = wp;
+  if ({fast.pre.name()}(arg, res, iw, w, 0)) return 1;
+  for (i = 0; i < n; ++i) {{
+{per_args}
+{per_res}
+    if ({fast.per.name()}(arg, res, iw, w, 0)) return 1;
+    if (out[{fast.status}][i * out_step[{fast.status}]] == 0) {{
+{fills}
+      continue;
+    }}
+    for (k = 0; k < {n_in}; ++k) arg[k] = in[k] + i * in_step[k];
+    for (k = 0; k < {n_out}; ++k) res[k] = out[k] + i * out_step[k];
+    if ({name}(arg, res, iw, w, 0)) return 1;
+  }}
+  return 0;
+}}
+"""
+
+
 class NativeLoop:
     """``<name>_batch`` of a compiled kernel library, called through ctypes
     (which releases the GIL, so threads run chunks in parallel)."""
@@ -148,7 +350,10 @@ class NativeLoop:
     def __init__(self, library: Path, name: str, function: ca.Function) -> None:
         self.function = function
         self._lib = ctypes.CDLL(str(library))
-        self.call = getattr(self._lib, f"{name}_batch")
+        try:  # the loop with the kernel's first pass (first_pass_source), where the library has one
+            self.call = getattr(self._lib, f"{name}_batch_first")
+        except AttributeError:
+            self.call = getattr(self._lib, f"{name}_batch")
         self.call.restype = ctypes.c_int
         self.call.argtypes = [ctypes.c_long, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
         self.n_in, self.n_out = function.n_in(), function.n_out()
@@ -246,11 +451,19 @@ class BoundNative(BoundCall):
 _KERNEL_NAME = re.compile(r"[A-Za-z](?:_?[A-Za-z0-9]){0,127}")
 
 
-def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Path:
+def build_library(
+    source: str,
+    name: str,
+    flags: tuple[str, ...] = CFLAGS,
+    second: Callable[[], str] | None = None,
+    second_key: str = "",
+) -> Path:
     """Compile ``source`` into a shared library in the cache (once per content).
 
     ``source`` is C that CasADi generated from the model's expressions (numbers and
-    symbols, never text from a file), plus `batch_loop_source`; ``name`` a
+    symbols, never text from a file), plus `batch_loop_source`; ``second``, if given, makes
+    the C of a second file of the library (`first_pass_source`), only when it is compiled: the
+    library is keyed by ``second_key`` in its place; ``name`` a
     kernel name (ASCII letters, digits and single underscores; a mechanism file's
     name is checked when it is read).  The command is the user's ``$CC`` or a
     compiler on PATH, never anything from a problem file."""
@@ -262,30 +475,29 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
             "no C compiler found for the compiled backend (set CC, or install gcc or clang); "
             "use backend='map', which needs none"
         )
-    digest = hashlib.sha256(
-        "\0".join([source, _compiler_identity(cmd), " ".join(flags), ca.__version__]).encode()
-    ).hexdigest()[:20]
+    key = [source, _compiler_identity(cmd), " ".join(flags), ca.__version__] + ([second_key] if second else [])
+    digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:20]
     folder = cache_dir() / "compiled" / digest
     lib = folder / f"{name}.so"
     if lib.exists():
         return lib
     folder.mkdir(parents=True, exist_ok=True)
-    src = folder / f"{name}.c"
-    if not src.exists():
-        fd, tmp_src = tempfile.mkstemp(dir=folder, suffix=".c")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(source)
-        os.replace(tmp_src, src)
+    sources = [_written(folder / f"{name}.c", source)]
+    if second is not None:
+        sources.append(_written(folder / f"{name}_first.c", second()))
     fd, tmp_lib = tempfile.mkstemp(dir=folder, suffix=".so")
     os.close(fd)
     try:
         run = subprocess.run(
-            cmd + list(flags) + [str(src), "-o", tmp_lib, "-lm"], capture_output=True, text=True, check=False
+            cmd + list(flags) + [str(f) for f in sources] + ["-o", tmp_lib, "-lm"],
+            capture_output=True,
+            text=True,
+            check=False,
         )
         if run.returncode != 0:
             detail = (run.stderr or run.stdout).strip().splitlines()
             raise CompilerError(
-                f"the C compiler failed on {src}: " + (detail[-1] if detail else f"exit {run.returncode}")
+                f"the C compiler failed on {sources[-1]}: " + (detail[-1] if detail else f"exit {run.returncode}")
             )
         os.replace(tmp_lib, lib)
     finally:
@@ -293,6 +505,16 @@ def build_library(source: str, name: str, flags: tuple[str, ...] = CFLAGS) -> Pa
             os.unlink(tmp_lib)
     log.info("compiled %s into %s", name, lib)
     return lib
+
+
+def _written(path: Path, text: str) -> Path:
+    """``text`` in the file ``path`` (written once, renamed into place: never half-written)."""
+    if not path.exists():
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".c")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    return path
 
 
 BACKENDS = ("map", "compiled", "auto")
@@ -347,7 +569,9 @@ def _source(closure: LoopClosure, kern: Kernel) -> str:
 
 def _library(closure: LoopClosure, kern: Kernel) -> Path:
     def build() -> Path:
-        return build_library(_source(closure, kern), kern.name)
+        first = kern.first is not None and kern.first.function.is_a("SXFunction")
+        second = (lambda: first_pass_source(kern)) if first else None
+        return build_library(_source(closure, kern), kern.name, second=second, second_key=first_pass_key())
 
     return solvers_of(closure).memo(("library", *cache_key()) + kern.key, build)
 

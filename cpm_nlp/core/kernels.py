@@ -19,8 +19,8 @@ for the embedding API).  Status codes are the positions in
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import casadi as ca
@@ -109,6 +109,17 @@ class Kernel:
     key: tuple = ()  # identity in the closure's cache
     #: inputs shared by every pose (numbers of one model), after ``pose_inputs``
     shared_inputs: tuple[str, ...] = ()
+    #: the kernel this one tries first (a flat SX kernel: the closed form, or the reduced Newton),
+    #: whose outputs it returns unchanged where that one's status is ``solved`` (a CasADi Switch);
+    #: the compiled loop over poses runs it directly and the whole kernel only where it does not
+    #: settle (`cpm_nlp.core.compiled.first_pass_source`).  None: no such first kernel
+    first: Kernel | None = None
+    #: outputs of this kernel that ``first`` does not give, with their values where it settles
+    #: (the reduced kernel's ``path``, 0)
+    first_fills: tuple[tuple[str, float], ...] = ()
+    #: builds ``first`` for a model without joint limits (``unlimited``: the limit check as
+    #: `cpm_nlp.core.pose_checks.check_expressions` writes it then), for the compiled loop only
+    first_unlimited: Callable[[], Kernel] | None = field(default=None, compare=False, repr=False)
 
     @property
     def name(self) -> str:
@@ -331,7 +342,9 @@ def gauss_newton_fk_kernel(
 REDUCED_STEPS = 3
 
 
-def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, steps: int = REDUCED_STEPS) -> Kernel:
+def reduced_fk_kernel(
+    closure: LoopClosure, config: SolverConfig | None = None, steps: int = REDUCED_STEPS, unlimited: bool = False
+) -> Kernel:
     """``<name>_fk_reduced: (q, x0, p, lower, upper, tol, J_home, Phi_x_home_inv)
     -> (x, passive, residual, branch_margin, round_trip_error, cond1,
     limit_margin, status)``: FK by Newton on the task coordinates through the
@@ -383,7 +396,7 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
         converged = robust_max_abs(q_ik - q) <= abstol
         # normal equations (an overconstrained graph): κ₂ of every closure equation's Jacobian, bounded at
         # the pose block by block (check_expressions); Φ_x⁻¹ at home serves the square closures
-        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
+        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b, unlimited=unlimited)
         singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))  # margin 2 over the certified bound
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         status = _first(ca.logic_not(converged), Status.NOT_CONVERGED, status)
@@ -398,7 +411,7 @@ def reduced_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, 
         )
         return Kernel(fn, "fk", ("q", "x0"), names, key, REDUCED_SHARED_INPUTS)
 
-    key = ("reduced_fk_kernel", _options_key(opts), steps)
+    key = ("reduced_fk_kernel", _options_key(opts), steps) + (("unlimited",) if unlimited else ())
     return solvers_of(closure).memo(key, build)
 
 
@@ -422,9 +435,10 @@ def fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kerne
 
     def build() -> Kernel:
         newton = _newton_fk_kernel(c, config, f"{c.name}_fk_newton_paths" if c.ik is not None else f"{c.name}_fk")
-        first = closed_fk_kernel(c, config).function
-        fn = _settled_or(first, newton.function, f"{c.name}_fk", newton.outputs)
-        return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs)
+        first = closed_fk_kernel(c, config)
+        fn = _settled_or(first.function, newton.function, f"{c.name}_fk", newton.outputs)
+        twin = lambda: closed_fk_kernel(c, config, unlimited=True)  # noqa: E731
+        return Kernel(fn, "fk", ("q", "x0"), newton.outputs, key, newton.shared_inputs, first, (), twin)
 
     key = ("fk_kernel_closed", _options_key(opts))
     return solvers_of(c).memo(key, build)
@@ -449,7 +463,7 @@ def _seeded_fk_kernel(closure: LoopClosure, config: SolverConfig | None) -> Kern
     return solvers_of(c).memo(key, build)
 
 
-def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -> Kernel:
+def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None, unlimited: bool = False) -> Kernel:
     """``<name>_fk_closed: (q, x0, p, lower, upper, tol[, J_home, Phi_x_home_inv]) -> (x, passive,
     residual, branch_margin, round_trip_error, cond1, limit_margin[, path], status)``: the pose from
     the closure's closed-form FK (``fk_closed``; x0 picks the side and the turn of an angle), one flat
@@ -478,7 +492,7 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
             b = ca.SX.sym("Phi_x_home_inv", c.nx, c.nx)
             ins, shared_names = ins + [jac_home, b], REDUCED_SHARED_INPUTS
         x, disc, side = c.fk_closed(q, x0, p)
-        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b)
+        chk = check_expressions(c, x, q, p, lower, upper, phi_x_home_inv=b, unlimited=unlimited)
         singular = is_singular(chk["cond1"], CASADI, factor=2 * screen_factor(c))  # margin 2 over the screen
         status = status_code(status_rules(chk, tol, singular, CASADI), CASADI)
         # every dyad assembles (disc >= 0) and the guess lies on the side of each dyad's two
@@ -495,7 +509,7 @@ def closed_fk_kernel(closure: LoopClosure, config: SolverConfig | None = None) -
         fn = ca.Function(f"{c.name}_fk_closed", ins, outs, ["q", "x0", *shared_names], names)
         return Kernel(fn, "fk", ("q", "x0"), tuple(names), key, shared_names)
 
-    key = ("closed_fk_kernel", _options_key(opts))
+    key = ("closed_fk_kernel", _options_key(opts)) + (("unlimited",) if unlimited else ())
     return solvers_of(closure).memo(key, build)
 
 
@@ -523,7 +537,8 @@ def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: s
     opts = newton_options(config)
 
     def build() -> Kernel:
-        reduced = reduced_fk_kernel(c, config).function
+        first = reduced_fk_kernel(c, config)
+        reduced = first.function
         full = full_fk_kernel(c, config).function
         names = ("x", "passive", *_STATUS_OUTPUTS)
         # outputs: (x, passive, checks..., path, status): status stays last
@@ -555,7 +570,9 @@ def _newton_fk_kernel(closure: LoopClosure, config: SolverConfig | None, name: s
         r = reduced(*ins)
         outs = switch(r[-1] == solved, *ins, *r)
         fn = ca.Function(name, ins, list(outs), in_names, out_names)
-        return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS)
+        fills = (("path", float(PATHS.index("reduced"))),)
+        twin = lambda: reduced_fk_kernel(c, config, unlimited=True)  # noqa: E731
+        return Kernel(fn, "fk", ("q", "x0"), tuple(out_names), key, REDUCED_SHARED_INPUTS, first, fills, twin)
 
     key = ("fk_kernel", _options_key(opts), name)
     return solvers_of(c).memo(key, build)

@@ -144,6 +144,7 @@ def check_expressions(
     upper: ca.SX,
     phi_x_home_inv: ca.SX | None = None,
     block_bound: bool = False,
+    unlimited: bool = False,
 ) -> dict[str, ca.SX]:
     """Symbolic checks of the pose (x, q): see `CHECKS`.
 
@@ -165,6 +166,12 @@ def check_expressions(
     block_bound
         ``cond1`` is the upper bound of `cond1_block_bound` (inverses of Φ_x's diagonal blocks
         at the pose; takes precedence over phi_x_home_inv).
+    unlimited
+        the checks where every limit is infinite (lower and upper unused): the same numbers as
+        with lower = -inf and upper = +inf, in fewer operations -- no angle is reduced (the
+        reduction is the identity without a finite range), and a joint is within (-inf, inf)
+        unless it is NaN (±inf is inside: its margin is inf - inf = NaN on one side, and
+        fmin takes the other, +inf), so ``limit_margin`` is +inf, or -inf where a joint is NaN.
     """
     c = closure
     out: dict[str, ca.SX] = {"finite": all_finite(ca.vertcat(x, q))}
@@ -196,6 +203,13 @@ def check_expressions(
         out["cond1"] = _cond1(phi_x, phi_x_home_inv, block_bound)
     passive = c.passive(x, q, p) if c.passive is not None else ca.SX(0, 1)
     n0 = c.nq + c.nx
+    if unlimited:
+        out["passive"] = passive
+        joints = ca.vertcat(q, x, passive)
+        # j <= inf: false for NaN alone (CasADi would fold j == j into 1)
+        number = [joints[k] <= ca.inf for k in range(joints.numel())]
+        out["limit_margin"] = ca.if_else(_all(number), ca.inf, -ca.inf)
+        return out
     passive = (
         ca.vertcat(
             *[
@@ -223,6 +237,14 @@ def check_expressions(
     else:  # pragma: no cover - every mechanism has actuators
         out["limit_margin"] = ca.SX(ca.inf)
     return out
+
+
+def _all(flags: list[ca.SX]) -> ca.SX:
+    """Every flag true (a balanced tree of and)."""
+    while len(flags) > 1:
+        pairs = range(0, len(flags), 2)
+        flags = [ca.logic_and(flags[k], flags[k + 1]) if k + 1 < len(flags) else flags[k] for k in pairs]
+    return flags[0]
 
 
 def _cond1(phi_x: ca.SX, phi_x_home_inv: ca.SX | None, block_bound: bool) -> ca.SX:
