@@ -28,10 +28,8 @@ from ...core.model import LoopClosure, Model
 from ...core.origin import Origin
 from ...io.inputs import display_name, input_dir, read_input_text
 from ...io.yamlfile import load_yaml_text, parse_yaml, read_yaml
-from . import expr as ex
-from .chains import chains_function
-from .chains import supported as chains_supported
-from .closure import closure_parts
+from . import stored
+from .chains import chains_maker
 from .drawing import geometry_of, graph_geometry
 from .options import described_limits, parameter_options
 from .read import description_from_dict
@@ -88,7 +86,7 @@ def load_file_description(path: str | Path, *, allow_pipe: bool = False) -> tupl
     base_dir = input_dir(path)
     text_key = hashlib.sha256(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode()).hexdigest()
     data = parse_yaml(text, file)
-    mech = _cached(text_key, lambda: from_dict(data, file=file, base_dir=base_dir))
+    mech = _cached(text_key, lambda: _from_file(data, file, base_dir, text.encode()))
     with _LOCK:
         _TEXT_HASH[id(mech)] = hashlib.sha256(text.encode()).hexdigest()
     return mech, description_from_dict(data, file=file)  # read without error: from_dict read it
@@ -124,27 +122,44 @@ def _cached(key: str, make: Any) -> Mechanism:
 
 def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Mechanism:
     """The mechanism a parsed mapping describes."""
+    return _from_file(data, file, base_dir, None)
+
+
+def _from_file(data: Any, file: str | None, base_dir: Path | None, text: bytes | None) -> Mechanism:
+    """The mechanism a parsed mapping describes; ``text``: the bytes of the file it was read
+    from, whose generated closure is kept across processes (`stored`)."""
     try:
         d = description_from_dict(data, file=file)
     except InputError as exc:
         raise exc.at(file=file) from None
-    return mechanism(d, base_dir=base_dir)
+    return _made(d, base_dir, None if text is None else stored.entry_key(text))
 
 
 def mechanism(d: Description, *, base_dir: Path | None = None) -> Mechanism:
     """A [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] from a description built in code or read from a file."""
+    return _made(d, base_dir, None)
+
+
+def _made(d: Description, base_dir: Path | None, key: str | None) -> Mechanism:
+    """The mechanism of a description: its closure generated, or read from the entry ``key`` of
+    the cache (`stored`; None: not kept), where a file's closure generated here is kept."""
     try:
-        return _mechanism(d, base_dir)
+        kept = stored.load(key) if key is not None else None
+        g = kept or stored.generate(d)
+        mech = _mechanism(d, base_dir, g)
+        if key is not None and kept is None:  # generated and its reference configuration checked
+            stored.save(key, d, g)
+        return mech
     except InputError as exc:
         raise exc.at(file=d.file) from None
 
 
-def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
-    gen, fns = closure_parts(d)
+def _mechanism(d: Description, base_dir: Path | None, g: stored.Generated) -> Mechanism:
+    fns = g.fns
     closure = LoopClosure(
         d.name,
-        x=gen.x_coords,
-        q=gen.q_coords,
+        x=g.x_coords,
+        q=g.q_coords,
         parameters=[p.name for p in d.parameters],
         phi=fns["phi"],
         task=d.platform.task,
@@ -152,7 +167,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         bounds=lambda p: tuple(np.asarray(v, dtype=float).ravel() for v in fns["extras"](p)[:2]),
         ik=fns["ik"],
         passive=fns["passive"],
-        passive_coords=[r.coord for r in gen.reported],
+        passive_coords=g.passive_coords,
         branch=fns["branch"],
         offsets=d.platform.offsets,
         branch_names=fns["branch_names"],
@@ -165,11 +180,11 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
     if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
         check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))
     params = parameter_options(d)
-    limits = described_limits(gen.limit_options(), d)
+    limits = described_limits(g.limits, d)
     examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)
     #: (name, dimension, size): a derived vector is reported as a vector under its name
-    derived_names = [(n, dim, int(sx.numel())) for n, sx, dim in gen.derived]
-    symbol_dims = {n: gen.env[n].dim for n in [p.name for p in d.parameters] + [n for n, _, _ in derived_names]}
+    derived_names = g.derived
+    symbol_dims = g.symbol_dims
 
     loading = [True]  # while the mechanism is loaded, errors are located in its file by mechanism()
 
@@ -197,12 +212,12 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         closure=lambda: closure,
         build=build,
         problem_files=examples,
-        geometry=graph_geometry(*fns["graph_drawing"], gen)
+        geometry=graph_geometry(*fns["graph_drawing"], g.gen)
         if d.is_graph
         else geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
         origin=Origin("file", d.name, path=d.file) if d.file else Origin("inline", d.name),
         # its hinges, and its legs as serial chains (legs only: a graph has none)
-        parts=tuple(p for p in (d.stiffness, LegChains(chains_function(gen)) if chains_supported(gen) else None) if p),
+        parts=tuple(p for p in (d.stiffness, LegChains(chains_maker(*g.chains)) if g.chains else None) if p),
     )
     if all(not p.required for p in params):  # check the reference configuration now, with the defaults
         model = mech.model(closure, {}, {}, ())
@@ -276,6 +291,8 @@ def _check_finite(d: Description, parameters: dict, derived: list[np.ndarray], s
     for q, vec in zip(d.derived, derived):
         v = float(vec[0]) if vec.size == 1 else vec.tolist()
         if not np.all(np.isfinite(vec)):
+            from . import expr as ex  # the expression language, for the message only
+
             exc = ex.diagnose(q.value, known)
             why = f": column {exc.column}: {exc.message}" if exc is not None else ""
             names = ex.names_in(q.value)
@@ -290,6 +307,7 @@ def _check_finite(d: Description, parameters: dict, derived: list[np.ndarray], s
 def _quantity(value: float | list[float], dim: Any) -> str:
     """A parameter's value for a message, in the unit people read (``20 mm``, ``60 deg``)."""
     from ...core.units import format_quantity
+    from . import expr as ex
 
     name = {ex.LENGTH: "length", ex.ANGLE: "angle", ex.NUMBER: "dimensionless"}.get(dim)
     if name is None or isinstance(value, list):
