@@ -11,7 +11,6 @@ on disk by their source like the built-ins'.
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import math
 import threading
@@ -22,6 +21,7 @@ import numpy as np
 
 from ...analysis.compliance import check_declared
 from ...core.chains import LegChains
+from ...core.digest import sha256_hex
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
@@ -84,12 +84,13 @@ def load_file_description(path: str | Path, *, allow_pipe: bool = False) -> tupl
     text = read_input_text(path, allow_pipe=allow_pipe)
     file = display_name(path)
     base_dir = input_dir(path)
-    text_key = hashlib.sha256(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode()).hexdigest()
+    text_key = sha256_hex(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode())
     data = parse_yaml(text, file)
-    mech = _cached(text_key, lambda: _from_file(data, file, base_dir, text.encode()))
+    mech, d = _cached(text_key, lambda: _description_and_mechanism(data, file, base_dir, text.encode()))
     with _LOCK:
-        _TEXT_HASH[id(mech)] = hashlib.sha256(text.encode()).hexdigest()
-    return mech, description_from_dict(data, file=file)  # read without error: from_dict read it
+        _TEXT_HASH[id(mech)] = sha256_hex(text.encode())
+    # made now, or read again (a description of its own; without error: it was read before)
+    return mech, d if d is not None else description_from_dict(data, file=file)
 
 
 def same_text(a: Mechanism, b: Mechanism) -> bool:
@@ -110,29 +111,38 @@ def with_same_text(mech: Mechanism, read: Mechanism) -> Mechanism:
     return mech
 
 
-def _cached(key: str, make: Any) -> Mechanism:
+def _cached(key: str, make: Any) -> tuple[Mechanism, Description | None]:
+    """The mechanism of ``key`` made once per process: ``make() -> (mechanism, description)``;
+    the description only where it was made now (None: the mechanism was made before)."""
     with _LOCK:
         mech = _CACHE.get(key)
-    if mech is None:
-        mech = make()
-        with _LOCK:
-            _CACHE[key] = mech
-    return mech
+    if mech is not None:
+        return mech, None
+    mech, d = make()
+    with _LOCK:
+        _CACHE[key] = mech
+    return mech, d
 
 
 def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Mechanism:
     """The mechanism a parsed mapping describes."""
-    return _from_file(data, file, base_dir, None)
+    return _description_and_mechanism(data, file, base_dir, None)[0]
 
 
 def _from_file(data: Any, file: str | None, base_dir: Path | None, text: bytes | None) -> Mechanism:
     """The mechanism a parsed mapping describes; ``text``: the bytes of the file it was read
     from, whose generated closure is kept across processes (`stored`)."""
+    return _description_and_mechanism(data, file, base_dir, text)[0]
+
+
+def _description_and_mechanism(
+    data: Any, file: str | None, base_dir: Path | None, text: bytes | None
+) -> tuple[Mechanism, Description]:
     try:
         d = description_from_dict(data, file=file)
     except InputError as exc:
         raise exc.at(file=file) from None
-    return _made(d, base_dir, None if text is None else stored.entry_key(text))
+    return _made(d, base_dir, None if text is None else stored.entry_key(text)), d
 
 
 def mechanism(d: Description, *, base_dir: Path | None = None) -> Mechanism:

@@ -28,7 +28,6 @@ under ``described/``) keeps it:
 
 from __future__ import annotations
 
-import hashlib
 import json
 import logging
 import os
@@ -38,6 +37,7 @@ from typing import Any
 import casadi as ca
 
 from ...core import version
+from ...core.digest import sha256, sha256_hex
 from ...core.model import Coordinate
 from ...core.options import Option
 
@@ -121,7 +121,7 @@ def generate(d: Any) -> Generated:
 
 def entry_key(text: bytes) -> str:
     """The key of a mechanism file's entry: its bytes, the format, the versions and the generator's modules."""
-    h = hashlib.sha256()
+    h = sha256()
     h.update(f"cpm_nlp-described {FORMAT} {version.__version__} casadi {ca.__version__}\0".encode())
     h.update(_generator_fingerprint().encode())
     h.update(b"\0")
@@ -208,7 +208,7 @@ def save(key: str, d: Any, g: Generated) -> None:
     path = entry_path(key)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        write_atomic(str(path), hashlib.sha256(text.encode()).hexdigest() + "\n" + text)
+        write_atomic(str(path), sha256_hex(text.encode()) + "\n" + text)
     except (OSError, InputError) as exc:
         log.debug("mechanism %s: closure not kept in %s (%s)", d.name, path, exc)
 
@@ -244,7 +244,7 @@ def load(key: str) -> Generated | None:
     except OSError:
         return None
     digest, _, text = raw.partition(b"\n")
-    if hashlib.sha256(text).hexdigest().encode() != digest:
+    if sha256_hex(text).encode() != digest:
         log.debug("cached closure %s is corrupt: ignored", path)
         return None
     try:
