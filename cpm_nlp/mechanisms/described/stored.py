@@ -20,10 +20,11 @@ under ``described/``) keeps it:
   configuration was checked, once, atomically (`cpm_nlp.io.atomic.write_atomic`);
   only for a legs file (a graph file's and a drawn-rods legs file's assembly is Python,
   rebuilt every time) and only if the entry reads back equal to what was generated;
-* **when it is read**: the entry's SHA-256 is checked before CasADi reads a byte of it; an
-  entry that is missing, truncated, corrupt, of another format or another key is ignored
-  (logged at debug level) and the file generated again -- never an error, never a stale
-  Function.
+* **when it is read**: the entry's checksum (CRC-32 of its JSON, made for catching
+  corruption, and 0.05 ms where a SHA-256 takes 1 ms) is checked before CasADi reads a byte
+  of it; an entry that is missing, truncated, corrupt, of another format or another key is
+  ignored (logged at debug level) and the file generated again -- never an error, never a
+  stale Function.
 """
 
 from __future__ import annotations
@@ -31,13 +32,14 @@ from __future__ import annotations
 import json
 import logging
 import os
+import zlib
 from pathlib import Path
 from typing import Any
 
 import casadi as ca
 
 from ...core import version
-from ...core.digest import sha256, sha256_hex
+from ...core.digest import sha256
 from ...core.model import Coordinate
 from ...core.options import Option
 
@@ -208,9 +210,14 @@ def save(key: str, d: Any, g: Generated) -> None:
     path = entry_path(key)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        write_atomic(str(path), sha256_hex(text.encode()) + "\n" + text)
+        write_atomic(str(path), _checksum(text.encode()) + "\n" + text)
     except (OSError, InputError) as exc:
         log.debug("mechanism %s: closure not kept in %s (%s)", d.name, path, exc)
+
+
+def _checksum(payload: bytes) -> str:
+    """The checksum of an entry's JSON: its CRC-32, 8 hex digits."""
+    return f"{zlib.crc32(payload):08x}"
 
 
 def _same(a: Generated, b: Generated) -> bool:
@@ -244,7 +251,7 @@ def load(key: str) -> Generated | None:
     except OSError:
         return None
     digest, _, text = raw.partition(b"\n")
-    if sha256_hex(text).encode() != digest:
+    if _checksum(text).encode() != digest:
         log.debug("cached closure %s is corrupt: ignored", path)
         return None
     try:
