@@ -249,3 +249,34 @@ def test_a_cache_that_cannot_be_written_is_no_error(tmp_path, monkeypatch):
     data, file, text = _read("prs3")
     mech = described._from_file(data, file, None, text)
     assert mech.name == "prs3" and not _entry(text).exists()
+
+
+def test_a_solve_with_the_closure_kept_loads_no_generator(tmp_path):
+    """With the 3-PRS's closure kept, `cpm-nlp solve` of its FK file imports neither the
+    expression language nor the generator, nor hashlib (OpenSSL), nor the validity module
+    (issue 23, start-up); the first solve, which generates and keeps it, does."""
+    watched = (
+        "cpm_nlp.mechanisms.described.expr",
+        "cpm_nlp.mechanisms.described.generate",
+        "cpm_nlp.mechanisms.described.builder",
+        "cpm_nlp.mechanisms.described.closure",
+        "cpm_nlp.mechanisms.described.motions",
+        "cpm_nlp.analysis.validity",
+        "hashlib",
+    )
+    body = (
+        "import sys, io; from cpm_nlp.cli.main import main; "
+        "assert main(['solve', 'problems/prs3_forward_kinematics.yaml'], out=io.StringIO()) == 0; "
+        f"print('loaded:' + ','.join(m for m in {watched!r} if m in sys.modules))"
+    )
+    env = {**os.environ, "CPM_NLP_CACHE": str(tmp_path / "cache"), "PYTHONPATH": str(ROOT)}
+
+    def loaded() -> set[str]:
+        run = subprocess.run([sys.executable, "-c", body], cwd=ROOT, env=env, capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        line = [ln for ln in run.stdout.splitlines() if ln.startswith("loaded:")][-1]
+        return {m for m in line[len("loaded:") :].split(",") if m}
+
+    first = loaded()
+    assert "cpm_nlp.mechanisms.described.generate" in first and "cpm_nlp.mechanisms.described.expr" in first
+    assert loaded() == set()
