@@ -8,7 +8,8 @@ and an entry of the cache directory (`cpm_nlp.core.cache.cache_dir`, ``CPM_NLP_C
 under ``described/``) keeps it:
 
 * **what it holds**: the Functions as CasADi's own serialization of their expression
-  graphs (``Function.serialize``: instructions and constants, no code), and the names,
+  graphs (``Function.serialize`` of SX Functions: instructions and constants, no code; an
+  entry's Function of another class is refused), and the names,
   dimensions, limits and drawing layout as JSON; no pickle, nothing a reader executes;
 * **its key**: the SHA-256 of the file's bytes, the entry's format, the versions of cpm_nlp
   and CasADi, and the size and modification time of every module of the generator
@@ -300,9 +301,11 @@ def _read_payload(key: str, data: dict[str, Any]) -> Generated:
 
 
 def _function(text: str, name: str) -> ca.Function:
+    """A Function of an entry: an SX expression graph (nothing else is ever written: no
+    external library, no compiled code, no MX) of the name it is kept under."""
     f = ca.Function.deserialize(text)
-    if f.name() != name:
-        raise ValueError(f"expected the function {name!r}, found {f.name()!r}")
+    if f.class_name() != "SXFunction" or f.name() != name:
+        raise ValueError(f"expected the SX function {name!r}, found {f.class_name()} {f.name()!r}")
     return f
 
 
