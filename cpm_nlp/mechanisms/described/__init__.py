@@ -156,7 +156,7 @@ def _made(d: Description, base_dir: Path | None, key: str | None) -> Mechanism:
     try:
         kept = stored.load(key) if key is not None else None
         g = kept or stored.generate(d)
-        mech = _mechanism(d, base_dir, g)
+        mech = _mechanism(d, base_dir, g, checked=kept is not None)
         if key is not None and kept is None:  # generated and its reference configuration checked
             stored.save(key, d, g)
         return mech
@@ -164,7 +164,11 @@ def _made(d: Description, base_dir: Path | None, key: str | None) -> Mechanism:
         raise exc.at(file=d.file) from None
 
 
-def _mechanism(d: Description, base_dir: Path | None, g: stored.Generated) -> Mechanism:
+def _mechanism(d: Description, base_dir: Path | None, g: stored.Generated, checked: bool = False) -> Mechanism:
+    """The mechanism of a description and its generated closure; ``checked``: the closure was
+    read back from the cache, whose entry is written only once the checks below passed on
+    the same file's bytes with the same code (the entry's key), so they are not run again
+    (the declared hinges' formulas, 4-5 ms of the 3-PRS's start-up)."""
     fns = g.fns
     closure = LoopClosure(
         d.name,
@@ -187,7 +191,7 @@ def _mechanism(d: Description, base_dir: Path | None, g: stored.Generated) -> Me
         fk_closed=fns.get("fk_closed"),
         fk_seed=fns.get("fk_seed"),
     )
-    if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
+    if d.stiffness is not None and not checked:  # a bad hinge is an error of the mechanism file, at load
         check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))
     params = parameter_options(d)
     limits = described_limits(g.limits, d)
@@ -229,7 +233,7 @@ def _mechanism(d: Description, base_dir: Path | None, g: stored.Generated) -> Me
         # its hinges, and its legs as serial chains (legs only: a graph has none)
         parts=tuple(p for p in (d.stiffness, LegChains(chains_maker(*g.chains)) if g.chains else None) if p),
     )
-    if all(not p.required for p in params):  # check the reference configuration now, with the defaults
+    if all(not p.required for p in params) and not checked:  # the reference configuration, with the defaults
         model = mech.model(closure, {}, {}, ())
         log.debug("%s: reference configuration checked (%d coordinates)", d.name, len(model.x_home))
     loading[0] = False

@@ -12,9 +12,11 @@ under ``described/``) keeps it:
   entry's Function of another class is refused), and the names,
   dimensions, limits and drawing layout as JSON; no pickle, nothing a reader executes;
 * **its key**: the SHA-256 of the file's bytes, the entry's format, the versions of cpm_nlp
-  and CasADi, and the size and modification time of every module of the generator
-  (`cpm_nlp.mechanisms.described` and `cpm_nlp.core`), so that an edited generator never
-  reads an entry an older one wrote.  The Functions are symbolic in the parameters: the
+  and CasADi, and the size and modification time of every module of the generator and of
+  the checks a file passes when it is read (`cpm_nlp.mechanisms.described`, `cpm_nlp.core`,
+  `cpm_nlp.analysis`), so that an edited generator never reads an entry an older one wrote;
+  an entry is written only after those checks passed, so a file read back from it is not
+  checked again (its declared hinges, its reference configuration).  The Functions are symbolic in the parameters: the
   parameters a problem gives are applied to them when its model is built, as without the
   cache, so they are not part of the key;
 * **when it is written**: after the file generated without error and its reference
@@ -133,10 +135,11 @@ def entry_key(text: bytes) -> str:
 
 
 def _generator_fingerprint() -> str:
-    """The size and modification time (ns) of every module of the generator and of core."""
+    """The size and modification time (ns) of every module of the generator, of core and of
+    the analysis modules that check a file's hinges (an entry stands for those checks too)."""
     package = Path(__file__).resolve().parents[2]
     parts = []
-    for folder in (package / "mechanisms" / "described", package / "core"):
+    for folder in (package / "mechanisms" / "described", package / "core", package / "analysis"):
         with os.scandir(folder) as it:
             for e in sorted(it, key=lambda e: e.name):
                 if e.name.endswith(".py"):

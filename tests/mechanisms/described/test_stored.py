@@ -232,7 +232,8 @@ def test_the_key_changes_with_the_file_the_format_and_the_versions(monkeypatch):
 
 def test_the_generator_fingerprint_covers_its_modules():
     fingerprint = stored._generator_fingerprint()
-    for module in ("described/generate.py", "described/expr.py", "described/stored.py", "core/model.py"):
+    modules = ("described/generate.py", "described/expr.py", "described/stored.py", "core/model.py")
+    for module in modules + ("analysis/compliance.py", "analysis/hinge_types.py"):
         assert module + ":" in fingerprint
 
 
@@ -253,8 +254,9 @@ def test_a_cache_that_cannot_be_written_is_no_error(tmp_path, monkeypatch):
 
 def test_a_solve_with_the_closure_kept_loads_no_generator(tmp_path):
     """With the 3-PRS's closure kept, `cpm-nlp solve` of its FK file imports neither the
-    expression language nor the generator, nor hashlib (OpenSSL), nor the validity module
-    (issue 23, start-up); the first solve, which generates and keeps it, does."""
+    expression language nor the generator, nor hashlib (OpenSSL), nor the validity module, nor
+    numpy.polynomial (issue 23, start-up); the first solve, which generates, checks and keeps
+    it, does."""
     watched = (
         "cpm_nlp.mechanisms.described.expr",
         "cpm_nlp.mechanisms.described.generate",
@@ -263,6 +265,7 @@ def test_a_solve_with_the_closure_kept_loads_no_generator(tmp_path):
         "cpm_nlp.mechanisms.described.motions",
         "cpm_nlp.analysis.validity",
         "hashlib",
+        "numpy.polynomial",  # the filleted rod's formula: its hinges are not checked again
     )
     body = (
         "import sys, io; from cpm_nlp.cli.main import main; "
@@ -278,5 +281,19 @@ def test_a_solve_with_the_closure_kept_loads_no_generator(tmp_path):
         return {m for m in line[len("loaded:") :].split(",") if m}
 
     first = loaded()
-    assert "cpm_nlp.mechanisms.described.generate" in first and "cpm_nlp.mechanisms.described.expr" in first
+    assert {"cpm_nlp.mechanisms.described.generate", "cpm_nlp.mechanisms.described.expr", "numpy.polynomial"} <= first
     assert loaded() == set()
+
+
+def test_a_file_read_back_is_not_checked_again(cache, monkeypatch):
+    """An entry is written only after the file's checks passed (its declared hinges): read
+    back with the same code (the key), they are not run again; generated, they are."""
+    data, file, text = _read("prs3")
+    described._from_file(data, file, None, text)  # generated, checked, kept
+    calls = []
+    monkeypatch.setattr(described, "check_declared", lambda *a: calls.append(a))
+    described._from_file(data, file, None, text)  # read back
+    assert calls == []
+    _entry(text).unlink()
+    described._from_file(data, file, None, text)  # generated again: checked again
+    assert len(calls) == 1
