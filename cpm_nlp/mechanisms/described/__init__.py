@@ -5,7 +5,8 @@
 [`Description`][cpm_nlp.mechanisms.described.spec.Description] built in code; each returns a
 [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] with its symbolic closure, ready to
 register.  A description is generated once per content (SHA-256 of the file's
-text, or of the description) and kept in memory; compiled kernels are cached
+text, or of the description) and kept in memory; a file's generated closure is
+also kept on disk for the next process (`stored`), and compiled kernels are cached
 on disk by their source like the built-ins'.
 """
 
@@ -129,15 +130,11 @@ def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = Non
     return _description_and_mechanism(data, file, base_dir, None)[0]
 
 
-def _from_file(data: Any, file: str | None, base_dir: Path | None, text: bytes | None) -> Mechanism:
-    """The mechanism a parsed mapping describes; ``text``: the bytes of the file it was read
-    from, whose generated closure is kept across processes (`stored`)."""
-    return _description_and_mechanism(data, file, base_dir, text)[0]
-
-
 def _description_and_mechanism(
     data: Any, file: str | None, base_dir: Path | None, text: bytes | None
 ) -> tuple[Mechanism, Description]:
+    """The mechanism a parsed mapping describes, and its description; ``text``: the bytes of
+    the file it was read from, whose generated closure is kept across processes (`stored`)."""
     try:
         d = description_from_dict(data, file=file)
     except InputError as exc:

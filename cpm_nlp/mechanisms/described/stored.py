@@ -119,7 +119,7 @@ def generate(d: Any) -> Generated:
         derived=derived,
         symbol_dims={n: gen.env[n].dim for n in names + [n for n, _, _ in derived]},
         fns=fns,
-        chains=None if d.is_graph or not chains_supported(gen) else chain_parts(gen),
+        chains=chain_parts(gen) if chains_supported(gen) else None,
         gen=gen,
     )
 
@@ -159,9 +159,9 @@ def entry_path(key: str) -> Path:
 def storable(d: Any, g: Generated) -> bool:
     """Whether a generated closure is all data: a legs file's, its Functions CasADi's and its
     assembly not Python (a drawn rod's legs file assembles by a Python solver: not kept)."""
-    if d.is_graph or g.gen is None or "assemble" in g.fns:
+    if d.is_graph or g.gen is None:
         return False
-    if any(g.fns.get(k) is not None for k in ("loops", "fk_seed", "graph_drawing")):
+    if set(g.fns) - set(FUNCTIONS) - set(METADATA):  # a part an entry does not hold (an assembly)
         return False
     return all(g.fns.get(k) is None or isinstance(g.fns[k], ca.Function) for k in FUNCTIONS)
 

@@ -103,6 +103,11 @@ def test_cold_and_warm_cache_give_the_same_results_byte_for_byte(tmp_path):
         assert len(a.splitlines()) == len(b.splitlines()), name
 
 
+def _mechanism(data, file, base_dir, text):
+    """The mechanism of a mechanism file's parsed text, its closure kept under the file's bytes."""
+    return described._description_and_mechanism(data, file, base_dir, text)[0]
+
+
 def _read(name: str) -> tuple:
     path = MECH / f"{name}.yaml"
     text = path.read_text()
@@ -133,14 +138,14 @@ def _fk(mech) -> np.ndarray:
 
 def test_an_entry_is_written_read_back_and_holds_what_was_generated(cache):
     data, file, text = _read("prs3")
-    first = described._from_file(data, file, None, text)
+    first = _mechanism(data, file, None, text)
     path = _entry(text)
     assert path.is_file() and path.parent == cache / "described"
     g = stored.load(stored.entry_key(text))
     assert g is not None and g.gen is None
     d = described.read_description(MECH / "prs3.yaml")
     assert stored._same(stored.generate(d), g)
-    second = described._from_file(data, file, None, text)  # from the entry
+    second = _mechanism(data, file, None, text)  # from the entry
     assert np.array_equal(_fk(first), _fk(second))
     # the entry is CasADi's serialized expression graphs and JSON: no pickle, no code
     digest, _, payload = path.read_bytes().partition(b"\n")
@@ -195,18 +200,18 @@ def _corruptions(path: Path) -> list:
 
 def test_a_corrupt_entry_is_ignored_and_the_file_generated_again(cache):
     data, file, text = _read("prs3")
-    reference = _fk(described._from_file(data, file, None, text))
+    reference = _fk(_mechanism(data, file, None, text))
     path = _entry(text)
     key = stored.entry_key(text)
     good = path.read_bytes()
     for what, corrupt in _corruptions(path):
         corrupt()
         assert stored.load(key) is None, what
-        mech = described._from_file(data, file, None, text)  # never an error
+        mech = _mechanism(data, file, None, text)  # never an error
         assert np.array_equal(_fk(mech), reference), what
         if path.is_dir():
             path.rmdir()
-            mech = described._from_file(data, file, None, text)
+            mech = _mechanism(data, file, None, text)
         assert path.read_bytes() == good, what  # rewritten as the first process wrote it
         assert stored.load(key) is not None, what
 
@@ -239,7 +244,7 @@ def test_the_generator_fingerprint_covers_its_modules():
 
 def test_a_graph_file_is_not_kept(cache):
     data, file, text = _read("jansen")
-    described._from_file(data, file, None, text)
+    _mechanism(data, file, None, text)
     assert not _entry(text).exists()
 
 
@@ -248,7 +253,7 @@ def test_a_cache_that_cannot_be_written_is_no_error(tmp_path, monkeypatch):
     blocker.write_text("")
     monkeypatch.setenv("CPM_NLP_CACHE", str(blocker / "cache"))  # under a regular file
     data, file, text = _read("prs3")
-    mech = described._from_file(data, file, None, text)
+    mech = _mechanism(data, file, None, text)
     assert mech.name == "prs3" and not _entry(text).exists()
 
 
@@ -289,11 +294,11 @@ def test_a_file_read_back_is_not_checked_again(cache, monkeypatch):
     """An entry is written only after the file's checks passed (its declared hinges): read
     back with the same code (the key), they are not run again; generated, they are."""
     data, file, text = _read("prs3")
-    described._from_file(data, file, None, text)  # generated, checked, kept
+    _mechanism(data, file, None, text)  # generated, checked, kept
     calls = []
     monkeypatch.setattr(described, "check_declared", lambda *a: calls.append(a))
-    described._from_file(data, file, None, text)  # read back
+    _mechanism(data, file, None, text)  # read back
     assert calls == []
     _entry(text).unlink()
-    described._from_file(data, file, None, text)  # generated again: checked again
+    _mechanism(data, file, None, text)  # generated again: checked again
     assert len(calls) == 1
