@@ -29,7 +29,12 @@ Measurements
                         (the interpreter without site).  The children run with
                         bytecode caching on (PYTHONDONTWRITEBYTECODE removed from
                         their environment, one warm-up run each), as an installed
-                        package runs.
+                        package runs; the solve with the mechanism file's closure
+                        kept in the cache directory by the warm-up run
+                        (`cpm_nlp.mechanisms.described.stored`), and
+                        ``solve_prs3_fk_cold`` with an emptied cache directory
+                        before each run (the first solve after an install or an
+                        edit of the file).
 """
 
 from __future__ import annotations
@@ -39,9 +44,11 @@ import json
 import os
 import platform
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -214,6 +221,9 @@ def bench_startup(repeats: int, before_checkout: str | None = None) -> dict:
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONPATH")}
     env["PYTHONPATH"] = str(ROOT)
     runs = dict(STARTUP)
+    # the same solve with an empty cache directory before each run: the closure generated again
+    cold = Path(tempfile.mkdtemp(prefix="cpm_nlp_cold_cache_"))
+    runs["solve_prs3_fk_cold"] = (STARTUP["solve_prs3_fk"][0], {"CPM_NLP_CACHE": str(cold)})
     if before_checkout:
         other = {"PYTHONPATH": str(Path(before_checkout).resolve())}
         runs["help_before"] = (STARTUP["help"][0], other)
@@ -226,10 +236,13 @@ def bench_startup(repeats: int, before_checkout: str | None = None) -> dict:
     before = load()
     for _ in range(repeats):
         for k, (argv, extra) in runs.items():
+            if k == "solve_prs3_fk_cold":
+                shutil.rmtree(cold, ignore_errors=True)
             c, w = _child(argv, {**env, **extra})
             cpu[k].append(c)
             wall[k].append(w)
     after = load()
+    shutil.rmtree(cold, ignore_errors=True)
     med = {k: statistics.median(v) for k, v in cpu.items()}
     out: dict = {}
     for k in runs:

@@ -36,6 +36,7 @@ Sources:
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -44,8 +45,14 @@ import numpy as np
 
 from ..core import screws
 
-#: Gauss-Legendre nodes and weights on [-1, 1].
-_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(32)
+
+@functools.cache
+def _gauss_legendre() -> tuple[np.ndarray, np.ndarray]:
+    """32-point Gauss-Legendre nodes and weights on [-1, 1] (made on first use: numpy.polynomial
+    is not imported by a solve that evaluates no hinge formula; issue 23, start-up)."""
+    return np.polynomial.legendre.leggauss(32)
+
+
 #: Timoshenko shear coefficient of a rectangle.
 SHEAR_COEFFICIENT = 6.0 / 5.0
 
@@ -98,7 +105,7 @@ def circular_notch_compliances(E, G, b, t, r) -> dict[str, Any]:
     k = (t / (t + 4.0 * r)) ** 0.5
     psi_end = _atan(1.0 / k)
     acc = {key: 0.0 for key in ("x", "y", "z", "rx", "ry", "rz")}
-    for node, weight in zip(_NODES, _WEIGHTS):
+    for node, weight in zip(*_gauss_legendre()):
         psi = float(node) * psi_end
         u = k * _tan(psi)
         phi = 2.0 * _atan(u)

@@ -11,6 +11,7 @@ model's types), and/or the largest rotation at the allowable stress (the rotatio
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -185,7 +186,11 @@ def _leaf_six(E, G, d) -> dict[str, float]:
     return out
 
 
-_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(32)
+@functools.cache
+def _gauss_legendre() -> tuple[np.ndarray, np.ndarray]:
+    """32-point Gauss-Legendre nodes and weights on [-1, 1] (made on first use: numpy.polynomial
+    is not imported by a solve that evaluates no hinge formula; issue 23, start-up)."""
+    return np.polynomial.legendre.leggauss(32)
 
 
 def _filleted_rod_integrals(d: Mapping[str, float]) -> dict[str, float]:
@@ -198,7 +203,7 @@ def _filleted_rod_integrals(d: Mapping[str, float]) -> dict[str, float]:
     half = length / 2.0
     inertia, area = math.pi * dia**4 / 64.0, math.pi * dia**2 / 4.0
     out = {"I": length / inertia, "A": length / area, "x2I": 2.0 * half**3 / 3.0 / inertia}
-    for node, weight in zip(_GL_NODES, _GL_WEIGHTS):
+    for node, weight in zip(*_gauss_legendre()):
         phi = (float(node) + 1.0) * math.pi / 4.0  # [0, pi/2]
         ds = r * math.cos(phi) * float(weight) * math.pi / 4.0
         D = dia + 2.0 * r * (1.0 - math.cos(phi))

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.conditioning import NEAR_SINGULAR_CONDITION
 from ..core.result import ResultWarning
 
 #: Largest rotation (rad) about any axis of a hinge that its stiffness formula
@@ -64,12 +65,6 @@ LINEAR_RANGE = 0.10
 #: nonlinearity: the FK tolerance of 1e-10 (relative) leaves 1e-11 rad of noise at no load
 #: (a four-bar gave -8.4e-12 rad against a linearised 0, "differ by 100 %")
 DEFLECTION_NOISE = {"angle": 1e-9, "length": 1e-12}
-#: Condition number of Φ_x (or of the homogenised J) above which a pose is reported
-#: as near a singularity: 1e4 below the 1e10 at which it is refused as singular
-#: (status ``singular``); at 1e6 an error of 1e-10 in the closures (the solver's
-#: tolerance) can move the pose by 1e-4 of its scale, and an actuator error is
-#: amplified a million times in the worst direction.
-NEAR_SINGULAR_CONDITION = 1e6
 
 
 def hinge_geometry_warnings(hinges: Iterable[Any], where: str = "hinge") -> list[ResultWarning]:

@@ -24,7 +24,6 @@ import re
 import shlex
 import shutil
 import subprocess
-import sys
 import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -34,6 +33,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from .cache import cache_dir, cache_key
 from .errors import CpmError, InputError, suggest
 from .fast_calls import BoundCall
 from .kernels import Kernel
@@ -55,27 +55,6 @@ CFLAGS = ("-O3", "-ffp-contract=off", "-fvisibility=hidden", "-DGCC_HASCLASSVISI
 
 class CompilerError(CpmError):
     """No C compiler, or the compiler rejected the generated code."""
-
-
-def cache_dir() -> Path:
-    """Where compiled libraries are kept (created on demand)."""
-    env = os.environ.get("CPM_NLP_CACHE")
-    if env:
-        return Path(env)
-    if sys.platform == "darwin":
-        return Path.home() / "Library" / "Caches" / "cpm_nlp"
-    if os.name == "nt":  # pragma: no cover - not tested on Windows
-        return Path(os.environ.get("LOCALAPPDATA", Path.home())) / "cpm_nlp" / "Cache"
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "cpm_nlp"
-
-
-def cache_key() -> tuple[str | None, ...]:
-    """The environment that decides `cache_dir` (``CPM_NLP_CACHE``, ``XDG_CACHE_HOME``,
-    ``HOME``, ``LOCALAPPDATA``), as a key of the per-process memos: a changed variable (a test's
-    fresh cache) means other libraries, and no path is built on every call."""
-    env = os.environ
-    return (env.get("CPM_NLP_CACHE"), env.get("XDG_CACHE_HOME"), env.get("HOME"), env.get("LOCALAPPDATA"))
 
 
 def find_compiler() -> list[str] | None:

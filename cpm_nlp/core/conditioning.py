@@ -31,6 +31,14 @@ def robust_max_abs(v: ca.SX) -> ca.SX:
     return ca.if_else(all_finite(v), ca.mmax(ca.fabs(v)), ca.inf)
 
 
+#: Condition number of Φ_x (or of the homogenised J) above which a pose is reported
+#: as near a singularity: 1e4 below the 1e10 at which it is refused as singular
+#: (status ``singular``); at 1e6 an error of 1e-10 in the closures (the solver's
+#: tolerance) can move the pose by 1e-4 of its scale, and an actuator error is
+#: amplified a million times in the worst direction (`cpm_nlp.analysis.validity` words
+#: the warning; the kinds read the threshold here without importing it).
+NEAR_SINGULAR_CONDITION = 1e6
+
 #: the preconditioned residual ‖I - Φ_x B‖₁ must stay below this for `cond1_bound` to certify
 CERTIFY_DELTA = 0.9
 

@@ -19,6 +19,7 @@ limits (Pinocchio's split: the model holds constants, algorithms in
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -171,43 +172,68 @@ class LoopClosure:
 
     # -- AD-derived functions ------------------------------------------------
     def _derive(self) -> None:
+        """The AD-derived functions every solve uses, now: Φ_x, Φ_q and the FK residual; the
+        others (`cond_matrix`, `phi_y`, `jacobian`, `inverse_jacobian`, `ik_residual`) are
+        made on first use (about 2 ms of symbolic work a forward-kinematics solve never needs;
+        issue 23, start-up)."""
         x = ca.SX.sym("x", self.nx)
         q = ca.SX.sym("q", self.nq)
         p = ca.SX.sym("p", self.np)
         phi = self.phi(x, q, p)
         phi_x = ca.jacobian(phi, x)
         phi_q = ca.jacobian(phi, q)
-        # forward Jacobian by the implicit function theorem: dx/dq = -Φ_x⁻¹ Φ_q
-        jac = -ca.solve(phi_x, phi_q)
-        # inverse: unknowns y = (x_dep, q) given the task coordinates t
-        phi_t = phi_x[:, list(self.task_index)]
-        phi_y = ca.horzcat(phi_x[:, list(self.dep_index)], phi_q)
-        dy_dt = -ca.solve(phi_y, phi_t)
-        jac_inv = dy_dt[len(self.dep_index) :, :]
+        self._symbols = (x, q, p, phi_x, phi_q)
         io = (["x", "q", "p"],)
         self.phi_x = ca.Function("phi_x", [x, q, p], [phi_x], *io, ["phi_x"])
-        # the matrix whose 2-norm condition number says how near a singularity the pose is: Φ_x, or
-        # for normal equations (phi = Aᵀ e with e every closure equation, where Φ_x ≈ e_xᵀ e_x up to
-        # scaling squares the condition number) the Jacobian e_x of every closure equation -- the
-        # same measure as a square closure's, which is its own e
-        cond_x = phi_x if self.loops is None else ca.jacobian(self.loops(x, q, p), x)
-        self.cond_matrix = ca.Function("cond_matrix", [x, q, p], [cond_x], *io, ["cond_x"])
         self.phi_q = ca.Function("phi_q", [x, q, p], [phi_q], *io, ["phi_q"])
-        self.phi_y = ca.Function("phi_y", [x, q, p], [phi_y], *io, ["phi_y"])
-        self.jacobian = ca.Function("jacobian", [x, q, p], [jac], *io, ["J"])
-        self.inverse_jacobian = ca.Function("inverse_jacobian", [x, q, p], [jac_inv], *io, ["J_inv"])
         # residuals in the solver layout: FK unknown x, known (q, p); IK unknown (x_dep, q), known (t, p)
         w_fk = ca.SX.sym("w", self.nq + self.np)
         self.fk_residual = ca.Function(
             "fk_residual", [x, w_fk], [self.phi(x, w_fk[: self.nq], w_fk[self.nq :])], ["x", "w"], ["phi"]
         )
+
+    @functools.cached_property
+    def cond_matrix(self) -> ca.Function:
+        """The matrix whose 2-norm condition number says how near a singularity the pose is: Φ_x, or
+        for normal equations (phi = Aᵀ e with e every closure equation, where Φ_x ≈ e_xᵀ e_x up to
+        scaling squares the condition number) the Jacobian e_x of every closure equation -- the
+        same measure as a square closure's, which is its own e."""
+        x, q, p, phi_x, _phi_q = self._symbols
+        cond_x = phi_x if self.loops is None else ca.jacobian(self.loops(x, q, p), x)
+        return ca.Function("cond_matrix", [x, q, p], [cond_x], ["x", "q", "p"], ["cond_x"])
+
+    @functools.cached_property
+    def _inverse_blocks(self) -> tuple[ca.SX, ca.SX]:
+        """Φ_y = ∂Φ/∂(x_dep, q) and dy/dt: the inverse problem's unknowns y given the task coordinates t."""
+        _x, _q, _p, phi_x, phi_q = self._symbols
+        phi_t = phi_x[:, list(self.task_index)]
+        phi_y = ca.horzcat(phi_x[:, list(self.dep_index)], phi_q)
+        return phi_y, -ca.solve(phi_y, phi_t)
+
+    @functools.cached_property
+    def phi_y(self) -> ca.Function:
+        x, q, p, _phi_x, _phi_q = self._symbols
+        return ca.Function("phi_y", [x, q, p], [self._inverse_blocks[0]], ["x", "q", "p"], ["phi_y"])
+
+    @functools.cached_property
+    def jacobian(self) -> ca.Function:
+        """The forward Jacobian by the implicit function theorem: dx/dq = -Φ_x⁻¹ Φ_q."""
+        x, q, p, phi_x, phi_q = self._symbols
+        return ca.Function("jacobian", [x, q, p], [-ca.solve(phi_x, phi_q)], ["x", "q", "p"], ["J"])
+
+    @functools.cached_property
+    def inverse_jacobian(self) -> ca.Function:
+        x, q, p, _phi_x, _phi_q = self._symbols
+        jac_inv = self._inverse_blocks[1][len(self.dep_index) :, :]
+        return ca.Function("inverse_jacobian", [x, q, p], [jac_inv], ["x", "q", "p"], ["J_inv"])
+
+    @functools.cached_property
+    def ik_residual(self) -> ca.Function:
         nd = len(self.dep_index)
         y = ca.SX.sym("y", nd + self.nq)
         w_ik = ca.SX.sym("w", self.nq + self.np)
         x_full = self.assemble_x(w_ik[: self.nq], y[:nd])
-        self.ik_residual = ca.Function(
-            "ik_residual", [y, w_ik], [self.phi(x_full, y[nd:], w_ik[self.nq :])], ["y", "w"], ["phi"]
-        )
+        return ca.Function("ik_residual", [y, w_ik], [self.phi(x_full, y[nd:], w_ik[self.nq :])], ["y", "w"], ["phi"])
 
     def assemble_x(self, t: Any, d: Any) -> Any:
         """x from its task part t and dependent part d (symbolic or numeric)."""

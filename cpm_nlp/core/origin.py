@@ -14,11 +14,12 @@ rebuilds the very mechanism that was solved:
 
 from __future__ import annotations
 
-import hashlib
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from .digest import sha256_hex
 
 #: the kinds of origin
 ORIGIN_KINDS = ("built-in", "file", "inline", "plugin", "code")
@@ -89,13 +90,13 @@ class Origin:
 
 def file_sha256(path: str | Path) -> str:
     """SHA-256 of a file's bytes (hex)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    return sha256_hex(Path(path).read_bytes())
 
 
 def data_sha256(data: Any) -> str:
     """SHA-256 of data's canonical JSON (sorted keys, no spaces; hex)."""
     text = json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()
+    return sha256_hex(text.encode())
 
 
 def as_origin(value: Any, name: str = "") -> Origin:

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import casadi as ca
@@ -70,10 +69,15 @@ def status_of(code: Any) -> Status:
 # -- the status rule, symbolic or numeric ----------------------------------------------------
 
 
-@dataclass(frozen=True)
 class _Ops:
-    where: Callable
-    not_: Callable
+    """The two operations the status rules are written with, for one kind of value (a plain
+    class: a dataclass costs every process 0.5 ms to create; issue 23, start-up)."""
+
+    __slots__ = ("where", "not_")
+
+    def __init__(self, where: Callable, not_: Callable) -> None:
+        self.where = where
+        self.not_ = not_
 
 
 NUMPY = _Ops(np.where, np.logical_not)

@@ -46,7 +46,7 @@ from __future__ import annotations
 import functools
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
@@ -300,13 +300,34 @@ def _library_solver(section: str) -> str | None:
     return section.split()[0].lower()
 
 
+class _Rules(Mapping):
+    """Allowed options by name, each made on first use: a solve checks a few of IPOPT's 200
+    (making them all took about 3 ms of every solve's start-up; issue 23)."""
+
+    def __init__(self, makers: dict[str, Callable[[], SolverOption]]) -> None:
+        self._makers = makers
+        self._made: dict[str, SolverOption] = {}
+
+    def __getitem__(self, name: str) -> SolverOption:
+        rule = self._made.get(name)
+        if rule is None:
+            rule = self._made[name] = self._makers[name]()
+        return rule
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._makers)
+
+    def __len__(self) -> int:
+        return len(self._makers)
+
+
 @functools.cache
-def ipopt_rules() -> tuple[dict[str, SolverOption], dict[str, tuple[str, ...]], dict[tuple[str, str], str]]:
+def ipopt_rules() -> tuple[Mapping[str, SolverOption], dict[str, tuple[str, ...]], dict[tuple[str, str], str]]:
     """(allowed IPOPT options by name, refused ones with (reason, instead), refused
     (option, value) choices with the reason), from the table and the policy above."""
     data = table()
     builtin = set(data["ipopt_builtin_linear_solvers"])
-    allowed: dict[str, SolverOption] = {}
+    allowed: dict[str, Callable[[], SolverOption]] = {}
     refused: dict[str, tuple[str, ...]] = {}
     bad_choices: dict[tuple[str, str], str] = {}
     for entry in data["ipopt"]:
@@ -330,10 +351,12 @@ def ipopt_rules() -> tuple[dict[str, SolverOption], dict[str, tuple[str, ...]], 
                     bad_choices[(name, value)] = "needs a linear solver that the shipped IPOPT does not have"
                 else:
                     choices.append(value)
-            allowed[name] = _from_ipopt(entry, tuple(choices))
+            allowed[name] = functools.partial(_from_ipopt, entry, tuple(choices))
     for opt in IPOPT_HIDDEN:
-        allowed.setdefault(opt.name, SolverOption(opt.name, opt.kind, opt.description, None, choices=opt.choices))
-    return allowed, refused, bad_choices
+        allowed.setdefault(
+            opt.name, functools.partial(SolverOption, opt.name, opt.kind, opt.description, None, choices=opt.choices)
+        )
+    return _Rules(allowed), refused, bad_choices
 
 
 def _casadi_rule(name: str, kind: str, descriptions: Mapping[str, str]) -> SolverOption:

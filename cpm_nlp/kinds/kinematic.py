@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.validity import NEAR_SINGULAR_CONDITION, near_singular_warning
+from ..core.conditioning import NEAR_SINGULAR_CONDITION
 from ..core.errors import InputError
 from ..core.kernels import batch_newton_supported
 from ..core.kind import (
@@ -170,6 +170,8 @@ def _singularity_warning(model: Model, sols: Sequence[PoseSolution]) -> Any:
     near = [ck for ck in conds if ck[0] > NEAR_SINGULAR_CONDITION]
     if not near:
         return None
+    from ..analysis.validity import near_singular_warning  # only for a warning (issue 23, start-up)
+
     cond, k = max(near)
     points = f" (at {len(near)} of {len(sols)} points; the worst, point {k})" if len(sols) > 1 else ""
     return near_singular_warning(cond, "Phi_x", "Phi_x", points)
@@ -476,6 +478,8 @@ class Jacobian(ProblemKind):
             }
         res = _result(self.name, model, [sol], False, solver, extra, _jacobian_outputs(c) if extra else ())
         if extra:  # an inverse (type I) singularity: the homogenized J_task loses rank
+            from ..analysis.validity import near_singular_warning
+
             res.warn(*filter(None, [near_singular_warning(extra["cond"], "J_task, homogenized", "cond")]))
         return res
 

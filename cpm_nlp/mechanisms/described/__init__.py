@@ -5,13 +5,13 @@
 [`Description`][cpm_nlp.mechanisms.described.spec.Description] built in code; each returns a
 [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] with its symbolic closure, ready to
 register.  A description is generated once per content (SHA-256 of the file's
-text, or of the description) and kept in memory; compiled kernels are cached
+text, or of the description) and kept in memory; a file's generated closure is
+also kept on disk for the next process (`stored`), and compiled kernels are cached
 on disk by their source like the built-ins'.
 """
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import math
 import threading
@@ -22,16 +22,15 @@ import numpy as np
 
 from ...analysis.compliance import check_declared
 from ...core.chains import LegChains
+from ...core.digest import sha256_hex
 from ...core.errors import InputError
 from ...core.mechanism import Mechanism
 from ...core.model import LoopClosure, Model
 from ...core.origin import Origin
 from ...io.inputs import display_name, input_dir, read_input_text
 from ...io.yamlfile import load_yaml_text, parse_yaml, read_yaml
-from . import expr as ex
-from .chains import chains_function
-from .chains import supported as chains_supported
-from .closure import closure_parts
+from . import stored
+from .chains import chains_maker
 from .drawing import geometry_of, graph_geometry
 from .options import described_limits, parameter_options
 from .read import description_from_dict
@@ -86,12 +85,13 @@ def load_file_description(path: str | Path, *, allow_pipe: bool = False) -> tupl
     text = read_input_text(path, allow_pipe=allow_pipe)
     file = display_name(path)
     base_dir = input_dir(path)
-    text_key = hashlib.sha256(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode()).hexdigest()
+    text_key = sha256_hex(text.encode() + b"\0" + str(base_dir / Path(str(path)).name).encode())
     data = parse_yaml(text, file)
-    mech = _cached(text_key, lambda: from_dict(data, file=file, base_dir=base_dir))
+    mech, d = _cached(text_key, lambda: _description_and_mechanism(data, file, base_dir, text.encode()))
     with _LOCK:
-        _TEXT_HASH[id(mech)] = hashlib.sha256(text.encode()).hexdigest()
-    return mech, description_from_dict(data, file=file)  # read without error: from_dict read it
+        _TEXT_HASH[id(mech)] = sha256_hex(text.encode())
+    # made now, or read again (a description of its own; without error: it was read before)
+    return mech, d if d is not None else description_from_dict(data, file=file)
 
 
 def same_text(a: Mechanism, b: Mechanism) -> bool:
@@ -112,39 +112,65 @@ def with_same_text(mech: Mechanism, read: Mechanism) -> Mechanism:
     return mech
 
 
-def _cached(key: str, make: Any) -> Mechanism:
+def _cached(key: str, make: Any) -> tuple[Mechanism, Description | None]:
+    """The mechanism of ``key`` made once per process: ``make() -> (mechanism, description)``;
+    the description only where it was made now (None: the mechanism was made before)."""
     with _LOCK:
         mech = _CACHE.get(key)
-    if mech is None:
-        mech = make()
-        with _LOCK:
-            _CACHE[key] = mech
-    return mech
+    if mech is not None:
+        return mech, None
+    mech, d = make()
+    with _LOCK:
+        _CACHE[key] = mech
+    return mech, d
 
 
 def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Mechanism:
     """The mechanism a parsed mapping describes."""
+    return _description_and_mechanism(data, file, base_dir, None)[0]
+
+
+def _description_and_mechanism(
+    data: Any, file: str | None, base_dir: Path | None, text: bytes | None
+) -> tuple[Mechanism, Description]:
+    """The mechanism a parsed mapping describes, and its description; ``text``: the bytes of
+    the file it was read from, whose generated closure is kept across processes (`stored`)."""
     try:
         d = description_from_dict(data, file=file)
     except InputError as exc:
         raise exc.at(file=file) from None
-    return mechanism(d, base_dir=base_dir)
+    return _made(d, base_dir, None if text is None else stored.entry_key(text)), d
 
 
 def mechanism(d: Description, *, base_dir: Path | None = None) -> Mechanism:
     """A [`Mechanism`][cpm_nlp.core.mechanism.Mechanism] from a description built in code or read from a file."""
+    return _made(d, base_dir, None)
+
+
+def _made(d: Description, base_dir: Path | None, key: str | None) -> Mechanism:
+    """The mechanism of a description: its closure generated, or read from the entry ``key`` of
+    the cache (`stored`; None: not kept), where a file's closure generated here is kept."""
     try:
-        return _mechanism(d, base_dir)
+        kept = stored.load(key) if key is not None else None
+        g = kept or stored.generate(d)
+        mech = _mechanism(d, base_dir, g, checked=kept is not None)
+        if key is not None and kept is None:  # generated and its reference configuration checked
+            stored.save(key, d, g)
+        return mech
     except InputError as exc:
         raise exc.at(file=d.file) from None
 
 
-def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
-    gen, fns = closure_parts(d)
+def _mechanism(d: Description, base_dir: Path | None, g: stored.Generated, checked: bool = False) -> Mechanism:
+    """The mechanism of a description and its generated closure; ``checked``: the closure was
+    read back from the cache, whose entry is written only once the checks below passed on
+    the same file's bytes with the same code (the entry's key), so they are not run again
+    (the declared hinges' formulas, 4-5 ms of the 3-PRS's start-up)."""
+    fns = g.fns
     closure = LoopClosure(
         d.name,
-        x=gen.x_coords,
-        q=gen.q_coords,
+        x=g.x_coords,
+        q=g.q_coords,
         parameters=[p.name for p in d.parameters],
         phi=fns["phi"],
         task=d.platform.task,
@@ -152,7 +178,7 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         bounds=lambda p: tuple(np.asarray(v, dtype=float).ravel() for v in fns["extras"](p)[:2]),
         ik=fns["ik"],
         passive=fns["passive"],
-        passive_coords=[r.coord for r in gen.reported],
+        passive_coords=g.passive_coords,
         branch=fns["branch"],
         offsets=d.platform.offsets,
         branch_names=fns["branch_names"],
@@ -162,14 +188,14 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         fk_closed=fns.get("fk_closed"),
         fk_seed=fns.get("fk_seed"),
     )
-    if d.stiffness is not None:  # a bad hinge is an error of the mechanism file, at load
+    if d.stiffness is not None and not checked:  # a bad hinge is an error of the mechanism file, at load
         check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))
     params = parameter_options(d)
-    limits = described_limits(gen.limit_options(), d)
+    limits = described_limits(g.limits, d)
     examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)
     #: (name, dimension, size): a derived vector is reported as a vector under its name
-    derived_names = [(n, dim, int(sx.numel())) for n, sx, dim in gen.derived]
-    symbol_dims = {n: gen.env[n].dim for n in [p.name for p in d.parameters] + [n for n, _, _ in derived_names]}
+    derived_names = g.derived
+    symbol_dims = g.symbol_dims
 
     loading = [True]  # while the mechanism is loaded, errors are located in its file by mechanism()
 
@@ -197,14 +223,14 @@ def _mechanism(d: Description, base_dir: Path | None) -> Mechanism:
         closure=lambda: closure,
         build=build,
         problem_files=examples,
-        geometry=graph_geometry(*fns["graph_drawing"], gen)
+        geometry=graph_geometry(*fns["graph_drawing"], g.gen)
         if d.is_graph
         else geometry_of(fns["drawing"], fns["drawing_legs"], d.platform.planar),
         origin=Origin("file", d.name, path=d.file) if d.file else Origin("inline", d.name),
         # its hinges, and its legs as serial chains (legs only: a graph has none)
-        parts=tuple(p for p in (d.stiffness, LegChains(chains_function(gen)) if chains_supported(gen) else None) if p),
+        parts=tuple(p for p in (d.stiffness, LegChains(chains_maker(*g.chains)) if g.chains else None) if p),
     )
-    if all(not p.required for p in params):  # check the reference configuration now, with the defaults
+    if all(not p.required for p in params) and not checked:  # the reference configuration, with the defaults
         model = mech.model(closure, {}, {}, ())
         log.debug("%s: reference configuration checked (%d coordinates)", d.name, len(model.x_home))
     loading[0] = False
@@ -276,6 +302,8 @@ def _check_finite(d: Description, parameters: dict, derived: list[np.ndarray], s
     for q, vec in zip(d.derived, derived):
         v = float(vec[0]) if vec.size == 1 else vec.tolist()
         if not np.all(np.isfinite(vec)):
+            from . import expr as ex  # the expression language, for the message only
+
             exc = ex.diagnose(q.value, known)
             why = f": column {exc.column}: {exc.message}" if exc is not None else ""
             names = ex.names_in(q.value)
@@ -290,6 +318,7 @@ def _check_finite(d: Description, parameters: dict, derived: list[np.ndarray], s
 def _quantity(value: float | list[float], dim: Any) -> str:
     """A parameter's value for a message, in the unit people read (``20 mm``, ``60 deg``)."""
     from ...core.units import format_quantity
+    from . import expr as ex
 
     name = {ex.LENGTH: "length", ex.ANGLE: "angle", ex.NUMBER: "dimensionless"}.get(dim)
     if name is None or isinstance(value, list):

@@ -9,14 +9,18 @@ legs of P, R, C, U and S joints are supported; a planar mechanism or a
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
 
 from ...core.chains import JOINT_DOF, ChainJoint, Chains, LegChain
-from .generate import Generator
-from .motions import elementary_motions
+
+if TYPE_CHECKING:
+    from .generate import Generator
+
+#: each leg's name and its joints as (type, elementary motions, coordinates, actuator or None)
+Layout = list[tuple[str, list[tuple[str, list[str], tuple[str, ...], str | None]]]]
 
 
 def supported(gen: Generator) -> bool:
@@ -32,12 +36,14 @@ def _names(j: Any) -> tuple[str, ...]:
     return names if len(names) == dof else ("",) * dof
 
 
-def chains_function(gen: Generator):
-    """``(model) -> Chains`` for a built generator (the chains' geometry is a CasADi
-    function of the parameters, evaluated once per model)."""
+def chain_parts(gen: Generator) -> tuple[ca.Function, ca.Function, ca.Function, Layout]:
+    """What `chains_maker` needs of a built generator: the chains' geometry (a CasADi function
+    of the parameters), the platform's frame, the reference configuration and the layout."""
+    from .motions import elementary_motions
+
     q = ca.vertcat(*gen.q_syms)
     outs: list[Any] = []
-    layout: list[tuple[str, list[tuple[Any, list[str], tuple[str, ...], str | None]]]] = []
+    layout: Layout = []
     for leg, joints in gen.leg_joints:
         rows = []
         for j in joints:
@@ -49,16 +55,26 @@ def chains_function(gen: Generator):
             if j.spec.actuated is not None and j.value is not None:
                 gain = ca.sum1(ca.jacobian(j.value, q).T)
             outs.append(gain)
-            rows.append((j, kinds, _names(j), j.spec.actuated))
+            rows.append((j.type, kinds, _names(j), j.spec.actuated))
         layout.append((leg.name, rows))
     geom = ca.Function("chain_geometry", [gen.p], outs)
-    x = gen.x
-    frame = ca.Function("platform_frame_p", [x, gen.p], [gen.P, gen.R], ["x", "p"], ["P", "R"])
+    frame = ca.Function("platform_frame_p", [gen.x, gen.p], [gen.P, gen.R], ["x", "p"], ["P", "R"])
     refs = ca.Function("chain_reference", [gen.p], [gen.x_home, ca.vertcat(*gen.q_home)])
+    return geom, frame, refs, layout
+
+
+def chains_function(gen: Generator):
+    """``(model) -> Chains`` for a built generator."""
+    return chains_maker(*chain_parts(gen))
+
+
+def chains_maker(geom: ca.Function, frame: ca.Function, refs: ca.Function, layout: Layout):
+    """``(model) -> Chains`` from `chain_parts` (the chains' geometry is evaluated once per model)."""
+    nx = frame.size1_in(0)
 
     def make(model: Any) -> Chains:
         p = np.asarray(model.p, dtype=float)
-        vals = [np.asarray(v, dtype=float) for v in geom(p)] if outs else []
+        vals = [np.asarray(v, dtype=float) for v in geom(p)] if geom.n_out() else []
         legs = []
         k = 0
         for name, rows in layout:
@@ -72,7 +88,7 @@ def chains_function(gen: Generator):
             for n, (at, axes, kinds, names, actuated, gain) in enumerate(built):
                 joints.append(
                     ChainJoint(
-                        type=rows[n][0].type,
+                        type=rows[n][0],
                         at=at,
                         axes=axes / np.linalg.norm(axes, axis=0),
                         motions=tuple(kinds),
@@ -83,7 +99,7 @@ def chains_function(gen: Generator):
                     )
                 )
             legs.append(LegChain(name, tuple(joints), locs[-1]))
-        xs = ca.SX.sym("x", x.numel())
+        xs = ca.SX.sym("x", nx)
         P, R = frame(xs, p)
         platform = ca.Function("platform_frame", [xs], [P, R], ["x"], ["P", "R"])
         x_ref, q_ref = (np.asarray(v, dtype=float).ravel() for v in refs(p))
@@ -103,4 +119,4 @@ def _link(locs: list[np.ndarray], n: int) -> np.ndarray | None:
     return None
 
 
-__all__ = ["chains_function", "supported"]
+__all__ = ["Layout", "chain_parts", "chains_function", "chains_maker", "supported"]

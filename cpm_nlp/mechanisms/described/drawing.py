@@ -13,14 +13,16 @@ joints, each leg's joints and links, the platform through the legs' last joints.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
 
 from ...core.joints import JOINT_TYPES
 from ...core.mechanism import Drawing
-from .motions import LETTER, ResolvedJoint, chain_motion
+
+if TYPE_CHECKING:
+    from .motions import ResolvedJoint
 
 #: (leg name, [(joint letter, actuated, the link after it changes length)])
 Layout = Sequence[tuple[str, Sequence[tuple[str, bool, bool]]]]
@@ -267,6 +269,8 @@ def leg_points(
     chain's joints moved by the joints before them, the eliminated joint by the whole
     proximal chain, a P along the leg at its reference distance from there, the last
     joint where the platform puts it."""
+    from .motions import LETTER, chain_motion  # generation only: a kept closure's drawing needs neither
+
     out: list[tuple[str, ca.SX, bool, bool]] = []
     Rk, tk = ca.SX.eye(3), ca.SX.zeros(3)
     for j in before:
