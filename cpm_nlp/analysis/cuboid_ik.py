@@ -70,6 +70,18 @@ ESCALATE = 6
 MAX_SETTLE = 40
 #: CasADi options of the working-set NLP: NaN (no assembly) is a rejected trial point, not a warning
 QUIET = {"show_eval_warnings": False, "calc_lam_p": False}
+#: IPOPT's defaults of ``bound_relax_factor`` and ``constr_viol_tol`` (where the options do not set them)
+IPOPT_BOUND_RELAX, IPOPT_CONSTR_VIOL_TOL = 1e-8, 1e-4
+
+
+def relaxation(bound: np.ndarray, options: dict) -> np.ndarray:
+    """How far IPOPT relaxes a constraint bound before it starts (``bound_relax_factor`` times
+    max(1, |bound|), at most ``constr_viol_tol``): the rows of a working set may end that far
+    outside their bounds, so a row left out counts as violated only beyond the same slack."""
+    factor = float(options.get("ipopt.bound_relax_factor", IPOPT_BOUND_RELAX))
+    most = float(options.get("ipopt.constr_viol_tol", IPOPT_CONSTR_VIOL_TOL))
+    with np.errstate(invalid="ignore"):
+        return np.minimum(factor * np.maximum(1.0, np.abs(bound)), most)
 
 
 def row_key(rows: tuple[int, ...]) -> tuple:
@@ -100,6 +112,70 @@ def slots(rows: int) -> int:
     while K < rows:
         K = K * 3 // 2 if K & (K - 1) == 0 else K * 4 // 3
     return K
+
+
+def hessian_of_lagrangian(name: str, rows_fn: ca.Function, sel, K: int, J: int, Z, p, S, E, centre, size, f):
+    """``hess_lag`` of `SlotNLP`, through the task points: (z, p, lam_f, lam_g) -> triu(∇²_z L).
+
+    A slot's row depends on its box z = (u, w) only through its task point
+    t = c + D∘(u + s∘w), linear in z: with A = λ ∇²_t(e·G(t)) (d x d, one
+    forward-over-reverse sweep of d directions),
+    ∇²_z λ g = Jᵀ A J with J = [diag(D), diag(D∘s)], i.e. the blocks
+    D_a D_b Σ A_ab, D_a D_b Σ A_ab s_b and D_a D_b Σ A_ab s_a s_b summed over the
+    slots; the same matrix as CasADi's Hessian of the whole Lagrangian over the
+    2d unknowns (2d directions through every slot), for about half the instructions.
+    """
+    d, m = centre.numel(), len(sel)
+    t, e, pp = ca.SX.sym("t", d), ca.SX.sym("e", m), ca.SX.sym("p", p.numel())
+    H_t, _ = ca.hessian(ca.dot(e, rows_fn(t, pp)[list(sel)]), t)
+    slot = ca.Function("cuboid_slot_hess", [t, e, pp], [ca.cse(H_t)], ["t", "e", "p"], ["h"])
+    lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", K * J)
+    blocks = []
+    for j in range(J):
+        u, w = Z[:d, j], Z[d:, j]
+        Sj, Ej = S[:, j * K : (j + 1) * K], E[:, j * K : (j + 1) * K]
+        T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
+        Hs = slot.map(K)(T, Ej, ca.repmat(p, 1, K))  # d x dK
+        lam = lam_g[j * K : (j + 1) * K]
+        uu, uw, ww = ca.SX(d, d), ca.SX(d, d), ca.SX(d, d)
+        for k in range(K):
+            A = lam[k] * Hs[:, k * d : (k + 1) * d]
+            s = Sj[:, k]
+            uu += A
+            uw += A * ca.repmat(s.T, d, 1)
+            ww += A * ca.mtimes(s, s.T)
+        Dd = ca.mtimes(size, size.T)
+        blocks.append(ca.blockcat([[Dd * uu, Dd * uw], [(Dd * uw).T, Dd * ww]]))
+    H = ca.diagcat(*blocks) + lam_f * ca.hessian(f, ca.vec(Z))[0]
+    x = ca.vec(Z)
+    params = ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size)
+    return ca.Function(
+        name, [x, params, lam_f, lam_g], [ca.triu(H)], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
+    )
+
+
+def jacobian_of_rows(name: str, rows_fn: ca.Function, sel, K: int, J: int, Z, p, S, E, centre, size):
+    """``jac_g`` of `SlotNLP`, through the task points: (z, p) -> (g, ∂g/∂z).  A slot's row
+    g = e·G(t) has the gradient ∇_t g (one reverse sweep) and ∂g/∂z = (D∘∇_t g, D∘s∘∇_t g)
+    (t = c + D∘(u + s∘w)); CasADi's own Jacobian takes 2d forward directions through each slot."""
+    d, m = centre.numel(), len(sel)
+    t, e, pp = ca.SX.sym("t", d), ca.SX.sym("e", m), ca.SX.sym("p", p.numel())
+    g_t = ca.dot(e, rows_fn(t, pp)[list(sel)])
+    slot = ca.Function(
+        "cuboid_slot_grad", [t, e, pp], ca.cse([g_t, ca.gradient(g_t, t)]), ["t", "e", "p"], ["g", "grad"]
+    )
+    gs, jacs = [], []
+    for j in range(J):
+        u, w = Z[:d, j], Z[d:, j]
+        Sj, Ej = S[:, j * K : (j + 1) * K], E[:, j * K : (j + 1) * K]
+        T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
+        G, grad = slot.map(K)(T, Ej, ca.repmat(p, 1, K))  # 1 x K, d x K
+        scaled = grad * ca.repmat(size, 1, K)
+        gs.append(G.T)
+        jacs.append(ca.horzcat(scaled.T, (scaled * Sj).T))
+    x = ca.vec(Z)
+    params = ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size)
+    return ca.Function(name, [x, params], [ca.vertcat(*gs), ca.diagcat(*jacs)], ["x", "p"], ["g", "jac_g_x"])
 
 
 class SlotNLP:
@@ -140,7 +216,11 @@ class SlotNLP:
             "g": ca.vertcat(*g),
         }
         name = f"{c.name}_cuboid_slots_{K}" + (f"_x{J}" if J > 1 else "")
-        self._solver = ca.nlpsol(name, "ipopt", nlp, options)
+        derivatives = {
+            "hess_lag": hessian_of_lagrangian(f"{name}_hess_l", rows_fn, sel, K, J, Z, p, S, E, centre, size, f),
+            "jac_g": jacobian_of_rows(f"{name}_jac_g", rows_fn, sel, K, J, Z, p, S, E, centre, size),
+        }
+        self._solver = ca.nlpsol(name, "ipopt", nlp, {**options, **derivatives})
         self._out = {name: k for k, name in enumerate(self._solver.name_out())}
         self._local = threading.local()
 
@@ -224,6 +304,8 @@ class ClosedFormCuboid:
         self.S = np.array(samples, dtype=float)
         self.centre, self.size = np.asarray(centre, dtype=float), np.asarray(size, dtype=float)
         self.options = {**options, **QUIET}
+        self._lo_slack = self.lo - relaxation(self.lo, self.options)
+        self._hi_slack = self.hi + relaxation(self.hi, self.options)
         self.d = c.nq
         self._lbx = np.r_[np.full(self.d, -np.inf), np.full(self.d, 1e-10)]
         corners = np.flatnonzero(np.all((self.S == 0.0) | (self.S == 1.0), axis=1))
@@ -280,11 +362,12 @@ class ClosedFormCuboid:
         return evaluate_points(self.closure, row_key(self.rows), self.fn, [T], self.model.p)[0]
 
     def _violated(self, V: np.ndarray, work: set[tuple[int, int]], per_quantity: int | None) -> set[tuple[int, int]]:
-        """Rows outside the working set that V (N, m) violates: of each quantity the
-        ``per_quantity`` worst (all if None; NaN, a sample that does not assemble,
-        counts as worst)."""
+        """Rows outside the working set that V (N, m) violates beyond IPOPT's relaxation of
+        the bounds (`relaxation`: what the rows in the working set may violate too): of each
+        quantity the ``per_quantity`` worst (all if None; NaN, a sample that does not
+        assemble, counts as worst)."""
         with np.errstate(invalid="ignore"):
-            excess = np.maximum(self.lo - V, V - self.hi)
+            excess = np.maximum(self._lo_slack - V, V - self._hi_slack)
         excess = np.where(np.isnan(excess), np.inf, excess)
         for j, r in work:
             excess[j, r] = -np.inf

@@ -11,6 +11,7 @@ import casadi as ca
 import numpy as np
 
 from ...core.batch import evaluate_points
+from ...core.conditioning import closure_blocks, cond2_left_inverse_bound
 from ...core.model import LoopClosure, Model
 from ...core.pose_checks import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
 from ...core.solver import SolverConfig, solvers_of
@@ -115,32 +116,41 @@ TASK_POINT_KEY = ("workspace", "task_point")
 
 def _pose_values(c: LoopClosure, x, q, p) -> list:
     """Symbolic values the membership test needs at a pose: the limited
-    quantities, the loop-closure residuals and the matrix whose condition number
+    quantities, the loop-closure residuals, the matrix whose condition number
     decides a singularity, `LoopClosure.cond_matrix` (dense, column-major;
     Φ_x, or for normal equations the Jacobian of every closure equation, whose
-    rows then join the residuals), common subexpressions shared."""
+    rows then join the residuals), and a certified upper bound of its 2-norm
+    condition number from a block left inverse at the pose
+    (`cpm_nlp.core.conditioning.cond2_left_inverse_bound`; +inf where it certifies
+    nothing), common subexpressions shared."""
     fn, _names = limited_function(c)
     res = c.phi(x, q, p) if c.loops is None else ca.vertcat(c.phi(x, q, p), c.loops(x, q, p))
-    return ca.cse([fn(x, q, p), res, ca.vec(ca.densify(c.cond_matrix(x, q, p)))])
+    cond_x = c.cond_matrix(x, q, p)
+    bound = cond2_left_inverse_bound(cond_x, closure_blocks(c))
+    return ca.cse([fn(x, q, p), res, ca.vec(ca.densify(cond_x)), bound])
 
 
 def pose_check_function(closure: LoopClosure) -> ca.Function:
-    """``<name>_pose_values: (x, q, p) -> (v, phi, phi_x)`` (built once per mechanism type; see
-    `_pose_values`: for normal equations ``phi`` also holds every closure equation and
+    """``<name>_pose_values: (x, q, p) -> (v, phi, phi_x, cond_bound)`` (built once per mechanism
+    type; see `_pose_values`: for normal equations ``phi`` also holds every closure equation and
     ``phi_x`` is their Jacobian)."""
 
     def build() -> ca.Function:
         c = closure
         x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
         return ca.Function(
-            f"{c.name}_pose_values", [x, q, p], _pose_values(c, x, q, p), ["x", "q", "p"], ["v", "phi", "phi_x"]
+            f"{c.name}_pose_values",
+            [x, q, p],
+            _pose_values(c, x, q, p),
+            ["x", "q", "p"],
+            ["v", "phi", "phi_x", "cond_bound"],
         )
 
     return solvers_of(closure).memo(POSE_VALUES_KEY, build)
 
 
 def task_point_function(closure: LoopClosure) -> ca.Function:
-    """``<name>_task_point: (t, p) -> (x, q, reach, v, phi, phi_x)``: the closed-form
+    """``<name>_task_point: (t, p) -> (x, q, reach, v, phi, phi_x, cond_bound)``: the closed-form
     IK at a task point and the values of `pose_check_function` there (one
     flat SX graph, built once per mechanism type)."""
 
@@ -153,7 +163,7 @@ def task_point_function(closure: LoopClosure) -> ca.Function:
             [t, p],
             ca.cse([x, q, reach, *_pose_values(c, x, q, p)]),
             ["t", "p"],
-            ["x", "q", "reach", "v", "phi", "phi_x"],
+            ["x", "q", "reach", "v", "phi", "phi_x", "cond_bound"],
         )
 
     return solvers_of(closure).memo(TASK_POINT_KEY, build)
@@ -187,42 +197,56 @@ def judge(
     model: Model, X: np.ndarray, Q: np.ndarray, config: SolverConfig, tolerance: float = CHECK_TOLERANCE, values=None
 ) -> _Judged:
     """Judge M poses (X, Q): residual, branch, limits (to ``tolerance``) and Φ_x.
-    ``values``: (V, R, PX) already evaluated at them (else one mapped call)."""
+    ``values``: (V, R, PX, B) already evaluated at them (else one mapped call); B, the
+    certified bound of cond(Φ_x), decides where it is below half of `SINGULAR_CONDITION`,
+    `condition_numbers` elsewhere (the same verdicts: the bound is at least κ₂)."""
     c = model.closure
     M = X.shape[0]
     _fn, names = limited_function(c)
     lo, hi = limit_bounds(model)
     finite = np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
-    V = np.full((M, len(names)), np.nan)
-    fn = pose_check_function(c)
-    R = np.full((M, fn.nnz_out(1)), np.nan)
-    PX = np.full((M, fn.nnz_out(2)), np.nan)
     if values is not None:
-        V, R, PX = (np.array(v, dtype=float) for v in values)
-    elif np.any(finite):
-        V[finite], R[finite], PX[finite] = evaluate_points(c, POSE_VALUES_KEY, fn, [X[finite], Q[finite]], model.p)
+        V, R, PX, B = (np.asarray(v, dtype=float) for v in values)
+    else:
+        fn = pose_check_function(c)
+        V = np.full((M, len(names)), np.nan)
+        R = np.full((M, fn.nnz_out(1)), np.nan)
+        PX = np.full((M, fn.nnz_out(2)), np.nan)
+        B = np.full((M, 1), np.inf)
+        if np.any(finite):
+            V[finite], R[finite], PX[finite], B[finite] = evaluate_points(
+                c, POSE_VALUES_KEY, fn, [X[finite], Q[finite]], model.p
+            )
     with np.errstate(invalid="ignore"):
         resid = np.where(finite, np.max(np.abs(R), axis=1), np.inf)
-        converged = finite & (resid <= config.tolerance)
+        converged = finite & (resid <= config.tolerance)  # NaN: False
         m = np.minimum(V - lo, hi - V)
     m = np.where(np.isnan(m), np.inf, m)
-    is_branch = np.array([n.startswith("branch[") for n in names], dtype=bool)
+    branch_rows = _branch_rows(names)
     with np.errstate(invalid="ignore"):
-        on_branch = np.all(m[:, is_branch] >= -tolerance, axis=1) if is_branch.any() else np.ones(M, dtype=bool)
+        on_branch = np.all(m[:, branch_rows] >= -tolerance, axis=1) if branch_rows.size else np.ones(M, dtype=bool)
         xd = X[:, c.dep_index]
         on_branch &= np.all(xd >= model.x_lower[c.dep_index] - tolerance, axis=1)
         on_branch &= np.all(xd <= model.x_upper[c.dep_index] + tolerance, axis=1)
     worst = np.argmin(m, axis=1) if M else np.zeros(0, dtype=int)
     w = m[np.arange(M), worst]
-    binding = np.where(np.isfinite(w), np.asarray(names, dtype=object)[worst], "")
-    margin = np.where(np.isfinite(w), w, np.inf)
-    margin = np.where(converged, margin, -np.inf)
-    binding = np.where(converged, binding, "no assembly")
-    idx = np.flatnonzero(converged)
-    if idx.size:  # forward singularities: Φ_x rank deficient
+    margin = np.where(converged, np.where(np.isfinite(w), w, np.inf), -np.inf)
+    # binding names: index -1 for "no assembly", -2 for none (w not finite), -3 for "singular"
+    code = np.where(converged, np.where(np.isfinite(w), worst, -2), -1)
+    # forward singularities (Φ_x rank deficient): the bound clears most poses; the rest exactly
+    unclear = converged & ~(B.reshape(-1) < 0.5 * SINGULAR_CONDITION)
+    idx = np.flatnonzero(unclear)
+    if idx.size:
         sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, -1)) < SINGULAR_CONDITION)  # transposed
-        margin[idx[sing]], binding[idx[sing]] = -np.inf, "singular"
-    return _Judged(converged, on_branch, margin, binding.astype(object), X, Q, tolerance)
+        margin[idx[sing]], code[idx[sing]] = -np.inf, -3
+    binding = np.asarray(list(names) + ["singular", "", "no assembly"], dtype=object)[code]
+    return _Judged(converged, on_branch, margin, binding, X, Q, tolerance)
+
+
+@functools.cache
+def _branch_rows(names: tuple[str, ...]) -> np.ndarray:
+    """Positions of the branch indicators among the limited quantities ``names``."""
+    return np.flatnonzero([n.startswith("branch[") for n in names])
 
 
 @dataclass
@@ -240,11 +264,11 @@ def _closed_form_points(model: Model, T: np.ndarray, config: SolverConfig, toler
     """Every point at once through the closed-form IK: decided inside or outside (a
     negative reach margin proves that the mechanism does not assemble there)."""
     c = model.closure
-    X, Q, reach, V, R, PX = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
+    X, Q, reach, V, R, PX, B = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
     ok = reach.ravel() >= 0
     V, R = np.where(ok[:, None], V, np.nan), np.where(ok[:, None], R, np.nan)
     X, Q = np.where(ok[:, None], X, np.nan), np.where(ok[:, None], Q, np.nan)
-    j = judge(model, X, Q, config, tolerance, (V, R, PX))
+    j = judge(model, X, Q, config, tolerance, (V, R, PX, B))
     # on the closed form's branch by construction; the branch rows still count as limits
     status = np.where(j.converged & (j.margin >= -tolerance), INSIDE, OUTSIDE).astype(object)
     return _Points(status, j.margin, j.binding, X, Q)
