@@ -24,7 +24,8 @@ handful are active.  It is therefore solved on a **working set** of rows
 The result satisfies every row; the rows left out are inactive, with zero
 multipliers, so it is a KKT point of the NLP with all rows -- the optimum the
 full NLP has, not an approximation of it.  The first start begins with the
-corners' rows of the quantities that bind somewhere in the search region;
+rows of the corners and face centres of the quantities that bind somewhere in the
+search region;
 the later ones with the rows active at the optima found before (a warm start
 of the working set across starts), and each start runs from its own initial
 box.  An exchange round adds sample points and continues from the current
@@ -275,8 +276,8 @@ class ClosedFormCuboid:
     centre, size
         the normalisation of the box;
     initial
-        quantities (positions in ``rows``, and len(rows) for the reach margin) whose corner rows
-        start the first solve.
+        quantities (positions in ``rows``, and len(rows) for the reach margin) whose rows at the corners
+        and (``face_centres``) the face centres start the first solve.
     """
 
     def __init__(
@@ -293,6 +294,7 @@ class ClosedFormCuboid:
         size: np.ndarray,
         options: dict,
         initial: list[int],
+        face_centres: bool = True,
     ):
         c = model.closure
         self.model, self.config, self.closure = model, config, c
@@ -308,8 +310,12 @@ class ClosedFormCuboid:
         self._hi_slack = self.hi + relaxation(self.hi, self.options)
         self.d = c.nq
         self._lbx = np.r_[np.full(self.d, -np.inf), np.full(self.d, 1e-10)]
-        corners = np.flatnonzero(np.all((self.S == 0.0) | (self.S == 1.0), axis=1))
-        self.initial = {(int(j), int(r)) for j in corners for r in (initial or range(self.m))}
+        # the corners and the face centres (where the grid has them): a box whose limits bind at
+        # a corner (a convex boundary) or at a face's middle (a concave one) starts from these rows
+        ends = np.sum((self.S == 0.0) | (self.S == 1.0), axis=1)
+        middles = np.sum(self.S == 0.5, axis=1)
+        firsts = np.flatnonzero((ends == self.d) | (face_centres & (ends == 1) & (middles == self.d - 1)))
+        self.initial = {(int(j), int(r)) for j in firsts for r in (initial or range(self.m))}
         self.memory: set[tuple[int, int]] = set()  # rows active at the optima found so far
 
     # -- the NLP ----------------------------------------------------------------------------------
@@ -435,7 +441,7 @@ class ClosedFormCuboid:
         unknowns here): (converged, z, status, iterations)."""
         z0 = np.r_[u0, w0]
         z, ok, status, iters, active = self.settle(z0, self.memory or self.initial)
-        if not ok and self.memory:  # the rows of other optima did not hold the box: add the corners'
+        if not ok and self.memory:  # the rows of other optima did not hold the box: add the initial rows
             log.debug("start from the active rows failed (%s); again with the corner rows", status)
             z, ok, status, more, active = self.settle(z0, self.memory | self.initial)
             iters += more
@@ -448,7 +454,7 @@ class ClosedFormCuboid:
         each from the rows of the optima found before (the first start's, run by
         `start`): ([(converged, z, status, 0) per start], IPOPT iterations).  The
         runs are None if the joint solve did not converge: the caller then runs the
-        starts one by one (which also retries a start with the corners' rows)."""
+        starts one by one (which also retries a start with the initial rows)."""
         if not self.memory or len(boxes) < 2:
             return None, 0
         z0s = [np.r_[u0, w0] for u0, w0 in boxes]

@@ -331,7 +331,10 @@ class _PoseCuboid:
 def _closed_form_cuboid(
     model: Model, config: SolverConfig, base: np.ndarray, centre, size, cloud: Membership
 ) -> ClosedFormCuboid:
-    """The working-set NLP through the closed-form IK (`cpm_nlp.analysis.cuboid_ik`)."""
+    """The working-set NLP through the closed-form IK (`cpm_nlp.analysis.cuboid_ik`); its first
+    rows at the corners and, where every cloud point assembles, the face centres (where the
+    IK's reach margin bounds the workspace, the corners alone, as IPOPT converges there less
+    reliably)."""
     fn, names = limited_function(model.closure)
     lo, hi = limit_bounds(model)
     rows = tuple(int(r) for r in np.flatnonzero(np.isfinite(lo) | np.isfinite(hi)))
@@ -342,7 +345,10 @@ def _closed_form_cuboid(
     if "no assembly" in binding:
         initial.append(len(rows))  # the reach margin
     options = {**config.casadi_options(), **CUBOID_IPOPT, **CLOSED_FORM_IPOPT, **dict(config.options)}
-    return ClosedFormCuboid(model, config, fn, rows, lower, upper, NLP_MARGIN, base, centre, size, options, initial)
+    face_centres = "no assembly" not in binding
+    return ClosedFormCuboid(
+        model, config, fn, rows, lower, upper, NLP_MARGIN, base, centre, size, options, initial, face_centres
+    )
 
 
 #: the initial box of a start: a cube of this width (unit box) about its seed, unless the cloud
@@ -367,16 +373,20 @@ def _start_box(model: Model, t_c: np.ndarray, S: np.ndarray, centre, size, confi
 
 
 def _start_widths(seeds: list, cloud_T: np.ndarray, cloud: Membership, centre, size) -> np.ndarray:
-    """The initial width (unit box, the same along every axis) of each seed's box: the
-    cube about the seed that holds no cloud point outside the workspace, times
-    `START_FRACTION`, at least `START_WIDTH` (the cloud is already judged: no new
-    evaluation).  A larger initial box takes IPOPT fewer iterations to the optimum."""
+    """The initial width (unit box, the same along every axis) of each seed's box.  The first
+    seed's is `START_WIDTH`, as it always was; each later one's is the cube about the seed
+    that holds no cloud point outside the workspace, times `START_FRACTION`, at least
+    `START_WIDTH` (the cloud is already judged: no new evaluation).  A larger initial box
+    takes IPOPT fewer iterations to the optimum (the later starts are solved together, where
+    the iterations cost most), but it can also reach another local optimum of a coarse
+    discretised NLP (the five-bar with 2 samples per edge): the first start keeps the box
+    it had."""
     out = (cloud_T[~cloud.inside] - centre) / size
     widths = np.full(len(seeds), START_WIDTH)
     if not len(out):
         return widths
-    for k, t in enumerate(seeds):
-        free = 2.0 * float(np.min(np.max(np.abs(out - (t - centre) / size), axis=1)))
+    for k in range(1, len(seeds)):
+        free = 2.0 * float(np.min(np.max(np.abs(out - (seeds[k] - centre) / size), axis=1)))
         widths[k] = max(START_FRACTION * free, START_WIDTH)
     return widths
 
@@ -475,10 +485,10 @@ def _seeds(
     rng = np.random.default_rng(seed)
     home_t = model.task_of(model.x_home)
     T = lo_r + (hi_r - lo_r) * rng.random((cloud, lo_r.size))
-    cloud_mem = membership(model, T, config)
+    cloud_mem = membership(model, T, config, detail=False)  # verdicts and the limits that bind
     members = T[cloud_mem.inside]
     seeds = []
-    if membership(model, home_t[None, :], config).inside[0]:
+    if membership(model, home_t[None, :], config, detail=False).inside[0]:
         seeds.append(home_t)
     seeds += list(members[rng.permutation(len(members))[: max(starts - len(seeds), 0)]])
     return seeds[:starts], cloud_mem, T
@@ -641,7 +651,8 @@ def inscribed_cuboid(
         engine = _closed_form_cuboid(model, config, base, centre, size, cloud_mem)
     else:
         engine = _PoseCuboid(model, config, base, centre, size)
-    widths = _start_widths(seeds, cloud_T, cloud_mem, centre, size)
+    # larger initial boxes where every cloud point assembles (as for the face centres' rows)
+    widths = _start_widths(seeds, cloud_T, cloud_mem, centre, size) if assembles else None
     boxes = _start_boxes(model, seeds, engine.S, centre, size, config, widths)
     runs, iterations = _run_starts(engine, boxes)
     volumes = [float(np.prod(size * r[1][d : 2 * d])) if r[0] else None for r in runs]
