@@ -81,8 +81,9 @@ def relaxation(bound: np.ndarray, options: dict) -> np.ndarray:
     outside their bounds, so a row left out counts as violated only beyond the same slack."""
     factor = float(options.get("ipopt.bound_relax_factor", IPOPT_BOUND_RELAX))
     most = float(options.get("ipopt.constr_viol_tol", IPOPT_CONSTR_VIOL_TOL))
-    with np.errstate(invalid="ignore"):
-        return np.minimum(factor * np.maximum(1.0, np.abs(bound)), most)
+    bound = np.asarray(bound, dtype=float)
+    finite = np.isfinite(bound)  # an infinite bound stays infinite (no 0 * inf)
+    return np.where(finite, np.minimum(factor * np.maximum(1.0, np.abs(np.where(finite, bound, 0.0))), most), 0.0)
 
 
 def row_key(rows: tuple[int, ...]) -> tuple:
