@@ -114,6 +114,7 @@ POSE_VALUES_KEY = ("workspace", "pose_values")
 POSE_BOUND_KEY = ("workspace", "pose_bound")
 TASK_POINT_KEY = ("workspace", "task_point")
 TASK_POSE_KEY = ("workspace", "task_pose")
+TASK_POINT_BOUND_KEY = ("workspace", "task_point_bound")
 
 
 def _pose_values(c: LoopClosure, x, q, p) -> list:
@@ -179,6 +180,28 @@ def task_point_function(closure: LoopClosure) -> ca.Function:
     return solvers_of(closure).memo(TASK_POINT_KEY, build)
 
 
+def task_point_bound_function(closure: LoopClosure) -> ca.Function:
+    """``<name>_task_point_bound: (t, p) -> (x, q, reach, v, phi, cond_bound)``: `task_point_function`
+    and `pose_bound_function` at its pose in one flat SX graph, their common subexpressions
+    shared (for points that are all screened: about 8 % fewer instructions than the two)."""
+
+    def build() -> ca.Function:
+        c = closure
+        t, p = ca.SX.sym("t", c.nq), ca.SX.sym("p", c.np)
+        x, q, reach = c.ik(t, p)
+        v, res, _phi_x = _pose_values(c, x, q, p)
+        bound = cond2_left_inverse_bound(c.cond_matrix(x, q, p), closure_blocks(c))
+        return ca.Function(
+            f"{c.name}_task_point_bound",
+            [t, p],
+            ca.cse([x, q, reach, v, res, bound]),
+            ["t", "p"],
+            ["x", "q", "reach", "v", "phi", "cond_bound"],
+        )
+
+    return solvers_of(closure).memo(TASK_POINT_BOUND_KEY, build)
+
+
 def task_pose_function(closure: LoopClosure) -> ca.Function:
     """``<name>_task_pose: (t, p) -> (x, q, reach)``: the closed-form IK alone (built once per
     mechanism type)."""
@@ -225,7 +248,8 @@ def judge(
     detail: bool = True,
 ) -> _Judged:
     """Judge M poses (X, Q): residual, branch, limits (to ``tolerance``) and Φ_x.
-    ``values``: (V, R) already evaluated at them (else one mapped call).
+    ``values``: (V, R) already evaluated at them (else one mapped call), or (V, R, B) with
+    the bounds of `pose_bound_function` too.
 
     The singularity screen (`singular`) runs on every converged pose, or with ``detail``
     False only on those within every limit (the others are outside either way: the
@@ -235,8 +259,10 @@ def judge(
     _fn, names = limited_function(c)
     lo, hi = limit_bounds(model)
     finite = np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
+    B = None
     if values is not None:
-        V, R = (np.asarray(v, dtype=float) for v in values)
+        V, R, *rest = (np.asarray(v, dtype=float) for v in values)
+        B = rest[0].reshape(-1) if rest else None
     else:
         fn = pose_check_function(c)
         V = np.full((M, len(names)), np.nan)
@@ -261,19 +287,23 @@ def judge(
     code = np.where(converged, np.where(np.isfinite(w), worst, -2), -1)
     idx = np.flatnonzero(converged if detail else converged & (margin >= -tolerance))
     if idx.size:  # forward singularities: Φ_x rank deficient
-        sing = singular(model, X[idx], Q[idx])
+        sing = singular(model, X[idx], Q[idx], None if B is None else B[idx])
         margin[idx[sing]], code[idx[sing]] = -np.inf, -3
     binding = np.asarray(list(names) + ["singular", "", "no assembly"], dtype=object)[code]
     return _Judged(converged, on_branch, margin, binding, X, Q, tolerance)
 
 
-def singular(model: Model, X: np.ndarray, Q: np.ndarray) -> np.ndarray:
+def singular(model: Model, X: np.ndarray, Q: np.ndarray, bound: np.ndarray | None = None) -> np.ndarray:
     """Whether each pose (X, Q) is singular: cond(Φ_x) (`LoopClosure.cond_matrix`) at or above
-    `SINGULAR_CONDITION`.  The certified bound of `pose_bound_function` decides where it is
-    below half the threshold (κ₂ is then below it); `condition_numbers` of Φ_x decides the
-    rest (the same verdicts as `condition_numbers` everywhere)."""
+    `SINGULAR_CONDITION`.  The certified bound of `pose_bound_function` (``bound``: already
+    evaluated at the poses) decides where it is below half the threshold (κ₂ is then below
+    it); `condition_numbers` of Φ_x decides the rest (the same verdicts as
+    `condition_numbers` everywhere)."""
     c = model.closure
-    (B,) = evaluate_points(c, POSE_BOUND_KEY, pose_bound_function(c), [X, Q], model.p)
+    if bound is None:
+        (B,) = evaluate_points(c, POSE_BOUND_KEY, pose_bound_function(c), [X, Q], model.p)
+    else:
+        B = np.asarray(bound, dtype=float)
     out = np.zeros(X.shape[0], dtype=bool)
     rest = np.flatnonzero(~(B.reshape(-1) < 0.5 * SINGULAR_CONDITION))
     if rest.size:
@@ -305,11 +335,16 @@ def _closed_form_points(
     """Every point at once through the closed-form IK: decided inside or outside (a
     negative reach margin proves that the mechanism does not assemble there)."""
     c = model.closure
-    X, Q, reach, V, R = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
+    if detail:  # every pose that assembles is screened: the bound with the rest, in one graph
+        X, Q, reach, V, R, B = evaluate_points(c, TASK_POINT_BOUND_KEY, task_point_bound_function(c), [T], model.p)
+        extra = [B]
+    else:
+        X, Q, reach, V, R = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
+        extra = []
     ok = reach.ravel() >= 0
     V, R = np.where(ok[:, None], V, np.nan), np.where(ok[:, None], R, np.nan)
     X, Q = np.where(ok[:, None], X, np.nan), np.where(ok[:, None], Q, np.nan)
-    j = judge(model, X, Q, config, tolerance, (V, R), detail)
+    j = judge(model, X, Q, config, tolerance, (V, R, *extra), detail)
     # on the closed form's branch by construction; the branch rows still count as limits
     status = np.where(j.converged & (j.margin >= -tolerance), INSIDE, OUTSIDE).astype(object)
     return _Points(status, j.margin, j.binding, X, Q)
