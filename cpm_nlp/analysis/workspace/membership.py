@@ -248,8 +248,9 @@ def judge(
     detail: bool = True,
 ) -> _Judged:
     """Judge M poses (X, Q): residual, branch, limits (to ``tolerance``) and Φ_x.
-    ``values``: (V, R) already evaluated at them (else one mapped call), or (V, R, B) with
-    the bounds of `pose_bound_function` too.
+    ``values``: (V, R) already evaluated at them, or (V, R, B) with the bounds of
+    `pose_bound_function` too (the screen is then `singular`); else one mapped call of
+    `pose_check_function`, whose Φ_x `condition_numbers` judges.
 
     The singularity screen (`singular`) runs on every converged pose, or with ``detail``
     False only on those within every limit (the others are outside either way: the
@@ -259,16 +260,17 @@ def judge(
     _fn, names = limited_function(c)
     lo, hi = limit_bounds(model)
     finite = np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
-    B = None
+    B = PX = None
     if values is not None:
         V, R, *rest = (np.asarray(v, dtype=float) for v in values)
         B = rest[0].reshape(-1) if rest else None
-    else:
+    else:  # Φ_x comes with the values here: it is judged directly (`condition_numbers`)
         fn = pose_check_function(c)
         V = np.full((M, len(names)), np.nan)
         R = np.full((M, fn.nnz_out(1)), np.nan)
+        PX = np.full((M, fn.nnz_out(2)), np.nan)
         if np.any(finite):
-            V[finite], R[finite], _PX = evaluate_points(c, POSE_VALUES_KEY, fn, [X[finite], Q[finite]], model.p)
+            V[finite], R[finite], PX[finite] = evaluate_points(c, POSE_VALUES_KEY, fn, [X[finite], Q[finite]], model.p)
     with np.errstate(invalid="ignore"):
         resid = np.where(finite, np.max(np.abs(R), axis=1), np.inf)
         converged = finite & (resid <= config.tolerance)  # NaN: False
@@ -287,7 +289,10 @@ def judge(
     code = np.where(converged, np.where(np.isfinite(w), worst, -2), -1)
     idx = np.flatnonzero(converged if detail else converged & (margin >= -tolerance))
     if idx.size:  # forward singularities: Φ_x rank deficient
-        sing = singular(model, X[idx], Q[idx], None if B is None else B[idx])
+        if PX is not None:
+            sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, -1)) < SINGULAR_CONDITION)  # transposed
+        else:
+            sing = singular(model, X[idx], Q[idx], None if B is None else B[idx])
         margin[idx[sing]], code[idx[sing]] = -np.inf, -3
     binding = np.asarray(list(names) + ["singular", "", "no assembly"], dtype=object)[code]
     return _Judged(converged, on_branch, margin, binding, X, Q, tolerance)
