@@ -365,8 +365,13 @@ class ClosedFormCuboid:
 
     def values(self, z: np.ndarray) -> np.ndarray:
         """Every quantity at every sample of the box z: (N, m)."""
-        T = self.centre + self.size * (z[: self.d] + self.S * z[self.d :])
-        return evaluate_points(self.closure, row_key(self.rows), self.fn, [T], self.model.p)[0]
+        return self.values_of([z])[0]
+
+    def values_of(self, boxes: list[np.ndarray]) -> list[np.ndarray]:
+        """`values` of several boxes, in one mapped call."""
+        T = np.vstack([self.centre + self.size * (z[: self.d] + self.S * z[self.d :]) for z in boxes])
+        V = evaluate_points(self.closure, row_key(self.rows), self.fn, [T], self.model.p)[0]
+        return np.split(V, len(boxes))
 
     def _violated(self, V: np.ndarray, work: set[tuple[int, int]], per_quantity: int | None) -> set[tuple[int, int]]:
         """Rows outside the working set that V (N, m) violates beyond IPOPT's relaxation of
@@ -420,8 +425,8 @@ class ClosedFormCuboid:
             if not ok:
                 return [], False, status, iterations, []
             grown = False
-            for j, z in enumerate(Z):
-                new = self._violated(self.values(z), works[j], ADD_PER_QUANTITY if solve < ESCALATE else None)
+            for j, V in enumerate(self.values_of(list(Z))):
+                new = self._violated(V, works[j], ADD_PER_QUANTITY if solve < ESCALATE else None)
                 if new:
                     works[j] |= new
                     grown = True

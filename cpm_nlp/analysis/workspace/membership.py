@@ -252,7 +252,7 @@ def judge(
     `pose_bound_function` too (the screen is then `singular`); else one mapped call of
     `pose_check_function`, whose Φ_x `condition_numbers` judges.
 
-    The singularity screen (`singular`) runs on every converged pose, or with ``detail``
+    The singularity screen runs on every converged pose, or with ``detail``
     False only on those within every limit (the others are outside either way: the
     verdicts are the same, but such a pose reports its worst limit, never "singular")."""
     c = model.closure
