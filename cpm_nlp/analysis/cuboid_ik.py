@@ -38,10 +38,11 @@ whose KKT points are exactly the tuples of the starts' KKT points; IPOPT's fixed
 cost per iteration, which dominates for so few unknowns, is then paid once.  If
 that joint solve fails the starts run one by one, as the first.
 
-The working-set NLP has K row slots (K = 16, 32, 64, ...; one IPOPT solver
-per K, built once per mechanism type and configuration); a slot holds a
-sample point s_k and a one-hot selector e_k of the quantity it bounds, both
-parameters, and unused slots are free (bounds ±inf).
+The working-set NLP has its row slots in groups, one per quantity with rows
+(K_r = 4, 6, 8, 12, 16, ... slots for quantity r; one IPOPT solver per layout
+of groups, built once per mechanism type and configuration); a slot holds a
+sample point s_k, a parameter, and evaluates (and differentiates) its own
+quantity only; unused slots are free (bounds ±inf).
 """
 
 from __future__ import annotations
@@ -58,8 +59,8 @@ from ..core.solver import SolverConfig, solvers_of
 
 log = logging.getLogger(__name__)
 
-#: row slots of the smallest working-set NLP (see `slots`)
-MIN_SLOTS = 16
+#: row slots of the smallest group of one quantity in the working-set NLP (see `slots`)
+MIN_SLOTS = 4
 #: a row is active (kept for the next starts) when its multiplier exceeds this, relative to the largest
 ACTIVE_MULTIPLIER = 1e-6
 #: rows of one quantity added per solve (the most violated ones)
@@ -108,36 +109,54 @@ def row_function(closure: LoopClosure, limited: ca.Function, rows: tuple[int, ..
 
 
 def slots(rows: int) -> int:
-    """Slots of the smallest working-set NLP that holds ``rows`` rows: MIN_SLOTS times
-    1, 1.5, 2, 3, 4, 6, 8, ... (one IPOPT solver per size)."""
+    """Slots of the smallest group that holds ``rows`` rows of one quantity: MIN_SLOTS times
+    1, 1.5, 2, 3, 4, 6, 8, ... (one IPOPT solver per layout of groups)."""
     K = MIN_SLOTS
     while K < rows:
         K = K * 3 // 2 if K & (K - 1) == 0 else K * 4 // 3
     return K
 
 
-def hessian_of_lagrangian(name: str, rows_fn: ca.Function, sel, K: int, J: int, Z, p, S, E, centre, size, f):
+def _task_points(Z, S, centre, size, j: int, K: int):
+    """The task points (d x K) of block j's K slots: t = c + D∘(u + s∘w)."""
+    d = centre.numel()
+    u, w, Sj = Z[:d, j], Z[d:, j], S[:, j * K : (j + 1) * K]
+    return ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
+
+
+def _per_group(layout, fns: dict, T, p) -> list:
+    """Each output of the slot functions ``fns[r]`` over the groups' slots of T, side by side
+    (the groups in ``layout`` order: (quantity, slots) each)."""
+    outs, offset = [], 0
+    for r, Kr in layout:
+        got = fns[r].map(Kr)(T[:, offset : offset + Kr], ca.repmat(p, 1, Kr))
+        outs.append(list(got) if isinstance(got, (list, tuple)) else [got])  # one output: a matrix
+        offset += Kr
+    return [ca.horzcat(*[o[k] for o in outs]) for k in range(len(outs[0]))]
+
+
+def hessian_of_lagrangian(name: str, rows_fn: ca.Function, layout, J: int, Z, p, S, centre, size, f):
     """``hess_lag`` of `SlotNLP`, through the task points: (z, p, lam_f, lam_g) -> triu(∇²_z L).
 
     A slot's row depends on its box z = (u, w) only through its task point
-    t = c + D∘(u + s∘w), linear in z: with A = λ ∇²_t(e·G(t)) (d x d, one
-    forward-over-reverse sweep of d directions),
+    t = c + D∘(u + s∘w), linear in z: with A = λ ∇²_t G_r(t) (d x d, one
+    forward-over-reverse sweep of d directions, of the slot's own quantity r only),
     ∇²_z λ g = Jᵀ A J with J = [diag(D), diag(D∘s)], i.e. the blocks
     D_a D_b Σ A_ab, D_a D_b Σ A_ab s_b and D_a D_b Σ A_ab s_a s_b summed over the
     slots; the same matrix as CasADi's Hessian of the whole Lagrangian over the
-    2d unknowns (2d directions through every slot), for about half the instructions.
+    2d unknowns (2d directions through every slot), for a fraction of the instructions.
     """
-    d, m = centre.numel(), len(sel)
-    t, e, pp = ca.SX.sym("t", d), ca.SX.sym("e", m), ca.SX.sym("p", p.numel())
-    H_t, _ = ca.hessian(ca.dot(e, rows_fn(t, pp)[list(sel)]), t)
-    slot = ca.Function("cuboid_slot_hess", [t, e, pp], [ca.cse(H_t)], ["t", "e", "p"], ["h"])
+    d, K = centre.numel(), sum(Kr for _, Kr in layout)
+    t, pp = ca.SX.sym("t", d), ca.SX.sym("p", p.numel())
+    fns = {
+        r: ca.Function("cuboid_slot_hess", [t, pp], [ca.cse(ca.hessian(rows_fn(t, pp)[r], t)[0])], ["t", "p"], ["h"])
+        for r, _ in layout
+    }
     lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", K * J)
     blocks = []
     for j in range(J):
-        u, w = Z[:d, j], Z[d:, j]
-        Sj, Ej = S[:, j * K : (j + 1) * K], E[:, j * K : (j + 1) * K]
-        T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
-        Hs = slot.map(K)(T, Ej, ca.repmat(p, 1, K))  # d x dK
+        Sj = S[:, j * K : (j + 1) * K]
+        (Hs,) = _per_group(layout, fns, _task_points(Z, S, centre, size, j, K), p)  # d x dK
         lam = lam_g[j * K : (j + 1) * K]
         uu, uw, ww = ca.SX(d, d), ca.SX(d, d), ca.SX(d, d)
         for k in range(K):
@@ -150,77 +169,67 @@ def hessian_of_lagrangian(name: str, rows_fn: ca.Function, sel, K: int, J: int, 
         blocks.append(ca.blockcat([[Dd * uu, Dd * uw], [(Dd * uw).T, Dd * ww]]))
     H = ca.diagcat(*blocks) + lam_f * ca.hessian(f, ca.vec(Z))[0]
     x = ca.vec(Z)
-    params = ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size)
+    params = ca.vertcat(p, ca.vec(S), centre, size)
     return ca.Function(
         name, [x, params, lam_f, lam_g], [ca.triu(H)], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
     )
 
 
-def jacobian_of_rows(name: str, rows_fn: ca.Function, sel, K: int, J: int, Z, p, S, E, centre, size):
+def jacobian_of_rows(name: str, rows_fn: ca.Function, layout, J: int, Z, p, S, centre, size):
     """``jac_g`` of `SlotNLP`, through the task points: (z, p) -> (g, ∂g/∂z).  A slot's row
-    g = e·G(t) has the gradient ∇_t g (one reverse sweep) and ∂g/∂z = (D∘∇_t g, D∘s∘∇_t g)
+    g = G_r(t) has the gradient ∇_t g (one reverse sweep) and ∂g/∂z = (D∘∇_t g, D∘s∘∇_t g)
     (t = c + D∘(u + s∘w)); CasADi's own Jacobian takes 2d forward directions through each slot."""
-    d, m = centre.numel(), len(sel)
-    t, e, pp = ca.SX.sym("t", d), ca.SX.sym("e", m), ca.SX.sym("p", p.numel())
-    g_t = ca.dot(e, rows_fn(t, pp)[list(sel)])
-    slot = ca.Function(
-        "cuboid_slot_grad", [t, e, pp], ca.cse([g_t, ca.gradient(g_t, t)]), ["t", "e", "p"], ["g", "grad"]
-    )
+    d, K = centre.numel(), sum(Kr for _, Kr in layout)
+    t, pp = ca.SX.sym("t", d), ca.SX.sym("p", p.numel())
+    fns = {}
+    for r, _ in layout:
+        g_t = rows_fn(t, pp)[r]
+        fns[r] = ca.Function("cuboid_slot_grad", [t, pp], ca.cse([g_t, ca.gradient(g_t, t)]), ["t", "p"], ["g", "grad"])
     gs, jacs = [], []
     for j in range(J):
-        u, w = Z[:d, j], Z[d:, j]
-        Sj, Ej = S[:, j * K : (j + 1) * K], E[:, j * K : (j + 1) * K]
-        T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
-        G, grad = slot.map(K)(T, Ej, ca.repmat(p, 1, K))  # 1 x K, d x K
+        G, grad = _per_group(layout, fns, _task_points(Z, S, centre, size, j, K), p)  # 1 x K, d x K
         scaled = grad * ca.repmat(size, 1, K)
         gs.append(G.T)
-        jacs.append(ca.horzcat(scaled.T, (scaled * Sj).T))
+        jacs.append(ca.horzcat(scaled.T, (scaled * S[:, j * K : (j + 1) * K]).T))
     x = ca.vec(Z)
-    params = ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size)
+    params = ca.vertcat(p, ca.vec(S), centre, size)
     return ca.Function(name, [x, params], [ca.vertcat(*gs), ca.diagcat(*jacs)], ["x", "p"], ["g", "jac_g_x"])
 
 
 class SlotNLP:
-    """IPOPT on the working-set cuboid NLP with K row slots (see the module docstring),
-    for the quantities ``sel`` (positions in the output of ``rows_fn``; the others
-    are not evaluated).
+    """IPOPT on the working-set cuboid NLP with row slots in groups, one group of K_r slots
+    per quantity r (``layout``: (r, K_r) each; positions in the output of ``rows_fn``; the
+    other quantities are not evaluated), K = Σ K_r slots in all (see the module docstring).
 
     With ``blocks`` = J > 1 it solves J such NLPs (J starts, each with its own box
-    z_j = (u_j, w_j), K slots and selectors) as one block-separable NLP: the
+    z_j = (u_j, w_j) and K slots) as one block-separable NLP: the
     objective is the sum of theirs and no constraint couples two blocks, so its
     KKT points are exactly the tuples of KKT points of the J NLPs; IPOPT's
     fixed cost per iteration is then paid once for all J starts.  The unknowns
-    are (z_1, ..., z_J), the parameters (p, S_1 ... S_J, E_1 ... E_J, c, D).
+    are (z_1, ..., z_J), the parameters (p, S_1 ... S_J, c, D).
     """
 
-    def __init__(
-        self, closure: LoopClosure, rows_fn: ca.Function, sel: tuple[int, ...], K: int, options: dict, blocks: int = 1
-    ):
+    def __init__(self, closure: LoopClosure, rows_fn: ca.Function, layout: tuple, options: dict, blocks: int = 1):
         c = closure
-        d, m, J = c.nq, len(sel), blocks
-        self.d, self.m, self.K, self.J = d, m, K, J
+        d, J = c.nq, blocks
+        K = sum(Kr for _, Kr in layout)
+        self.d, self.K, self.J, self.layout = d, K, J, tuple(layout)
         Z = ca.SX.sym("z", 2 * d, J)
         p = ca.SX.sym("p", c.np)
-        S, E = ca.SX.sym("S", d, K * J), ca.SX.sym("E", m, K * J)
+        S = ca.SX.sym("S", d, K * J)
         centre, size = ca.SX.sym("c", d), ca.SX.sym("D", d)
+        t, q = ca.SX.sym("t", d), ca.SX.sym("p", c.np)
+        fns = {r: ca.Function("cuboid_slot_row", [t, q], [rows_fn(t, q)[r]], ["t", "p"], ["g"]) for r, _ in layout}
         f, g = 0, []
         for j in range(J):
-            u, w = Z[:d, j], Z[d:, j]
-            Sj, Ej = S[:, j * K : (j + 1) * K], E[:, j * K : (j + 1) * K]
-            T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
-            G = rows_fn.map(K)(T, ca.repmat(p, 1, K))[list(sel), :]
-            f -= ca.sum1(ca.log(w))
-            g.append(ca.sum1(Ej * G).T)
-        nlp = {
-            "x": ca.vec(Z),
-            "p": ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size),
-            "f": f,
-            "g": ca.vertcat(*g),
-        }
-        name = f"{c.name}_cuboid_slots_{K}" + (f"_x{J}" if J > 1 else "")
+            (G,) = _per_group(layout, fns, _task_points(Z, S, centre, size, j, K), p)
+            f -= ca.sum1(ca.log(Z[d:, j]))
+            g.append(G.T)
+        nlp = {"x": ca.vec(Z), "p": ca.vertcat(p, ca.vec(S), centre, size), "f": f, "g": ca.vertcat(*g)}
+        name = f"{c.name}_cuboid_slots_" + "_".join(f"{r}x{Kr}" for r, Kr in layout) + (f"_x{J}" if J > 1 else "")
         derivatives = {
-            "hess_lag": hessian_of_lagrangian(f"{name}_hess_l", rows_fn, sel, K, J, Z, p, S, E, centre, size, f),
-            "jac_g": jacobian_of_rows(f"{name}_jac_g", rows_fn, sel, K, J, Z, p, S, E, centre, size),
+            "hess_lag": hessian_of_lagrangian(f"{name}_hess_l", rows_fn, layout, J, Z, p, S, centre, size, f),
+            "jac_g": jacobian_of_rows(f"{name}_jac_g", rows_fn, layout, J, Z, p, S, centre, size),
         }
         self._solver = ca.nlpsol(name, "ipopt", nlp, {**options, **derivatives})
         self._out = {name: k for k, name in enumerate(self._solver.name_out())}
@@ -321,47 +330,63 @@ class ClosedFormCuboid:
 
     # -- the NLP ----------------------------------------------------------------------------------
 
-    def _nlp(self, sel: tuple[int, ...], K: int, blocks: int = 1) -> SlotNLP:
-        key = ("cuboid_slots", self.rows, sel, K, blocks, repr(sorted(self.options.items())))
+    def _nlp(self, layout: tuple, blocks: int = 1) -> SlotNLP:
+        key = ("cuboid_slots", self.rows, layout, blocks, repr(sorted(self.options.items())))
         return solvers_of(self.closure).get(
-            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, sel, K, self.options, blocks)
+            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, layout, self.options, blocks)
         )
 
-    def _slots(self, work: list[tuple[int, int]], K: int, sel: tuple[int, ...]):
-        """The parameters of K slots holding the rows ``work``: S (K, d), E (K, m), lbg, ubg."""
-        S, E = np.full((K, self.d), 0.5), np.zeros((K, len(sel)))
+    @staticmethod
+    def _layout(works: list[list[tuple[int, int]]]) -> tuple:
+        """The groups of slots that hold every working set of ``works``: (quantity, slots) for
+        each quantity with rows (only those are evaluated), in order."""
+        most: dict[int, int] = {}
+        for work in works:
+            for r in {r for _, r in work}:
+                most[r] = max(most.get(r, 0), sum(1 for _, q in work if q == r))
+        return tuple((r, slots(n)) for r, n in sorted(most.items()))
+
+    def _slots(self, work: list[tuple[int, int]], layout: tuple):
+        """The parameters of the slots of ``layout`` holding the rows ``work``: S (K, d), lbg,
+        ubg, and the slot of each row of ``work``."""
+        K = sum(Kr for _, Kr in layout)
+        S = np.full((K, self.d), 0.5)
         lbg, ubg = np.full(K, -np.inf), np.full(K, np.inf)
-        for k, (j, r) in enumerate(work):
-            S[k], E[k, sel.index(r)], lbg[k], ubg[k] = self.S[j], 1.0, self.lo[r], self.hi[r]
-        return S, E, lbg, ubg
+        offsets, used = {}, {}
+        offset = 0
+        for r, Kr in layout:
+            offsets[r], used[r] = offset, 0
+            offset += Kr
+        where = np.empty(len(work), dtype=int)
+        for i, (j, r) in enumerate(work):
+            k = offsets[r] + used[r]
+            used[r] += 1
+            S[k], lbg[k], ubg[k], where[i] = self.S[j], self.lo[r], self.hi[r], k
+        return S, lbg, ubg, where
 
     def _solve(self, z0: np.ndarray, work: list[tuple[int, int]]):
-        K = slots(len(work))
-        sel = tuple(sorted({r for _, r in work}))  # the quantities with rows: only those are evaluated
-        S, E, lbg, ubg = self._slots(work, K, sel)
-        params = np.r_[self.model.p, S.ravel(), E.ravel(), self.centre, self.size]
-        return self._nlp(sel, K).solve(z0, params, self._lbx, lbg, ubg)
+        """One solve on the rows ``work``: (z, ok, status, iterations, the multiplier of each row)."""
+        layout = self._layout([work])
+        S, lbg, ubg, where = self._slots(work, layout)
+        params = np.r_[self.model.p, S.ravel(), self.centre, self.size]
+        z, ok, status, iters, lam = self._nlp(layout).solve(z0, params, self._lbx, lbg, ubg)
+        return z, ok, status, iters, lam[where]
 
     def _solve_blocks(self, z0s: list[np.ndarray], works: list[list[tuple[int, int]]]):
         """Several starts, each on its own working set, as one block-separable NLP
-        (`SlotNLP` with blocks): (Z (J, 2d), ok, status, iterations, multipliers (J, K))."""
+        (`SlotNLP` with blocks): (Z (J, 2d), ok, status, iterations, the multiplier of each
+        row of each start)."""
         J = len(works)
-        K = slots(max(len(w) for w in works))
-        sel = tuple(sorted({r for w in works for _, r in w}))
-        parts = [self._slots(w, K, sel) for w in works]
-        params = np.r_[
-            self.model.p,
-            np.concatenate([S.ravel() for S, *_ in parts]),
-            np.concatenate([E.ravel() for _, E, *_ in parts]),
-            self.centre,
-            self.size,
-        ]
-        lbg = np.concatenate([q[2] for q in parts])
-        ubg = np.concatenate([q[3] for q in parts])
-        z, ok, status, iters, lam = self._nlp(sel, K, J).solve(
+        layout = self._layout(works)
+        parts = [self._slots(w, layout) for w in works]
+        params = np.r_[self.model.p, np.concatenate([S.ravel() for S, *_ in parts]), self.centre, self.size]
+        lbg = np.concatenate([q[1] for q in parts])
+        ubg = np.concatenate([q[2] for q in parts])
+        z, ok, status, iters, lam = self._nlp(layout, J).solve(
             np.concatenate(z0s), params, np.tile(self._lbx, J), lbg, ubg
         )
-        return z.reshape(J, 2 * self.d), ok, status, iters, lam.reshape(J, K)
+        lam = lam.reshape(J, -1)
+        return z.reshape(J, 2 * self.d), ok, status, iters, [lam[j][q[3]] for j, q in enumerate(parts)]
 
     def values(self, z: np.ndarray) -> np.ndarray:
         """Every quantity at every sample of the box z: (N, m)."""
@@ -404,7 +429,7 @@ class ClosedFormCuboid:
                 return z, False, status, iterations, set()
             new = self._violated(self.values(z), work, ADD_PER_QUANTITY if solve < ESCALATE else None)
             if not new:
-                lam = np.abs(lam[: len(order)])
+                lam = np.abs(lam)
                 top = float(lam.max()) if lam.size else 0.0
                 active = {row for row, v in zip(order, lam) if v > ACTIVE_MULTIPLIER * top}
                 return z, True, status, iterations, active
@@ -433,7 +458,7 @@ class ClosedFormCuboid:
             if not grown:
                 actives = []
                 for order, lj in zip(orders, lam):
-                    lj = np.abs(lj[: len(order)])
+                    lj = np.abs(lj)
                     top = float(lj.max()) if lj.size else 0.0
                     actives.append({row for row, v in zip(order, lj) if v > ACTIVE_MULTIPLIER * top})
                 return list(Z), True, status, iterations, actives

@@ -30,15 +30,17 @@ def pantograph():
 
 @pytest.mark.parametrize("blocks", [1, 2])
 def test_working_set_derivatives_equal_casadi_ad(pantograph, blocks):
-    """hess_lag and jac_g of `SlotNLP` (through the task points) against CasADi's Hessian and
-    Jacobian of the NLP's own f and g over all 2d unknowns, and the Jacobian against central
-    differences of g (numpy), at boxes about the optimum with random slots and multipliers."""
+    """hess_lag and jac_g of `SlotNLP` (through the task points, each slot's own quantity)
+    against CasADi's Hessian and Jacobian of the NLP's own f and g over all 2d unknowns, and
+    the Jacobian against central differences of g (numpy), at boxes about the optimum with
+    random slots and multipliers."""
     m, (lo, hi), T = pantograph
     config = cn.SolverConfig()
     centre, size = 0.5 * (lo + hi), hi - lo
     engine = W._closed_form_cuboid(m, config, W.surface_grid(3, 5), centre, size, W.membership(m, T, config))
-    sel, K = (0, 1, 2), 16
-    nlp = engine._nlp(sel, K, blocks)._solver
+    layout = ((0, 6), (1, 6), (2, 4))  # phi, psi, a branch indicator: 16 slots in groups
+    K = sum(Kr for _, Kr in layout)
+    nlp = engine._nlp(layout, blocks)._solver
     hess, jac = nlp.get_function("nlp_hess_l"), nlp.get_function("nlp_jac_g")
     f_fn, g_fn = nlp.get_function("nlp_f"), nlp.get_function("nlp_g")
     X, P = ca.SX.sym("x", nlp.nnz_in(0)), ca.SX.sym("p", nlp.nnz_in(1))
@@ -51,9 +53,7 @@ def test_working_set_derivatives_equal_casadi_ad(pantograph, blocks):
     for _ in range(3):
         z = np.tile(np.r_[-0.24, -0.2, -0.24, 0.32, 0.4, 0.48], blocks) + 0.01 * rng.standard_normal(2 * d * blocks)
         S = rng.random((K * blocks, d))
-        E = np.zeros((K * blocks, len(sel)))
-        E[np.arange(K * blocks), rng.integers(0, len(sel), K * blocks)] = 1.0
-        p = np.r_[m.p, S.ravel(), E.ravel(), centre, size]
+        p = np.r_[m.p, S.ravel(), centre, size]
         lam = rng.standard_normal(K * blocks)
         H = np.array(ca.densify(hess(z, p, 0.7, lam)))
         H_ref = np.array(ca.densify(ref_h(z, p, 0.7, lam)))
