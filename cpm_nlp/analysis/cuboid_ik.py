@@ -24,7 +24,8 @@ handful are active.  It is therefore solved on a **working set** of rows
 The result satisfies every row; the rows left out are inactive, with zero
 multipliers, so it is a KKT point of the NLP with all rows -- the optimum the
 full NLP has, not an approximation of it.  The first start begins with the
-corners' rows of the quantities that bind somewhere in the search region;
+rows of the corners and face centres of the quantities that bind somewhere in the
+search region;
 the later ones with the rows active at the optima found before (a warm start
 of the working set across starts), and each start runs from its own initial
 box.  An exchange round adds sample points and continues from the current
@@ -37,10 +38,11 @@ whose KKT points are exactly the tuples of the starts' KKT points; IPOPT's fixed
 cost per iteration, which dominates for so few unknowns, is then paid once.  If
 that joint solve fails the starts run one by one, as the first.
 
-The working-set NLP has K row slots (K = 16, 32, 64, ...; one IPOPT solver
-per K, built once per mechanism type and configuration); a slot holds a
-sample point s_k and a one-hot selector e_k of the quantity it bounds, both
-parameters, and unused slots are free (bounds ±inf).
+The working-set NLP has its row slots in groups, one per quantity with rows
+(K_r = 4, 6, 8, 12, 16, ... slots for quantity r; one IPOPT solver per layout
+of groups, built once per mechanism type and configuration); a slot holds a
+sample point s_k, a parameter, and evaluates (and differentiates) its own
+quantity only; unused slots are free (bounds ±inf).
 """
 
 from __future__ import annotations
@@ -57,8 +59,8 @@ from ..core.solver import SolverConfig, solvers_of
 
 log = logging.getLogger(__name__)
 
-#: row slots of the smallest working-set NLP (see `slots`)
-MIN_SLOTS = 16
+#: row slots of the smallest group of one quantity in the working-set NLP (see `slots`)
+MIN_SLOTS = 4
 #: a row is active (kept for the next starts) when its multiplier exceeds this, relative to the largest
 ACTIVE_MULTIPLIER = 1e-6
 #: rows of one quantity added per solve (the most violated ones)
@@ -70,6 +72,19 @@ ESCALATE = 6
 MAX_SETTLE = 40
 #: CasADi options of the working-set NLP: NaN (no assembly) is a rejected trial point, not a warning
 QUIET = {"show_eval_warnings": False, "calc_lam_p": False}
+#: IPOPT's defaults of ``bound_relax_factor`` and ``constr_viol_tol`` (where the options do not set them)
+IPOPT_BOUND_RELAX, IPOPT_CONSTR_VIOL_TOL = 1e-8, 1e-4
+
+
+def relaxation(bound: np.ndarray, options: dict) -> np.ndarray:
+    """How far IPOPT relaxes a constraint bound before it starts (``bound_relax_factor`` times
+    max(1, |bound|), at most ``constr_viol_tol``): the rows of a working set may end that far
+    outside their bounds, so a row left out counts as violated only beyond the same slack."""
+    factor = float(options.get("ipopt.bound_relax_factor", IPOPT_BOUND_RELAX))
+    most = float(options.get("ipopt.constr_viol_tol", IPOPT_CONSTR_VIOL_TOL))
+    bound = np.asarray(bound, dtype=float)
+    finite = np.isfinite(bound)  # an infinite bound stays infinite (no 0 * inf)
+    return np.where(finite, np.minimum(factor * np.maximum(1.0, np.abs(np.where(finite, bound, 0.0))), most), 0.0)
 
 
 def row_key(rows: tuple[int, ...]) -> tuple:
@@ -94,53 +109,129 @@ def row_function(closure: LoopClosure, limited: ca.Function, rows: tuple[int, ..
 
 
 def slots(rows: int) -> int:
-    """Slots of the smallest working-set NLP that holds ``rows`` rows: MIN_SLOTS times
-    1, 1.5, 2, 3, 4, 6, 8, ... (one IPOPT solver per size)."""
+    """Slots of the smallest group that holds ``rows`` rows of one quantity: MIN_SLOTS times
+    1, 1.5, 2, 3, 4, 6, 8, ... (one IPOPT solver per layout of groups)."""
     K = MIN_SLOTS
     while K < rows:
         K = K * 3 // 2 if K & (K - 1) == 0 else K * 4 // 3
     return K
 
 
+def _task_points(Z, S, centre, size, j: int, K: int):
+    """The task points (d x K) of block j's K slots: t = c + D∘(u + s∘w)."""
+    d = centre.numel()
+    u, w, Sj = Z[:d, j], Z[d:, j], S[:, j * K : (j + 1) * K]
+    return ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
+
+
+def _per_group(layout, fns: dict, T, p) -> list:
+    """Each output of the slot functions ``fns[r]`` over the groups' slots of T, side by side
+    (the groups in ``layout`` order: (quantity, slots) each)."""
+    outs, offset = [], 0
+    for r, Kr in layout:
+        got = fns[r].map(Kr)(T[:, offset : offset + Kr], ca.repmat(p, 1, Kr))
+        outs.append(list(got) if isinstance(got, (list, tuple)) else [got])  # one output: a matrix
+        offset += Kr
+    return [ca.horzcat(*[o[k] for o in outs]) for k in range(len(outs[0]))]
+
+
+def hessian_of_lagrangian(name: str, rows_fn: ca.Function, layout, J: int, Z, p, S, centre, size, f):
+    """``hess_lag`` of `SlotNLP`, through the task points: (z, p, lam_f, lam_g) -> triu(∇²_z L).
+
+    A slot's row depends on its box z = (u, w) only through its task point
+    t = c + D∘(u + s∘w), linear in z: with A = λ ∇²_t G_r(t) (d x d, one
+    forward-over-reverse sweep of d directions, of the slot's own quantity r only),
+    ∇²_z λ g = Jᵀ A J with J = [diag(D), diag(D∘s)], i.e. the blocks
+    D_a D_b Σ A_ab, D_a D_b Σ A_ab s_b and D_a D_b Σ A_ab s_a s_b summed over the
+    slots; the same matrix as CasADi's Hessian of the whole Lagrangian over the
+    2d unknowns (2d directions through every slot), for a fraction of the instructions.
+    """
+    d, K = centre.numel(), sum(Kr for _, Kr in layout)
+    t, pp = ca.SX.sym("t", d), ca.SX.sym("p", p.numel())
+    fns = {
+        r: ca.Function("cuboid_slot_hess", [t, pp], [ca.cse(ca.hessian(rows_fn(t, pp)[r], t)[0])], ["t", "p"], ["h"])
+        for r, _ in layout
+    }
+    lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", K * J)
+    blocks = []
+    for j in range(J):
+        Sj = S[:, j * K : (j + 1) * K]
+        (Hs,) = _per_group(layout, fns, _task_points(Z, S, centre, size, j, K), p)  # d x dK
+        lam = lam_g[j * K : (j + 1) * K]
+        uu, uw, ww = ca.SX(d, d), ca.SX(d, d), ca.SX(d, d)
+        for k in range(K):
+            A = lam[k] * Hs[:, k * d : (k + 1) * d]
+            s = Sj[:, k]
+            uu += A
+            uw += A * ca.repmat(s.T, d, 1)
+            ww += A * ca.mtimes(s, s.T)
+        Dd = ca.mtimes(size, size.T)
+        blocks.append(ca.blockcat([[Dd * uu, Dd * uw], [(Dd * uw).T, Dd * ww]]))
+    H = ca.diagcat(*blocks) + lam_f * ca.hessian(f, ca.vec(Z))[0]
+    x = ca.vec(Z)
+    params = ca.vertcat(p, ca.vec(S), centre, size)
+    return ca.Function(
+        name, [x, params, lam_f, lam_g], [ca.triu(H)], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
+    )
+
+
+def jacobian_of_rows(name: str, rows_fn: ca.Function, layout, J: int, Z, p, S, centre, size):
+    """``jac_g`` of `SlotNLP`, through the task points: (z, p) -> (g, ∂g/∂z).  A slot's row
+    g = G_r(t) has the gradient ∇_t g (one reverse sweep) and ∂g/∂z = (D∘∇_t g, D∘s∘∇_t g)
+    (t = c + D∘(u + s∘w)); CasADi's own Jacobian takes 2d forward directions through each slot."""
+    d, K = centre.numel(), sum(Kr for _, Kr in layout)
+    t, pp = ca.SX.sym("t", d), ca.SX.sym("p", p.numel())
+    fns = {}
+    for r, _ in layout:
+        g_t = rows_fn(t, pp)[r]
+        fns[r] = ca.Function("cuboid_slot_grad", [t, pp], ca.cse([g_t, ca.gradient(g_t, t)]), ["t", "p"], ["g", "grad"])
+    gs, jacs = [], []
+    for j in range(J):
+        G, grad = _per_group(layout, fns, _task_points(Z, S, centre, size, j, K), p)  # 1 x K, d x K
+        scaled = grad * ca.repmat(size, 1, K)
+        gs.append(G.T)
+        jacs.append(ca.horzcat(scaled.T, (scaled * S[:, j * K : (j + 1) * K]).T))
+    x = ca.vec(Z)
+    params = ca.vertcat(p, ca.vec(S), centre, size)
+    return ca.Function(name, [x, params], [ca.vertcat(*gs), ca.diagcat(*jacs)], ["x", "p"], ["g", "jac_g_x"])
+
+
 class SlotNLP:
-    """IPOPT on the working-set cuboid NLP with K row slots (see the module docstring),
-    for the quantities ``sel`` (positions in the output of ``rows_fn``; the others
-    are not evaluated).
+    """IPOPT on the working-set cuboid NLP with row slots in groups, one group of K_r slots
+    per quantity r (``layout``: (r, K_r) each; positions in the output of ``rows_fn``; the
+    other quantities are not evaluated), K = Σ K_r slots in all (see the module docstring).
 
     With ``blocks`` = J > 1 it solves J such NLPs (J starts, each with its own box
-    z_j = (u_j, w_j), K slots and selectors) as one block-separable NLP: the
+    z_j = (u_j, w_j) and K slots) as one block-separable NLP: the
     objective is the sum of theirs and no constraint couples two blocks, so its
     KKT points are exactly the tuples of KKT points of the J NLPs; IPOPT's
     fixed cost per iteration is then paid once for all J starts.  The unknowns
-    are (z_1, ..., z_J), the parameters (p, S_1 ... S_J, E_1 ... E_J, c, D).
+    are (z_1, ..., z_J), the parameters (p, S_1 ... S_J, c, D).
     """
 
-    def __init__(
-        self, closure: LoopClosure, rows_fn: ca.Function, sel: tuple[int, ...], K: int, options: dict, blocks: int = 1
-    ):
+    def __init__(self, closure: LoopClosure, rows_fn: ca.Function, layout: tuple, options: dict, blocks: int = 1):
         c = closure
-        d, m, J = c.nq, len(sel), blocks
-        self.d, self.m, self.K, self.J = d, m, K, J
+        d, J = c.nq, blocks
+        K = sum(Kr for _, Kr in layout)
+        self.d, self.K, self.J, self.layout = d, K, J, tuple(layout)
         Z = ca.SX.sym("z", 2 * d, J)
         p = ca.SX.sym("p", c.np)
-        S, E = ca.SX.sym("S", d, K * J), ca.SX.sym("E", m, K * J)
+        S = ca.SX.sym("S", d, K * J)
         centre, size = ca.SX.sym("c", d), ca.SX.sym("D", d)
+        t, q = ca.SX.sym("t", d), ca.SX.sym("p", c.np)
+        fns = {r: ca.Function("cuboid_slot_row", [t, q], [rows_fn(t, q)[r]], ["t", "p"], ["g"]) for r, _ in layout}
         f, g = 0, []
         for j in range(J):
-            u, w = Z[:d, j], Z[d:, j]
-            Sj, Ej = S[:, j * K : (j + 1) * K], E[:, j * K : (j + 1) * K]
-            T = ca.repmat(centre, 1, K) + ca.repmat(size, 1, K) * (ca.repmat(u, 1, K) + Sj * ca.repmat(w, 1, K))
-            G = rows_fn.map(K)(T, ca.repmat(p, 1, K))[list(sel), :]
-            f -= ca.sum1(ca.log(w))
-            g.append(ca.sum1(Ej * G).T)
-        nlp = {
-            "x": ca.vec(Z),
-            "p": ca.vertcat(p, ca.vec(S), ca.vec(E), centre, size),
-            "f": f,
-            "g": ca.vertcat(*g),
+            (G,) = _per_group(layout, fns, _task_points(Z, S, centre, size, j, K), p)
+            f -= ca.sum1(ca.log(Z[d:, j]))
+            g.append(G.T)
+        nlp = {"x": ca.vec(Z), "p": ca.vertcat(p, ca.vec(S), centre, size), "f": f, "g": ca.vertcat(*g)}
+        name = f"{c.name}_cuboid_slots_" + "_".join(f"{r}x{Kr}" for r, Kr in layout) + (f"_x{J}" if J > 1 else "")
+        derivatives = {
+            "hess_lag": hessian_of_lagrangian(f"{name}_hess_l", rows_fn, layout, J, Z, p, S, centre, size, f),
+            "jac_g": jacobian_of_rows(f"{name}_jac_g", rows_fn, layout, J, Z, p, S, centre, size),
         }
-        name = f"{c.name}_cuboid_slots_{K}" + (f"_x{J}" if J > 1 else "")
-        self._solver = ca.nlpsol(name, "ipopt", nlp, options)
+        self._solver = ca.nlpsol(name, "ipopt", nlp, {**options, **derivatives})
         self._out = {name: k for k, name in enumerate(self._solver.name_out())}
         self._local = threading.local()
 
@@ -195,8 +286,8 @@ class ClosedFormCuboid:
     centre, size
         the normalisation of the box;
     initial
-        quantities (positions in ``rows``, and len(rows) for the reach margin) whose corner rows
-        start the first solve.
+        quantities (positions in ``rows``, and len(rows) for the reach margin) whose rows at the corners
+        and (``face_centres``) the face centres start the first solve.
     """
 
     def __init__(
@@ -213,6 +304,7 @@ class ClosedFormCuboid:
         size: np.ndarray,
         options: dict,
         initial: list[int],
+        face_centres: bool = True,
     ):
         c = model.closure
         self.model, self.config, self.closure = model, config, c
@@ -224,67 +316,95 @@ class ClosedFormCuboid:
         self.S = np.array(samples, dtype=float)
         self.centre, self.size = np.asarray(centre, dtype=float), np.asarray(size, dtype=float)
         self.options = {**options, **QUIET}
+        self._lo_slack = self.lo - relaxation(self.lo, self.options)
+        self._hi_slack = self.hi + relaxation(self.hi, self.options)
         self.d = c.nq
         self._lbx = np.r_[np.full(self.d, -np.inf), np.full(self.d, 1e-10)]
-        corners = np.flatnonzero(np.all((self.S == 0.0) | (self.S == 1.0), axis=1))
-        self.initial = {(int(j), int(r)) for j in corners for r in (initial or range(self.m))}
+        # the corners and the face centres (where the grid has them): a box whose limits bind at
+        # a corner (a convex boundary) or at a face's middle (a concave one) starts from these rows
+        ends = np.sum((self.S == 0.0) | (self.S == 1.0), axis=1)
+        middles = np.sum(self.S == 0.5, axis=1)
+        firsts = np.flatnonzero((ends == self.d) | (face_centres & (ends == 1) & (middles == self.d - 1)))
+        self.initial = {(int(j), int(r)) for j in firsts for r in (initial or range(self.m))}
         self.memory: set[tuple[int, int]] = set()  # rows active at the optima found so far
 
     # -- the NLP ----------------------------------------------------------------------------------
 
-    def _nlp(self, sel: tuple[int, ...], K: int, blocks: int = 1) -> SlotNLP:
-        key = ("cuboid_slots", self.rows, sel, K, blocks, repr(sorted(self.options.items())))
+    def _nlp(self, layout: tuple, blocks: int = 1) -> SlotNLP:
+        key = ("cuboid_slots", self.rows, layout, blocks, repr(sorted(self.options.items())))
         return solvers_of(self.closure).get(
-            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, sel, K, self.options, blocks)
+            repr(key), self.config, lambda: SlotNLP(self.closure, self.fn, layout, self.options, blocks)
         )
 
-    def _slots(self, work: list[tuple[int, int]], K: int, sel: tuple[int, ...]):
-        """The parameters of K slots holding the rows ``work``: S (K, d), E (K, m), lbg, ubg."""
-        S, E = np.full((K, self.d), 0.5), np.zeros((K, len(sel)))
+    @staticmethod
+    def _layout(works: list[list[tuple[int, int]]]) -> tuple:
+        """The groups of slots that hold every working set of ``works``: (quantity, slots) for
+        each quantity with rows (only those are evaluated), in order."""
+        most: dict[int, int] = {}
+        for work in works:
+            for r in {r for _, r in work}:
+                most[r] = max(most.get(r, 0), sum(1 for _, q in work if q == r))
+        return tuple((r, slots(n)) for r, n in sorted(most.items()))
+
+    def _slots(self, work: list[tuple[int, int]], layout: tuple):
+        """The parameters of the slots of ``layout`` holding the rows ``work``: S (K, d), lbg,
+        ubg, and the slot of each row of ``work``."""
+        K = sum(Kr for _, Kr in layout)
+        S = np.full((K, self.d), 0.5)
         lbg, ubg = np.full(K, -np.inf), np.full(K, np.inf)
-        for k, (j, r) in enumerate(work):
-            S[k], E[k, sel.index(r)], lbg[k], ubg[k] = self.S[j], 1.0, self.lo[r], self.hi[r]
-        return S, E, lbg, ubg
+        offsets, used = {}, {}
+        offset = 0
+        for r, Kr in layout:
+            offsets[r], used[r] = offset, 0
+            offset += Kr
+        where = np.empty(len(work), dtype=int)
+        for i, (j, r) in enumerate(work):
+            k = offsets[r] + used[r]
+            used[r] += 1
+            S[k], lbg[k], ubg[k], where[i] = self.S[j], self.lo[r], self.hi[r], k
+        return S, lbg, ubg, where
 
     def _solve(self, z0: np.ndarray, work: list[tuple[int, int]]):
-        K = slots(len(work))
-        sel = tuple(sorted({r for _, r in work}))  # the quantities with rows: only those are evaluated
-        S, E, lbg, ubg = self._slots(work, K, sel)
-        params = np.r_[self.model.p, S.ravel(), E.ravel(), self.centre, self.size]
-        return self._nlp(sel, K).solve(z0, params, self._lbx, lbg, ubg)
+        """One solve on the rows ``work``: (z, ok, status, iterations, the multiplier of each row)."""
+        layout = self._layout([work])
+        S, lbg, ubg, where = self._slots(work, layout)
+        params = np.r_[self.model.p, S.ravel(), self.centre, self.size]
+        z, ok, status, iters, lam = self._nlp(layout).solve(z0, params, self._lbx, lbg, ubg)
+        return z, ok, status, iters, lam[where]
 
     def _solve_blocks(self, z0s: list[np.ndarray], works: list[list[tuple[int, int]]]):
         """Several starts, each on its own working set, as one block-separable NLP
-        (`SlotNLP` with blocks): (Z (J, 2d), ok, status, iterations, multipliers (J, K))."""
+        (`SlotNLP` with blocks): (Z (J, 2d), ok, status, iterations, the multiplier of each
+        row of each start)."""
         J = len(works)
-        K = slots(max(len(w) for w in works))
-        sel = tuple(sorted({r for w in works for _, r in w}))
-        parts = [self._slots(w, K, sel) for w in works]
-        params = np.r_[
-            self.model.p,
-            np.concatenate([S.ravel() for S, *_ in parts]),
-            np.concatenate([E.ravel() for _, E, *_ in parts]),
-            self.centre,
-            self.size,
-        ]
-        lbg = np.concatenate([q[2] for q in parts])
-        ubg = np.concatenate([q[3] for q in parts])
-        z, ok, status, iters, lam = self._nlp(sel, K, J).solve(
+        layout = self._layout(works)
+        parts = [self._slots(w, layout) for w in works]
+        params = np.r_[self.model.p, np.concatenate([S.ravel() for S, *_ in parts]), self.centre, self.size]
+        lbg = np.concatenate([q[1] for q in parts])
+        ubg = np.concatenate([q[2] for q in parts])
+        z, ok, status, iters, lam = self._nlp(layout, J).solve(
             np.concatenate(z0s), params, np.tile(self._lbx, J), lbg, ubg
         )
-        return z.reshape(J, 2 * self.d), ok, status, iters, lam.reshape(J, K)
+        lam = lam.reshape(J, -1)
+        return z.reshape(J, 2 * self.d), ok, status, iters, [lam[j][q[3]] for j, q in enumerate(parts)]
 
     def values(self, z: np.ndarray) -> np.ndarray:
         """Every quantity at every sample of the box z: (N, m)."""
-        T = self.centre + self.size * (z[: self.d] + self.S * z[self.d :])
-        return evaluate_points(self.closure, row_key(self.rows), self.fn, [T], self.model.p)[0]
+        return self.values_of([z])[0]
+
+    def values_of(self, boxes: list[np.ndarray]) -> list[np.ndarray]:
+        """`values` of several boxes, in one mapped call."""
+        T = np.vstack([self.centre + self.size * (z[: self.d] + self.S * z[self.d :]) for z in boxes])
+        V = evaluate_points(self.closure, row_key(self.rows), self.fn, [T], self.model.p)[0]
+        return np.split(V, len(boxes))
 
     def _violated(self, V: np.ndarray, work: set[tuple[int, int]], per_quantity: int | None) -> set[tuple[int, int]]:
-        """Rows outside the working set that V (N, m) violates: of each quantity the
-        ``per_quantity`` worst (all if None; NaN, a sample that does not assemble,
-        counts as worst)."""
+        """Rows outside the working set that V (N, m) violates beyond IPOPT's relaxation of
+        the bounds (`relaxation`: what the rows in the working set may violate too): of each
+        quantity the ``per_quantity`` worst (all if None; NaN, a sample that does not
+        assemble, counts as worst)."""
         with np.errstate(invalid="ignore"):
-            excess = np.maximum(self.lo - V, V - self.hi)
+            excess = np.maximum(self._lo_slack - V, V - self._hi_slack)
         excess = np.where(np.isnan(excess), np.inf, excess)
         for j, r in work:
             excess[j, r] = -np.inf
@@ -309,7 +429,7 @@ class ClosedFormCuboid:
                 return z, False, status, iterations, set()
             new = self._violated(self.values(z), work, ADD_PER_QUANTITY if solve < ESCALATE else None)
             if not new:
-                lam = np.abs(lam[: len(order)])
+                lam = np.abs(lam)
                 top = float(lam.max()) if lam.size else 0.0
                 active = {row for row, v in zip(order, lam) if v > ACTIVE_MULTIPLIER * top}
                 return z, True, status, iterations, active
@@ -330,15 +450,15 @@ class ClosedFormCuboid:
             if not ok:
                 return [], False, status, iterations, []
             grown = False
-            for j, z in enumerate(Z):
-                new = self._violated(self.values(z), works[j], ADD_PER_QUANTITY if solve < ESCALATE else None)
+            for j, V in enumerate(self.values_of(list(Z))):
+                new = self._violated(V, works[j], ADD_PER_QUANTITY if solve < ESCALATE else None)
                 if new:
                     works[j] |= new
                     grown = True
             if not grown:
                 actives = []
                 for order, lj in zip(orders, lam):
-                    lj = np.abs(lj[: len(order)])
+                    lj = np.abs(lj)
                     top = float(lj.max()) if lj.size else 0.0
                     actives.append({row for row, v in zip(order, lj) if v > ACTIVE_MULTIPLIER * top})
                 return list(Z), True, status, iterations, actives
@@ -352,7 +472,7 @@ class ClosedFormCuboid:
         unknowns here): (converged, z, status, iterations)."""
         z0 = np.r_[u0, w0]
         z, ok, status, iters, active = self.settle(z0, self.memory or self.initial)
-        if not ok and self.memory:  # the rows of other optima did not hold the box: add the corners'
+        if not ok and self.memory:  # the rows of other optima did not hold the box: add the initial rows
             log.debug("start from the active rows failed (%s); again with the corner rows", status)
             z, ok, status, more, active = self.settle(z0, self.memory | self.initial)
             iters += more
@@ -365,7 +485,7 @@ class ClosedFormCuboid:
         each from the rows of the optima found before (the first start's, run by
         `start`): ([(converged, z, status, 0) per start], IPOPT iterations).  The
         runs are None if the joint solve did not converge: the caller then runs the
-        starts one by one (which also retries a start with the corners' rows)."""
+        starts one by one (which also retries a start with the initial rows)."""
         if not self.memory or len(boxes) < 2:
             return None, 0
         z0s = [np.r_[u0, w0] for u0, w0 in boxes]

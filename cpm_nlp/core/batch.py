@@ -431,10 +431,10 @@ def evaluate_points(
 
     Large N goes through `evaluate` (chunks on all threads); smaller N
     through one mapped call on one thread (faster here than two threads below
-    `THREADED_POINTS`), of a size rounded up to a power of two (to a
-    multiple of 256 above 256), the mapped Functions kept with the closure
-    (CasADi keeps them only while referenced) and the padding rows repeating
-    the first point.
+    `THREADED_POINTS`), of a size rounded up to a multiple of an eighth of the
+    power of two at or above it (at least 8; at most 12.5 % padding, 8 sizes an
+    octave), the mapped Functions kept with the closure (CasADi keeps them only
+    while referenced) and the padding rows repeating the first point.
     """
     n = per_point[0].shape[0]
     args = [np.ascontiguousarray(a, dtype=float) for a in per_point]
@@ -443,7 +443,8 @@ def evaluate_points(
         return [np.empty((0, function.nnz_out(k))) for k in range(function.n_out())]
     if n >= THREADED_POINTS:
         return evaluate(function, args + [p])
-    size = max(8, 1 << (n - 1).bit_length()) if n <= 256 else -(-n // 256) * 256
+    step = max(8, 1 << max((n - 1).bit_length() - 3, 0))
+    size = -(-n // step) * step
     mapped = solvers_of(closure).memo(("mapped", size) + tuple(key), lambda: function.map(size))
     padded = [np.vstack([a, np.repeat(a[:1], size - n, axis=0)]) if size > n else a for a in args]
     flat = [np.ascontiguousarray(a).reshape(-1) for a in padded] + [np.ascontiguousarray(np.tile(p, size))]

@@ -331,7 +331,10 @@ class _PoseCuboid:
 def _closed_form_cuboid(
     model: Model, config: SolverConfig, base: np.ndarray, centre, size, cloud: Membership
 ) -> ClosedFormCuboid:
-    """The working-set NLP through the closed-form IK (`cpm_nlp.analysis.cuboid_ik`)."""
+    """The working-set NLP through the closed-form IK (`cpm_nlp.analysis.cuboid_ik`); its first
+    rows at the corners and, where every cloud point assembles, the face centres (where the
+    IK's reach margin bounds the workspace, the corners alone, as IPOPT converges there less
+    reliably)."""
     fn, names = limited_function(model.closure)
     lo, hi = limit_bounds(model)
     rows = tuple(int(r) for r in np.flatnonzero(np.isfinite(lo) | np.isfinite(hi)))
@@ -342,14 +345,24 @@ def _closed_form_cuboid(
     if "no assembly" in binding:
         initial.append(len(rows))  # the reach margin
     options = {**config.casadi_options(), **CUBOID_IPOPT, **CLOSED_FORM_IPOPT, **dict(config.options)}
-    return ClosedFormCuboid(model, config, fn, rows, lower, upper, NLP_MARGIN, base, centre, size, options, initial)
+    face_centres = "no assembly" not in binding
+    return ClosedFormCuboid(
+        model, config, fn, rows, lower, upper, NLP_MARGIN, base, centre, size, options, initial, face_centres
+    )
+
+
+#: the initial box of a start: a cube of this width (unit box) about its seed, unless the cloud
+#: shows more room (`_start_widths`)
+START_WIDTH = 1e-3
+#: the fraction of the room the cloud shows about a seed that its initial box takes
+START_FRACTION = 0.5
 
 
 def _start_box(model: Model, t_c: np.ndarray, S: np.ndarray, centre, size, config: SolverConfig):
     """The initial box of a start about the task point t_c: (u0, w0, X, Q) with the
     poses of its samples, shrunk until every sample assembles; None if none does."""
     d = model.closure.nq
-    w0 = np.full(d, 1e-3)
+    w0 = np.full(d, START_WIDTH)
     for _ in range(4):
         u0 = (t_c - centre) / size - 0.5 * w0
         X, Q, ok = poses(model, centre + size * (u0 + S * w0), config)
@@ -359,26 +372,48 @@ def _start_box(model: Model, t_c: np.ndarray, S: np.ndarray, centre, size, confi
     return None
 
 
-def _start_boxes(model: Model, seeds: list, S: np.ndarray, centre, size, config: SolverConfig) -> list:
+def _start_widths(seeds: list, cloud_T: np.ndarray, cloud: Membership, centre, size) -> np.ndarray:
+    """The initial width (unit box, the same along every axis) of each seed's box.  The first
+    seed's is `START_WIDTH`, as it always was; each later one's is the cube about the seed
+    that holds no cloud point outside the workspace, times `START_FRACTION`, at least
+    `START_WIDTH` (the cloud is already judged: no new evaluation).  A larger initial box
+    takes IPOPT fewer iterations to the optimum (the later starts are solved together, where
+    the iterations cost most), but it can also reach another local optimum of a coarse
+    discretised NLP (the five-bar with 2 samples per edge): the first start keeps the box
+    it had."""
+    out = (cloud_T[~cloud.inside] - centre) / size
+    widths = np.full(len(seeds), START_WIDTH)
+    if not len(out):
+        return widths
+    for k in range(1, len(seeds)):
+        free = 2.0 * float(np.min(np.max(np.abs(out - (seeds[k] - centre) / size), axis=1)))
+        widths[k] = max(START_FRACTION * free, START_WIDTH)
+    return widths
+
+
+def _start_boxes(
+    model: Model, seeds: list, S: np.ndarray, centre, size, config: SolverConfig, widths: np.ndarray | None = None
+) -> list:
     """`_start_box` of every seed; with a closed-form IK the poses of all seeds'
-    samples in one call per shrink step (the same boxes)."""
+    samples in one call per shrink step, each seed's box from its width in ``widths``
+    (default `START_WIDTH`), shrunk by 10 until every sample assembles."""
     if model.closure.ik is None:
         return [_start_box(model, t_c, S, centre, size, config) for t_c in seeds]
     d = model.closure.nq
     boxes: list = [None] * len(seeds)
     todo = list(range(len(seeds)))
-    w0 = np.full(d, 1e-3)
+    w0 = np.full(len(seeds), START_WIDTH) if widths is None else np.asarray(widths, dtype=float).copy()
     for _ in range(4):
         if not todo:
             break
-        u0 = [(seeds[k] - centre) / size - 0.5 * w0 for k in todo]
-        X, Q, ok = poses(model, np.vstack([centre + size * (u + S * w0) for u in u0]), config)
+        u0 = [(seeds[k] - centre) / size - 0.5 * w0[k] for k in todo]
+        X, Q, ok = poses(model, np.vstack([centre + size * (u + S * w0[k]) for u, k in zip(u0, todo)]), config)
         n = len(S)
         left = []
         for i, k in enumerate(todo):
             part = slice(i * n, (i + 1) * n)
             if np.all(ok[part]):
-                boxes[k] = (u0[i], w0.copy(), X[part], Q[part])
+                boxes[k] = (u0[i], np.full(d, w0[k]), X[part], Q[part])
             else:
                 left.append(k)
         todo = left
@@ -443,20 +478,20 @@ def cuboid_formulation(formulation: str | CuboidFormulation) -> CuboidFormulatio
 
 def _seeds(
     model: Model, config: SolverConfig, region: tuple, starts: int, seed: int, cloud: int
-) -> tuple[list, Membership]:
+) -> tuple[list, Membership, np.ndarray]:
     """The start points (home where it is inside, then points of a seeded cloud of the
-    region that are inside), and the cloud's membership."""
+    region that are inside), the cloud's membership and its points."""
     lo_r, hi_r = region
     rng = np.random.default_rng(seed)
     home_t = model.task_of(model.x_home)
     T = lo_r + (hi_r - lo_r) * rng.random((cloud, lo_r.size))
-    cloud_mem = membership(model, T, config)
+    cloud_mem = membership(model, T, config, detail=False)  # verdicts and the limits that bind
     members = T[cloud_mem.inside]
     seeds = []
-    if membership(model, home_t[None, :], config).inside[0]:
+    if membership(model, home_t[None, :], config, detail=False).inside[0]:
         seeds.append(home_t)
     seeds += list(members[rng.permutation(len(members))[: max(starts - len(seeds), 0)]])
-    return seeds[:starts], cloud_mem
+    return seeds[:starts], cloud_mem, T
 
 
 def _run_starts(engine: Any, boxes: list) -> tuple[list, int]:
@@ -597,7 +632,7 @@ def inscribed_cuboid(
             )
     lo_r, hi_r = (np.asarray(v, dtype=float) for v in region)
     centre, size = 0.5 * (lo_r + hi_r), np.maximum(hi_r - lo_r, 1e-12)
-    seeds, cloud_mem = _seeds(model, config, (lo_r, hi_r), starts, seed, cloud)
+    seeds, cloud_mem, cloud_T = _seeds(model, config, (lo_r, hi_r), starts, seed, cloud)
     if not seeds:
         return CuboidResult(
             False,
@@ -616,7 +651,9 @@ def inscribed_cuboid(
         engine = _closed_form_cuboid(model, config, base, centre, size, cloud_mem)
     else:
         engine = _PoseCuboid(model, config, base, centre, size)
-    boxes = _start_boxes(model, seeds, engine.S, centre, size, config)
+    # larger initial boxes where every cloud point assembles (as for the face centres' rows)
+    widths = _start_widths(seeds, cloud_T, cloud_mem, centre, size) if assembles else None
+    boxes = _start_boxes(model, seeds, engine.S, centre, size, config, widths)
     runs, iterations = _run_starts(engine, boxes)
     volumes = [float(np.prod(size * r[1][d : 2 * d])) if r[0] else None for r in runs]
     ok_vols = [v for v in volumes if v is not None]

@@ -11,6 +11,7 @@ import casadi as ca
 import numpy as np
 
 from ...core.batch import evaluate_points
+from ...core.conditioning import closure_blocks, cond2_left_inverse_bound
 from ...core.model import LoopClosure, Model
 from ...core.pose_checks import SINGULAR_CONDITION  # cond(Φ_x) above it: singular, outside the workspace
 from ...core.solver import SolverConfig, solvers_of
@@ -110,7 +111,10 @@ class Membership:
 
 #: cache keys of the membership functions
 POSE_VALUES_KEY = ("workspace", "pose_values")
+POSE_BOUND_KEY = ("workspace", "pose_bound")
 TASK_POINT_KEY = ("workspace", "task_point")
+TASK_POSE_KEY = ("workspace", "task_pose")
+TASK_POINT_BOUND_KEY = ("workspace", "task_point_bound")
 
 
 def _pose_values(c: LoopClosure, x, q, p) -> list:
@@ -139,24 +143,75 @@ def pose_check_function(closure: LoopClosure) -> ca.Function:
     return solvers_of(closure).memo(POSE_VALUES_KEY, build)
 
 
+def pose_bound_function(closure: LoopClosure) -> ca.Function:
+    """``<name>_pose_bound: (x, q, p) -> cond_bound``: a certified upper bound of the 2-norm
+    condition number of `LoopClosure.cond_matrix` at the pose, from a block left inverse
+    (`cpm_nlp.core.conditioning.cond2_left_inverse_bound`: no inverse of the whole matrix,
+    no SVD; +inf where it certifies nothing), built once per mechanism type."""
+
+    def build() -> ca.Function:
+        c = closure
+        x, q, p = ca.SX.sym("x", c.nx), ca.SX.sym("q", c.nq), ca.SX.sym("p", c.np)
+        bound = cond2_left_inverse_bound(c.cond_matrix(x, q, p), closure_blocks(c))
+        return ca.Function(f"{c.name}_pose_bound", [x, q, p], [ca.cse(bound)], ["x", "q", "p"], ["cond_bound"])
+
+    return solvers_of(closure).memo(POSE_BOUND_KEY, build)
+
+
 def task_point_function(closure: LoopClosure) -> ca.Function:
-    """``<name>_task_point: (t, p) -> (x, q, reach, v, phi, phi_x)``: the closed-form
-    IK at a task point and the values of `pose_check_function` there (one
-    flat SX graph, built once per mechanism type)."""
+    """``<name>_task_point: (t, p) -> (x, q, reach, v, phi)``: the closed-form IK at a task
+    point and the limited quantities and residuals of `pose_check_function` there (one flat
+    SX graph, built once per mechanism type; Φ_x and its conditioning are evaluated
+    afterwards, only at the poses that need them, see `judge`)."""
 
     def build() -> ca.Function:
         c = closure
         t, p = ca.SX.sym("t", c.nq), ca.SX.sym("p", c.np)
         x, q, reach = c.ik(t, p)
+        v, res, _phi_x = _pose_values(c, x, q, p)
         return ca.Function(
             f"{c.name}_task_point",
             [t, p],
-            ca.cse([x, q, reach, *_pose_values(c, x, q, p)]),
+            ca.cse([x, q, reach, v, res]),
             ["t", "p"],
-            ["x", "q", "reach", "v", "phi", "phi_x"],
+            ["x", "q", "reach", "v", "phi"],
         )
 
     return solvers_of(closure).memo(TASK_POINT_KEY, build)
+
+
+def task_point_bound_function(closure: LoopClosure) -> ca.Function:
+    """``<name>_task_point_bound: (t, p) -> (x, q, reach, v, phi, cond_bound)``: `task_point_function`
+    and `pose_bound_function` at its pose in one flat SX graph, their common subexpressions
+    shared (for points that are all screened: about 8 % fewer instructions than the two)."""
+
+    def build() -> ca.Function:
+        c = closure
+        t, p = ca.SX.sym("t", c.nq), ca.SX.sym("p", c.np)
+        x, q, reach = c.ik(t, p)
+        v, res, _phi_x = _pose_values(c, x, q, p)
+        bound = cond2_left_inverse_bound(c.cond_matrix(x, q, p), closure_blocks(c))
+        return ca.Function(
+            f"{c.name}_task_point_bound",
+            [t, p],
+            ca.cse([x, q, reach, v, res, bound]),
+            ["t", "p"],
+            ["x", "q", "reach", "v", "phi", "cond_bound"],
+        )
+
+    return solvers_of(closure).memo(TASK_POINT_BOUND_KEY, build)
+
+
+def task_pose_function(closure: LoopClosure) -> ca.Function:
+    """``<name>_task_pose: (t, p) -> (x, q, reach)``: the closed-form IK alone (built once per
+    mechanism type)."""
+
+    def build() -> ca.Function:
+        c = closure
+        t, p = ca.SX.sym("t", c.nq), ca.SX.sym("p", c.np)
+        return ca.Function(f"{c.name}_task_pose", [t, p], ca.cse(list(c.ik(t, p))), ["t", "p"], ["x", "q", "reach"])
+
+    return solvers_of(closure).memo(TASK_POSE_KEY, build)
 
 
 @dataclass
@@ -184,45 +239,88 @@ class _Judged:
 
 
 def judge(
-    model: Model, X: np.ndarray, Q: np.ndarray, config: SolverConfig, tolerance: float = CHECK_TOLERANCE, values=None
+    model: Model,
+    X: np.ndarray,
+    Q: np.ndarray,
+    config: SolverConfig,
+    tolerance: float = CHECK_TOLERANCE,
+    values=None,
+    detail: bool = True,
 ) -> _Judged:
     """Judge M poses (X, Q): residual, branch, limits (to ``tolerance``) and Φ_x.
-    ``values``: (V, R, PX) already evaluated at them (else one mapped call)."""
+    ``values``: (V, R) already evaluated at them, or (V, R, B) with the bounds of
+    `pose_bound_function` too (the screen is then `singular`); else one mapped call of
+    `pose_check_function`, whose Φ_x `condition_numbers` judges.
+
+    The singularity screen runs on every converged pose, or with ``detail``
+    False only on those within every limit (the others are outside either way: the
+    verdicts are the same, but such a pose reports its worst limit, never "singular")."""
     c = model.closure
     M = X.shape[0]
     _fn, names = limited_function(c)
     lo, hi = limit_bounds(model)
     finite = np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
-    V = np.full((M, len(names)), np.nan)
-    fn = pose_check_function(c)
-    R = np.full((M, fn.nnz_out(1)), np.nan)
-    PX = np.full((M, fn.nnz_out(2)), np.nan)
+    B = PX = None
     if values is not None:
-        V, R, PX = (np.array(v, dtype=float) for v in values)
-    elif np.any(finite):
-        V[finite], R[finite], PX[finite] = evaluate_points(c, POSE_VALUES_KEY, fn, [X[finite], Q[finite]], model.p)
+        V, R, *rest = (np.asarray(v, dtype=float) for v in values)
+        B = rest[0].reshape(-1) if rest else None
+    else:  # Φ_x comes with the values here: it is judged directly (`condition_numbers`)
+        fn = pose_check_function(c)
+        V = np.full((M, len(names)), np.nan)
+        R = np.full((M, fn.nnz_out(1)), np.nan)
+        PX = np.full((M, fn.nnz_out(2)), np.nan)
+        if np.any(finite):
+            V[finite], R[finite], PX[finite] = evaluate_points(c, POSE_VALUES_KEY, fn, [X[finite], Q[finite]], model.p)
     with np.errstate(invalid="ignore"):
         resid = np.where(finite, np.max(np.abs(R), axis=1), np.inf)
-        converged = finite & (resid <= config.tolerance)
+        converged = finite & (resid <= config.tolerance)  # NaN: False
         m = np.minimum(V - lo, hi - V)
     m = np.where(np.isnan(m), np.inf, m)
-    is_branch = np.array([n.startswith("branch[") for n in names], dtype=bool)
+    branch_rows = _branch_rows(names)
     with np.errstate(invalid="ignore"):
-        on_branch = np.all(m[:, is_branch] >= -tolerance, axis=1) if is_branch.any() else np.ones(M, dtype=bool)
+        on_branch = np.all(m[:, branch_rows] >= -tolerance, axis=1) if branch_rows.size else np.ones(M, dtype=bool)
         xd = X[:, c.dep_index]
         on_branch &= np.all(xd >= model.x_lower[c.dep_index] - tolerance, axis=1)
         on_branch &= np.all(xd <= model.x_upper[c.dep_index] + tolerance, axis=1)
     worst = np.argmin(m, axis=1) if M else np.zeros(0, dtype=int)
     w = m[np.arange(M), worst]
-    binding = np.where(np.isfinite(w), np.asarray(names, dtype=object)[worst], "")
-    margin = np.where(np.isfinite(w), w, np.inf)
-    margin = np.where(converged, margin, -np.inf)
-    binding = np.where(converged, binding, "no assembly")
-    idx = np.flatnonzero(converged)
+    margin = np.where(converged, np.where(np.isfinite(w), w, np.inf), -np.inf)
+    # the binding quantity's position in `names`; -1 "no assembly", -2 none (w not finite), -3 "singular"
+    code = np.where(converged, np.where(np.isfinite(w), worst, -2), -1)
+    idx = np.flatnonzero(converged if detail else converged & (margin >= -tolerance))
     if idx.size:  # forward singularities: Φ_x rank deficient
-        sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, -1)) < SINGULAR_CONDITION)  # transposed
-        margin[idx[sing]], binding[idx[sing]] = -np.inf, "singular"
-    return _Judged(converged, on_branch, margin, binding.astype(object), X, Q, tolerance)
+        if PX is not None:
+            sing = ~(condition_numbers(PX[idx].reshape(idx.size, c.nx, -1)) < SINGULAR_CONDITION)  # transposed
+        else:
+            sing = singular(model, X[idx], Q[idx], None if B is None else B[idx])
+        margin[idx[sing]], code[idx[sing]] = -np.inf, -3
+    binding = np.asarray(list(names) + ["singular", "", "no assembly"], dtype=object)[code]
+    return _Judged(converged, on_branch, margin, binding, X, Q, tolerance)
+
+
+def singular(model: Model, X: np.ndarray, Q: np.ndarray, bound: np.ndarray | None = None) -> np.ndarray:
+    """Whether each pose (X, Q) is singular: cond(Φ_x) (`LoopClosure.cond_matrix`) at or above
+    `SINGULAR_CONDITION`.  The certified bound of `pose_bound_function` (``bound``: already
+    evaluated at the poses) decides where it is below half the threshold (κ₂ is then below
+    it); `condition_numbers` of Φ_x decides the rest (the same verdicts as
+    `condition_numbers` everywhere)."""
+    c = model.closure
+    if bound is None:
+        (B,) = evaluate_points(c, POSE_BOUND_KEY, pose_bound_function(c), [X, Q], model.p)
+    else:
+        B = np.asarray(bound, dtype=float)
+    out = np.zeros(X.shape[0], dtype=bool)
+    rest = np.flatnonzero(~(B.reshape(-1) < 0.5 * SINGULAR_CONDITION))
+    if rest.size:
+        PX = evaluate_points(c, POSE_VALUES_KEY, pose_check_function(c), [X[rest], Q[rest]], model.p)[2]
+        out[rest] = ~(condition_numbers(PX.reshape(rest.size, c.nx, -1)) < SINGULAR_CONDITION)  # transposed
+    return out
+
+
+@functools.cache
+def _branch_rows(names: tuple[str, ...]) -> np.ndarray:
+    """Positions of the branch indicators among the limited quantities ``names``."""
+    return np.flatnonzero([n.startswith("branch[") for n in names])
 
 
 @dataclass
@@ -236,15 +334,22 @@ class _Points:
     Q: np.ndarray
 
 
-def _closed_form_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float) -> _Points:
+def _closed_form_points(
+    model: Model, T: np.ndarray, config: SolverConfig, tolerance: float, detail: bool = True
+) -> _Points:
     """Every point at once through the closed-form IK: decided inside or outside (a
     negative reach margin proves that the mechanism does not assemble there)."""
     c = model.closure
-    X, Q, reach, V, R, PX = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
+    if detail:  # every pose that assembles is screened: the bound with the rest, in one graph
+        X, Q, reach, V, R, B = evaluate_points(c, TASK_POINT_BOUND_KEY, task_point_bound_function(c), [T], model.p)
+        extra = [B]
+    else:
+        X, Q, reach, V, R = evaluate_points(c, TASK_POINT_KEY, task_point_function(c), [T], model.p)
+        extra = []
     ok = reach.ravel() >= 0
     V, R = np.where(ok[:, None], V, np.nan), np.where(ok[:, None], R, np.nan)
     X, Q = np.where(ok[:, None], X, np.nan), np.where(ok[:, None], Q, np.nan)
-    j = judge(model, X, Q, config, tolerance, (V, R, PX))
+    j = judge(model, X, Q, config, tolerance, (V, R, *extra), detail)
     # on the closed form's branch by construction; the branch rows still count as limits
     status = np.where(j.converged & (j.margin >= -tolerance), INSIDE, OUTSIDE).astype(object)
     return _Points(status, j.margin, j.binding, X, Q)
@@ -285,7 +390,7 @@ def _decide(points: _Points, model, T, todo: np.ndarray, Y: np.ndarray, j: _Judg
         _take(points, model, T, todo[has_e], Y, j, rows)
 
 
-def _solved_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float) -> _Points:
+def _solved_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance: float, detail: bool = True) -> _Points:
     """Every point from its own start set (`point_ik`), never from another point."""
     c = model.closure
     N = T.shape[0]
@@ -314,7 +419,7 @@ def _solved_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance:
         Y, _norm = newton(model, Y0, Tr, config.tolerance)
         Y = reduce_angles(model, Y)
         X, Q = _assemble(model, Tr, Y)
-        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance), per)
+        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance, detail=detail), per)
     for s in range(min(IPOPT_STARTS, starts.shape[1])):  # IPOPT with the strokes as bounds
         todo = np.flatnonzero(points.status == UNDECIDED)
         if not todo.size:
@@ -326,13 +431,13 @@ def _solved_points(model: Model, T: np.ndarray, config: SolverConfig, tolerance:
                 Y[i] = y
         Y = reduce_angles(model, Y)
         X, Q = _assemble(model, T[todo], Y)
-        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance), 1)
+        _decide(points, model, T, todo, Y, judge(model, X, Q, config, tolerance, detail=detail), 1)
     und = points.status == UNDECIDED
     points.binding[und] = f"undecided: no pose on the designated branch from {starts.shape[1]} starts"
     return points
 
 
-def _points(model: Model, T, solver: SolverConfig | None, tolerance: float) -> _Points:
+def _points(model: Model, T, solver: SolverConfig | None, tolerance: float, detail: bool = True) -> _Points:
     c = model.closure
     config = solver or SolverConfig()
     T = np.atleast_2d(np.asarray(T, dtype=float))
@@ -340,20 +445,29 @@ def _points(model: Model, T, solver: SolverConfig | None, tolerance: float) -> _
         e = np.zeros(0, dtype=object)
         return _Points(e, np.zeros(0), e.copy(), np.zeros((0, c.nx)), np.zeros((0, c.nq)))
     if c.ik is not None:
-        return _closed_form_points(model, T, config, tolerance)
-    return _solved_points(model, T, config, tolerance)
+        return _closed_form_points(model, T, config, tolerance, detail)
+    return _solved_points(model, T, config, tolerance, detail)
 
 
 def poses(model: Model, T: np.ndarray, solver: SolverConfig | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Poses (X, Q) for task points T (N, nq) and whether each assembles on the
     designated branch (inside or outside the limits).
 
-    With a closed-form IK all points are evaluated at once (one mapped CasADi call);
-    otherwise each point's IK is solved from its own start set (`point_ik`).
+    With a closed-form IK all points are evaluated at once (one mapped CasADi call of the
+    IK alone: a point assembles where its reach margin is not negative); otherwise each
+    point's IK is solved from its own start set (`point_ik`; the binding quantities of the
+    membership test are not needed, see `judge`'s ``detail``).
     """
-    got = _points(model, T, solver, CHECK_TOLERANCE)
-    ok = np.all(np.isfinite(got.X), axis=1) & np.all(np.isfinite(got.Q), axis=1)
-    return got.X, got.Q, ok
+    c = model.closure
+    T = np.atleast_2d(np.asarray(T, dtype=float))
+    if c.ik is not None and T.shape[0]:
+        X, Q, reach = evaluate_points(c, TASK_POSE_KEY, task_pose_function(c), [T], model.p)
+        ok = reach.ravel() >= 0
+        X, Q = np.where(ok[:, None], X, np.nan), np.where(ok[:, None], Q, np.nan)
+    else:
+        got = _points(model, T, solver, CHECK_TOLERANCE, detail=False)
+        X, Q = got.X, got.Q
+    return X, Q, np.all(np.isfinite(X), axis=1) & np.all(np.isfinite(Q), axis=1)
 
 
 def condition_numbers(PX: np.ndarray) -> np.ndarray:
@@ -382,7 +496,9 @@ def condition_numbers(PX: np.ndarray) -> np.ndarray:
     return out
 
 
-def membership(model: Model, T, solver: SolverConfig | None = None, tolerance: float = CHECK_TOLERANCE) -> Membership:
+def membership(
+    model: Model, T, solver: SolverConfig | None = None, tolerance: float = CHECK_TOLERANCE, *, detail: bool = True
+) -> Membership:
     """Which task points T (N, nq) lie in the reachable workspace: the pose
     assembles on the designated branch, is not singular, and every limited
     quantity is within its limits (to ``tolerance``).
@@ -390,7 +506,11 @@ def membership(model: Model, T, solver: SolverConfig | None = None, tolerance: f
     Each point is decided on its own (never from another point's solution): inside
     (a pose that passes), outside (the closed form's reach margin is negative, or
     the pose on the designated branch violates a limit or is singular) or undecided
-    (no pose on the designated branch from any start; ``inside`` is False there)."""
-    got = _points(model, T, solver, tolerance)
+    (no pose on the designated branch from any start; ``inside`` is False there).
+
+    ``detail`` False: only the verdicts are needed; a point outside a limit is not screened
+    for a singularity (the same verdicts; its margin and binding are then its worst limit's,
+    never "singular")."""
+    got = _points(model, T, solver, tolerance, detail)
     inside = got.status == INSIDE
     return Membership(inside, got.margin, got.binding.tolist(), got.X, got.Q, got.status.tolist())

@@ -40,7 +40,7 @@ def _double(model: Model, solver: SolverConfig | None, t0: np.ndarray, dirs: np.
             break
         s = np.array(steps[first : first + block])
         pts = t0 + s[None, :, None] * dirs[todo][:, None, :]
-        inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(todo.size, s.size)
+        inside = membership(model, pts.reshape(-1, d), solver, detail=False).inside.reshape(todo.size, s.size)
         for row, k in enumerate(todo):
             out = np.flatnonzero(~inside[row])
             # the step before the first outside one is inside (none before the first step)
@@ -64,7 +64,7 @@ def _bisect_levels(model, solver, t0, dirs, inside_step, outside_step, k: int) -
             low[2 * i + 1], high[2 * i + 1] = low[i], mid[i]
             low[2 * i + 2], high[2 * i + 2] = mid[i], high[i]
     pts = t0 + mid[:, :, None] * dirs[None, :, :]
-    inside = membership(model, pts.reshape(-1, d), solver).inside.reshape(nodes, len(dirs))
+    inside = membership(model, pts.reshape(-1, d), solver, detail=False).inside.reshape(nodes, len(dirs))
     node = np.zeros(len(dirs), dtype=int)
     for _ in range(k):
         ins, m = inside[node, cols], mid[node, cols]
@@ -88,7 +88,7 @@ def probe_region(
     """
     t0 = model.task_of(model.x_home) if centre is None else np.asarray(centre, dtype=float)
     d = t0.size
-    if not membership(model, t0[None, :], solver).inside[0]:
+    if not membership(model, t0[None, :], solver, detail=False).inside[0]:
         return None
     dirs = np.vstack([np.eye(d), -np.eye(d)])
     inside_step, outside_step = _double(model, solver, t0, dirs)
