@@ -33,8 +33,10 @@ reduces to the pseudo-rigid-body C = J (K_q + K_a)⁻¹ Jᵀ (tested), and at an
 unstressed pose to the compliance-matrix method Σ_legs (Σ_h Ad C_h Adᵀ)⁻¹
 (tested against an independent numpy derivation).
 
-The links and the platform stay rigid: a slender leg's own bending is not in
-the model (declare it as a hinge of its own to include it).
+A link may be flexible (``bodies``: `cpm_nlp.analysis.beam_inputs`): a beam of
+n elements between two neighbouring joints of a leg, each element six more
+variables ε after the first joint's motions and the energy ½ εᵀ K_e ε
+(`cpm_nlp.analysis.beams`, geometrically nonlinear).  The platform stays rigid.
 """
 
 from __future__ import annotations
@@ -55,6 +57,8 @@ from ..core.errors import InputError
 from ..core.fast_calls import FastFunction
 from ..core.model import Model
 from ..core.screws import axis_rotation, vee
+from .beam_inputs import PLATFORM, Body
+from .beams import DEFORMATIONS, beam_elements, element_motions, element_wrenches
 from .compliance import HINGE_TYPES, HingeSet, six_axis_stiffness
 from .hinge_types import SIX_AXES
 
@@ -147,6 +151,7 @@ class SixAxisModel:
                 fr.variables[a] = (self._new(f"{fr.name}_{a}", rest), 0.0)
                 kind, u = fr.axes[a]
                 extra.setdefault(fr.loc, []).append((kind, u, self._z[-1]))
+        self.beams = self._beam_elements(hs, chains, rest, extra)
         self.rest = np.array(rest)
         self.nz = len(self._z)
         z = ca.vertcat(*self._z)
@@ -196,12 +201,13 @@ class SixAxisModel:
         for li, rows in enumerate(legs):
             Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
             for ji, (j, motions) in enumerate(rows):
-                for kind, axis, value in motions + extra.get((li, ji), []):
+                for kind, axis, value, *point in motions + extra.get((li, ji), []):
+                    at = ca.DM(point[0] if point else j.at)  # a beam element turns about its spring point
                     if kind == "P":
                         Rk, tk = ca.SX.eye(3), value * ca.DM(axis)
                     else:
                         Rk = _rot(axis, value)
-                        tk = ca.DM(j.at) - Rk @ ca.DM(j.at)
+                        tk = at - Rk @ at
                     Rm, tm = Rm @ Rk, Rm @ tk + tm
             tip = ca.DM(ch.legs[li].tip)
             g.append(Rm @ tip + tm - (DR @ (tip - P0) + P))  # the leg's platform point
@@ -216,6 +222,10 @@ class SixAxisModel:
         for fr in self.frames:
             for a, (zi, r0) in fr.variables.items():
                 U += 0.5 * fr.k[a] * (z[zi] - r0) ** 2
+        for _, _, elements in self.beams:
+            for el, idx in elements:
+                e = ca.vertcat(*[z[i] for i in idx])
+                U += 0.5 * ca.dot(e, ca.mtimes(ca.DM(el.K), e))
         f = ca.SX.sym("f", self.nx)
         qc, ka, Fc = ca.SX.sym("qc", self.nq), ca.SX.sym("ka", self.nq), ca.SX.sym("Fc", self.nq)
         dq = z[self.nx : self.nx + self.nq] - qc
@@ -279,6 +289,47 @@ class SixAxisModel:
             fr.loc = loc
             frames.append(fr)
         return frames
+
+    # -- the flexible bodies in the chains --------------------------------------------------------
+    def _beam_elements(self, hs: HingeSet, chains: Chains, rest: list[float], extra: dict) -> list:
+        """Each flexible body's beam elements on each leg, their deformation variables, and their
+        motions after the body's first joint (`cpm_nlp.analysis.beams`): [(body, leg, [(element,
+        z indices)])]."""
+        where: dict[str, tuple[int, int]] = {}
+        for li, leg in enumerate(chains.legs):
+            for ji, j in enumerate(leg.joints):
+                for cname in (*j.coordinates, j.actuated):
+                    if cname:
+                        where[cname] = (li, ji)
+        out = []
+        for body in hs.bodies:
+            for m, (first, second) in enumerate(body.members):
+                li, ja, jb = _body_ends(body, m, first, second, where, chains)
+                leg = chains.legs[li]
+                start = leg.joints[ja].at
+                end = leg.tip if jb == len(leg.joints) else leg.joints[jb].at
+                bend = (
+                    _first_rotation(leg.joints[ja])
+                    if _first_rotation(leg.joints[ja]) is not None
+                    else (_first_rotation(leg.joints[jb]) if jb < len(leg.joints) else None)
+                )
+                mat = body.material
+                elements = []
+                for k, el in enumerate(beam_elements(body.beam, start, end, bend, mat.E, mat.nu, mat.density)):
+                    idx = [self._new(f"{body.name}{m + 1}_e{k + 1}_{DEFORMATIONS[d]}", rest) for d in el.dofs]
+                    extra.setdefault((li, ja), []).extend(element_motions(el, [self._z[i] for i in idx]))
+                    elements.append((el, idx))
+                out.append((body, li, elements))
+        return out
+
+    def body_stresses(self, z: np.ndarray) -> dict[str, float]:
+        """The largest nominal stress of each flexible body (over its legs and elements)."""
+        out: dict[str, float] = {}
+        for body, _, elements in self.beams:
+            for el, idx in elements:
+                worst = max(element_wrenches(el, np.asarray(z)[idx], body.beam.section))
+                out[body.name] = max(out.get(body.name, 0.0), worst)
+        return out
 
     @property
     def six_axis_hinges(self) -> list[str]:
@@ -391,6 +442,37 @@ class SixAxisModel:
         gl = np.asarray(self.kkt(z, lam, par)[0], dtype=float).ravel()
         return gl[self.nx : self.nx + self.nq]
 
+    @one_blas_thread
+    def input_stiffness(self, z: np.ndarray, lam: np.ndarray, f: np.ndarray) -> np.ndarray:
+        """K_q = dF/dq (nq x nq) at an equilibrium with the actuators held: the sensitivity of the
+        reactions through the KKT system, [H_ff A_fᵀ; A_f 0][dz_f; dλ] = -[H_fq; A_q]."""
+        par = self._par(f, z[self.nx : self.nx + self.nq], None, None)
+        _, _, H, A = self._eval(z, lam, par)
+        free, qi = self._free(None), np.arange(self.nx, self.nx + self.nq)
+        K = self._kkt_matrix(H, A, free)
+        rhs = -np.vstack([H[np.ix_(free, qi)], A[:, qi]])
+        sol = _solve(K, rhs)
+        dz, dlam = sol[: len(free)], sol[len(free) :]
+        Kq = H[np.ix_(qi, qi)] + H[np.ix_(qi, free)] @ dz + A[:, qi].T @ dlam
+        return 0.5 * (Kq + Kq.T)
+
+    def energy(self, z: np.ndarray, f: np.ndarray) -> float:
+        """V = U - fᵀx at z (the actuators held)."""
+        par = self._par(f, z[self.nx : self.nx + self.nq], None, None)
+        return float(self._eval_v(z, par))
+
+    def _eval_v(self, z: np.ndarray, par: np.ndarray) -> float:
+        return float(np.asarray(self.kkt(z, np.zeros(self.ng), par)[4]).ravel()[0])
+
+    def joint_vector(self, z: np.ndarray, theta: np.ndarray) -> np.ndarray:
+        """The hinge set's joint vector (x, q, passive) with each hinge's axes read from z."""
+        out = np.array(theta, dtype=float)
+        for fr, h in zip(self.frames, self.hs.hinges, strict=True):
+            for a, i in h.axes.items():
+                zi, r0 = fr.variables[a]
+                out[i] = self.hs.theta0[i] + z[zi] - r0
+        return out
+
     def stresses(self, z: np.ndarray) -> dict[str, float | None]:
         """Largest stress of each hinge from its moments (all three rotations) and axial force."""
         out: dict[str, float | None] = {}
@@ -420,6 +502,36 @@ class SixAxisModel:
         K[:n, n:] = A[:, free].T
         K[n:, :n] = A[:, free]
         return K
+
+
+def _first_rotation(joint: Any) -> np.ndarray | None:
+    for d, kind in enumerate(joint.motions):
+        if kind == "R":
+            return joint.axes[:, d]
+    return None
+
+
+def _body_ends(body: Body, m: int, first: str, second: str, where: dict, chains: Chains) -> tuple[int, int, int]:
+    """(leg, first joint, second joint) of a body's member; the second joint len(joints) at the platform."""
+    if first not in where or (second != PLATFORM and second not in where):
+        missing = first if first not in where else second
+        raise InputError(
+            f"body {body.name}: joint {missing} is not in the legs' chains, so the body cannot be placed",
+            path=body.path + ("between",),
+        )
+    li, ja = where[first]
+    if second == PLATFORM:
+        lj, jb = li, len(chains.legs[li].joints)
+    else:
+        lj, jb = where[second]
+    ja, jb = min(ja, jb), max(ja, jb)
+    if lj != li or jb != ja + 1:
+        raise InputError(
+            f"body {body.name}: {first} and {second} (member {m + 1}) are not neighbouring joints of one leg; a "
+            "flexible body is the link between two neighbouring joints (or the last joint and the platform)",
+            path=body.path + ("between",),
+        )
+    return li, ja, jb
 
 
 def _check_reference(model: Model, chains: Chains) -> None:
@@ -471,7 +583,8 @@ def _key(model: Model, hs: HingeSet) -> tuple:
         )
         for h in hs.hinges
     )
-    return (mech.name, mech.origin, tuple(np.asarray(model.p, dtype=float)), tuple(model.x_home), hinges)
+    bodies = tuple((repr(b.beam), b.members, b.material.E, b.material.nu, b.material.density) for b in hs.bodies)
+    return (mech.name, mech.origin, tuple(np.asarray(model.p, dtype=float)), tuple(model.x_home), hinges, bodies)
 
 
 def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:
