@@ -226,4 +226,16 @@ def bodies_of(
     return out
 
 
-__all__ = ["BODIES", "PLATFORM", "Body", "BodySpec", "bodies_of", "body_spec", "parse_bodies"]
+def merged_bodies(
+    c: LoopClosure, declared: Mapping[str, BodySpec | None], bodies: Any, mat: Material | None, path: tuple
+) -> list[Body]:
+    """A mechanism's declared bodies merged, body by body, with a problem file's ``bodies``
+    (a body of the same name replaces the mechanism's; null removes it)."""
+    given = parse_bodies(bodies, path + ("bodies",))
+    merged = {**declared, **given}
+    specs = {n: b for n, b in merged.items() if b is not None}
+    paths = {n: path + ("bodies", n) if n in given else ("mechanism", "stiffness", "bodies", n) for n in specs}
+    return bodies_of(c, specs, mat, paths)
+
+
+__all__ = ["BODIES", "PLATFORM", "Body", "BodySpec", "bodies_of", "body_spec", "merged_bodies", "parse_bodies"]

@@ -59,7 +59,7 @@ from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import LoopClosure, Model
 from ..core.options import Option, validate_mapping
 from ..core.schema import Either, MappingOf, Quantity, Record
-from .beam_inputs import Body, bodies_of, parse_bodies
+from .beam_inputs import Body, bodies_of, merged_bodies, parse_bodies
 from .flexure import Material, material, material_node
 from .hinge_types import DIM_OPTIONS, HINGE_TABLE, HingeType
 
@@ -537,17 +537,8 @@ def hinge_set(
     theta0 = joint_vector(model, model.x_home, model.q_home)
     hs = HingeSet(names, [co.kind for co in coords], k, theta0, out, sigma_allow, [decl.source] if decl else [])
     hs.material_at = _material_at(mech, out, merged, given, material_spec, path)
-    hs.bodies = _bodies(c, decl, bodies, mat, path)
+    hs.bodies = merged_bodies(c, decl.body_records if decl else {}, bodies, mat, path)
     return hs
-
-
-def _bodies(c: LoopClosure, decl: JointStiffness | None, bodies: Any, mat: Material | None, path: tuple) -> list[Body]:
-    """The mechanism's flexible bodies merged, body by body, with a problem file's ``bodies``."""
-    given = parse_bodies(bodies, path + ("bodies",))
-    merged = {**(decl.body_records if decl else {}), **given}
-    specs = {n: b for n, b in merged.items() if b is not None}
-    paths = {n: path + ("bodies", n) if n in given else ("mechanism", "stiffness", "bodies", n) for n in specs}
-    return bodies_of(c, specs, mat, paths)
 
 
 def _material_at(mech: Any, out: list[Hinge], merged: Mapping, hinges: Any, material_spec: Any, path: tuple) -> dict:

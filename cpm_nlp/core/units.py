@@ -114,7 +114,7 @@ FAST_UNITS: Mapping[str, tuple[float, str]] = MappingProxyType(
         "cm^2": (0.0001, "area"),
         "um^2": (1e-12, "area"),
         "m^4": (1.0, "area_moment"),
-        "mm^4": (1e-12, "area_moment"),
+        "mm^4": (1.0000000000000002e-12, "area_moment"),
         "m^3": (1.0, "volume"),
         "mm^3": (1e-09, "volume"),
         "cm^3": (1.0000000000000002e-06, "volume"),

@@ -314,6 +314,10 @@ class ActuatorForces(_HingeKind):
         """The scale λ of the ray home -> end at which the largest stress reaches σ_allow."""
         sigma = inputs["sigma"]
         ray = _Ray(model, end, bool(given(inputs, model.closure.q_names)), solver)
+        if inputs.get("six_axis") is not None:
+            flexed = self._point(model, inputs, end)
+            if flexed is not None:
+                ray.t_linear_end = model.task_of(flexed[0].x)
 
         def excess(lam: float) -> float:
             sol = ray.pose(lam)
@@ -418,6 +422,9 @@ class _Ray:
     def __init__(self, model: Model, end: PoseSolution, by_actuators: bool, solver: SolverConfig) -> None:
         self.model, self.end, self.by_actuators, self.solver = model, end, by_actuators, solver
         self.t_home, self.t_end = model.task_of(model.x_home), model.task_of(end.x)
+        #: the task at the motion's end that the linear extrapolation scales (the flexible mechanism's
+        #: pose there, with flexible bodies)
+        self.t_linear_end = self.t_end
 
     def pose(self, lam: float) -> PoseSolution:
         m = self.model
@@ -450,7 +457,7 @@ def _limit_values(
     values: list[Any] = [sigma, lam, lam_lin]
     linear = {}
     for k, i in enumerate(c.task_index):
-        linear[i] = ray.t_home[k] + lam_lin * (ray.t_end[k] - ray.t_home[k])
+        linear[i] = ray.t_home[k] + lam_lin * (ray.t_linear_end[k] - ray.t_home[k])
         values += [float(sol.x[i]), float(linear[i])]
     for target in c.offsets.values():
         i = c.x_names.index(target)
