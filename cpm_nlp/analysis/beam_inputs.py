@@ -92,6 +92,15 @@ BODY = Record(
             Option("joint", "str", "a coordinate or family name"),
             min_len=2,
             max_len=2,
+            default=None,
+        ),
+        Option(
+            "at",
+            "str",
+            "instead of between: a passive joint (coordinate or family name) whose hinge this beam is, centred there "
+            "along the link (a notch profile's 2r long, else length): it replaces the hinge's six-axis spring and the "
+            "joint's own rotation",
+            default=None,
         ),
         Record("section", _SECTION_TEXT, _section_fields(), what="section key", sparse=True, convert=_section),
         Option("beam", "choice", "the beam theory", default="timoshenko", choices=THEORIES),
@@ -141,9 +150,11 @@ def _specs(value: Mapping[str, Any], path: tuple) -> dict[str, BodySpec | None]:
 class BodySpec:
     """One body as parsed by `BODIES` (SI)."""
 
-    between: tuple[str, str]
+    between: tuple[str, str] | None
     beam: BeamSpec
     material: Material | None
+    #: the joint whose hinge the beam is (instead of ``between``)
+    at: str | None = None
 
 
 def body_spec(name: str, value: Mapping[str, Any], path: tuple) -> BodySpec:
@@ -157,7 +168,15 @@ def body_spec(name: str, value: Mapping[str, Any], path: tuple) -> BodySpec:
         )
     beam = BeamSpec(name, value["section"], value["beam"], int(value["elements"]), models, value["length"])
     mat = None if value.get("material") is None else material(value["material"], path + ("material",))
-    return BodySpec(tuple(value["between"]), beam, mat)
+    if (value.get("between") is None) == (value.get("at") is None):
+        raise InputError("give either between (a link's two joints) or at (a joint's hinge)", path=path)
+    if value.get("at") is not None and value["section"].length is None and value["length"] is None:
+        raise InputError(
+            "a hinge as a beam (at) needs its length: give length, or a notch profile (2r long)",
+            path=path + ("length",),
+        )
+    between = None if value.get("between") is None else tuple(value["between"])
+    return BodySpec(between, beam, mat, value.get("at"))
 
 
 def parse_bodies(raw: Any, path: tuple) -> dict[str, BodySpec | None]:
@@ -179,6 +198,8 @@ class Body:
     members: tuple[tuple[str, str], ...]
     material: Material
     path: tuple
+    #: a hinge's beam, centred at the first joint of each member (the second is "")
+    centred: bool = False
 
 
 def _members(closure: LoopClosure, name: str, path: tuple) -> list[str]:
@@ -205,6 +226,11 @@ def bodies_of(
     out = []
     for name, spec in specs.items():
         path = paths[name]
+        if spec.at is not None:
+            first = _members(closure, spec.at, path + ("at",))
+            m = _material(spec, mat, name, path)
+            out.append(Body(name, spec.beam, tuple((f, "") for f in first), m, path, True))
+            continue
         first = _members(closure, spec.between[0], path + ("between", 0))
         second = (
             [PLATFORM] * len(first)
@@ -217,13 +243,18 @@ def bodies_of(
                 "as many members (one per leg)",
                 path=path + ("between",),
             )
-        m = spec.material or mat
-        if m is None:
-            raise InputError(f"body {name}: its stiffness needs a material", path=path + ("material",))
-        m.require("E", path + ("material",), "a flexible body")
-        m.require("nu", path + ("material",), "a flexible body's shear and torsion")
+        m = _material(spec, mat, name, path)
         out.append(Body(name, spec.beam, tuple(zip(first, second, strict=True)), m, path))
     return out
+
+
+def _material(spec: BodySpec, mat: Material | None, name: str, path: tuple) -> Material:
+    m = spec.material or mat
+    if m is None:
+        raise InputError(f"body {name}: its stiffness needs a material", path=path + ("material",))
+    m.require("E", path + ("material",), "a flexible body")
+    m.require("nu", path + ("material",), "a flexible body's shear and torsion")
+    return m
 
 
 def merged_bodies(

@@ -142,6 +142,9 @@ class SixAxisModel:
         rest: list[float] = list(model.x_home) + list(model.q_home)
         self._dof: dict[str, tuple[int, float, int, int, int]] = {}  # coordinate -> (z, rest, leg, joint, dof)
         self._z: list[Any] = [ca.SX.sym(n) for n in self.names]
+        self._where = _joint_places(chains)
+        #: (leg, joint) -> the body whose beam is that joint's hinge (`Body.centred`)
+        self.hinge_beams = _hinge_beams(hs, self._where, chains, set(c.x_names))
         legs = [self._leg_motions(li, x_index, q_index, rest) for li in range(len(chains.legs))]
         self.frames = self._hinge_frames(hs, c, x_index, q_index, chains)
         # the extra axes of each hinge: new variables, placed after their joint's own motions
@@ -183,7 +186,8 @@ class SixAxisModel:
                     self._dof[cname] = (xi, ch.x_reference[xi], li, ji, d)
                 else:
                     zi = self._new(cname or f"{leg.name}_j{ji + 1}_{d + 1}", rest)
-                    value = self._z[zi]
+                    # a hinge modelled as a beam: the beam's elements carry the joint's motion
+                    value = 0 if (li, ji) in self.hinge_beams else self._z[zi]
                     if cname:
                         self._dof[cname] = (zi, 0.0, li, ji, d)
                 motions.append((kind, j.axes[:, d], value))
@@ -282,7 +286,7 @@ class SixAxisModel:
                 fr.centre = joint.at
                 frame = _frame(known, joint.link)
                 dirs = {**frame, "axial": frame["torsion"], "shear": frame["bend2"], "shear2": frame["bend"]}
-                fr.extra = tuple(a for a in SIX_AXES if a not in fr.variables)
+                fr.extra = () if loc in self.hinge_beams else tuple(a for a in SIX_AXES if a not in fr.variables)
                 for a in fr.extra:
                     fr.axes[a] = ("R" if a in _ROT_AXES else "P", dirs[a])
                     fr.k[a] = six[a]
@@ -295,19 +299,23 @@ class SixAxisModel:
         """Each flexible body's beam elements on each leg, their deformation variables, and their
         motions after the body's first joint (`cpm_nlp.analysis.beams`): [(body, leg, [(element,
         z indices)])]."""
-        where: dict[str, tuple[int, int]] = {}
-        for li, leg in enumerate(chains.legs):
-            for ji, j in enumerate(leg.joints):
-                for cname in (*j.coordinates, j.actuated):
-                    if cname:
-                        where[cname] = (li, ji)
+        where = self._where
         out = []
+        self._beam_joints: list[tuple[int, int]] = []
         for body in hs.bodies:
             for m, (first, second) in enumerate(body.members):
-                li, ja, jb = _body_ends(body, m, first, second, where, chains)
-                leg = chains.legs[li]
-                start = leg.joints[ja].at
-                end = leg.tip if jb == len(leg.joints) else leg.joints[jb].at
+                if body.centred:
+                    li, ja = where[first]
+                    leg = chains.legs[li]
+                    joint = leg.joints[ja]
+                    t = joint.link if joint.link is not None else _perpendicular(joint.axes[:, 0])
+                    half = 0.5 * float(body.beam.section.length or body.beam.length)
+                    start, end, jb = joint.at - half * t, joint.at + half * t, ja
+                else:
+                    li, ja, jb = _body_ends(body, m, first, second, where, chains)
+                    leg = chains.legs[li]
+                    start = leg.joints[ja].at
+                    end = leg.tip if jb == len(leg.joints) else leg.joints[jb].at
                 bend = (
                     _first_rotation(leg.joints[ja])
                     if _first_rotation(leg.joints[ja]) is not None
@@ -320,16 +328,23 @@ class SixAxisModel:
                     extra.setdefault((li, ja), []).extend(element_motions(el, [self._z[i] for i in idx]))
                     elements.append((el, idx))
                 out.append((body, li, elements))
+                self._beam_joints.append((ja, m))
         return out
 
     def body_stresses(self, z: np.ndarray) -> dict[str, float]:
         """The largest nominal stress of each flexible body (over its legs and elements)."""
         out: dict[str, float] = {}
-        for body, _, elements in self.beams:
-            for el, idx in elements:
-                worst = max(element_wrenches(el, np.asarray(z)[idx], body.beam.section))
+        for (body, _, _), worst in zip(self.beams, self._beam_stresses(z), strict=True):
+            if not body.centred:
                 out[body.name] = max(out.get(body.name, 0.0), worst)
         return out
+
+    def _beam_stresses(self, z: np.ndarray) -> list[float]:
+        """The largest nominal stress of each beam of `beams` (a body on one leg)."""
+        return [
+            max(max(element_wrenches(el, np.asarray(z)[idx], body.beam.section)) for el, idx in elements)
+            for body, _, elements in self.beams
+        ]
 
     @property
     def six_axis_hinges(self) -> list[str]:
@@ -476,7 +491,12 @@ class SixAxisModel:
     def stresses(self, z: np.ndarray) -> dict[str, float | None]:
         """Largest stress of each hinge from its moments (all three rotations) and axial force."""
         out: dict[str, float | None] = {}
+        beams = zip(self.beams, self._beam_stresses(z), self._beam_joints, strict=True)
+        beam_stress = {(li, ja): worst for (body, li, _), worst, (ja, _) in beams if body.centred}
         for fr in self.frames:
+            if fr.loc in self.hinge_beams:  # a hinge modelled as a beam: the beam's largest stress
+                out[fr.name] = beam_stress[fr.loc]
+                continue
             if fr.kind is None:
                 out[fr.name] = None
                 continue
@@ -502,6 +522,42 @@ class SixAxisModel:
         K[:n, n:] = A[:, free].T
         K[n:, :n] = A[:, free]
         return K
+
+
+def _joint_places(chains: Chains) -> dict[str, tuple[int, int]]:
+    """Every coordinate and actuator of the chains -> (leg, joint)."""
+    where: dict[str, tuple[int, int]] = {}
+    for li, leg in enumerate(chains.legs):
+        for ji, j in enumerate(leg.joints):
+            for cname in (*j.coordinates, j.actuated):
+                if cname:
+                    where[cname] = (li, ji)
+    return where
+
+
+def _hinge_beams(hs: HingeSet, where: dict, chains: Chains, pose: set[str]) -> dict[tuple[int, int], Body]:
+    """(leg, joint) -> the body modelling that joint's hinge as a beam (``at``): a passive joint."""
+    out: dict[tuple[int, int], Body] = {}
+    for body in hs.bodies:
+        if not body.centred:
+            continue
+        for first, _ in body.members:
+            if first not in where:
+                raise InputError(
+                    f"body {body.name}: joint {first} is not in the legs' chains, so the body cannot be placed",
+                    path=body.path + ("at",),
+                )
+            li, ji = where[first]
+            joint = chains.legs[li].joints[ji]
+            if joint.actuated is not None or any(c in pose for c in joint.coordinates):
+                raise InputError(
+                    f"body {body.name}: {first} is an actuated or pose joint; a hinge beam sits at a passive joint",
+                    path=body.path + ("at",),
+                )
+            if (li, ji) in out:
+                raise InputError(f"joint {first} carries two hinge beams", path=body.path + ("at",))
+            out[(li, ji)] = body
+    return out
 
 
 def _first_rotation(joint: Any) -> np.ndarray | None:

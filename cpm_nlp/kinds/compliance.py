@@ -286,7 +286,7 @@ class ActuatorForces(_HingeKind):
             flex = [None if sp is None else sp.x for sp in points]
             flexed = [_Flexed(s, s.x if x is None else x) for s, x in zip(sols, flex)]
             out = Values(_pose_outputs(model), _pose_values(model, flexed, batch))
-            bodies = [None if g is None else max(g[1].values()) for g in got]
+            bodies = [None if g is None else max(g[1].values(), default=None) for g in got]
             out.add(Output("stress_bodies_max", "stress"), per_point(bodies))
             message += "; flexible bodies " + ", ".join(b.name for b in hs.bodies) + " (six-axis hinges, beams)"
         for j, q in enumerate(c.q):
