@@ -239,6 +239,8 @@ class SixAxisHinges(HingeModel):
         out.add(Output("stress_max_unloaded", "stress"), largest(sm.stresses(z_u)))
         out.add(Output("stress_peak_max_unloaded", "stress"), largest(sm.hs.peaks(sm.stresses(z_u))))
         note = f"six-axis hinges: {', '.join(sm.six_axis_hinges) or 'none'}; {sm.chains.note}"
+        if hs.bodies:  # the chains' note speaks of rigid links: say which are not
+            note += "; except the flexible bodies (beams): " + ", ".join(b.name for b in hs.bodies)
         if not np.any(f):
             info = SolverInfo("newton-kkt", pose.iterations + it_u, pose.seconds)
             msg = f"no load: the output compliance only ({note})"
