@@ -83,7 +83,7 @@ def _stiffness_models(value: Any, path: tuple) -> tuple[str, ...]:
 
 BODY = Record(
     "<body>",
-    "one flexible body: a beam between two joints of each leg",
+    "one flexible body: a beam between two neighbouring joints of each leg, or a joint's hinge as a beam",
     (
         ListOf(
             "between",

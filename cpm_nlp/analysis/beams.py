@@ -137,7 +137,7 @@ class Section:
             out["kappa"] = v["kappa"]
         return out
 
-    def stress(self, x: Any, wrench: np.ndarray) -> float:
+    def stress(self, x: Any, wrench: np.ndarray) -> float | None:
         """Largest nominal stress of the section at x under the section wrench (N_x, V_y, V_z,
         T, M_y, M_z): σ = |N|/A + |M_y| c_y/I_y + |M_z| c_z/I_z, τ from torsion, von Mises
         (a rectangle's corner, a round's resultant moment)."""
@@ -149,7 +149,7 @@ class Section:
             sigma = abs(N) / p["A"] + math.hypot(My, Mz) * d / 2.0 / p["I_y"]
             tau = abs(T) * d / 2.0 / p["J"]
         elif k == "given":
-            return float("nan")
+            return None  # no dimensions: no stress
         else:
             b, h = (v["b"], v["h"]) if k == "rectangle" else (v["w"], self.thickness(x))
             b, h = float(b), float(h)
@@ -316,9 +316,10 @@ def product(motions: Sequence[tuple[str, np.ndarray, Any, np.ndarray]]) -> tuple
     return Rm, tm
 
 
-def element_wrenches(el: Element, eps: np.ndarray, sec: Section) -> list[float]:
-    """The largest nominal stress at the element's two ends, from the wrench K ε at its
-    spring point (the element's axes; the force carried to each end)."""
+def element_wrenches(el: Element, eps: np.ndarray, sec: Section) -> list[float | None]:
+    """The nominal stress at the element's two ends (None for a given section, which has no
+    dimensions), from the wrench K ε at its spring point (the element's axes; the force
+    carried to each end)."""
     full = np.zeros(6)
     full[list(el.dofs)] = el.K @ np.asarray(eps, dtype=float)
     F, M = full[:3], full[3:]

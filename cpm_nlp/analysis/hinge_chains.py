@@ -332,19 +332,22 @@ class SixAxisModel:
         return out
 
     def body_stresses(self, z: np.ndarray) -> dict[str, float]:
-        """The largest nominal stress of each flexible body (over its legs and elements)."""
+        """The largest nominal stress of each flexible body (over its legs and elements; a given
+        section has none)."""
         out: dict[str, float] = {}
         for (body, _, _), worst in zip(self.beams, self._beam_stresses(z), strict=True):
-            if not body.centred:
+            if not body.centred and worst is not None:
                 out[body.name] = max(out.get(body.name, 0.0), worst)
         return out
 
-    def _beam_stresses(self, z: np.ndarray) -> list[float]:
-        """The largest nominal stress of each beam of `beams` (a body on one leg)."""
-        return [
-            max(max(element_wrenches(el, np.asarray(z)[idx], body.beam.section)) for el, idx in elements)
-            for body, _, elements in self.beams
-        ]
+    def _beam_stresses(self, z: np.ndarray) -> list[float | None]:
+        """The largest nominal stress of each beam of `beams` (a body on one leg; None for a given
+        section)."""
+        out = []
+        for body, _, elements in self.beams:
+            vals = [v for el, idx in elements for v in element_wrenches(el, np.asarray(z)[idx], body.beam.section)]
+            out.append(None if any(v is None for v in vals) else max(vals))
+        return out
 
     @property
     def six_axis_hinges(self) -> list[str]:
