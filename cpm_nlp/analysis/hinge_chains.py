@@ -143,6 +143,7 @@ class SixAxisModel:
         self._dof: dict[str, tuple[int, float, int, int, int]] = {}  # coordinate -> (z, rest, leg, joint, dof)
         self._z: list[Any] = [ca.SX.sym(n) for n in self.names]
         self._where = _joint_places(chains)
+        self._pinned: list[int] = []
         #: (leg, joint) -> the body whose beam is that joint's hinge (`Body.centred`)
         self.hinge_beams = _hinge_beams(hs, self._where, chains, set(c.x_names))
         legs = [self._leg_motions(li, x_index, q_index, rest) for li in range(len(chains.legs))]
@@ -186,8 +187,12 @@ class SixAxisModel:
                     self._dof[cname] = (xi, ch.x_reference[xi], li, ji, d)
                 else:
                     zi = self._new(cname or f"{leg.name}_j{ji + 1}_{d + 1}", rest)
-                    # a hinge modelled as a beam: the beam's elements carry the joint's motion
-                    value = 0 if (li, ji) in self.hinge_beams else self._z[zi]
+                    # a hinge modelled as a beam: the beam's elements carry the joint's motion, and the
+                    # joint's own variable, out of the chain, is pinned at zero (`_functions`)
+                    value = self._z[zi]
+                    if (li, ji) in self.hinge_beams:
+                        value = 0
+                        self._pinned.append(zi)
                     if cname:
                         self._dof[cname] = (zi, 0.0, li, ji, d)
                 motions.append((kind, j.axes[:, d], value))
@@ -230,6 +235,8 @@ class SixAxisModel:
             for el, idx in elements:
                 e = ca.vertcat(*[z[i] for i in idx])
                 U += 0.5 * ca.dot(e, ca.mtimes(ca.DM(el.K), e))
+        for zi in self._pinned:  # out of the chain: a unit spring keeps the KKT matrix regular, at zero
+            U += 0.5 * z[zi] ** 2
         f = ca.SX.sym("f", self.nx)
         qc, ka, Fc = ca.SX.sym("qc", self.nq), ca.SX.sym("ka", self.nq), ca.SX.sym("Fc", self.nq)
         dq = z[self.nx : self.nx + self.nq] - qc
@@ -321,6 +328,14 @@ class SixAxisModel:
                     if _first_rotation(leg.joints[ja]) is not None
                     else (_first_rotation(leg.joints[jb]) if jb < len(leg.joints) else None)
                 )
+                span = float(np.linalg.norm(np.asarray(end) - np.asarray(start)))
+                ell = body.beam.section.length if body.beam.section.length is not None else body.beam.length
+                if ell is not None and float(ell) > span * (1 + 1e-12):
+                    raise InputError(
+                        f"body {body.name}: a flexible length of {float(ell) * 1e3:g} mm does not fit the "
+                        f"{span * 1e3:g} mm between its joints",
+                        path=body.path + ("section" if body.beam.section.length is not None else "length",),
+                    )
                 mat = body.material
                 elements = []
                 for k, el in enumerate(beam_elements(body.beam, start, end, bend, mat.E, mat.nu, mat.density)):

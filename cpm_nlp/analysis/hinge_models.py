@@ -289,7 +289,10 @@ def six_axis_point(
     (flexible bodies included) at the actuators q, starting from the rigid pose x: the
     equilibrium by Newton on the KKT conditions, None when it does not converge; and the
     largest stress of each flexible body."""
-    ok, z, lam, _ = sm.newton(sm.start(x, q), f, q, None, None)
+    try:
+        ok, z, lam, _ = sm.newton(sm.start(x, q), f, q, None, None)
+    except np.linalg.LinAlgError:  # a motion without stiffness: no equilibrium to report
+        return None
     if not ok:
         return None
     theta = sm.joint_vector(z, cm.joint_vector(model, z[: model.closure.nx], q))
