@@ -351,7 +351,7 @@ class SixAxisModel:
         section has none)."""
         out: dict[str, float] = {}
         for (body, _, _), worst in zip(self.beams, self._beam_stresses(z), strict=True):
-            if not body.centred and worst is not None:
+            if worst is not None:
                 out[body.name] = max(out.get(body.name, 0.0), worst)
         return out
 
