@@ -328,3 +328,20 @@ def test_bad_hinge_beams(body, needle):
     m = build_model("prs3", PRS3)
     with pytest.raises(cm.InputError, match=needle):
         six_axis_model(m, cm.hinge_set(m, None, bodies={"notch": body}))
+
+
+def test_small_loads_follow_the_linearization_with_flexible_legs(prs3):
+    """The loaded pose by IPOPT (minimum potential energy, the legs' beams geometrically
+    nonlinear) under 1 N in x, y, z follows C f; Newton and IPOPT agree on the unloaded pose."""
+    m, hs, sm = prs3
+    ok, z_u, lam_u, _ = sm.newton(sm.start(m.x_home, m.q_home), np.zeros(6), m.q_home, None, None)
+    assert ok
+    ok_i, z_i, *_ = sm.ipopt(sm.start(m.x_home, m.q_home), np.zeros(6), m.q_home, None, None)
+    assert ok_i
+    np.testing.assert_allclose(z_i[:6], z_u[:6], atol=1e-12)
+    C = sm.compliance(z_u, lam_u, None, None)
+    f = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+    ok, z, *_ = sm.ipopt(z_u, f, m.q_home, None, None)
+    assert ok
+    d = z[:6] - z_u[:6]
+    np.testing.assert_allclose(d, C @ f, rtol=2e-3, atol=2e-3 * np.max(np.abs(C @ f)))
