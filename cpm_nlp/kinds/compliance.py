@@ -287,7 +287,7 @@ class ActuatorForces(_HingeKind):
             flexed = [_Flexed(s, s.x if x is None else x) for s, x in zip(sols, flex)]
             out = Values(_pose_outputs(model), _pose_values(model, flexed, batch))
             bodies = [None if g is None else max(g[1].values(), default=None) for g in got]
-            out.add(Output("stress_bodies_max", "stress"), per_point(bodies))
+            out.add(Output("beam_stress_max", "stress"), per_point(bodies))
             message += "; flexible bodies " + ", ".join(b.name for b in hs.bodies) + " (six-axis hinges, beams)"
         for j, q in enumerate(c.q):
             out.add(force_output(f"F{j + 1}", q), per_point([None if sp is None else float(sp.F[j]) for sp in points]))
