@@ -253,6 +253,8 @@ def test_a_mechanism_file_declares_flexible_bodies(tmp_path):
     prob.write_text(
         f"problem: platform_compliance\nmechanism: {{file: {mech}, parameters: {{b: 47.91 mm, L: 109.215 mm}}}}\n"
     )
+    described = subprocess.run([sys.executable, "-m", "cpm_nlp", "describe", str(mech)], capture_output=True, text=True)
+    assert "leg        flexible body: between: ['alpha', 'beta_m']" in described.stdout, described.stderr
     cmd = [sys.executable, "-m", "cpm_nlp", "solve", str(prob), "--json"]
     out = subprocess.run(cmd, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
