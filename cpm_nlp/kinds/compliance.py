@@ -205,6 +205,10 @@ def _hinge_result(
     )
 
 
+#: the largest nominal stress in the flexible bodies' beams
+BEAM_STRESS = Output("beam_stress_max", "stress", when="bodies")
+
+
 class ActuatorForces(_HingeKind):
     name = "actuator_forces"
     description = (
@@ -232,6 +236,15 @@ class ActuatorForces(_HingeKind):
             ),
             Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
             Option(
+                "hinge_axes",
+                "choice",
+                "the hinge model: 'kinematic' (the pseudo-rigid-body energy method on the kinematics) or 'all' (every "
+                "hinge a six-axis spring on the legs' chains, the equilibrium at each input); default: kinematic, or "
+                "all with flexible bodies",
+                default=None,
+                choices=tuple(HINGE_MODELS),
+            ),
+            Option(
                 "stress_check",
                 "choice",
                 "the stress the stress limit checks: nominal (at the thinnest section, as the papers do) or peak "
@@ -257,7 +270,12 @@ class ActuatorForces(_HingeKind):
         """The hinges, and with flexible bodies the six-axis model that carries them."""
         super().resolve(inputs, model, path)
         hs = inputs["hinge_set"]
-        inputs["six_axis"] = HINGE_MODELS["all"].prepare(model, hs, path + ("bodies",), True) if hs.bodies else None
+        chosen = inputs.get("hinge_axes")
+        if chosen is None:  # the energy method on the kinematics, unless flexible bodies need the six-axis model
+            chosen = "all" if hs.bodies else "kinematic"
+        at = path + ("hinge_axes" if inputs.get("hinge_axes") is not None else "bodies",)
+        prepared = HINGE_MODELS[chosen].prepare(model, hs, at, True)
+        inputs["six_axis"] = prepared if chosen == "all" else None
 
     @staticmethod
     def _point(model: Model, inputs: Mapping[str, Any], sol: PoseSolution) -> tuple[Any, dict] | None:
@@ -286,9 +304,11 @@ class ActuatorForces(_HingeKind):
             flex = [None if sp is None else sp.x for sp in points]
             flexed = [_Flexed(s, s.x if x is None else x) for s, x in zip(sols, flex)]
             out = Values(_pose_outputs(model), _pose_values(model, flexed, batch))
-            bodies = [None if g is None else max(g[1].values(), default=None) for g in got]
-            out.add(Output("beam_stress_max", "stress"), per_point(bodies))
-            message += "; flexible bodies " + ", ".join(b.name for b in hs.bodies) + " (six-axis hinges, beams)"
+            if hs.bodies:
+                beam_stress = [None if g is None else max(g[1].values(), default=None) for g in got]
+                out.add(BEAM_STRESS, per_point(beam_stress))
+            names = ", ".join(b.name for b in hs.bodies)
+            message += "; six-axis hinges" + (f", flexible bodies {names} (beams)" if names else "")
         for j, q in enumerate(c.q):
             out.add(force_output(f"F{j + 1}", q), per_point([None if sp is None else float(sp.F[j]) for sp in points]))
         out.extend(stress_values(hs, points, batch))
@@ -395,6 +415,7 @@ class ActuatorForces(_HingeKind):
             *formula,
             *K_FORMULA.values(),
             *_limit_outputs(model),
+            BEAM_STRESS,
         ]
 
 
