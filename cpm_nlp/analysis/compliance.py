@@ -59,6 +59,7 @@ from ..core.mechanism import MechanismDeclarationError, Part
 from ..core.model import LoopClosure, Model
 from ..core.options import Option, validate_mapping
 from ..core.schema import Either, MappingOf, Quantity, Record
+from .beam_inputs import Body, bodies_of, merged_bodies, parse_bodies
 from .flexure import Material, material, material_node
 from .hinge_types import DIM_OPTIONS, HINGE_TABLE, HingeType
 
@@ -220,10 +221,14 @@ class JointStiffness(Part):
     hinges: Mapping[str, Mapping[str, Any]]
     material: Any = None
     source: str = ""
+    #: flexible bodies by name, as a problem file's ``inputs.bodies`` (`cpm_nlp.analysis.beam_inputs`)
+    bodies: Mapping[str, Mapping[str, Any]] | None = None
     #: hinge name -> its record (`HingeSpec`), parsed once from ``hinges``
     records: Mapping[str, HingeSpec] = field(init=False, repr=False, compare=False)
     #: the material, parsed once (None when not given)
     parsed_material: Material | None = field(init=False, repr=False, compare=False)
+    #: body name -> its record, parsed once from ``bodies``
+    body_records: Mapping[str, Any] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.hinges, Mapping) or not all(
@@ -237,6 +242,7 @@ class JointStiffness(Part):
         object.__setattr__(self, "records", records)
         mat = None if self.material is None else material(self.material, ("stiffness", "material"))
         object.__setattr__(self, "parsed_material", mat)
+        object.__setattr__(self, "body_records", parse_bodies(self.bodies, ("stiffness", "bodies")))
 
 
 def check_geometry(kind: str, d: Mapping[str, float], path: tuple) -> None:
@@ -308,6 +314,8 @@ class HingeSet:
     #: material name -> (key path, message prefix) where it was given, for a message
     #: about it (the prefix names a mechanism file that declares it)
     material_at: dict[str, tuple[tuple, str]] = field(default_factory=dict)
+    #: the flexible bodies (`cpm_nlp.analysis.beam_inputs.Body`): beams in the six-axis model
+    bodies: list[Body] = field(default_factory=list)
 
     def moments(self, theta: np.ndarray) -> np.ndarray:
         return self.k * (np.asarray(theta, dtype=float) - self.theta0)
@@ -475,7 +483,9 @@ def parse_hinges(
     return k, out
 
 
-def check_declared(closure: LoopClosure, hinges: Mapping[str, Any], material_spec: Any, path: tuple) -> None:
+def check_declared(
+    closure: LoopClosure, hinges: Mapping[str, Any], material_spec: Any, path: tuple, bodies: Any = None
+) -> None:
     """Check a mechanism's declared hinges and material (its part ``stiffness``)
     against its closure, by the rules of a problem file's ``inputs.hinges``: joints
     that name coordinates or families, known hinge types and keys, possible geometry,
@@ -483,6 +493,8 @@ def check_declared(closure: LoopClosure, hinges: Mapping[str, Any], material_spe
     mat = None if material_spec is None else material(material_spec, path + ("material",))
     parsed = {g: HingeSpec.parsed(v) for g, v in HINGES.parse(hinges, path + ("hinges",)).items()}
     parse_hinges(closure, parsed, mat, {g: path + ("hinges", g) for g in parsed})
+    specs = {n: b for n, b in parse_bodies(bodies, path + ("bodies",)).items() if b is not None}
+    bodies_of(closure, specs, mat, {n: path + ("bodies", n) for n in specs})
 
 
 def hinge_set(
@@ -491,6 +503,7 @@ def hinge_set(
     material_spec: Any = None,
     sigma_allow: float | None = None,
     path: tuple = ("inputs",),
+    bodies: Any = None,
 ) -> HingeSet:
     """The hinges of a model: the mechanism's declared defaults (its part ``stiffness``,
     parsed when it was declared) merged, hinge by hinge and key by key, with ``hinges`` from
@@ -524,6 +537,7 @@ def hinge_set(
     theta0 = joint_vector(model, model.x_home, model.q_home)
     hs = HingeSet(names, [co.kind for co in coords], k, theta0, out, sigma_allow, [decl.source] if decl else [])
     hs.material_at = _material_at(mech, out, merged, given, material_spec, path)
+    hs.bodies = merged_bodies(c, decl.body_records if decl else {}, bodies, mat, path)
     return hs
 
 

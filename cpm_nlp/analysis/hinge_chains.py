@@ -33,8 +33,10 @@ reduces to the pseudo-rigid-body C = J (K_q + K_a)⁻¹ Jᵀ (tested), and at an
 unstressed pose to the compliance-matrix method Σ_legs (Σ_h Ad C_h Adᵀ)⁻¹
 (tested against an independent numpy derivation).
 
-The links and the platform stay rigid: a slender leg's own bending is not in
-the model (declare it as a hinge of its own to include it).
+A link may be flexible (``bodies``: `cpm_nlp.analysis.beam_inputs`): a beam of
+n elements between two neighbouring joints of a leg, each element six more
+variables ε after the first joint's motions and the energy ½ εᵀ K_e ε
+(`cpm_nlp.analysis.beams`, geometrically nonlinear).  The platform stays rigid.
 """
 
 from __future__ import annotations
@@ -55,6 +57,8 @@ from ..core.errors import InputError
 from ..core.fast_calls import FastFunction
 from ..core.model import Model
 from ..core.screws import axis_rotation, vee
+from .beam_inputs import PLATFORM, Body
+from .beams import DEFORMATIONS, beam_elements, element_motions, element_wrenches
 from .compliance import HINGE_TYPES, HingeSet, six_axis_stiffness
 from .hinge_types import SIX_AXES
 
@@ -138,6 +142,10 @@ class SixAxisModel:
         rest: list[float] = list(model.x_home) + list(model.q_home)
         self._dof: dict[str, tuple[int, float, int, int, int]] = {}  # coordinate -> (z, rest, leg, joint, dof)
         self._z: list[Any] = [ca.SX.sym(n) for n in self.names]
+        self._where = _joint_places(chains)
+        self._pinned: list[int] = []
+        #: (leg, joint) -> the body whose beam is that joint's hinge (`Body.centred`)
+        self.hinge_beams = _hinge_beams(hs, self._where, chains, set(c.x_names))
         legs = [self._leg_motions(li, x_index, q_index, rest) for li in range(len(chains.legs))]
         self.frames = self._hinge_frames(hs, c, x_index, q_index, chains)
         # the extra axes of each hinge: new variables, placed after their joint's own motions
@@ -147,6 +155,7 @@ class SixAxisModel:
                 fr.variables[a] = (self._new(f"{fr.name}_{a}", rest), 0.0)
                 kind, u = fr.axes[a]
                 extra.setdefault(fr.loc, []).append((kind, u, self._z[-1]))
+        self.beams = self._beam_elements(hs, chains, rest, extra)
         self.rest = np.array(rest)
         self.nz = len(self._z)
         z = ca.vertcat(*self._z)
@@ -178,7 +187,12 @@ class SixAxisModel:
                     self._dof[cname] = (xi, ch.x_reference[xi], li, ji, d)
                 else:
                     zi = self._new(cname or f"{leg.name}_j{ji + 1}_{d + 1}", rest)
+                    # a hinge modelled as a beam: the beam's elements carry the joint's motion, and the
+                    # joint's own variable, out of the chain, is pinned at zero (`_functions`)
                     value = self._z[zi]
+                    if (li, ji) in self.hinge_beams:
+                        value = 0
+                        self._pinned.append(zi)
                     if cname:
                         self._dof[cname] = (zi, 0.0, li, ji, d)
                 motions.append((kind, j.axes[:, d], value))
@@ -196,12 +210,13 @@ class SixAxisModel:
         for li, rows in enumerate(legs):
             Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
             for ji, (j, motions) in enumerate(rows):
-                for kind, axis, value in motions + extra.get((li, ji), []):
+                for kind, axis, value, *point in motions + extra.get((li, ji), []):
+                    at = ca.DM(point[0] if point else j.at)  # a beam element turns about its spring point
                     if kind == "P":
                         Rk, tk = ca.SX.eye(3), value * ca.DM(axis)
                     else:
                         Rk = _rot(axis, value)
-                        tk = ca.DM(j.at) - Rk @ ca.DM(j.at)
+                        tk = at - Rk @ at
                     Rm, tm = Rm @ Rk, Rm @ tk + tm
             tip = ca.DM(ch.legs[li].tip)
             g.append(Rm @ tip + tm - (DR @ (tip - P0) + P))  # the leg's platform point
@@ -216,6 +231,12 @@ class SixAxisModel:
         for fr in self.frames:
             for a, (zi, r0) in fr.variables.items():
                 U += 0.5 * fr.k[a] * (z[zi] - r0) ** 2
+        for _, _, elements in self.beams:
+            for el, idx in elements:
+                e = ca.vertcat(*[z[i] for i in idx])
+                U += 0.5 * ca.dot(e, ca.mtimes(ca.DM(el.K), e))
+        for zi in self._pinned:  # out of the chain: a unit spring keeps the KKT matrix regular, at zero
+            U += 0.5 * z[zi] ** 2
         f = ca.SX.sym("f", self.nx)
         qc, ka, Fc = ca.SX.sym("qc", self.nq), ca.SX.sym("ka", self.nq), ca.SX.sym("Fc", self.nq)
         dq = z[self.nx : self.nx + self.nq] - qc
@@ -272,13 +293,76 @@ class SixAxisModel:
                 fr.centre = joint.at
                 frame = _frame(known, joint.link)
                 dirs = {**frame, "axial": frame["torsion"], "shear": frame["bend2"], "shear2": frame["bend"]}
-                fr.extra = tuple(a for a in SIX_AXES if a not in fr.variables)
+                fr.extra = () if loc in self.hinge_beams else tuple(a for a in SIX_AXES if a not in fr.variables)
                 for a in fr.extra:
                     fr.axes[a] = ("R" if a in _ROT_AXES else "P", dirs[a])
                     fr.k[a] = six[a]
             fr.loc = loc
             frames.append(fr)
         return frames
+
+    # -- the flexible bodies in the chains --------------------------------------------------------
+    def _beam_elements(self, hs: HingeSet, chains: Chains, rest: list[float], extra: dict) -> list:
+        """Each flexible body's beam elements on each leg, their deformation variables, and their
+        motions after the body's first joint (`cpm_nlp.analysis.beams`): [(body, leg, [(element,
+        z indices)])]."""
+        where = self._where
+        out = []
+        self._beam_joints: list[tuple[int, int]] = []
+        for body in hs.bodies:
+            for m, (first, second) in enumerate(body.members):
+                if body.centred:
+                    li, ja = where[first]
+                    leg = chains.legs[li]
+                    joint = leg.joints[ja]
+                    t = joint.link if joint.link is not None else _perpendicular(joint.axes[:, 0])
+                    half = 0.5 * float(body.beam.section.length or body.beam.length)
+                    start, end, jb = joint.at - half * t, joint.at + half * t, ja
+                else:
+                    li, ja, jb = _body_ends(body, m, first, second, where, chains)
+                    leg = chains.legs[li]
+                    start = leg.joints[ja].at
+                    end = leg.tip if jb == len(leg.joints) else leg.joints[jb].at
+                bend = (
+                    _first_rotation(leg.joints[ja])
+                    if _first_rotation(leg.joints[ja]) is not None
+                    else (_first_rotation(leg.joints[jb]) if jb < len(leg.joints) else None)
+                )
+                span = float(np.linalg.norm(np.asarray(end) - np.asarray(start)))
+                ell = body.beam.section.length if body.beam.section.length is not None else body.beam.length
+                if ell is not None and float(ell) > span * (1 + 1e-12):
+                    raise InputError(
+                        f"body {body.name}: a flexible length of {float(ell) * 1e3:g} mm does not fit the "
+                        f"{span * 1e3:g} mm between its joints",
+                        path=body.path + ("section" if body.beam.section.length is not None else "length",),
+                    )
+                mat = body.material
+                elements = []
+                for k, el in enumerate(beam_elements(body.beam, start, end, bend, mat.E, mat.nu, mat.density)):
+                    idx = [self._new(f"{body.name}{m + 1}_e{k + 1}_{DEFORMATIONS[d]}", rest) for d in el.dofs]
+                    extra.setdefault((li, ja), []).extend(element_motions(el, [self._z[i] for i in idx]))
+                    elements.append((el, idx))
+                out.append((body, li, elements))
+                self._beam_joints.append((ja, m))
+        return out
+
+    def body_stresses(self, z: np.ndarray) -> dict[str, float]:
+        """The largest nominal stress of each flexible body (over its legs and elements; a given
+        section has none)."""
+        out: dict[str, float] = {}
+        for (body, _, _), worst in zip(self.beams, self._beam_stresses(z), strict=True):
+            if worst is not None:
+                out[body.name] = max(out.get(body.name, 0.0), worst)
+        return out
+
+    def _beam_stresses(self, z: np.ndarray) -> list[float | None]:
+        """The largest nominal stress of each beam of `beams` (a body on one leg; None for a given
+        section)."""
+        out = []
+        for body, _, elements in self.beams:
+            vals = [v for el, idx in elements for v in element_wrenches(el, np.asarray(z)[idx], body.beam.section)]
+            out.append(None if any(v is None for v in vals) else max(vals))
+        return out
 
     @property
     def six_axis_hinges(self) -> list[str]:
@@ -391,10 +475,46 @@ class SixAxisModel:
         gl = np.asarray(self.kkt(z, lam, par)[0], dtype=float).ravel()
         return gl[self.nx : self.nx + self.nq]
 
+    @one_blas_thread
+    def input_stiffness(self, z: np.ndarray, lam: np.ndarray, f: np.ndarray) -> np.ndarray:
+        """K_q = dF/dq (nq x nq) at an equilibrium with the actuators held: the sensitivity of the
+        reactions through the KKT system, [H_ff A_fᵀ; A_f 0][dz_f; dλ] = -[H_fq; A_q]."""
+        par = self._par(f, z[self.nx : self.nx + self.nq], None, None)
+        _, _, H, A = self._eval(z, lam, par)
+        free, qi = self._free(None), np.arange(self.nx, self.nx + self.nq)
+        K = self._kkt_matrix(H, A, free)
+        rhs = -np.vstack([H[np.ix_(free, qi)], A[:, qi]])
+        sol = _solve(K, rhs)
+        dz, dlam = sol[: len(free)], sol[len(free) :]
+        Kq = H[np.ix_(qi, qi)] + H[np.ix_(qi, free)] @ dz + A[:, qi].T @ dlam
+        return 0.5 * (Kq + Kq.T)
+
+    def energy(self, z: np.ndarray, f: np.ndarray) -> float:
+        """V = U - fᵀx at z (the actuators held)."""
+        par = self._par(f, z[self.nx : self.nx + self.nq], None, None)
+        return float(self._eval_v(z, par))
+
+    def _eval_v(self, z: np.ndarray, par: np.ndarray) -> float:
+        return float(np.asarray(self.kkt(z, np.zeros(self.ng), par)[4]).ravel()[0])
+
+    def joint_vector(self, z: np.ndarray, theta: np.ndarray) -> np.ndarray:
+        """The hinge set's joint vector (x, q, passive) with each hinge's axes read from z."""
+        out = np.array(theta, dtype=float)
+        for fr, h in zip(self.frames, self.hs.hinges, strict=True):
+            for a, i in h.axes.items():
+                zi, r0 = fr.variables[a]
+                out[i] = self.hs.theta0[i] + z[zi] - r0
+        return out
+
     def stresses(self, z: np.ndarray) -> dict[str, float | None]:
         """Largest stress of each hinge from its moments (all three rotations) and axial force."""
         out: dict[str, float | None] = {}
+        beams = zip(self.beams, self._beam_stresses(z), self._beam_joints, strict=True)
+        beam_stress = {(li, ja): worst for (body, li, _), worst, (ja, _) in beams if body.centred}
         for fr in self.frames:
+            if fr.loc in self.hinge_beams:  # a hinge modelled as a beam: the beam's largest stress
+                out[fr.name] = beam_stress[fr.loc]
+                continue
             if fr.kind is None:
                 out[fr.name] = None
                 continue
@@ -420,6 +540,72 @@ class SixAxisModel:
         K[:n, n:] = A[:, free].T
         K[n:, :n] = A[:, free]
         return K
+
+
+def _joint_places(chains: Chains) -> dict[str, tuple[int, int]]:
+    """Every coordinate and actuator of the chains -> (leg, joint)."""
+    where: dict[str, tuple[int, int]] = {}
+    for li, leg in enumerate(chains.legs):
+        for ji, j in enumerate(leg.joints):
+            for cname in (*j.coordinates, j.actuated):
+                if cname:
+                    where[cname] = (li, ji)
+    return where
+
+
+def _hinge_beams(hs: HingeSet, where: dict, chains: Chains, pose: set[str]) -> dict[tuple[int, int], Body]:
+    """(leg, joint) -> the body modelling that joint's hinge as a beam (``at``): a passive joint."""
+    out: dict[tuple[int, int], Body] = {}
+    for body in hs.bodies:
+        if not body.centred:
+            continue
+        for first, _ in body.members:
+            if first not in where:
+                raise InputError(
+                    f"body {body.name}: joint {first} is not in the legs' chains, so the body cannot be placed",
+                    path=body.path + ("at",),
+                )
+            li, ji = where[first]
+            joint = chains.legs[li].joints[ji]
+            if joint.actuated is not None or any(c in pose for c in joint.coordinates):
+                raise InputError(
+                    f"body {body.name}: {first} is an actuated or pose joint; a hinge beam sits at a passive joint",
+                    path=body.path + ("at",),
+                )
+            if (li, ji) in out:
+                raise InputError(f"joint {first} carries two hinge beams", path=body.path + ("at",))
+            out[(li, ji)] = body
+    return out
+
+
+def _first_rotation(joint: Any) -> np.ndarray | None:
+    for d, kind in enumerate(joint.motions):
+        if kind == "R":
+            return joint.axes[:, d]
+    return None
+
+
+def _body_ends(body: Body, m: int, first: str, second: str, where: dict, chains: Chains) -> tuple[int, int, int]:
+    """(leg, first joint, second joint) of a body's member; the second joint len(joints) at the platform."""
+    if first not in where or (second != PLATFORM and second not in where):
+        missing = first if first not in where else second
+        raise InputError(
+            f"body {body.name}: joint {missing} is not in the legs' chains, so the body cannot be placed",
+            path=body.path + ("between",),
+        )
+    li, ja = where[first]
+    if second == PLATFORM:
+        lj, jb = li, len(chains.legs[li].joints)
+    else:
+        lj, jb = where[second]
+    ja, jb = min(ja, jb), max(ja, jb)
+    if lj != li or jb != ja + 1:
+        raise InputError(
+            f"body {body.name}: {first} and {second} (member {m + 1}) are not neighbouring joints of one leg; a "
+            "flexible body is the link between two neighbouring joints (or the last joint and the platform)",
+            path=body.path + ("between",),
+        )
+    return li, ja, jb
 
 
 def _check_reference(model: Model, chains: Chains) -> None:
@@ -471,7 +657,8 @@ def _key(model: Model, hs: HingeSet) -> tuple:
         )
         for h in hs.hinges
     )
-    return (mech.name, mech.origin, tuple(np.asarray(model.p, dtype=float)), tuple(model.x_home), hinges)
+    bodies = tuple((repr(b.beam), b.members, b.material.E, b.material.nu, b.material.density) for b in hs.bodies)
+    return (mech.name, mech.origin, tuple(np.asarray(model.p, dtype=float)), tuple(model.x_home), hinges, bodies)
 
 
 def six_axis_model(model: Model, hs: HingeSet) -> SixAxisModel | None:

@@ -116,6 +116,14 @@ class KinematicHinges(HingeModel):
     kinematics moves; the output compliance at the pose, the loaded pose by IPOPT."""
 
     def prepare(self, model: Model, hs: cm.HingeSet, path: tuple, chosen: bool) -> Prepared:  # noqa: ARG002 - one signature for every hinge model
+        if hs.bodies:
+            raise InputError(
+                "the kinematic hinge model has rigid links; flexible bodies ("
+                + ", ".join(b.name for b in hs.bodies)
+                + ") need the six-axis model",
+                path=path,
+                hint="use hinge_axes: all",
+            )
         return Prepared(self, None, chosen)
 
     def solve(
@@ -185,7 +193,7 @@ class SixAxisHinges(HingeModel):
                 path=path,
                 hint="use hinge_axes: kinematic",
             )
-        if chosen:
+        if chosen or hs.bodies:  # flexible bodies: only the six-axis model has them
             return Prepared(self, six_axis_model(model, hs), True)
         try:  # the default: the six-axis model where it can place every hinge
             return Prepared(self, six_axis_model(model, hs), False)
@@ -231,6 +239,8 @@ class SixAxisHinges(HingeModel):
         out.add(Output("stress_max_unloaded", "stress"), largest(sm.stresses(z_u)))
         out.add(Output("stress_peak_max_unloaded", "stress"), largest(sm.hs.peaks(sm.stresses(z_u))))
         note = f"six-axis hinges: {', '.join(sm.six_axis_hinges) or 'none'}; {sm.chains.note}"
+        if hs.bodies:  # the chains' note speaks of rigid links: say which are not
+            note += "; except the flexible bodies (beams): " + ", ".join(b.name for b in hs.bodies)
         if not np.any(f):
             info = SolverInfo("newton-kkt", pose.iterations + it_u, pose.seconds)
             msg = f"no load: the output compliance only ({note})"
@@ -270,6 +280,34 @@ HINGE_MODELS: Mapping[str, HingeModel] = MappingProxyType(
         "kinematic": KINEMATIC,
     }
 )
+
+
+def six_axis_point(
+    sm: SixAxisModel, model: Model, x: np.ndarray, q: np.ndarray, f: np.ndarray
+) -> tuple[cm.StaticPoint, dict[str, float]] | None:
+    """The actuator forces, input stiffness, hinge stresses and energy of the six-axis model
+    (flexible bodies included) at the actuators q, starting from the rigid pose x: the
+    equilibrium by Newton on the KKT conditions, None when it does not converge; and the
+    largest stress of each flexible body."""
+    try:
+        ok, z, lam, _ = sm.newton(sm.start(x, q), f, q, None, None)
+    except np.linalg.LinAlgError:  # a motion without stiffness: no equilibrium to report
+        return None
+    if not ok:
+        return None
+    theta = sm.joint_vector(z, cm.joint_vector(model, z[: model.closure.nx], q))
+    F = sm.actuator_reactions(z, lam, f)
+    sp = cm.StaticPoint(
+        z[: model.closure.nx].copy(),
+        np.asarray(q, dtype=float),
+        F,
+        sm.input_stiffness(z, lam, f),
+        np.full((model.closure.nx, model.closure.nq), np.nan),  # J: not defined off the rigid kinematics
+        theta,
+        sm.energy(z, f),
+        sm.stresses(z),
+    )
+    return sp, sm.body_stresses(z)
 
 
 def has_chains(model: Model) -> bool:

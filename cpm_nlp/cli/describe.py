@@ -78,6 +78,9 @@ def _write_mechanism(mt: Any, out: TextIO) -> None:
         for hname, spec in stiffness.hinges.items():
             text = ", ".join(f"{k}: {v}" for k, v in spec.items())
             out.write(f"  {hname:<10} {text}\n")
+        for bname, spec in (stiffness.bodies or {}).items():  # flexible bodies (beams)
+            text = ", ".join(f"{k}: {v}" for k, v in spec.items())
+            out.write(f"  {bname:<10} flexible body: {text}\n")
     if mt.kinds:
         out.write("its own problem kinds: " + ", ".join(sorted(mt.kinds)) + "\n")
 

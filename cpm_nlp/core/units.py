@@ -59,6 +59,7 @@ DIMENSIONS: Mapping[str, Dimension] = MappingProxyType(
             Dimension("force", "N", "N", "20 N", ("N", "mN", "kN"), 1e7),
             Dimension("mass", "kg", "g", "12 g", ("kg", "g", "mg"), 1e4),
             Dimension("area", "m^2", "mm^2", "12 mm^2", ("m^2", "mm^2", "cm^2", "um^2"), 1e6),
+            Dimension("area_moment", "m^4", "mm^4", "833.3 mm^4", ("m^4", "mm^4"), 1.0),  # I, J of a section
             Dimension("volume", "m^3", "mm^3", "1.78e-6 m^3", ("m^3", "mm^3", "cm^3", "um^3"), 1e3),
             # sizes of boxes of task coordinates with angles among them (size_dimension)
             Dimension("length_angle", "m*rad", "mm*deg", "2 mm*deg", ("m*rad", "mm*deg"), 1e4),
@@ -112,6 +113,8 @@ FAST_UNITS: Mapping[str, tuple[float, str]] = MappingProxyType(
         "mm^2": (1e-06, "area"),
         "cm^2": (0.0001, "area"),
         "um^2": (1e-12, "area"),
+        "m^4": (1.0, "area_moment"),
+        "mm^4": (1.0000000000000002e-12, "area_moment"),
         "m^3": (1.0, "volume"),
         "mm^3": (1e-09, "volume"),
         "cm^3": (1.0000000000000002e-06, "volume"),

@@ -14,6 +14,7 @@ joints carry hinges (declared by the mechanism's part ``stiffness``, a
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
@@ -35,7 +36,7 @@ from ..analysis.compliance_values import (
 )
 from ..analysis.dynamics import parse_inertia, parse_mass
 from ..analysis.hinge_chains import LegChains
-from ..analysis.hinge_models import HINGE_MODELS, Prepared, default_hinge_model, hinge_model_text
+from ..analysis.hinge_models import HINGE_MODELS, Prepared, default_hinge_model, hinge_model_text, six_axis_point
 from ..core.canonical import canonical_eigh, degenerate_note, multiplicities
 from ..core.errors import InputError
 from ..core.kind import (
@@ -55,7 +56,7 @@ from ..core.result import STATUS_TEXT, Result, SolverInfo, Status, poses_solver_
 from ..core.schema import Record
 from ..core.solver import SolverConfig
 from ..core.units import result_unit
-from .hinge_inputs import hinge_options, k_actuator_option, load_option, mass_node
+from .hinge_inputs import bodies_option, hinge_options, k_actuator_option, load_option, mass_node
 from .kinematic import _model_info, _pose_outputs, _pose_values
 
 
@@ -127,11 +128,13 @@ class _HingeKind(ProblemKind):
         return []
 
     def input_options(self, model: Model) -> list[Option]:
-        return _pose_inputs(model) + hinge_options() + [load_option(model)] + self.extra_options(model)
+        return _pose_inputs(model) + hinge_options() + [bodies_option(), load_option(model)] + self.extra_options(model)
 
     def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
         """The hinges (the mechanism's merged with ``hinges`` and ``material``)."""
-        inputs["hinge_set"] = cm.hinge_set(model, inputs["hinges"], inputs["material"], inputs.get("sigma_allow"), path)
+        inputs["hinge_set"] = cm.hinge_set(
+            model, inputs["hinges"], inputs["material"], inputs.get("sigma_allow"), path, inputs.get("bodies")
+        )
 
 
 #: the stiffness of a hinge group's formula about each of its axes: on an angle coordinate, on a length
@@ -202,6 +205,10 @@ def _hinge_result(
     )
 
 
+#: the largest nominal stress in the flexible bodies' beams
+BEAM_STRESS = Output("beam_stress_max", "stress", when="bodies")
+
+
 class ActuatorForces(_HingeKind):
     name = "actuator_forces"
     description = (
@@ -229,6 +236,15 @@ class ActuatorForces(_HingeKind):
             ),
             Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
             Option(
+                "hinge_axes",
+                "choice",
+                "the hinge model: 'kinematic' (the pseudo-rigid-body energy method on the kinematics) or 'all' (every "
+                "hinge a six-axis spring on the legs' chains, the equilibrium at each input); default: kinematic, or "
+                "all with flexible bodies",
+                default=None,
+                choices=tuple(HINGE_MODELS),
+            ),
+            Option(
                 "stress_check",
                 "choice",
                 "the stress the stress limit checks: nominal (at the thinnest section, as the papers do) or peak "
@@ -250,17 +266,49 @@ class ActuatorForces(_HingeKind):
                 )
             inputs["sigma"] = cm.allowable(hs, inputs.get("sigma_allow"), inputs["safety_factor"], path)
 
+    def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:
+        """The hinges, and with flexible bodies the six-axis model that carries them."""
+        super().resolve(inputs, model, path)
+        hs = inputs["hinge_set"]
+        chosen = inputs.get("hinge_axes")
+        if chosen is None:  # the energy method on the kinematics, unless flexible bodies need the six-axis model
+            chosen = "all" if hs.bodies else "kinematic"
+        at = path + ("hinge_axes" if inputs.get("hinge_axes") is not None else "bodies",)
+        prepared = HINGE_MODELS[chosen].prepare(model, hs, at, True)
+        inputs["six_axis"] = prepared if chosen == "all" else None
+
+    @staticmethod
+    def _point(model: Model, inputs: Mapping[str, Any], sol: PoseSolution) -> tuple[Any, dict] | None:
+        """Forces, K_q, stresses and energy at a solved pose: the energy method on the kinematics,
+        or, with flexible bodies, the six-axis model's equilibrium at the pose's actuators."""
+        hs: cm.HingeSet = inputs["hinge_set"]
+        if inputs.get("six_axis") is None:
+            return cm.static_point(model, hs, sol.x, sol.q, inputs["load"]), {}
+        return six_axis_point(inputs["six_axis"].six_axis, model, sol.x, sol.q, inputs["load"])
+
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         c = model.closure
         hs: cm.HingeSet = inputs["hinge_set"]
         sols, batch = _solve_poses(model, inputs, solver)
-        points = [cm.static_point(model, hs, s.x, s.q, inputs["load"]) if s.ok else None for s in sols]
+        got = [self._point(model, inputs, s) if s.ok else None for s in sols]
+        points = [None if g is None else g[0] for g in got]
         status, message, statuses = _summary(sols, batch)
+        if any(s.ok and g is None for s, g in zip(sols, got)):
+            status, message = Status.NOT_CONVERGED, "the six-axis model with flexible bodies found no equilibrium"
 
         def per_point(col: list) -> Any:
             return col if batch else col[0]
 
         out = Values(_pose_outputs(model), _pose_values(model, sols, batch))
+        if inputs.get("six_axis") is not None:  # the pose of the flexible mechanism, not the rigid one
+            flex = [None if sp is None else sp.x for sp in points]
+            flexed = [_Flexed(s, s.x if x is None else x) for s, x in zip(sols, flex)]
+            out = Values(_pose_outputs(model), _pose_values(model, flexed, batch))
+            if hs.bodies:
+                beam_stress = [None if g is None else max(g[1].values(), default=None) for g in got]
+                out.add(BEAM_STRESS, per_point(beam_stress))
+            names = ", ".join(b.name for b in hs.bodies)
+            message += "; six-axis hinges" + (f", flexible bodies {names} (beams)" if names else "")
         for j, q in enumerate(c.q):
             out.add(force_output(f"F{j + 1}", q), per_point([None if sp is None else float(sp.F[j]) for sp in points]))
         out.extend(stress_values(hs, points, batch))
@@ -286,12 +334,19 @@ class ActuatorForces(_HingeKind):
         """The scale λ of the ray home -> end at which the largest stress reaches σ_allow."""
         sigma = inputs["sigma"]
         ray = _Ray(model, end, bool(given(inputs, model.closure.q_names)), solver)
+        if inputs.get("six_axis") is not None:
+            flexed = self._point(model, inputs, end)
+            if flexed is not None:
+                ray.t_linear_end = model.task_of(flexed[0].x)
 
         def excess(lam: float) -> float:
             sol = ray.pose(lam)
             if not sol.ok:
                 raise _OutOfReach(lam, sol)
-            sp = cm.static_point(model, hs, sol.x, sol.q, inputs["load"])
+            got = self._point(model, inputs, sol)
+            if got is None:
+                raise _OutOfReach(lam, sol)
+            sp = got[0]
             return (hs.checked(sp.stresses, inputs["stress_check"] == "peak") or 0.0) - sigma
 
         s_end = excess(1.0) + sigma
@@ -306,7 +361,10 @@ class ActuatorForces(_HingeKind):
             )
         if lam is None:
             return Values(), "the stresses never reach sigma_allow along this motion"
-        values = _limit_values(model, ray, ray.pose(lam), lam, lam_lin, sigma)
+        at = ray.pose(lam)
+        if inputs.get("six_axis") is not None:  # the flexible mechanism's pose there
+            at = _Flexed(at, self._point(model, inputs, at)[0].x)
+        values = _limit_values(model, ray, at, lam, lam_lin, sigma)
         which = "peak" if inputs["stress_check"] == "peak" else "nominal"
         return values, (
             f"first hinge at sigma_allow = {sigma / 1e6:.6g} MPa ({which} stress) at scale {lam:.6g} of the motion"
@@ -357,7 +415,19 @@ class ActuatorForces(_HingeKind):
             *formula,
             *K_FORMULA.values(),
             *_limit_outputs(model),
+            BEAM_STRESS,
         ]
+
+
+@dataclasses.dataclass(frozen=True)
+class _Flexed:
+    """A solved rigid pose with the pose of the flexible mechanism at its actuators."""
+
+    rigid: PoseSolution
+    x: np.ndarray
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.rigid, name)
 
 
 class _OutOfReach(Exception):
@@ -373,6 +443,9 @@ class _Ray:
     def __init__(self, model: Model, end: PoseSolution, by_actuators: bool, solver: SolverConfig) -> None:
         self.model, self.end, self.by_actuators, self.solver = model, end, by_actuators, solver
         self.t_home, self.t_end = model.task_of(model.x_home), model.task_of(end.x)
+        #: the task at the motion's end that the linear extrapolation scales (the flexible mechanism's
+        #: pose there, with flexible bodies)
+        self.t_linear_end = self.t_end
 
     def pose(self, lam: float) -> PoseSolution:
         m = self.model
@@ -405,7 +478,7 @@ def _limit_values(
     values: list[Any] = [sigma, lam, lam_lin]
     linear = {}
     for k, i in enumerate(c.task_index):
-        linear[i] = ray.t_home[k] + lam_lin * (ray.t_end[k] - ray.t_home[k])
+        linear[i] = ray.t_home[k] + lam_lin * (ray.t_linear_end[k] - ray.t_home[k])
         values += [float(sol.x[i]), float(linear[i])]
     for target in c.offsets.values():
         i = c.x_names.index(target)
@@ -532,6 +605,12 @@ class NaturalFrequencies(_HingeKind):
         super().resolve(inputs, model, path)
         c = model.closure
         hs: cm.HingeSet = inputs["hinge_set"]
+        if hs.bodies:
+            raise InputError(
+                "natural_frequencies takes rigid links, and the mechanism declares flexible bodies "
+                f"({', '.join(b.name for b in hs.bodies)}); platform_compliance and actuator_forces take them",
+                path=("mechanism", "stiffness", "bodies"),
+            )
         mat = next((h.material for h in hs.hinges if h.material is not None), None)
         density, name = (mat.density, mat.name) if mat else (None, "?")
         mx, mq = np.zeros(c.nx), np.zeros(c.nq)

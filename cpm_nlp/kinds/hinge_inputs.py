@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis import compliance as cm
+from ..analysis.beam_inputs import BODIES
 from ..analysis.dynamics import BLOCK, INERTIA_BLOCK
 from ..analysis.flexure import material_node
 from ..analysis.stress_limits import stress_angle_limits, with_limits
@@ -29,6 +30,11 @@ def hinge_options() -> list[Any]:
         ),
         material_node("material", "the hinge material (default: the mechanism's)", None),
     ]
+
+
+def bodies_option() -> Any:
+    """``bodies``: flexible bodies (beams) over the mechanism's, body by body; the six-axis hinge model."""
+    return BODIES
 
 
 def _load_dimension(kind: str) -> str:

@@ -311,8 +311,9 @@ def test_the_full_shipped_summary_counts_dependent_agreements_apart():
     are pinned by the per-paper tests and `cpm-nlp reproduce` in CI's smoke test)."""
     cats = [fig.category for _, _, fig in _shipped_rows()]
     # the 141 rows of issues 2-7, then the compliance rows and the file-described 3-PRS
-    # (167: K_Rsph and K_Tsph from the filleted neck, two rows where one said not reproducible)
-    assert len(cats) == 167
+    # (167: K_Rsph and K_Tsph from the filleted neck, two rows where one said not reproducible),
+    # then Table 2 with flexible legs (175: prs3_table2_flexible_legs.yaml, 8 rows)
+    assert len(cats) == 175
     assert cats.count("read_off_matrix") == 3 and cats.count("derived") == 2
     assert cats.count("consistency") == 35
     assert summarize([])["figures"] == 0

@@ -189,7 +189,7 @@ def _mechanism(d: Description, base_dir: Path | None, g: stored.Generated, check
         fk_seed=fns.get("fk_seed"),
     )
     if d.stiffness is not None and not checked:  # a bad hinge is an error of the mechanism file, at load
-        check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",))
+        check_declared(closure, d.stiffness.hinges, d.stiffness.material, ("stiffness",), d.stiffness.bodies)
     params = parameter_options(d)
     limits = described_limits(g.limits, d)
     examples = tuple(str((base_dir / e).resolve()) if base_dir else e for e in d.examples)

@@ -296,13 +296,15 @@ STIFFNESS_KEYS = {
     "hinges": "name -> {joints, type, k, t, r, w, d, l, Kt, material}, as a problem file's inputs.hinges",
     "material": "the hinge material: a name or an inline {name, E, nu, density, yield_strength, allowable}",
     "source": "where the values come from (paper, section, table)",
+    "bodies": "name -> {between, section, beam, elements, stiffness, length, material}: flexible bodies (beams), "
+    "as a problem file's inputs.bodies",
 }
 
 
 def _stiffness(raw: Any, path: tuple) -> JointStiffness:
     """The ``stiffness`` section: its shape and keys (the hinges are checked against the
     generated closure when the mechanism is built, by the rules of ``inputs.hinges``)."""
-    raw = as_mapping(raw, path, "a mapping {hinges, material, source}", STIFFNESS_KEYS)
+    raw = as_mapping(raw, path, "a mapping {hinges, material, source, bodies}", STIFFNESS_KEYS)
     if not raw.get("hinges"):
         raise InputError("missing key 'hinges' (" + STIFFNESS_KEYS["hinges"] + ")", path=path)
     hinges = {}
@@ -314,5 +316,8 @@ def _stiffness(raw: Any, path: tuple) -> JointStiffness:
             if key not in HINGE_KEYS:
                 raise unknown_key_error(str(key), HINGE_KEYS, p + (str(key),), "hinge key")
     return JointStiffness(
-        hinges=hinges, material=raw.get("material"), source=as_text(raw.get("source"), path + ("source",))
+        hinges=hinges,
+        material=raw.get("material"),
+        source=as_text(raw.get("source"), path + ("source",)),
+        bodies=raw.get("bodies"),
     )

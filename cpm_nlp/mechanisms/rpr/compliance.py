@@ -62,6 +62,7 @@ import numpy as np
 from ...analysis import compliance as cm
 from ...analysis import flexure
 from ...analysis import flexure_compliance as fc
+from ...analysis.beams import Section, element_compliance
 from ...analysis.flexure import Material
 from ...core import screws
 from ...core.kinematics import jacobians
@@ -321,6 +322,24 @@ def leaf_compliances(material: Material, length: float, thickness: float, width:
     c_r = 1.0 / flexure.leaf_spring_stiffness(material.E, width, thickness, length)
     c_t = length / (material.E * width * thickness)
     return c_r, c_t
+
+
+def leaf_beam_compliances(
+    material: Material, length: float, thickness: float, width: float
+) -> tuple[float, float, float]:
+    """(c_r, c_t, c_s) of a leaf hinge as a Timoshenko beam (`cpm_nlp.analysis.beams`: the
+    Castigliano integral over the leaf, carried to its centre, where the PRB model of Fig. 8 puts
+    its pivot): the rotation and the stretch the bridge model takes (eq 33-36; for a prismatic
+    leaf exactly the PRB's L/(EI) and L/(EA)), and the transverse compliance L³/(12 EI) +
+    L/(κ G A) that it leaves out ("ignores the deformations of the leaf spring in other
+    directions", section 3.2)."""
+    sec = Section("rectangle", {"b": width, "h": thickness})
+    C, _ = element_compliance(sec, material.E, material.nu, 0.0, length, length / 2, "timoshenko", "distributed")
+    C = np.array(C, dtype=float)
+    Ad = np.eye(6)
+    Ad[1, 5], Ad[2, 4] = -length / 2, length / 2  # (delta, theta) at the centre, rigid with the tip
+    Cc = Ad @ C @ Ad.T
+    return float(Cc[4, 4]), float(Cc[0, 0]), float(Cc[2, 2])
 
 
 def amplifier_matrices(l1: float, l2: float, c_r: float, c_t: float) -> dict[str, np.ndarray]:

@@ -155,3 +155,37 @@ def problem_kind_outputs(kind: str) -> dict:
 
     model, _ = reference_model("rpr")
     return {o.name: o for o in cn.problem_kind(kind).outputs(model)}
+
+
+def test_the_leaf_as_a_beam_against_eq_55_and_58():
+    """The amplifier's leaf hinge as a Timoshenko beam (leaf model: beam): its rotation and
+    stretch at the centre are the PRB's 12 L/(E w t^3) and L/(E w t) (Fig. 8), so C and C_in are
+    those of eq 33-44 (the eq 55, 58 model); it adds the transverse compliance the bridge model
+    leaves out, checked against L^3/(12 E I) + L/(kappa G A) written out (Cowper's kappa)."""
+    import json
+    import subprocess
+    import sys
+
+    length, t, w = 1e-3, 0.4e-3, 12e-3  # the shipped leaf (problems/rpr_compliance.yaml)
+    c_r, c_t, c_s = rc.leaf_beam_compliances(AL, length, t, w)
+    E, nu = AL.E, AL.nu
+    G, inertia, area = E / (2 * (1 + nu)), w * t**3 / 12, w * t
+    assert c_r == pytest.approx(12 * length / (E * w * t**3), rel=1e-12)
+    assert c_t == pytest.approx(length / (E * w * t), rel=1e-12)
+    kappa = 10 * (1 + nu) / (12 + 11 * nu)
+    assert c_s == pytest.approx(length**3 / (12 * E * inertia) + length / (kappa * G * area), rel=1e-12)
+    path = str(ROOT / "problems/rpr_compliance.yaml")
+    runs = [
+        json.loads(
+            subprocess.run(
+                [sys.executable, "-m", "cpm_nlp", "solve", path, "--json", *extra], capture_output=True, text=True
+            ).stdout
+        )["values"]
+        for extra in ([], ["--set", "inputs.amplifier.leaf.model=beam"])
+    ]
+    prb, beam = runs
+    np.testing.assert_allclose(beam["C"], prb["C"], rtol=1e-12, atol=1e-20)
+    np.testing.assert_allclose(beam["C_in"], prb["C_in"], rtol=1e-12, atol=1e-22)
+    assert prb["c_s"] is None and beam["c_s"] == pytest.approx(c_s, rel=1e-9)
+    # what the bridge model leaves out: 9.4 times the stretch, a fifth of C_in
+    assert beam["c_s"] / beam["c_t"] == pytest.approx(9.376, rel=1e-3)

@@ -47,6 +47,15 @@ _LEAF = (
     Option("length", "length", "leaf length", lower=0.0, upper=1.0, strict=True),
     Option("thickness", "length", "leaf thickness", lower=0.0, upper=1.0, strict=True),
     Option("width", "length", "leaf width", lower=0.0, upper=1.0, strict=True),
+    Option(
+        "model",
+        "choice",
+        "prb: the pseudo-rigid-body rotation and stretch of Fig. 8 (c_r = 12 L/(E w t^3), c_t = L/(E w t)); beam: "
+        "the leaf as a Timoshenko beam (its compliance at its centre; also reports the transverse compliance c_s "
+        "that eq 33-36 leave out)",
+        default="prb",
+        choices=("prb", "beam"),
+    ),
 )
 
 
@@ -107,9 +116,15 @@ class Compliance(RprKind):
         if not sol.ok:
             return _finish(self, model, sol.status, {}, message=sol.message)
         amp = inputs["amplifier"]
+        c_s = None
         if amp["leaf"] is not None:
             leaf = amp["leaf"]
-            c_r, c_t = rpr_compliance.leaf_compliances(mat, leaf["length"], leaf["thickness"], leaf["width"])
+            dims = (leaf["length"], leaf["thickness"], leaf["width"])
+            if leaf["model"] == "beam":
+                mat.require("nu", ("inputs", "material"), "the leaf as a Timoshenko beam")
+                c_r, c_t, c_s = rpr_compliance.leaf_beam_compliances(mat, *dims)
+            else:
+                c_r, c_t = rpr_compliance.leaf_compliances(mat, *dims)
         else:
             c_r, c_t = 1.0 / amp["k_r"], 1.0 / amp["k_t"]
         k = {}
@@ -131,6 +146,7 @@ class Compliance(RprKind):
         values = {
             "c_r": c_r,
             "c_t": c_t,
+            "c_s": c_s,
             "k_R": k["R"],
             "k_U": k["U"],
             "A11": float(out["A11"][0, 0]),
@@ -162,6 +178,7 @@ class Compliance(RprKind):
         dims = {
             "c_r": "rotational_compliance",
             "c_t": "compliance",
+            "c_s": "compliance",
             "k_R": "rotational_stiffness",
             "k_U": "rotational_stiffness",
             **dict.fromkeys(("A11", "A12", "A21", "A22"), "compliance"),
