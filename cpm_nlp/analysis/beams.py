@@ -54,6 +54,7 @@ section dimension may be a symbol (a design variable).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -201,7 +202,11 @@ class Element:
     mass: float = 0.0
 
 
-_GAUSS = {n: np.polynomial.legendre.leggauss(n) for n in (4, 24)}
+@functools.cache
+def _gauss(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n-point Gauss-Legendre nodes and weights on [-1, 1] (made on first use: numpy.polynomial
+    costs every solve's start-up otherwise)."""
+    return np.polynomial.legendre.leggauss(n)
 
 
 def _section_compliance(sec: Section, E: Any, G: Any, nu: Any, x: Any, theory: str) -> list[Any]:
@@ -221,7 +226,7 @@ def element_compliance(
     if model == "lumped":
         mid = 0.5 * (s0 + s1)
         return ca.diag(ca.vertcat(*[c * ell for c in _section_compliance(sec, E, G, nu, mid - x_centre, theory)])), mid
-    nodes, weights = _GAUSS[4 if sec.kind != "circular_notch" else 24]
+    nodes, weights = _gauss(4 if sec.kind != "circular_notch" else 24)
     C = ca.DM.zeros(6, 6) if not any(isinstance(a, (ca.SX, ca.MX)) for a in (E, nu, s0, s1)) else ca.SX.zeros(6, 6)
     for xi, w in zip(nodes, weights):
         s = s0 + 0.5 * (xi + 1.0) * ell
