@@ -150,6 +150,7 @@ class SixAxisModel:
         self.rest = np.array(rest)
         self.nz = len(self._z)
         z = ca.vertcat(*self._z)
+        self._legs, self._extra = legs, extra  # for the bodies' frames (`body_frames`)
         g = self._closures(z, legs, extra)
         self.ng = g.numel()
         self._functions(z, g)
@@ -208,6 +209,29 @@ class SixAxisModel:
             M = DR.T @ Rm
             g.append(vee(M))  # rotation
         return ca.vertcat(*g)
+
+    def body_frames(self) -> ca.Function:
+        """``("<name>_body_frames", [z], [R, t])``: the rigid motion (R_b, t_b) of the body after
+        each joint of each leg (a point p0 of it at the reference configuration is at
+        R_b p0 + t_b), in leg and joint order, R stacked as 3 x 3 blocks side by side and t
+        as columns.  The body after a joint moves with that joint's motions and its hinge's
+        extra axes (the same product of exponentials as the closures)."""
+        z = ca.vertcat(*self._z)
+        Rs, ts = [], []
+        for li, rows in enumerate(self._legs):
+            Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
+            for ji, (j, motions) in enumerate(rows):
+                for kind, axis, value in motions + self._extra.get((li, ji), []):
+                    if kind == "P":
+                        Rk, tk = ca.SX.eye(3), value * ca.DM(axis)
+                    else:
+                        Rk = _rot(axis, value)
+                        tk = ca.DM(j.at) - Rk @ ca.DM(j.at)
+                    Rm, tm = Rm @ Rk, Rm @ tk + tm
+                Rs.append(Rm)
+                ts.append(tm)
+        name = f"{self.model.closure.name}_body_frames"
+        return ca.Function(name, [z], [ca.horzcat(*Rs), ca.horzcat(*ts)], ["z"], ["R", "t"])
 
     def _functions(self, z: Any, g: Any) -> None:
         """The energy of every axis of every hinge, and the named CasADi functions."""
