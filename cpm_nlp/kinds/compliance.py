@@ -521,7 +521,7 @@ def _links_node() -> MappingOf:
     inertia = ListOf(
         "inertia",
         "inertias about the link's centre about its own axes [along it, b1, b2]",
-        Quantity("inertia", "an inertia", kinds=("inertia",)),
+        Quantity("inertia", "an inertia", kinds=("inertia",), positive=True, si=True),
         min_len=3,
         max_len=3,
         default=None,
@@ -537,13 +537,37 @@ def _links_node() -> MappingOf:
                 Option("leg", "str", "a leg name (leg1), or a repeated leg's (leg: every copy)"),
                 Option("after_joint", "int", "the link's first joint, counted from the base (1, 2, ...)", lower=1),
                 section,
-                Quantity("mass", "its mass (default: density x section area x length)", kinds=("mass",), default=None),
+                Quantity(
+                    "mass",
+                    "its mass (default: density x section area x length)",
+                    kinds=("mass",),
+                    default=None,
+                    positive=True,
+                    si=True,
+                ),
                 inertia,
             ),
             what="link key",
         ),
         key_what="link",
         default=None,
+    )
+
+
+def masses_node(model: Model) -> Record:
+    """``masses``: a mass or an inertia per pose or actuator coordinate (a block of the material)."""
+    c = model.closure
+    names = c.x_names + c.q_names
+    return Record(
+        "masses",
+        "mass (on a length coordinate: '12 g', or a block {length, width, height} of the material) or "
+        "inertia (on an angle coordinate: kg*m^2, or a block {length, width, height, about: x|y|z} of the "
+        "material turning about its own axis through its centre) per pose or actuator coordinate: " + ", ".join(names),
+        tuple(mass_node(co.name, co.description, co.kind == "angle") for co in (*c.x, *c.q)),
+        what="coordinate",
+        sparse=True,
+        mismatch="expected masses: a mapping of coordinate -> mass or inertia over " + ", ".join(names),
+        default={},
     )
 
 
@@ -580,30 +604,7 @@ class NaturalFrequencies(_HingeKind):
 
     def input_options(self, model: Model) -> list[Option]:
         opts = task_options(model, "scalar") + actuator_options(model, "scalar") + hinge_options()
-        c = model.closure
-        names = c.x_names + c.q_names
-        coords = (*c.x, *c.q)
-        text = "expected masses: a mapping of coordinate -> mass or inertia over " + ", ".join(names)
-
-        def non_empty(value: Any, path: tuple) -> None:
-            if not value:
-                raise InputError(text, path=path)
-
-        opts.append(
-            Record(
-                "masses",
-                "mass (on a length coordinate: '12 g', or a block {length, width, height} of the material) or "
-                "inertia (on an angle coordinate: kg*m^2, or a block {length, width, height, about: x|y|z} of the "
-                "material turning about its own axis through its centre) per pose or actuator coordinate: "
-                + ", ".join(names),
-                tuple(mass_node(co.name, co.description, co.kind == "angle") for co in coords),
-                what="coordinate",
-                sparse=True,
-                mismatch=text,
-                check=non_empty,
-                default={},
-            )
-        )
+        opts.append(masses_node(model))
         ka = k_actuator_option(model)
         return [
             *opts,
