@@ -92,11 +92,16 @@ class Constraint:
     multiplier: float
     active: bool
 
+    #: the bounds of a design variable, "[low, high]" (its text then names both)
+    interval: str = ""
+
     def text(self) -> str:
         state = "active" if self.active else "inactive"
-        return (
-            f"{self.name} {self.sense} {self.bound:.6g}: {self.value:.6g} ({state}, multiplier {self.multiplier:.3g})"
-        )
+        mult = "a matrix" if math.isnan(self.multiplier) else f"{self.multiplier:.3g}"
+        value = f"{self.value:.6g} ({state}, multiplier {mult})"
+        if self.interval:
+            return f"{self.name} in {self.interval}: {value}"
+        return f"{self.name} {self.sense} {self.bound:.6g}: {value}"
 
 
 @dataclass
