@@ -121,6 +121,9 @@ class SynthesisOutcome:
     y: np.ndarray | None = None
     lam_g: np.ndarray | None = None
     lam_x: np.ndarray | None = None
+    #: the NLP's full solution (design, then ω₁² and L) and its parameters (scales)
+    w: np.ndarray | None = None
+    p: np.ndarray | None = None
 
 
 def stiffness_basis(model: Model, hs: cm.HingeSet, x: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -400,7 +403,7 @@ class ComplianceSynthesisNLP:
         out.kkt_residual = float(np.max(np.abs(grad_L)))
         nv = len(self.variables)
         y = w[:nv]
-        out.y, out.lam_g, out.lam_x = y, lam_g, lam_x
+        out.y, out.lam_g, out.lam_x, out.w, out.p = y, lam_g, lam_x, w, par
         out.design = {v.name: float(v.value(y[i])) for i, v in enumerate(self.variables)}
         g = g.ravel()
         viol = max([0.0, *(g[self.n_eq :] - 1.0)]) if g.size else 0.0

@@ -411,7 +411,7 @@ def designed_hinges(model: Model, inputs: Mapping[str, Any], design: Mapping[str
         if v.link:
             continue
         entry = dict(raw.get(v.owner) or {})
-        entry[v.key] = f"{design[v.name]!r} m"
+        entry[v.key] = float(design[v.name])  # a bare SI number
         entry["k"] = None
         raw[v.owner] = entry
     return cm.hinge_set(model, raw, inputs["material"], None)
