@@ -417,7 +417,13 @@ class ComplianceSynthesisNLP:
             mult = float(lam_g[self.n_eq + k])
             out.constraints.append(Constraint(name, gi * bound, bound, sense, mult, 1.0 - gi <= ACTIVE_RTOL))
         vals = self.evaluate(y)
-        f1 = float(np.sqrt(max(scipy.linalg.eigh(vals["K"], vals["M"], eigvals_only=True)[0], 0.0)) / (2 * math.pi))
+        f1 = None  # without masses, or with the actuators held, no frequency
+        if self.ka is not None and np.any(vals["M"]):
+            try:
+                lam = scipy.linalg.eigh(vals["K"], vals["M"], eigvals_only=True)[0]
+                f1 = float(np.sqrt(max(lam, 0.0)) / (2 * math.pi))
+            except np.linalg.LinAlgError:  # M singular: a motion without mass has no frequency
+                f1 = None
         out.measures = {**vals, "f1": f1}
         if self.req.frequency_min is not None:
             fmin = self.req.frequency_min
