@@ -11,8 +11,8 @@ stiffnesses k_j.  Hence, exactly,
     K_q(k) = Σ_j k_j G_j          (G_j: the input stiffness of a unit stiffness on joint j alone,
                                    the reduced Hessian of `cpm_nlp.analysis.compliance.static_point`)
     C(k)   = J (K_q + K_a)⁻¹ Jᵀ   (the output compliance at home, actuators on springs K_a)
-    σ_h    = σ(dims, {a: k_a δ_a})  at every pose of the required stroke (the hinge type's stress,
-                                   nominal or K_t × nominal)
+    σ_h    = σ(dims, {a: k_a δ_a})  at every corner of the required stroke and at the poses given
+                                   (the hinge type's stress, nominal or K_t × nominal)
     M(s)   = Jᵀ M_x J + M_q + Tᵀ M_links(s) T   (`cpm_nlp.analysis.link_masses`)
 
 with k_j = k_j(dims) the hinge type's stiffness formula (`cpm_nlp.analysis.hinge_types`,
@@ -70,13 +70,14 @@ class Variable:
 class Requirements:
     """The objective and the constraints.  ``objective``: (sense +1 minimise / -1 maximise,
     measure: ``compliance_<x>``, ``f1``, ``stress`` or ``input_stiffness``); ``compliance_max``:
-    pose index -> bound; ``stroke``: the poses (x, q) at the corners of the required stroke."""
+    pose index -> bound; ``stress_poses``: (label, x, q) of the poses where every hinge must stay
+    below ``sigma_allow``: the corners of the required stroke and any poses given."""
 
     objective: tuple[int, str]
     compliance_max: Mapping[int, float] = field(default_factory=dict)
     input_stiffness_max: float | None = None
     frequency_min: float | None = None
-    stroke_poses: Sequence[tuple[np.ndarray, np.ndarray]] = ()
+    stress_poses: Sequence[tuple[str, np.ndarray, np.ndarray]] = ()
     sigma_allow: float | None = None
     peak: bool = False
 
@@ -201,7 +202,7 @@ class ComplianceSynthesisNLP:
     def _stresses(self) -> list[tuple[str, Any]]:
         """(label, σ) of every hinge with a type at every stroke pose where it deflects."""
         out = []
-        for p, (x, q) in enumerate(self.req.stroke_poses):
+        for where, x, q in self.req.stress_poses:
             theta = cm.joint_vector(self.model, x, q)
             dev = theta - self.hs.theta0
             for h in self.hs.hinges:
@@ -214,7 +215,7 @@ class ComplianceSynthesisNLP:
                     kt = h.dims.get("Kt")
                     fit = HINGE_TABLE[h.kind].kt
                     sigma = sigma * (kt if kt is not None else 1.0 if fit is None else fit(dims))
-                out.append((f"stress {h.name} at stroke corner {p + 1}", sigma))
+                out.append((f"stress {h.name} at {where}", sigma))
         return out
 
     def _mass(self, M_x, M_q, values, links) -> Any:

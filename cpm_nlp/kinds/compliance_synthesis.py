@@ -20,7 +20,7 @@ from ..analysis.hinge_models import HINGE_MODELS, has_chains
 from ..analysis.hinge_types import DIM_OPTIONS
 from ..analysis.link_masses import link_bodies
 from ..core.errors import InputError, suggest
-from ..core.kind import ProblemKind, require_ipopt
+from ..core.kind import ProblemKind, broadcast, require_ipopt, task_options, task_values
 from ..core.kinematics import inverse_kinematics
 from ..core.model import Model
 from ..core.options import Option
@@ -36,7 +36,7 @@ from .kinematic import _model_info
 #: the measures an objective may name, beyond the compliance of each pose coordinate
 MEASURES = {
     "f1": "the first natural frequency (kinematic hinge model, the masses and links given)",
-    "stress": "the largest hinge stress over the corners of the required stroke",
+    "stress": "the largest hinge stress over the corners of the required stroke and the poses given",
     "input_stiffness": "the largest diagonal entry of the input stiffness K_q (what the actuators push against)",
 }
 
@@ -166,6 +166,15 @@ class ComplianceSynthesis(ProblemKind):
                 "frequency_min", "frequency", "the smallest allowed first natural frequency", None, 0.0, strict=True
             ),
             _stroke_node(model),
+            Record(
+                "poses",
+                "further poses where every hinge must stay below the allowable stress: task coordinates (or their "
+                "offsets from home), each a value or a list (lists of equal length); those not given at home",
+                tuple(task_options(model, "grid")),
+                what="task coordinate",
+                sparse=True,
+                default={},
+            ),
             Option("sigma_allow", "stress", "allowable stress (default: the hinge material's)", None, 0.0, strict=True),
             Option("safety_factor", "dimensionless", "divides the allowable stress", default=1.0, lower=1.0),
             Option("stress_check", "choice", "the stress checked", default="nominal", choices=("nominal", "peak")),
@@ -259,10 +268,17 @@ class ComplianceSynthesis(ProblemKind):
                 "a frequency with the actuators held has no motion; give k_actuator", path=path + ("k_actuator",)
             )
         stroke = {k: v for k, v in (inputs["stroke"] or {}).items() if v is not None}
-        if measure == "stress" and not stroke:
-            raise InputError("the stress objective needs the required stroke (inputs.stroke)", path=path + ("stroke",))
+        poses = _with_home({k: v for k, v in (inputs["poses"] or {}).items() if v is not None}, model)
+        inputs["poses"] = poses
+        if poses:
+            broadcast(task_values(poses, model, path + ("poses",)), list(c.task), path + ("poses",))
+        if measure == "stress" and not (stroke or poses):
+            raise InputError(
+                "the stress objective needs the required stroke (inputs.stroke) or poses (inputs.poses)",
+                path=path + ("stroke",),
+            )
         sigma = None
-        if stroke:
+        if stroke or poses:
             sigma = cm.allowable(hs, inputs["sigma_allow"], inputs["safety_factor"], path)
         inputs["stroke_box"] = stroke
         inputs["requirements"] = Requirements(
@@ -281,9 +297,12 @@ class ComplianceSynthesis(ProblemKind):
         req: Requirements = inputs["requirements"]
         out = Values()
         corners, message = self._corners(model, inputs["stroke_box"], solver)
+        if not message:
+            given, message = self._poses(model, inputs["poses"], solver)
+            corners += given
         if message:
             return self._result(model, Status.INFEASIBLE, out, SolverInfo("ipopt"), message)
-        req = Requirements(**{**req.__dict__, "stroke_poses": corners})
+        req = Requirements(**{**req.__dict__, "stress_poses": corners})
         hs: cm.HingeSet = inputs["hinge_set"]
         nlp = ComplianceSynthesisNLP(
             model,
@@ -350,7 +369,21 @@ class ComplianceSynthesis(ProblemKind):
             if not sol.ok:
                 where = ", ".join(f"{k} {box[k][(corner >> b) & 1]:+.6g}" for b, k in enumerate(keys))
                 return [], f"the required stroke is not reachable: the corner ({where}) from home: {sol.status.value}"
-            out.append((sol.x, sol.q))
+            out.append((f"stroke corner {corner + 1}", sol.x, sol.q))
+        return out, ""
+
+    @staticmethod
+    def _poses(model: Model, poses: Mapping[str, Any], solver: SolverConfig) -> tuple[list, str]:
+        """The poses given (task coordinates, lists of equal length) by IK: (label, x, q)."""
+        if not poses:
+            return [], ""
+        ts, _ = broadcast(task_values(poses, model, ("inputs", "poses")), list(model.closure.task), ("inputs", "poses"))
+        out = []
+        for k, t in enumerate(ts):
+            sol = inverse_kinematics(model, t, solver)
+            if not sol.ok:
+                return [], f"pose {k + 1} of inputs.poses is not reachable: {sol.status.value}"
+            out.append((f"pose {k + 1}", sol.x, sol.q))
         return out, ""
 
     @staticmethod
@@ -366,7 +399,7 @@ class ComplianceSynthesis(ProblemKind):
             dev.append(_rel(cm.output_compliance(sp, ka), m["C"]))
         if "stress" in m:
             peak = inputs["stress_check"] == "peak"
-            worst = max(hs2.checked(cm.static_point(model, hs2, x, q).stresses, peak) or 0.0 for x, q in corners)
+            worst = max(hs2.checked(cm.static_point(model, hs2, x, q).stresses, peak) or 0.0 for _, x, q in corners)
             dev.append(_rel(np.array([worst]), np.array([float(m["stress"])])))
         if m["f1"] is not None:
             lam = scipy.linalg.eigh(sp.K_q + np.diag(ka), m["M"], eigvals_only=True)[0]
@@ -395,6 +428,19 @@ class ComplianceSynthesis(ProblemKind):
             Output("kkt_residual", "dimensionless"),
             Output("recheck_deviation", "dimensionless"),
         ]
+
+
+def _with_home(poses: dict[str, Any], model: Model) -> dict[str, Any]:
+    """The poses given, the task coordinates not given (nor their offsets) at their home value."""
+    if not poses:
+        return poses
+    c = model.closure
+    out = dict(poses)
+    for i in c.task_index:
+        name = c.x[i].name
+        if name not in out and not any(o in out for o, target in c.offsets.items() if target == name):
+            out[name] = float(model.x_home[i])
+    return out
 
 
 def designed_hinges(model: Model, inputs: Mapping[str, Any], design: Mapping[str, float]) -> cm.HingeSet:

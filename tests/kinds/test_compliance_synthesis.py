@@ -34,7 +34,7 @@ def _nlp(problem):
     inputs = problem.inputs
     corners, msg = ComplianceSynthesis._corners(problem.model, inputs["stroke_box"], problem.solver)
     assert not msg
-    req = Requirements(**{**inputs["requirements"].__dict__, "stroke_poses": corners})
+    req = Requirements(**{**inputs["requirements"].__dict__, "stress_poses": corners})
     nlp = ComplianceSynthesisNLP(
         problem.model,
         inputs["hinge_set"],
@@ -97,6 +97,8 @@ def _forward(problem, design, kind, inputs):
     """An ordinary problem of ``kind`` on the synthesized hinges (their k from the formula)."""
     raw = dict(problem.inputs["hinges"] or {})
     for v in problem.inputs["variables"]:
+        if v.link:
+            continue
         entry = dict(raw.get(v.owner) or {})
         entry[v.key], entry["k"] = float(design[v.name]), None
         raw[v.owner] = entry
@@ -166,8 +168,9 @@ def test_ad_derivatives_equal_central_differences_of_the_forward_analysis(solved
                 i = model.closure.x_names.index(name[2:])
                 vals.append(cm.output_compliance(sp, inputs["k_actuator"])[i, i] / bound)
             elif name.startswith("stress"):
-                hinge, corner = name.split()[1], int(name.rsplit(" ", 1)[1]) - 1
-                st = cm.static_point(model, hs, *corners[corner]).stresses
+                hinge, where = name.split()[1], name.split(" at ", 1)[1]
+                x, q = next((x, q) for label, x, q in corners if label == where)
+                st = cm.static_point(model, hs, x, q).stresses
                 if inputs["stress_check"] == "peak":
                     st = hs.peaks(st)
                 vals.append(st[hinge] / bound)
@@ -258,3 +261,38 @@ def test_bad_synthesis_input_is_named(inputs, path, words):
         problem_from_dict(_problem(**inputs))
     assert err.value.path == path, err.value.message
     assert words in err.value.message
+
+
+def test_link_sections_as_design_variables():
+    """The legs' section as design variables for the highest f1: lighter legs raise it, so the
+    section ends on its lower bounds (multipliers of a lower bound: negative); the design's f1 is
+    natural_frequencies' with 6 x 6 mm legs and the same hinges."""
+    problem = load_problem(PRS3_FILE, ["inputs.link_design={legs: {width: [6 mm, 14 mm], height: [6 mm, 14 mm]}}"])
+    res = solve(problem)
+    assert res.ok, res.message
+    v = res.values
+    assert v["width_legs"] == pytest.approx(6e-3, rel=1e-7) and v["height_legs"] == pytest.approx(6e-3, rel=1e-7)
+    assert "width_legs" in v["active_constraints"].split(", ")
+    design = {x.name: v[x.name] for x in problem.inputs["variables"] if not x.link}
+    data_in = problem.data["inputs"]
+    links = {"legs": {**data_in["links"]["legs"], "section": {"width": "6 mm", "height": "6 mm"}}}
+    nf = _forward(
+        problem, design, "natural_frequencies", {"masses": data_in["masses"], "links": links, "k_actuator": "0 N/m"}
+    )
+    assert nf["f1"] == pytest.approx(v["f1"], rel=1e-9)
+    heavy = solve(load_problem(PRS3_FILE))
+    assert v["f1"] > heavy.values["f1"]
+
+
+def test_stress_over_given_poses_is_actuator_forces_stress():
+    """Stresses over a set of poses (inputs.poses, the others at home) instead of a stroke box: the
+    binding pose's peak stress is actuator_forces' at that pose on the designed hinges."""
+    problem = load_problem(RRR3_FILE, ["inputs.stroke={}", "inputs.poses={x: [4 mm, 0 mm], y: [0 mm, -4 mm]}"])
+    res = solve(problem)
+    assert res.ok, res.message
+    v = res.values
+    assert "stress elbow1 at pose 1" in v["active_constraints"]
+    design = {x.name: v[x.name] for x in problem.inputs["variables"]}
+    af = _forward(problem, design, "actuator_forces", {"x": [4e-3, 0.0], "y": [0.0, -4e-3], "phi": [0.0, 0.0]})
+    assert max(af["stress_peak_max"]) == pytest.approx(400e6, rel=1e-7)
+    assert af["stress_peak_max"][0] == pytest.approx(v["stress_max"], rel=1e-9)
