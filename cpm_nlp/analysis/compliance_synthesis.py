@@ -80,6 +80,10 @@ class Requirements:
     stress_poses: Sequence[tuple[str, np.ndarray, np.ndarray]] = ()
     sigma_allow: float | None = None
     peak: bool = False
+    #: a unit direction u in the pose coordinates (all lengths or all angles) and the largest
+    #: allowed compliance uᵀ C u along it
+    direction: np.ndarray | None = None
+    direction_max: float | None = None
 
 
 @dataclass
@@ -174,6 +178,9 @@ class ComplianceSynthesisNLP:
             self.measures["C"] = C
             for i, x in enumerate(c.x):
                 self.measures[f"compliance_{x.name}"] = C[i, i]
+            if req.direction is not None:
+                u = ca.DM(req.direction)
+                self.measures["compliance_direction"] = ca.mtimes([u.T, C, u])
         self.measures["input_stiffness"] = ca.mmax(ca.diag(Kq))
         self.stresses = self._stresses()
         if self.stresses:
@@ -275,7 +282,7 @@ class ComplianceSynthesisNLP:
             ["f", "g", "grad_f", "jac_g"],
         )
         outs = {"K": self.K, "M": self.M, "k": ca.vertcat(*self.k)}
-        for key in ("C", "K_q", "stress", "input_stiffness"):
+        for key in ("C", "K_q", "stress", "input_stiffness", "compliance_direction"):
             if key in self.measures:
                 outs[key] = self.measures[key]
         self.values_fn = ca.Function("compliance_synthesis_values", [self.y], list(outs.values()), ["y"], list(outs))
@@ -287,6 +294,9 @@ class ComplianceSynthesisNLP:
             x = self.model.closure.x[i]
             g.append(self.measures[f"compliance_{x.name}"] / bound)
             self.g_info.append((f"C_{x.name}", "<=", bound))
+        if req.direction_max is not None:
+            g.append(self.measures["compliance_direction"] / req.direction_max)
+            self.g_info.append(("C along the direction", "<=", req.direction_max))
         if req.input_stiffness_max is not None:
             for j, qn in enumerate(self.model.closure.q_names):
                 g.append(self.measures["K_q"][j, j] / req.input_stiffness_max)
@@ -328,7 +338,7 @@ class ComplianceSynthesisNLP:
         out: dict[str, Any] = {}
         for k, v in self.values_fn(y=y).items():
             a = np.asarray(v, dtype=float)
-            out[k] = float(a.ravel()[0]) if k in ("stress", "input_stiffness") else a
+            out[k] = float(a.ravel()[0]) if k in ("stress", "input_stiffness", "compliance_direction") else a
         return out
 
     def start(self, y0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

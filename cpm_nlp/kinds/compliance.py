@@ -652,7 +652,8 @@ class NaturalFrequencies(_HingeKind):
                     "mechanism file of spatial P, R, C, U, S legs gives them)",
                     path=path + (("hinge_axes",) if six else ("links",)),
                 )
-            inputs["hinge_model"] = HINGE_MODELS["all"].prepare(model, hs, path + ("hinge_axes",), True)
+            where = path + (("hinge_axes",) if six else ("links",))
+            inputs["hinge_model"] = HINGE_MODELS["all"].prepare(model, hs, where, True)
         inputs["link_bodies"] = []
         if inputs["links"]:
             inputs["link_bodies"] = link_bodies(

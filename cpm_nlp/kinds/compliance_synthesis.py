@@ -35,6 +35,7 @@ from .kinematic import _model_info
 
 #: the measures an objective may name, beyond the compliance of each pose coordinate
 MEASURES = {
+    "compliance_direction": "the compliance u^T C u along inputs.direction (a unit vector of pose coordinates)",
     "f1": "the first natural frequency (kinematic hinge model, the masses and links given)",
     "stress": "the largest hinge stress over the corners of the required stroke and the poses given",
     "input_stiffness": "the largest diagonal entry of the input stiffness K_q (what the actuators push against)",
@@ -154,6 +155,25 @@ class ComplianceSynthesis(ProblemKind):
             ka,
             _objective_node(model),
             _compliance_max_node(model),
+            Record(
+                "direction",
+                "a direction in the pose coordinates (components, normalized; all on lengths or all on angles) for "
+                "compliance_direction and compliance_direction_max",
+                tuple(
+                    Option(x.name, "dimensionless", f"component along {x.name}", default=None) for x in model.closure.x
+                ),
+                what="pose coordinate",
+                sparse=True,
+                default={},
+            ),
+            Quantity(
+                "compliance_direction_max",
+                "the largest allowed compliance u^T C u along the direction",
+                kinds=("compliance", "rotational_compliance"),
+                default=None,
+                positive=True,
+                si=True,
+            ),
             Quantity(
                 "input_stiffness_max",
                 "the largest allowed diagonal entry of K_q (each actuator's input stiffness)",
@@ -253,7 +273,8 @@ class ComplianceSynthesis(ProblemKind):
                 "expected objective: {minimize: <measure>} or {maximize: <measure>}", path=path + ("objective",)
             )
         sense, measure = (1, obj["minimize"]) if obj.get("minimize") else (-1, obj["maximize"])
-        needs_ka = measure.startswith("compliance_") or inputs["compliance_max"]
+        direction = self._direction(inputs, model, measure, path)
+        needs_ka = measure.startswith("compliance_") or inputs["compliance_max"] or direction is not None
         if needs_ka and inputs["k_actuator"] is None:
             raise InputError(
                 "the output compliance with the actuators held is zero in the kinematic hinge model; give k_actuator "
@@ -289,7 +310,30 @@ class ComplianceSynthesis(ProblemKind):
             (),
             sigma,
             inputs["stress_check"] == "peak",
+            direction,
+            inputs["compliance_direction_max"],
         )
+
+    @staticmethod
+    def _direction(inputs: dict[str, Any], model: Model, measure: str, path: tuple) -> np.ndarray | None:
+        """The unit direction u of ``direction`` (None when neither the objective nor a requirement needs it)."""
+        c = model.closure
+        given = {k: v for k, v in (inputs["direction"] or {}).items() if v}
+        wanted = measure == "compliance_direction" or inputs["compliance_direction_max"] is not None
+        if not wanted:
+            return None
+        if not given:
+            raise InputError(
+                "compliance_direction needs inputs.direction: pose coordinate -> component", path=path + ("direction",)
+            )
+        kinds = {c.x[c.x_names.index(k)].kind for k in given}
+        if len(kinds) > 1:
+            raise InputError(
+                "a direction mixes lengths and angles, whose compliances have different units; give one kind",
+                path=path + ("direction",),
+            )
+        u = np.array([float(given.get(n, 0.0)) for n in c.x_names])
+        return u / np.linalg.norm(u)
 
     def run(self, model: Model, inputs: Mapping[str, Any], solver: SolverConfig) -> Result:
         require_ipopt(solver, self.name)
@@ -330,6 +374,8 @@ class ComplianceSynthesis(ProblemKind):
         out.add(
             matrix("K_q", f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"), m["K_q"].tolist()
         )
+        if "compliance_direction" in m:
+            out.add(Output("C_direction", _direction_dimension(model, req)), float(m["compliance_direction"]))
         out.add(Output("f1", "frequency"), m["f1"])  # None without masses or with the actuators held
         if "stress" in m:
             out.add(Output("stress_max", "stress"), float(m["stress"]))
@@ -396,7 +442,11 @@ class ComplianceSynthesis(ProblemKind):
         dev = [_rel(sp.K_q, m["K_q"])]
         ka = inputs["k_actuator"]
         if "C" in m:
-            dev.append(_rel(cm.output_compliance(sp, ka), m["C"]))
+            C = cm.output_compliance(sp, ka)
+            dev.append(_rel(C, m["C"]))
+            u = inputs["requirements"].direction
+            if u is not None:
+                dev.append(_rel(np.array([u @ C @ u]), np.array([m["compliance_direction"]])))
         if "stress" in m:
             peak = inputs["stress_check"] == "peak"
             worst = max(hs2.checked(cm.static_point(model, hs2, x, q).stresses, peak) or 0.0 for _, x, q in corners)
@@ -419,6 +469,7 @@ class ComplianceSynthesis(ProblemKind):
             matrix("C", "rows and columns the pose coordinates; SI"),
             *(diagonal_output(x) for x in c.x),
             matrix("K_q", f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"),
+            Output("C_direction", "compliance", unit="m/N or rad/(N*m): along inputs.direction"),
             Output("f1", "frequency"),
             Output("stress_max", "stress"),
             Output("sigma_allow", "stress"),
@@ -428,6 +479,11 @@ class ComplianceSynthesis(ProblemKind):
             Output("kkt_residual", "dimensionless"),
             Output("recheck_deviation", "dimensionless"),
         ]
+
+
+def _direction_dimension(model: Model, req: Requirements) -> str:
+    i = int(np.flatnonzero(req.direction)[0])
+    return diagonal_output(model.closure.x[i]).dimension
 
 
 def _with_home(poses: dict[str, Any], model: Model) -> dict[str, Any]:

@@ -254,6 +254,12 @@ def _problem(**inputs):
         ({"k_actuator": "rigid"}, ("inputs", "k_actuator"), "compliance with the actuators held"),
         ({"objective": {"maximize": "f1"}}, ("inputs", "masses"), "needs masses"),
         ({"objective": {"minimize": "stress"}}, ("inputs", "stroke"), "required stroke"),
+        ({"objective": {"minimize": "compliance_direction"}}, ("inputs", "direction"), "needs inputs.direction"),
+        (
+            {"objective": {"minimize": "compliance_direction"}, "direction": {"x": 1, "phi": 1}},
+            ("inputs", "direction"),
+            "mixes lengths and angles",
+        ),
     ],
 )
 def test_bad_synthesis_input_is_named(inputs, path, words):
@@ -296,3 +302,26 @@ def test_stress_over_given_poses_is_actuator_forces_stress():
     af = _forward(problem, design, "actuator_forces", {"x": [4e-3, 0.0], "y": [0.0, -4e-3], "phi": [0.0, 0.0]})
     assert max(af["stress_peak_max"]) == pytest.approx(400e6, rel=1e-7)
     assert af["stress_peak_max"][0] == pytest.approx(v["stress_max"], rel=1e-9)
+
+
+def test_compliance_along_a_direction_is_the_forward_compliance():
+    """A requirement on u^T C u along a direction (x + 2y, normalized) that binds (the most
+    compliant x design under it): the value is
+    platform_compliance's C read along u at the design."""
+    problem = load_problem(
+        RRR3_FILE,
+        [
+            "inputs.direction={x: 1, y: 2}",
+            "inputs.compliance_direction_max=500 um/N",
+            "inputs.objective={maximize: compliance_x}",
+        ],
+    )
+    res = solve(problem)
+    assert res.ok, res.message
+    v = res.values
+    assert "C along the direction" in v["active_constraints"]
+    assert v["C_direction"] == pytest.approx(500e-6, rel=1e-7)
+    design = {x.name: v[x.name] for x in problem.inputs["variables"]}
+    pc = _forward(problem, design, "platform_compliance", {"k_actuator": "10 N*m/rad"})
+    u = np.array([1.0, 2.0, 0.0]) / np.sqrt(5.0)
+    assert u @ np.array(pc["C"]) @ u == pytest.approx(v["C_direction"], rel=1e-9)
