@@ -49,6 +49,9 @@ from .link_masses import LinkBody, LinkSection, body_jacobians, rigid_velocity_m
 
 #: a constraint counts as active when its slack is below this fraction of its bound
 ACTIVE_RTOL = 1e-6
+#: round-off: a KKT residual or a relative deviation below it is reported as this value (the
+#: same on every machine; the digits below it depend on the BLAS kernel)
+ROUND_OFF = 1e-12
 
 
 @dataclass(frozen=True)
@@ -101,8 +104,15 @@ class Constraint:
     interval: str = ""
 
     def text(self) -> str:
+        """One line; an inactive constraint's multiplier is 0 (IPOPT's interior-point value, of
+        the order of its barrier parameter, is round-off and differs between machines)."""
         state = "active" if self.active else "inactive"
-        mult = "a matrix" if math.isnan(self.multiplier) else f"{self.multiplier:.3g}"
+        if not self.active:
+            mult = "0"
+        elif math.isnan(self.multiplier):
+            mult = "a matrix"
+        else:
+            mult = f"{self.multiplier:.3g}"
         value = f"{self.value:.6g} ({state}, multiplier {mult})"
         if self.interval:
             return f"{self.name} in {self.interval}: {value}"
