@@ -151,6 +151,7 @@ class SixAxisModel:
         self.nz = len(self._z)
         z = ca.vertcat(*self._z)
         self._legs, self._extra = legs, extra  # for the bodies' frames (`body_frames`)
+        self._body_frames: ca.Function | None = None
         g = self._closures(z, legs, extra)
         self.ng = g.numel()
         self._functions(z, g)
@@ -215,7 +216,9 @@ class SixAxisModel:
         each joint of each leg (a point p0 of it at the reference configuration is at
         R_b p0 + t_b), in leg and joint order, R stacked as 3 x 3 blocks side by side and t
         as columns.  The body after a joint moves with that joint's motions and its hinge's
-        extra axes (the same product of exponentials as the closures)."""
+        extra axes (the same product of exponentials as the closures).  Built once."""
+        if self._body_frames is not None:
+            return self._body_frames
         z = ca.vertcat(*self._z)
         Rs, ts = [], []
         for li, rows in enumerate(self._legs):
@@ -231,7 +234,8 @@ class SixAxisModel:
                 Rs.append(Rm)
                 ts.append(tm)
         name = f"{self.model.closure.name}_body_frames"
-        return ca.Function(name, [z], [ca.horzcat(*Rs), ca.horzcat(*ts)], ["z"], ["R", "t"])
+        self._body_frames = ca.Function(name, [z], [ca.horzcat(*Rs), ca.horzcat(*ts)], ["z"], ["R", "t"])
+        return self._body_frames
 
     def _functions(self, z: Any, g: Any) -> None:
         """The energy of every axis of every hinge, and the named CasADi functions."""

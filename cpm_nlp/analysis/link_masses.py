@@ -35,6 +35,7 @@ stiffness needs too.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -217,22 +218,29 @@ def _vee(S: Any) -> Any:
 def body_jacobians(sm: SixAxisModel, bodies: Sequence[LinkBody]) -> ca.Function:
     """``("<name>_link_jacobians", [z], [Jc, W])``: per body, the Jacobian of its centre J_c
     (3 x nz, stacked) and W_b = J_ωᵀ R_b F_b (nz x 3, side by side: the angular velocity about
-    the body's own axes t, b1, b2 per unit ż), so that M_z = Σ m J_cᵀ J_c + W diag(I) Wᵀ."""
+    the body's own axes t, b1, b2 per unit ż), so that M_z = Σ m J_cᵀ J_c + W diag(I) Wᵀ.
+    Built once per six-axis model and set of bodies (their places and frames)."""
+    key = tuple((b.leg, b.joint, tuple(b.centre), tuple(b.axes.ravel())) for b in bodies)
+    return _body_jacobians(sm, key)
+
+
+@functools.lru_cache(maxsize=16)
+def _body_jacobians(sm: SixAxisModel, key: tuple) -> ca.Function:
     frames = sm.body_frames()
     z = ca.SX.sym("z", sm.nz)
     zd = ca.SX.sym("zd", sm.nz)
     R_all, t_all = frames(z)
     offsets = np.cumsum([0] + [len(leg.joints) for leg in sm.chains.legs])
     Jc, W = [], []
-    for b in bodies:
-        k = int(offsets[b.leg]) + b.joint
+    for leg, joint, centre, axes in key:
+        k = int(offsets[leg]) + joint
         R, t = R_all[:, 3 * k : 3 * k + 3], t_all[:, k]
-        c = R @ ca.DM(b.centre) + t
+        c = R @ ca.DM(centre) + t
         Jc.append(ca.jacobian(c, z))
         Rdot = ca.reshape(ca.jacobian(ca.reshape(R, 9, 1), z) @ zd, 3, 3)
         omega = _vee(Rdot @ R.T)
         J_omega = ca.jacobian(omega, zd)
-        W.append(J_omega.T @ R @ ca.DM(b.axes))
+        W.append(J_omega.T @ R @ ca.DM(np.reshape(axes, (3, 3))))
     name = f"{sm.model.closure.name}_link_jacobians"
     return ca.Function(name, [z], [ca.densify(ca.vertcat(*Jc)), ca.densify(ca.horzcat(*W))], ["z"], ["Jc", "W"])
 
