@@ -204,13 +204,17 @@ class ComplianceSynthesisNLP:
         """k_j over the joint vector: the hinge formula on the designed dimensions, the given k elsewhere."""
         k: list[Any] = [float(v) for v in self.hs.k]
         self.designed: dict[str, dict[str, Any]] = {}
+        formulas: dict[str, Any] = {}  # a group's members share their type, dimensions and material
         for h in self.hs.hinges:
             dims = {d: values.get((h.group, d), v) for d, v in h.dims.items() if d != "Kt"}
             if not any((h.group, d) in values for d in dims):
                 continue
             mat = h.material
             G = mat.G if mat.nu is not None else None
-            formula = HINGE_TABLE[h.kind].stiffness(mat.E, G, dims)
+            key = f"{h.group}/{mat.name}/{mat.E}/{mat.nu}"
+            if key not in formulas:
+                formulas[key] = HINGE_TABLE[h.kind].stiffness(mat.E, G, dims)
+            formula = formulas[key]
             for a, i in h.axes.items():
                 k[i] = formula[a]
             self.designed[h.name] = dims
