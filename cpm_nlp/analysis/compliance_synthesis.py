@@ -215,8 +215,8 @@ class ComplianceSynthesisNLP:
             if key not in formulas:
                 formulas[key] = HINGE_TABLE[h.kind].stiffness(mat.E, G, dims)
             formula = formulas[key]
-            for a, i in h.axes.items():
-                k[i] = formula[a]
+            for a, i in h.axes.items():  # an axis the formula does not give (no nu) keeps its given k
+                k[i] = formula.get(a, h.k[a])
             self.designed[h.name] = dims
         return k
 
