@@ -340,6 +340,12 @@ class SixAxisModel:
                 z[free] -= np.linalg.lstsq(Af, g, rcond=None)[0]
         return z
 
+    def linearization(self, z: np.ndarray, lam: np.ndarray, ka: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+        """H = ∇²(V + λᵀg) (nz x nz, with actuator springs ``ka`` on q) and A = ∂g/∂z (ng x nz) at
+        (z, λ), no load, the actuators commanded where they are."""
+        _, _, H, A = self._eval(z, lam, self._par(np.zeros(self.nx), z[self.nx : self.nx + self.nq], ka, None))
+        return H, A
+
     def _eval(self, z: np.ndarray, lam: np.ndarray, par: np.ndarray) -> tuple[np.ndarray, ...]:
         """grad_L (nz), g (ng), H (nz x nz), A (ng x nz) as numpy arrays."""
         gl, g, H, A, _ = self._kkt_fast(z, lam, par)

@@ -266,7 +266,7 @@ def rigid_velocity_map(sm: SixAxisModel, z: np.ndarray) -> np.ndarray:
     """T = dz/dq (nz x nq) along the rigid kinematics at z: the actuators move, the hinges'
     extra axes stay at rest, the chains' variables and the pose follow the closures
     (minimum norm where the chains leave a motion free, e.g. a leg's spin)."""
-    _, _, _, A = sm._eval(z, np.zeros(sm.ng), sm._par(np.zeros(sm.nx), z[sm.nx : sm.nx + sm.nq], None, None))
+    _, A = sm.linearization(z, np.zeros(sm.ng))
     extra = {zi for fr in sm.frames for a, (zi, _) in fr.variables.items() if a in fr.extra}
     q_idx = np.arange(sm.nx, sm.nx + sm.nq)
     rest = [i for i in range(sm.nz) if i not in extra and not (sm.nx <= i < sm.nx + sm.nq)]
@@ -299,7 +299,7 @@ def six_axis_modes(
     LinAlgError when the stiffness on the closures' motions is singular or no motion has mass."""
     nx, nq = sm.nx, sm.nq
     kav = np.zeros(nq) if ka is None else np.asarray(ka, dtype=float)
-    _, _, H, A = sm._eval(z, lam, sm._par(np.zeros(nx), z[nx : nx + nq], kav, None))
+    H, A = sm.linearization(z, lam, kav)
     free = np.concatenate([np.arange(nx), np.arange(nx + nq, sm.nz)]) if held else np.arange(sm.nz)
     N = scipy.linalg.null_space(A[:, free])
     Kr = N.T @ H[np.ix_(free, free)] @ N
