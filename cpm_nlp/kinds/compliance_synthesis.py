@@ -15,7 +15,7 @@ import scipy.linalg
 
 from ..analysis import compliance as cm
 from ..analysis.compliance_synthesis import ROUND_OFF, ComplianceSynthesisNLP, Requirements, Variable
-from ..analysis.compliance_values import diagonal_output
+from ..analysis.compliance_values import compliance_output, diagonal_output
 from ..analysis.hinge_models import HINGE_MODELS, has_chains
 from ..analysis.hinge_types import DIM_OPTIONS
 from ..analysis.link_masses import link_bodies
@@ -24,12 +24,11 @@ from ..core.kind import ProblemKind, broadcast, require_ipopt, task_options, tas
 from ..core.kinematics import inverse_kinematics
 from ..core.model import Model
 from ..core.options import Option
-from ..core.outputs import Output, Values, declared_result, matrix, text
+from ..core.outputs import Output, Values, declared_result, text
 from ..core.result import Result, SolverInfo, Status
 from ..core.schema import MappingOf, Quantity, Record
 from ..core.solver import SolverConfig
-from ..core.units import result_unit
-from .compliance import _coordinate_masses, _links_node, masses_node
+from .compliance import _coordinate_masses, _k_q_output, _links_node, masses_node
 from .hinge_inputs import hinge_options, k_actuator_option
 from .kinematic import _model_info
 
@@ -138,6 +137,8 @@ def _stroke_node(model: Model) -> Record:
 class ComplianceSynthesis(ProblemKind):
     name = "compliance_synthesis"
     parts = (cm.JointStiffness,)
+    #: the output compliance C and the input stiffness K_q of the design, as heat maps
+    plots = ("matrices",)
     description = (
         "hinge dimensions (t, r, w per hinge group) and link sections that minimize or maximize a compliance, "
         "stress, input-stiffness or frequency measure under stiffness, stress, frequency and stroke requirements "
@@ -369,11 +370,9 @@ class ComplianceSynthesis(ProblemKind):
             out.add(Output(v.name, "length"), res.design[v.name])
         m = res.measures
         if "C" in m:
-            out.add(matrix("C", "rows and columns the pose coordinates; SI"), m["C"].tolist())
+            out.add(compliance_output(c), m["C"].tolist())
             out.add_all((diagonal_output(x), float(m["C"][i, i])) for i, x in enumerate(c.x))
-        out.add(
-            matrix("K_q", f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"), m["K_q"].tolist()
-        )
+        out.add(_k_q_output(c), m["K_q"].tolist())
         if "compliance_direction" in m:
             out.add(Output("C_direction", _direction_dimension(model, req)), float(m["compliance_direction"]))
         out.add(Output("f1", "frequency"), m["f1"])  # None without masses or with the actuators held
@@ -467,9 +466,9 @@ class ComplianceSynthesis(ProblemKind):
         design = [Output("{name}", "length", per="design variable: <dimension>_<hinge group or link>")]
         return [
             *design,
-            matrix("C", "rows and columns the pose coordinates; SI"),
+            compliance_output(c),
             *(diagonal_output(x) for x in c.x),
-            matrix("K_q", f"{result_unit('stiffness')} or {result_unit('rotational_stiffness')}"),
+            _k_q_output(c),
             Output("C_direction", "compliance", unit="m/N or rad/(N*m): along inputs.direction"),
             Output("f1", "frequency"),
             Output("stress_max", "stress"),
