@@ -49,6 +49,11 @@ from .link_masses import LinkBody, LinkSection, body_jacobians, rigid_velocity_m
 
 #: a constraint counts as active when its slack is below this fraction of its bound
 ACTIVE_RTOL = 1e-6
+#: the measures minimized through an epigraph variable (their components: max_i c_i)
+EPIGRAPH = {
+    "stress": lambda nlp: ca.vertcat(*[sigma for _, sigma in nlp.stresses]),
+    "input_stiffness": lambda nlp: ca.diag(nlp.measures["K_q"]),
+}
 #: round-off: a KKT residual or a relative deviation below it is reported as this value (the
 #: same on every machine; the digits below it depend on the BLAS kernel)
 ROUND_OFF = 1e-12
@@ -277,17 +282,26 @@ class ComplianceSynthesisNLP:
             w += self._frequency_variables()
             g += self._frequency_equations()
         g += self._inequalities()
-        self.w = ca.vertcat(*w)
-        self.g = ca.vertcat(*g) if g else ca.SX.zeros(0)
+        self.n_ineq = len(self.g_info)
         sense, measure = req.objective
+        self.fscale = ca.SX.sym("fscale")
+        self.n_epi = 0
         if measure == "f1":
             f = -self.s if sense < 0 else self.s
+        elif measure in EPIGRAPH:  # min max_i c_i as min τ s.t. c_i / scale <= τ: smooth
+            parts = EPIGRAPH[measure](self)
+            self.tau = ca.SX.sym("tau")
+            w.append(self.tau)
+            g += [parts[i] / self.fscale - self.tau for i in range(parts.numel())]
+            self.n_epi = parts.numel()
+            f = self.measures[measure]
         else:
             f = sense * self.measures[measure]
+        self.w = ca.vertcat(*w)
+        self.g = ca.vertcat(*g) if g else ca.SX.zeros(0)
         self.f_raw = f
-        self.fscale = ca.SX.sym("fscale")
         self.p = ca.vertcat(self.fscale, self.kscale)
-        self.f = f / self.fscale
+        self.f = self.tau if self.n_epi else f / self.fscale
         self.nlp_fn = ca.Function(
             "compliance_synthesis_nlp",
             [self.w, self.p],
@@ -369,7 +383,12 @@ class ComplianceSynthesisNLP:
             Lc = np.linalg.cholesky(K - s0 * M + 1e-12 * np.abs(K).max() * np.eye(self.nq))
             w0 += [np.array([s0]), Lc[np.tril_indices(self.nq)]]
             kscale = [float(np.abs(K).max())]
-        f0 = float(ca.Function("f0", [self.w], [self.f_raw])(np.concatenate(w0)))
+        if self.req.objective[1] == "f1":
+            f0 = float(w0[1][0])  # ω₁² at the start
+        else:
+            f0 = float(ca.Function("f0", [self.y], [self.f_raw])(y0))
+        if self.n_epi:
+            w0.append(np.array([1.0]))  # τ = max_i c_i / scale at the start
         return np.concatenate(w0), np.array([max(abs(f0), 1e-300), *kscale])
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -391,6 +410,7 @@ class ComplianceSynthesisNLP:
         ng = self.g.numel()
         lbg, ubg = np.full(ng, -np.inf), np.ones(ng)
         lbg[: self.n_eq] = ubg[: self.n_eq] = 0.0
+        ubg[self.n_eq + self.n_ineq :] = 0.0  # the epigraph: c_i / scale - τ <= 0
         return lbx, ubx, lbg, ubg
 
     def solve(self, y0: np.ndarray, max_iter: int = 500) -> SynthesisOutcome:
@@ -431,7 +451,8 @@ class ComplianceSynthesisNLP:
         out.y, out.lam_g, out.lam_x, out.w, out.p = y, lam_g, lam_x, w, par
         out.design = {v.name: float(v.value(y[i])) for i, v in enumerate(self.variables)}
         g = g.ravel()
-        viol = max([0.0, *(g[self.n_eq :] - 1.0)]) if g.size else 0.0
+        _, _, _, ubg = self.bounds()
+        viol = max([0.0, *(g[self.n_eq :] - ubg[self.n_eq :])]) if g.size else 0.0
         if g.size and self.n_eq:
             viol = max(viol, float(np.max(np.abs(g[: self.n_eq]))))
         if viol > 1e-7:

@@ -274,6 +274,11 @@ class ComplianceSynthesis(ProblemKind):
                 "expected objective: {minimize: <measure>} or {maximize: <measure>}", path=path + ("objective",)
             )
         sense, measure = (1, obj["minimize"]) if obj.get("minimize") else (-1, obj["maximize"])
+        if sense < 0 and measure in ("stress", "input_stiffness"):
+            raise InputError(
+                f"{measure} is a largest value over hinges or actuators: it can be minimized, not maximized",
+                path=path + ("objective", "maximize"),
+            )
         direction = self._direction(inputs, model, measure, path)
         needs_ka = measure.startswith("compliance_") or inputs["compliance_max"] or direction is not None
         if needs_ka and inputs["k_actuator"] is None:
