@@ -22,7 +22,9 @@ a variable ω₁² = s_f and a Cholesky factor: K_q + K_a - s_f M = L Lᵀ with 
 and L_ii >= 0, which holds exactly when K_q + K_a - s_f M is positive semidefinite, i.e. when
 f1 >= sqrt(s_f)/(2π) -- smooth where the eigenvalue is not (the 3-PRS's tilt frequencies are
 repeated).  The stroke requirement (the stress-limited range covers the required stroke) is
-σ <= σ_allow at every corner of the stroke box, the motion's largest deflections.
+σ <= σ_allow at every corner of the stroke box, the motion's largest deflections.  The
+largest stress or input stiffness as an objective is min τ subject to every entry / scale <= τ
+(an epigraph variable: smooth where several entries are equal).
 
 The design variables are scaled to [0, 1] over their bounds.  The optimum is re-evaluated by
 the forward analysis (`static_point`, `output_compliance`, the eigenvalues), and every
