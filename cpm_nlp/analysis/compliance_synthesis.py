@@ -46,6 +46,7 @@ import scipy.linalg
 
 from ..core.model import Model
 from . import compliance as cm
+from .hinge_chains import six_axis_model
 from .hinge_types import HINGE_TABLE
 from .link_masses import LinkBody, LinkSection, body_jacobians, rigid_velocity_map
 
@@ -94,6 +95,8 @@ class Requirements:
     #: allowed compliance uᵀ C u along it
     direction: np.ndarray | None = None
     direction_max: float | None = None
+    #: the output compliance C of the six-axis hinge model at home (True) or of the kinematic one
+    six_axis: bool = False
 
 
 @dataclass
@@ -190,8 +193,11 @@ class ComplianceSynthesisNLP:
         self.K = Kq + (ca.diag(ca.DM(self.ka)) if self.ka is not None else 0)
         self.M = self._mass(M_x, M_q, values, links)
         self.measures: dict[str, Any] = {"K_q": Kq}
-        if self.ka is not None:
-            C = ca.mtimes(ca.DM(self.J), ca.solve(self.K, ca.DM(self.J.T)))
+        if req.six_axis or self.ka is not None:
+            if req.six_axis:
+                C = self._six_axis_compliance()
+            else:
+                C = ca.mtimes(ca.DM(self.J), ca.solve(self.K, ca.DM(self.J.T)))
             self.measures["C"] = C
             for i, x in enumerate(c.x):
                 self.measures[f"compliance_{x.name}"] = C[i, i]
@@ -226,6 +232,38 @@ class ComplianceSynthesisNLP:
                 k[i] = formula.get(a, h.k[a])
             self.designed[h.name] = dims
         return k
+
+    def _six_axis_compliance(self) -> Any:
+        """C of the six-axis hinge model at home (`cpm_nlp.analysis.hinge_chains`): unstressed, so
+        λ = 0 and the Hessian is diag(k) over the hinges' axis variables (plus K_a on q); with N a
+        basis of the closures' motions (actuators held, or free on K_a), C = P (Nᵀ diag(k) N)⁻¹ Pᵀ,
+        P the pose rows of N.  The designed hinges' k symbolic: their kinematic axes by the type's
+        stiffness formula, the others by its six-axis formula."""
+        model, nx, nq = self.model, self.model.closure.nx, self.nq
+        sm = six_axis_model(model, self.hs)
+        ok, z, lam, _ = sm.newton(sm.start(model.x_home, model.q_home), np.zeros(nx), model.q_home, None, None)
+        if not ok:  # pragma: no cover - home is the chains' reference, an equilibrium by construction
+            raise np.linalg.LinAlgError("no unloaded equilibrium of the six-axis model at home")
+        H, A = sm.linearization(z, lam, self.ka)
+        h: list[Any] = list(np.diag(H))
+        groups = {hg.name: hg for hg in self.hs.hinges}
+        six: dict[str, Any] = {}
+        for fr in sm.frames:
+            hinge = groups.get(fr.name)
+            if hinge is None or hinge.name not in self.designed:
+                continue
+            if hinge.group not in six:
+                mat = hinge.material
+                six[hinge.group] = HINGE_TABLE[hinge.kind].six_axis(mat.E, mat.G, self.designed[hinge.name])
+            for a, (zi, _) in fr.variables.items():
+                h[zi] = self.k[hinge.axes[a]] if a in hinge.axes else six[hinge.group][a]
+        held = self.ka is None
+        free = np.concatenate([np.arange(nx), np.arange(nx + nq, sm.nz)]) if held else np.arange(sm.nz)
+        N = scipy.linalg.null_space(A[:, free])
+        hv = ca.vertcat(*[h[i] for i in free])
+        Kr = ca.mtimes([ca.DM(N.T), ca.diag(hv), ca.DM(N)])
+        P = ca.DM(N[:nx])  # the pose coordinates come first among the free variables
+        return ca.mtimes(P, ca.solve(Kr, P.T))
 
     def _stresses(self) -> list[tuple[str, Any]]:
         """(label, σ) of every hinge with a type at every stroke pose where it deflects."""

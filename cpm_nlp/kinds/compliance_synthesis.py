@@ -16,6 +16,7 @@ import scipy.linalg
 from ..analysis import compliance as cm
 from ..analysis.compliance_synthesis import ROUND_OFF, ComplianceSynthesisNLP, Requirements, Variable
 from ..analysis.compliance_values import compliance_output, diagonal_output
+from ..analysis.hinge_chains import six_axis_model
 from ..analysis.hinge_models import HINGE_MODELS, has_chains
 from ..analysis.hinge_types import DIM_OPTIONS
 from ..analysis.link_masses import link_bodies
@@ -156,6 +157,15 @@ class ComplianceSynthesis(ProblemKind):
             ka,
             _objective_node(model),
             _compliance_max_node(model),
+            Option(
+                "hinge_axes",
+                "choice",
+                "the hinge model of the output compliance C: 'kinematic' (each hinge about the axes the kinematics "
+                "moves; C = J (K_q + K_a)^-1 J^T) or 'all' (every flexure a six-axis spring, at home: also with the "
+                "actuators held, the parasitic compliance); stresses, K_q and f1 are the kinematic model's",
+                default="kinematic",
+                choices=("kinematic", "all"),
+            ),
             Record(
                 "direction",
                 "a direction in the pose coordinates (components, normalized; all on lengths or all on angles) for "
@@ -281,7 +291,8 @@ class ComplianceSynthesis(ProblemKind):
             )
         direction = self._direction(inputs, model, measure, path)
         needs_ka = measure.startswith("compliance_") or inputs["compliance_max"] or direction is not None
-        if needs_ka and inputs["k_actuator"] is None:
+        six = _six_axis_chosen(inputs, model, hs, path)
+        if needs_ka and inputs["k_actuator"] is None and not six:
             raise InputError(
                 "the output compliance with the actuators held is zero in the kinematic hinge model; give k_actuator "
                 "(a stiffness, or 0 N/m for the actuator forces held)",
@@ -318,6 +329,7 @@ class ComplianceSynthesis(ProblemKind):
             inputs["stress_check"] == "peak",
             direction,
             inputs["compliance_direction_max"],
+            six,
         )
 
     @staticmethod
@@ -447,7 +459,7 @@ class ComplianceSynthesis(ProblemKind):
         dev = [_rel(sp.K_q, m["K_q"])]
         ka = inputs["k_actuator"]
         if "C" in m:
-            C = cm.output_compliance(sp, ka)
+            C = _six_axis_home(model, hs2, ka) if inputs["hinge_axes"] == "all" else cm.output_compliance(sp, ka)
             dev.append(_rel(C, m["C"]))
             u = inputs["requirements"].direction
             if u is not None:
@@ -484,6 +496,24 @@ class ComplianceSynthesis(ProblemKind):
             Output("kkt_residual", "dimensionless"),
             Output("recheck_deviation", "dimensionless"),
         ]
+
+
+def _six_axis_chosen(inputs: Mapping[str, Any], model: Model, hs: cm.HingeSet, path: tuple) -> bool:
+    """Whether C is the six-axis model's (``hinge_axes: all``), checked to place every hinge."""
+    if inputs["hinge_axes"] != "all":
+        return False
+    if not has_chains(model):
+        raise InputError(f"hinge_axes: all needs the legs of {model.name} as chains", path=path + ("hinge_axes",))
+    HINGE_MODELS["all"].prepare(model, hs, path + ("hinge_axes",), True)  # every hinge placed, else bad input
+    return True
+
+
+def _six_axis_home(model: Model, hs: cm.HingeSet, ka: np.ndarray | None) -> np.ndarray:
+    """The six-axis hinge model's C at home, as platform_compliance (hinge_axes: all) computes it."""
+    sm = six_axis_model(model, hs)
+    c = model.closure
+    _, z, lam, _ = sm.newton(sm.start(model.x_home, model.q_home), np.zeros(c.nx), model.q_home, None, None)
+    return sm.compliance(z, lam, ka, None if ka is None else np.zeros(c.nq))
 
 
 def _direction_dimension(model: Model, req: Requirements) -> str:

@@ -21,7 +21,7 @@ import pytest
 from cpm_nlp.analysis import compliance as cm
 from cpm_nlp.analysis.compliance_synthesis import ComplianceSynthesisNLP, Requirements
 from cpm_nlp.core.errors import InputError
-from cpm_nlp.kinds.compliance_synthesis import ComplianceSynthesis, designed_hinges
+from cpm_nlp.kinds.compliance_synthesis import ComplianceSynthesis, _six_axis_home, designed_hinges
 from cpm_nlp.problems.file import load_problem, problem_from_dict, solve
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -53,6 +53,16 @@ CASES = {
     "prs3": (PRS3_FILE, []),
     "rrr3": (RRR3_FILE, []),
     "rrr3_min_stress": (RRR3_FILE, ["inputs.objective={minimize: stress}", "inputs.compliance_max={x: 400 um/N}"]),
+    # the lateral (parasitic) compliance of the six-axis model with the sliders held, a requirement
+    "prs3_six_axis": (
+        PRS3_FILE,
+        [
+            "inputs.hinge_axes=all",
+            "inputs.k_actuator=rigid",
+            "inputs.compliance_max={px: 8 um/N}",
+            "inputs.objective={minimize: input_stiffness}",
+        ],
+    ),
 }
 
 
@@ -177,7 +187,11 @@ def test_ad_derivatives_equal_central_differences_of_the_forward_analysis(solved
         for name, _, bound in nlp.g_info:
             if name.startswith("C_"):
                 i = model.closure.x_names.index(name[2:])
-                vals.append(cm.output_compliance(sp, inputs["k_actuator"])[i, i] / bound)
+                if inputs["hinge_axes"] == "all":
+                    C = _six_axis_home(model, hs, inputs["k_actuator"])
+                else:
+                    C = cm.output_compliance(sp, inputs["k_actuator"])
+                vals.append(C[i, i] / bound)
             elif name.startswith("stress"):
                 hinge, where = name.split()[1], name.split(" at ", 1)[1]
                 x, q = next((x, q) for label, x, q in corners if label == where)
@@ -337,3 +351,17 @@ def test_compliance_along_a_direction_is_the_forward_compliance():
     pc = _forward(problem, design, "platform_compliance", {"k_actuator": "10 N*m/rad"})
     u = np.array([1.0, 2.0, 0.0]) / np.sqrt(5.0)
     assert u @ np.array(pc["C"]) @ u == pytest.approx(v["C_direction"], rel=1e-9)
+
+
+def test_six_axis_compliance_of_the_design_is_platform_compliances():
+    """With hinge_axes: all the lateral compliance with the sliders held binds at 8 um/N, and
+    platform_compliance (hinge_axes: all, sliders held) on the designed hinges gives that C."""
+    problem = load_problem(PRS3_FILE, list(CASES["prs3_six_axis"][1]))
+    res = solve(problem)
+    assert res.ok, res.message
+    v = res.values
+    assert "C_px" in v["active_constraints"].split(", ") and v["C_px"] == pytest.approx(8e-6, rel=1e-7)
+    design = {x.name: v[x.name] for x in problem.inputs["variables"]}
+    pc = _forward(problem, design, "platform_compliance", {"hinge_axes": "all", "k_actuator": "rigid"})
+    assert pc["hinge_model"] == "all"
+    np.testing.assert_allclose(pc["C"], v["C"], rtol=1e-7, atol=1e-7 * np.abs(v["C"]).max())
