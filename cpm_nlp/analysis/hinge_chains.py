@@ -159,6 +159,8 @@ class SixAxisModel:
         self.rest = np.array(rest)
         self.nz = len(self._z)
         z = ca.vertcat(*self._z)
+        self._legs, self._extra = legs, extra  # for the bodies' frames (`body_frames`)
+        self._body_frames: ca.Function | None = None
         g = self._closures(z, legs, extra)
         self.ng = g.numel()
         self._functions(z, g)
@@ -223,6 +225,32 @@ class SixAxisModel:
             M = DR.T @ Rm
             g.append(vee(M))  # rotation
         return ca.vertcat(*g)
+
+    def body_frames(self) -> ca.Function:
+        """``("<name>_body_frames", [z], [R, t])``: the rigid motion (R_b, t_b) of the body after
+        each joint of each leg (a point p0 of it at the reference configuration is at
+        R_b p0 + t_b), in leg and joint order, R stacked as 3 x 3 blocks side by side and t
+        as columns.  The body after a joint moves with that joint's motions and its hinge's
+        extra axes (the same product of exponentials as the closures).  Built once."""
+        if self._body_frames is not None:
+            return self._body_frames
+        z = ca.vertcat(*self._z)
+        Rs, ts = [], []
+        for li, rows in enumerate(self._legs):
+            Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
+            for ji, (j, motions) in enumerate(rows):
+                for kind, axis, value in motions + self._extra.get((li, ji), []):
+                    if kind == "P":
+                        Rk, tk = ca.SX.eye(3), value * ca.DM(axis)
+                    else:
+                        Rk = _rot(axis, value)
+                        tk = ca.DM(j.at) - Rk @ ca.DM(j.at)
+                    Rm, tm = Rm @ Rk, Rm @ tk + tm
+                Rs.append(Rm)
+                ts.append(tm)
+        name = f"{self.model.closure.name}_body_frames"
+        self._body_frames = ca.Function(name, [z], [ca.horzcat(*Rs), ca.horzcat(*ts)], ["z"], ["R", "t"])
+        return self._body_frames
 
     def _functions(self, z: Any, g: Any) -> None:
         """The energy of every axis of every hinge, and the named CasADi functions."""
@@ -395,6 +423,12 @@ class SixAxisModel:
             except np.linalg.LinAlgError:
                 z[free] -= np.linalg.lstsq(Af, g, rcond=None)[0]
         return z
+
+    def linearization(self, z: np.ndarray, lam: np.ndarray, ka: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+        """H = ∇²(V + λᵀg) (nz x nz, with actuator springs ``ka`` on q) and A = ∂g/∂z (ng x nz) at
+        (z, λ), no load, the actuators commanded where they are."""
+        _, _, H, A = self._eval(z, lam, self._par(np.zeros(self.nx), z[self.nx : self.nx + self.nq], ka, None))
+        return H, A
 
     def _eval(self, z: np.ndarray, lam: np.ndarray, par: np.ndarray) -> tuple[np.ndarray, ...]:
         """grad_L (nz), g (ng), H (nz x nz), A (ng x nz) as numpy arrays."""

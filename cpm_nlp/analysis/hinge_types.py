@@ -17,6 +17,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
+import casadi as ca
 import numpy as np
 
 from ..core.errors import InputError
@@ -33,12 +34,21 @@ from .flexure import (
 from .flexure_compliance import circular_notch_compliances, rectangle_torsion_constant
 
 
+def _larger(a, c):
+    """max(a, c), on floats and on CasADi symbols (a design variable)."""
+    return ca.fmax(a, c) if isinstance(a, ca.SX | ca.MX) or isinstance(c, ca.SX | ca.MX) else max(a, c)
+
+
+def _smaller(a, c):
+    return ca.fmin(a, c) if isinstance(a, ca.SX | ca.MX) or isinstance(c, ca.SX | ca.MX) else min(a, c)
+
+
 def rectangle_torsion_stress(T, a, c):
     """Largest shear stress of an a x c rectangle (a >= c) under torsion T,
     τ = 3T/(8 A B²) [1 + 0.6095 (B/A) + 0.8865 (B/A)² - 1.8023 (B/A)³ + 0.9100 (B/A)⁴]
     with 2A = a, 2B = c (W. C. Young, R. G. Budynas, Roark's Formulas for Stress
     and Strain, 7th ed., Table 10.7, case 4)."""
-    a, c = max(a, c), min(a, c)
+    a, c = _larger(a, c), _smaller(a, c)
     A, B = a / 2.0, c / 2.0
     ratio = B / A
     return 3.0 * T / (8.0 * A * B**2) * (1 + 0.6095 * ratio + 0.8865 * ratio**2 - 1.8023 * ratio**3 + 0.91 * ratio**4)
@@ -94,7 +104,7 @@ def filleted_rod_kt(d, r):
 
 
 def _von_mises(sigma: float, tau: float) -> float:
-    return math.sqrt(sigma**2 + 3.0 * tau**2)
+    return (sigma**2 + 3.0 * tau**2) ** 0.5  # ** 0.5: also on CasADi symbols
 
 
 def _rect_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
@@ -113,7 +123,7 @@ def _rod_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
     resultant of both bending moments, τ = 16 T/(π d³), von Mises (Euler-Bernoulli
     and Saint-Venant torsion of a circular section)."""
     dia = d["d"]
-    m = math.hypot(loads.get("bend", 0.0), loads.get("bend2", 0.0))
+    m = (loads.get("bend", 0.0) ** 2 + loads.get("bend2", 0.0) ** 2) ** 0.5
     sigma = 32.0 * m / (math.pi * dia**3) + 4.0 * abs(loads.get("axial", 0.0)) / (math.pi * dia**2)
     tau = 16.0 * abs(loads.get("torsion", 0.0)) / (math.pi * dia**3)
     return _von_mises(sigma, tau)
@@ -139,7 +149,7 @@ def _leaf_stiffness(E, G, d) -> dict[str, float]:
     t, w, length = d["t"], d["w"], d["l"]
     out = {"bend": E * w * t**3 / 12 / length, "bend2": E * t * w**3 / 12 / length, "axial": E * w * t / length}
     if G is not None:
-        out["torsion"] = G * float(rectangle_torsion_constant(max(w, t), min(w, t))) / length
+        out["torsion"] = G * rectangle_torsion_constant(_larger(w, t), _smaller(w, t)) / length
     return out
 
 

@@ -42,6 +42,7 @@ GENERIC = {
     "actuator_forces": "compliance:ActuatorForces",
     "platform_compliance": "compliance:PlatformCompliance",
     "natural_frequencies": "compliance:NaturalFrequencies",
+    "compliance_synthesis": "compliance_synthesis:ComplianceSynthesis",
 }
 
 

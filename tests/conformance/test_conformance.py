@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 import cpm_nlp as cn
+from cpm_nlp.analysis import compliance as cm
 from cpm_nlp.analysis import workspace as W
 from cpm_nlp.core.result import Status
 from cpm_nlp.problems.shipped import shipped_problems_dir
@@ -418,6 +419,32 @@ def _natural_frequencies(subject, near_home) -> None:
     np.testing.assert_allclose(f, np.sqrt(w2) / (2 * np.pi), rtol=1e-6)
 
 
+def _compliance_synthesis(subject, near_home) -> None:
+    """The thinnest section (t, else d) of the mechanism's first typed hinge group, 20 % about its
+    value, for the smallest input stiffness: the optimum sits on the lower bound (the stiffness
+    grows with it), re-evaluated by the forward analysis.  Without a typed hinge (generated
+    springs) the design is refused, naming the hinge."""
+    hs = cm.hinge_set(subject.model, cc.inputs_of(subject, "actuator_forces", near_home).get("hinges"))
+    typed = [h for h in hs.hinges if h.kind is not None and h.material is not None and h.material.E is not None]
+    objective = {"minimize": "input_stiffness"}
+    if not typed:
+        group = hs.hinges[0].group
+        with pytest.raises(cn.InputError, match="needs a flexure type"):
+            subject.problem(
+                "compliance_synthesis",
+                {"hinges": cc._hinges(subject), "design": {group: {"t": [1e-3, 2e-3]}}, "objective": objective},
+            )
+        return
+    h = typed[0]
+    dim = "t" if "t" in h.dims else "d"
+    v = h.dims[dim]
+    res = _solve(
+        subject, "compliance_synthesis", {"design": {h.group: {dim: [0.8 * v, 1.2 * v]}}, "objective": objective}
+    )
+    assert res.values[f"{dim}_{h.group}"] == pytest.approx(0.8 * v, rel=1e-6)
+    assert res.values["recheck_deviation"] < 1e-9 and res.values["kkt_residual"] < 1e-8
+
+
 def _dynamics(subject, near_home) -> None:
     """The mechanism's Lagrange model: f from |K - w^2 M| = 0 and q_static = -K^-1 G, on the
     parameters of its shipped dynamics example (the dynamics needs more than the kinematics)."""
@@ -448,6 +475,7 @@ CHECKS = {
     "actuator_forces": _actuator_forces,
     "platform_compliance": _platform_compliance,
     "natural_frequencies": _natural_frequencies,
+    "compliance_synthesis": _compliance_synthesis,
     "dynamics": _dynamics,
 }
 
