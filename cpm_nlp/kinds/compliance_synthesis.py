@@ -29,7 +29,8 @@ from ..core.outputs import Output, Values, declared_result, text
 from ..core.result import Result, SolverInfo, Status
 from ..core.schema import MappingOf, Quantity, Record
 from ..core.solver import SolverConfig
-from .compliance import _coordinate_masses, _k_q_output, _links_node, masses_node
+from .compliance import _k_q_output
+from .frequencies import _coordinate_masses, _links_node, masses_node
 from .hinge_inputs import hinge_options, k_actuator_option
 from .kinematic import _model_info
 

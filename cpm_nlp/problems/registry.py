@@ -41,7 +41,7 @@ GENERIC = {
     "synthesis": "synthesis:Synthesis",
     "actuator_forces": "compliance:ActuatorForces",
     "platform_compliance": "compliance:PlatformCompliance",
-    "natural_frequencies": "compliance:NaturalFrequencies",
+    "natural_frequencies": "frequencies:NaturalFrequencies",
     "compliance_synthesis": "compliance_synthesis:ComplianceSynthesis",
 }
 
