@@ -298,7 +298,7 @@ def richardson(values, scales=SCALES) -> dict:
     return {"values": [q1, q2, q3], "order": p, "extrapolated": ext, "error": err, "relative_error": err / abs(ext)}
 
 
-def notch_reference(t, R, w, E, nu, block=None, scales=SCALES, base=(8, 1, 2)) -> dict:
+def notch_reference(t, R, w, E, nu, block=None, scales=SCALES, base=(8, 1, 2), cases=None) -> dict:
     """The rotational (about z), other bending (about y), torsional and axial stiffnesses of a
     circular notch hinge [N m/rad, N/m] (the blocks' beam compliances subtracted) and its root
     stress ratios, per mesh scale and Richardson-extrapolated over three scales."""
@@ -306,11 +306,12 @@ def notch_reference(t, R, w, E, nu, block=None, scales=SCALES, base=(8, 1, 2)) -
     Lb = t + 2.0 * R if block is None else block
     blocks = block_compliances(t, R, w, Lb, E, nu)
     points = [(0.0, t / 2, 0.0), (0.0, t / 2, w / 2)]
-    runs = [solve(body, s, E, nu, stress_at=points) for s in scales]
+    runs = [solve(body, s, E, nu, stress_at=points, cases=cases) for s in scales]
     index = {"bend": 5, "bend2": 4, "torsion": 3, "axial": 0}
-    quantities = {key: [1.0 / (r["C"][i, i] - blocks[key]) for r in runs] for key, i in index.items()}
+    solved = {c for i in (range(4) if cases is None else cases) for c in SYMMETRY_CASES[i][2]}
+    quantities = {key: [1.0 / (r["C"][i, i] - blocks[key]) for r in runs] for key, i in index.items() if i in solved}
     nominal = 6.0 / (w * t**2)
-    for name, idx in (("mid", 0), ("edge", 1)):
+    for name, idx in (("mid", 0), ("edge", 1)) if 5 in solved else ():
         quantities[f"sxx_{name}"] = [-r["stress"][idx][0, 0] / nominal for r in runs]
         quantities[f"vm_{name}"] = [von_mises(r["stress"][idx]) / nominal for r in runs]
     out = {k: richardson(v, scales) if len(v) == 3 else {"values": v} for k, v in quantities.items()}
