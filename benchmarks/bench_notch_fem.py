@@ -6,7 +6,10 @@ tests/reference/notch_fem.py.
 
 Points (Al 7075-T6 of `cpm_nlp.analysis.flexure.MATERIALS`, E 71.7 GPa, ν 0.33):
 
-* the grid: R = 1 mm, t/R in {0.05, 0.1, 0.2, 0.3, 0.5} x w/t in {10, 30, 100};
+* the grid: R = 1 mm, t/R in {0.05, 0.1, 0.2, 0.3, 0.5} x w/t in {10, 30, 100}, the notch between
+  elastic blocks (``grid``: its rotation and axial stiffness are the reference) and with its own end
+  faces as the clamp and the rigid block (``end_faces_grid``, only the load cases of the other
+  bending and the torsion: their reference, benchmarks/fit_notch_3d.py ``FROM_BLOCKS`` says why);
 * the cross-check of the earlier, unpublished scikit-fem study quoted in issue 25
   (R = 1 mm, w = 5 mm): t/R = 0.1, 0.2, 0.3 (0.05 and 0.5 at w = 5 mm are grid points);
   each of these five also with the notch's end faces as the clamp and the rigid block

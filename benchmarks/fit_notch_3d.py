@@ -10,8 +10,7 @@ compliance by least squares on log(c_formula / c_3D) over the grid of the refere
 axial: the notch between elastic blocks; other bending and torsion: its end faces clamped and tied
 to the rigid body, see ``FROM_BLOCKS``; R = 1 mm,
 t/R 0.05-0.5, w/t 10-100; benchmarks/bench_notch_fem.py regenerates it), prints the constants to
-paste into ``NOTCH_3D_FIT`` (the torsion's with the thick-section warping factor ``thick`` of
-`notch_warping_compliance`) and the residual of every stored point (grid, the w = 5 mm
+paste into ``NOTCH_3D_FIT`` and the residual of every stored point (grid, the w = 5 mm
 cross-check points, the 3-PRS hinge), for the fitted constants and for the constants in the code,
 and writes them to the JSON.  Derived here; nothing in it is a published number.
 """
@@ -94,10 +93,8 @@ def fit_constants(reference: dict) -> dict:
             trial[key] = (float(np.exp(theta[0])), *(float(v) for v in theta[1:]))
             return np.log1p([row[name] for row in deviations(grid, trial) if name in row])
 
-        lower, upper = [np.log(1e-2), -0.5, 0.2], [np.log(1e4), 5.0, 4.0]  # 1 + a (t/R)^p > 0 on the grid
+        lower, upper = [np.log(1e-2), -0.5, 0.05], [np.log(1e4), 5.0, 4.0]  # 1 + a (t/R)^p > 0 on the grid
         start = [np.log(5.0), 0.1, 1.0]
-        if key == "rx":  # the warping constant's thick-section factor
-            lower, upper, start = lower + [0.0], upper + [1e3], start + [1.0]
         sol = least_squares(residual, np.array(start), bounds=(lower, upper))
         fit[key] = (float(np.exp(sol.x[0])), *(float(v) for v in sol.x[1:]))
     return fit

@@ -126,23 +126,20 @@ def circular_notch_compliances(E, G, b, t, r) -> dict[str, Any]:
 
 
 #: The constants of `circular_notch_compliances_3d`, per compliance: (s0, a, p) of
-#: c = c_beam (1 - ν² (w/t)/(w/t + s0)) (1 + a (t/r)^p); for the torsion also ``thick`` of
-#: `notch_warping_compliance`.  Fitted here (not published) to the 3-D
+#: c = c_beam (1 - ν² (w/t)/(w/t + s0)) (1 + a (t/r)^p).  Fitted here (not published) to the 3-D
 #: finite-element reference tests/data/notch_fem_reference.json by benchmarks/fit_notch_3d.py,
 #: which prints them and their residuals (docs/site/reference/flexures.md).
 NOTCH_3D_FIT = {
-    "rz": (10.65, 0.1594, 0.8639),
-    "ry": (367.3, 0.3568, 0.4134),
-    "x": (46.54, 0.3876, 0.355),
-    "rx": (0.01, 1.216, 0.6408, 0.0),
+    "rz": (5.654, 0.292, 0.8774),
+    "ry": (40.7, 0.08151, 0.05),
+    "x": (30.64, 0.2251, 0.1336),
+    "rx": (1.884, 1.916, 0.8596),
 }
 
 
-def notch_warping_compliance(E, b, t, r, thick=0.0):
+def notch_warping_compliance(E, b, t, r):
     """Torsional compliance of a notch whose section cannot warp at its ends (the blocks),
-    from the warping alone: 144/(E b³) ∫ x² (1 + thick (h/b)²) dx / h(x)³ over the notch
-    [rad/(N m)] (``thick`` 0: the narrow-strip warping constant below; a positive ``thick`` lowers
-    the warping constant where the section is not narrow, h ~ b, a form fitted here).
+    from the warping alone: 144/(E b³) ∫ x² dx / h(x)³ over the notch [rad/(N m)].
 
     Derived here from Vlasov's non-uniform torsion T = G J θ' - (E I_w θ'')' with the warping
     constant of a narrow rectangle, I_w = ∫∫ (y z)² dA = b³ h³/144 (y z: the Saint-Venant warping
@@ -154,7 +151,7 @@ def notch_warping_compliance(E, b, t, r, thick=0.0):
     rigid cap against Vlasov's restrained torsion of a uniform bar)."""
     acc = 0.0
     for x, dx, th in _notch_nodes(t, r):
-        acc += dx * x**2 * (1.0 + thick * (th / b) ** 2) / th**3
+        acc += dx * x**2 / th**3
     return 144.0 * acc / (E * b**3)
 
 
@@ -179,10 +176,9 @@ def circular_notch_compliances_3d(E, G, b, t, r, fit=None) -> dict[str, Any]:
     nu = E / (2.0 * G) - 1.0
     beam = circular_notch_compliances(E, G, b, t, r)
     out = dict(beam)
-    thick = constants["rx"][3]
-    out["rx"] = 1.0 / (1.0 / beam["rx"] + 1.0 / notch_warping_compliance(E, b, t, r, thick))
+    out["rx"] = 1.0 / (1.0 / beam["rx"] + 1.0 / notch_warping_compliance(E, b, t, r))
     for key in ("rz", "ry", "x", "rx"):
-        s0, a, p = constants[key][:3]
+        s0, a, p = constants[key]
         ratio = b / t
         out[key] = out[key] * (1.0 - nu**2 * ratio / (ratio + s0)) * (1.0 + a * (t / r) ** p)
     return out

@@ -22,7 +22,7 @@ G = E / (2.0 * (1.0 + NU))
 #: the issue-25 targets on the grid (t/R 0.05-0.5, w/t 10-100): rotation within 3 %, axial within 5 %;
 #: the other bending and the torsion within what the fitted form reaches there (see
 #: docs/site/reference/flexures.md, "Against a 3-D reference")
-TOLERANCE = {"bend": 0.03, "axial": 0.05, "bend2": 0.05, "torsion": 0.10}
+TOLERANCE = {"bend": 0.03, "axial": 0.05, "bend2": 0.05, "torsion": 0.03}
 KEYS = {"bend": "rz", "bend2": "ry", "torsion": "rx", "axial": "x"}
 
 
@@ -96,16 +96,16 @@ def test_3d_formula_on_casadi_symbols_with_exact_derivatives():
     out = ca.vertcat(*[c[k] for k in ("x", "y", "z", "rx", "ry", "rz")])
     f = ca.Function("notch3d", [z], [out, ca.jacobian(out, z)], ["btr"], ["c", "dc"])
     x0 = np.array([5e-3, 0.2e-3, 1e-3])
-    val, jac = f(x0)
+    val, jac = (np.array(v) for v in f(x0))
     ref = fc.circular_notch_compliances_3d(E, G, *x0)
-    np.testing.assert_allclose(np.ravel(val), [ref[k] for k in ("x", "y", "z", "rx", "ry", "rz")], rtol=1e-12)
+    np.testing.assert_allclose(val.ravel(), [ref[k] for k in ("x", "y", "z", "rx", "ry", "rz")], rtol=1e-12)
     for i in range(3):
         h = 1e-6 * x0[i]
         up, dn = x0.copy(), x0.copy()
         up[i] += h
         dn[i] -= h
-        fd = (np.ravel(f(up)[0]) - np.ravel(f(dn)[0])) / (2 * h)
-        np.testing.assert_allclose(np.ravel(jac[:, i]), fd, rtol=1e-6)
+        fd = (np.array(f(up)[0]) - np.array(f(dn)[0])).ravel() / (2 * h)
+        np.testing.assert_allclose(jac[:, i], fd, rtol=1e-6)
 
 
 def test_warping_compliance_is_twelve_over_w_squared_times_the_bending_part():
@@ -119,4 +119,4 @@ def test_warping_compliance_is_twelve_over_w_squared_times_the_bending_part():
         return t + 2.0 * (r - np.sqrt(r * r - x * x))
 
     bend_part, _ = quad(lambda x: x * x * 12.0 / (E * b * h(x) ** 3), -r, r, points=[0.0], limit=200)
-    assert fc.notch_warping_compliance(E, b, t, r) == pytest.approx(12.0 / b**2 * bend_part, rel=1e-8)
+    assert fc.notch_warping_compliance(E, b, t, r) == pytest.approx(12.0 / b**2 * bend_part, rel=1e-6)
