@@ -37,6 +37,7 @@ Sources:
 from __future__ import annotations
 
 import math
+from types import MappingProxyType
 from typing import Any
 
 import casadi as ca
@@ -129,12 +130,14 @@ def circular_notch_compliances(E, G, b, t, r) -> dict[str, Any]:
 #: c = c_beam (1 - ν² (w/t)/(w/t + s0)) (1 + a (t/r)^p).  Fitted here (not published) to the 3-D
 #: finite-element reference tests/data/notch_fem_reference.json by benchmarks/fit_notch_3d.py,
 #: which prints them and their residuals (docs/site/reference/flexures.md).
-NOTCH_3D_FIT = {
-    "rz": (5.654, 0.292, 0.8774),
-    "ry": (40.7, 0.08151, 0.05),
-    "x": (30.64, 0.2251, 0.1336),
-    "rx": (1.884, 1.916, 0.8596),
-}
+NOTCH_3D_FIT = MappingProxyType(
+    {
+        "rz": (5.654, 0.292, 0.8774),
+        "ry": (40.7, 0.08151, 0.05),
+        "x": (30.64, 0.2251, 0.1336),
+        "rx": (1.884, 1.916, 0.8596),
+    }
+)
 
 
 def notch_warping_compliance(E, b, t, r):
