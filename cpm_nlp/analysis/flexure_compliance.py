@@ -28,6 +28,11 @@ Sources:
   and Strain*, 7th ed., Table 10.7, case 4).
 * Shear coefficient α_s = 6/5 of a rectangular section (Timoshenko), as
   Lobontiu includes shear for short hinges.
+* `circular_notch_compliances_3d` (the default ``circular_notch`` of the compliance kinds):
+  those integrals corrected to a 3-D finite-element reference by a form fitted here (not
+  published), with the restrained warping of a short notch in torsion (derived here from
+  Vlasov's non-uniform torsion); docs/site/reference/flexures.md gives the reference, the
+  fit and its residuals.
 * Two orthogonal notches in series as a U joint (the notch-type universal
   flexure, e.g. G. Palmieri, M. C. Palpacelli, M. Callegari, J. Mech. Des.
   134(12), 2012): the series compliance is the sum of both notch compliances

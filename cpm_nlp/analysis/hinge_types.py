@@ -312,8 +312,8 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _notch_six,
                 _rect_stress,
                 "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance) with a correction fitted here to a "
-                "3-D finite-element reference (circular_notch_compliances_3d; benchmarks/fit_notch_3d.py), "
-                "Paros-Weisbord exact without nu; "
+                "3-D finite-element reference (circular_notch_compliances_3d, not published; the flexure reference "
+                "page), Paros-Weisbord exact without nu; "
                 "stress: nominal 6M/(w t^2) at the thinnest section (the stress of Elgammal et al. 2016 "
                 "eq 38); peak: K_t x nominal",
                 kt=lambda d: circular_notch_kt(d["t"], d["r"]),
