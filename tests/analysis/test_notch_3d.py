@@ -21,7 +21,7 @@ NU = REFERENCE["material"]["nu"]
 G = E / (2.0 * (1.0 + NU))
 #: the issue-25 targets on the grid (t/R 0.05-0.5, w/t 10-100): rotation within 3 %, axial within 5 %;
 #: the other bending and the torsion within what the fitted form reaches there (see
-#: docs/site/reference/flexures.md, "Against a 3-D reference")
+#: docs/site/reference/flexures.md, "Against a 3-D finite-element reference")
 TOLERANCE = {"bend": 0.03, "axial": 0.05, "bend2": 0.05, "torsion": 0.03}
 KEYS = {"bend": "rz", "bend2": "ry", "torsion": "rx", "axial": "x"}
 
