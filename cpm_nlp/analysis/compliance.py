@@ -61,7 +61,7 @@ from ..core.options import Option, validate_mapping
 from ..core.schema import Either, MappingOf, Quantity, Record
 from .beam_inputs import Body, bodies_of, merged_bodies, parse_bodies
 from .flexure import Material, material, material_node
-from .hinge_types import DIM_OPTIONS, HINGE_TABLE, HingeType
+from .hinge_types import DIM_OPTIONS, HINGE_TABLE, NOTCH_TYPES, HingeType
 
 #: the axes of a hinge a joint coordinate may turn (or stretch) it about
 AXES = ("bend", "bend2", "torsion", "axial")
@@ -248,7 +248,7 @@ class JointStiffness(Part):
 def check_geometry(kind: str, d: Mapping[str, float], path: tuple) -> None:
     """Reject a hinge that cannot exist (t >= 2r for a circular notch: the two
     notches would not leave a thinnest section narrower than the blank)."""
-    if kind == "circular_notch" and d["t"] >= 2.0 * d["r"]:
+    if kind in NOTCH_TYPES and d["t"] >= 2.0 * d["r"]:
         raise InputError(
             f"impossible circular notch: thickness t = {d['t'] * 1e3:g} mm must be below twice the notch radius "
             f"2r = {2 * d['r'] * 1e3:g} mm",

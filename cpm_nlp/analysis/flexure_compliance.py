@@ -28,6 +28,11 @@ Sources:
   and Strain*, 7th ed., Table 10.7, case 4).
 * Shear coefficient α_s = 6/5 of a rectangular section (Timoshenko), as
   Lobontiu includes shear for short hinges.
+* `circular_notch_compliances_3d` (the default ``circular_notch`` of the compliance kinds):
+  those integrals corrected to a 3-D finite-element reference by a form fitted here (not
+  published), with the restrained warping of a short notch in torsion (derived here from
+  Vlasov's non-uniform torsion); docs/site/reference/flexures.md gives the reference, the
+  fit and its residuals.
 * Two orthogonal notches in series as a U joint (the notch-type universal
   flexure, e.g. G. Palmieri, M. C. Palpacelli, M. Callegari, J. Mech. Des.
   134(12), 2012): the series compliance is the sum of both notch compliances
@@ -38,6 +43,7 @@ from __future__ import annotations
 
 import functools
 import math
+from types import MappingProxyType
 from typing import Any
 
 import casadi as ca
@@ -92,6 +98,20 @@ def rectangle_torsion_constant(a, c):
     return a * c**3 * (1.0 / 3.0 - 0.21 * ratio * (1.0 - ratio**4 / 12.0))
 
 
+def _notch_nodes(t, r):
+    """The quadrature nodes over the notch, (x, dx, h(x)): Gauss-Legendre in ψ with
+    tan(φ/2) = sqrt(t/(t+4r)) tan ψ, x = r sin φ, h = t + 2r (1 - cos φ)."""
+    k = (t / (t + 4.0 * r)) ** 0.5
+    psi_end = _atan(1.0 / k)
+    for node, weight in zip(*_gauss_legendre()):
+        psi = float(node) * psi_end
+        u = k * _tan(psi)
+        phi = 2.0 * _atan(u)
+        # dx = r cos(φ) dφ, dφ = 2 du / (1 + u²), du = k sec²(ψ) dψ
+        dx = r * _cos(phi) * 2.0 / (1.0 + u**2) * k / _cos(psi) ** 2 * float(weight) * psi_end
+        yield r * _sin(phi), dx, t + 2.0 * r * (1.0 - _cos(phi))
+
+
 def circular_notch_compliances(E, G, b, t, r) -> dict[str, Any]:
     """The six compliances of a right-circular notch hinge at its centre
     (Lobontiu 2002, ch. 2), for width b, thinnest section t and notch radius r.
@@ -102,17 +122,8 @@ def circular_notch_compliances(E, G, b, t, r) -> dict[str, Any]:
     ``rz`` the rotation the hinge is made for [rad/(N m)].
     Valid for t + 2r <= b (the torsion formula takes the width as the long side).
     """
-    k = (t / (t + 4.0 * r)) ** 0.5
-    psi_end = _atan(1.0 / k)
     acc = {key: 0.0 for key in ("x", "y", "z", "rx", "ry", "rz")}
-    for node, weight in zip(*_gauss_legendre()):
-        psi = float(node) * psi_end
-        u = k * _tan(psi)
-        phi = 2.0 * _atan(u)
-        # dx = r cos(φ) dφ, dφ = 2 du / (1 + u²), du = k sec²(ψ) dψ
-        dx = r * _cos(phi) * 2.0 / (1.0 + u**2) * k / _cos(psi) ** 2 * float(weight) * psi_end
-        x = r * _sin(phi)
-        th = t + 2.0 * r * (1.0 - _cos(phi))
+    for x, dx, th in _notch_nodes(t, r):
         area = b * th
         i_z = b * th**3 / 12.0  # bending about the rotation axis
         i_y = th * b**3 / 12.0  # out-of-plane bending
@@ -125,6 +136,67 @@ def circular_notch_compliances(E, G, b, t, r) -> dict[str, Any]:
         acc["y"] += dx * (x**2 / (E * i_z) + shear)
         acc["z"] += dx * (x**2 / (E * i_y) + shear)
     return acc
+
+
+#: The constants of `circular_notch_compliances_3d`, per compliance: (s0, a, p) of
+#: c = c_beam (1 - ν² (w/t)/(w/t + s0)) (1 + a (t/r)^p).  Fitted here (not published) to the 3-D
+#: finite-element reference tests/data/notch_fem_reference.json by benchmarks/fit_notch_3d.py,
+#: which prints them and their residuals (docs/site/reference/flexures.md).
+NOTCH_3D_FIT = MappingProxyType(
+    {
+        "rz": (5.654, 0.292, 0.8774),
+        "ry": (40.7, 0.08151, 0.05),
+        "x": (30.64, 0.2251, 0.1336),
+        "rx": (1.884, 1.916, 0.8596),
+    }
+)
+
+
+def notch_warping_compliance(E, b, t, r):
+    """Torsional compliance of a notch whose section cannot warp at its ends (the blocks),
+    from the warping alone: 144/(E b³) ∫ x² dx / h(x)³ over the notch [rad/(N m)].
+
+    Derived here from Vlasov's non-uniform torsion T = G J θ' - (E I_w θ'')' with the warping
+    constant of a narrow rectangle, I_w = ∫∫ (y z)² dA = b³ h³/144 (y z: the Saint-Venant warping
+    function of a thin strip).  When the notch is short against its width the warping term carries
+    the torque: E I_w θ'' = -T x, and with θ' = 0 at both ends (the blocks) the twist is
+    θ = T ∫ x² dx/(E I_w(x)), the compliance above ((12/b²) times the bending part of the notch's
+    transverse compliance).  `circular_notch_compliances_3d` puts it in parallel with Saint-Venant's
+    torsion (tests/analysis/test_notch_fem.py checks 3-D torsion of a thin strip between a clamp and a
+    rigid cap against Vlasov's restrained torsion of a uniform bar)."""
+    acc = 0.0
+    for x, dx, th in _notch_nodes(t, r):
+        acc += dx * x**2 / th**3
+    return 144.0 * acc / (E * b**3)
+
+
+def circular_notch_compliances_3d(E, G, b, t, r, fit=None) -> dict[str, Any]:
+    """The six compliances of a right-circular notch hinge (keys of `circular_notch_compliances`),
+    closer to 3-D elasticity than the beam integrals: the toolkit's default ``circular_notch``.
+
+    * ``rz``, ``ry``, ``x`` (rotation, the other bending, axial): the beam integrals of
+      `circular_notch_compliances` times (1 - ν² (w/t)/(w/t + s0)) (1 + a (t/r)^p).  The first
+      factor moves the modulus from E (a narrow hinge, plane stress) towards E/(1 - ν²) (a wide one,
+      whose thin section cannot contract across its width: plane strain); the second is the
+      compliance the beam integrals miss where the notch meets its blocks, growing with t/r.
+    * ``rx`` (torsion): Saint-Venant's torsion (the beam integral) in parallel with the restrained
+      warping of `notch_warping_compliance`, times the same kind of factors.
+    * ``y``, ``z`` (transverse): the beam integrals, uncorrected (no 3-D reference computed).
+
+    The constants (`NOTCH_3D_FIT`, or ``fit``) are fitted here, not published: to the 3-D
+    finite-element reference tests/data/notch_fem_reference.json (scikit-fem, R = 1 mm,
+    t/r 0.05 to 0.5, w/t 10 to 100, ν = 0.33), by benchmarks/fit_notch_3d.py; outside that range
+    they extrapolate.  Works on floats and CasADi symbols."""
+    constants = NOTCH_3D_FIT if fit is None else fit
+    nu = E / (2.0 * G) - 1.0
+    beam = circular_notch_compliances(E, G, b, t, r)
+    out = dict(beam)
+    out["rx"] = 1.0 / (1.0 / beam["rx"] + 1.0 / notch_warping_compliance(E, b, t, r))
+    for key in ("rz", "ry", "x", "rx"):
+        s0, a, p = constants[key]
+        ratio = b / t
+        out[key] = out[key] * (1.0 - nu**2 * ratio / (ratio + s0)) * (1.0 + a * (t / r) ** p)
+    return out
 
 
 def _diag(values) -> Any:

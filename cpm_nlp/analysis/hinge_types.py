@@ -31,7 +31,7 @@ from .flexure import (
     elastic_limits,
     leaf_spring_max_rotation,
 )
-from .flexure_compliance import circular_notch_compliances, rectangle_torsion_constant
+from .flexure_compliance import circular_notch_compliances, circular_notch_compliances_3d, rectangle_torsion_constant
 
 
 def _larger(a, c):
@@ -129,10 +129,10 @@ def _rod_stress(d: Mapping[str, float], loads: Mapping[str, float]) -> float:
     return _von_mises(sigma, tau)
 
 
-def _notch_stiffness(E, G, d) -> dict[str, float]:
+def _notch_stiffness(E, G, d, compliances=circular_notch_compliances_3d) -> dict[str, float]:
     if G is None:  # without Poisson's ratio only the bending stiffness (Paros-Weisbord exact)
         return {"bend": float(circular_notch_stiffness_exact(E, d["w"], d["t"], d["r"]))}
-    c = circular_notch_compliances(E, G, d["w"], d["t"], d["r"])
+    c = compliances(E, G, d["w"], d["t"], d["r"])
     return {"bend": 1 / c["rz"], "bend2": 1 / c["ry"], "torsion": 1 / c["rx"], "axial": 1 / c["x"]}
 
 
@@ -168,8 +168,8 @@ def _beam_shear(E, G, length, inertia, area, alpha_s):
     return 1.0 / (length**3 / (12.0 * E * inertia) + alpha_s * length / (G * area))
 
 
-def _notch_six(E, G, d) -> dict[str, float]:
-    c = circular_notch_compliances(E, G, d["w"], d["t"], d["r"])
+def _notch_six(E, G, d, compliances=circular_notch_compliances_3d) -> dict[str, float]:
+    c = compliances(E, G, d["w"], d["t"], d["r"])
     return {
         "bend": 1 / c["rz"],
         "bend2": 1 / c["ry"],
@@ -326,7 +326,9 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _notch_stiffness,
                 _notch_six,
                 _rect_stress,
-                "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance), Paros-Weisbord exact without nu; "
+                "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance) with a correction fitted here to a "
+                "3-D finite-element reference (circular_notch_compliances_3d, not published; the flexure reference "
+                "page), Paros-Weisbord exact without nu; "
                 "stress: nominal 6M/(w t^2) at the thinnest section (the stress of Elgammal et al. 2016 "
                 "eq 38); peak: K_t x nominal",
                 kt=lambda d: circular_notch_kt(d["t"], d["r"]),
@@ -335,6 +337,20 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 limit_dims=("t", "r"),
                 rotation=lambda E, sigma, d: circular_notch_max_rotation(E, d["t"], d["r"], sigma),
                 limit_source="Elgammal et al. 2016, eq 38",
+            ),
+            HingeType(
+                "circular_notch_paros_weisbord",
+                ("t", "r", "w"),
+                lambda E, G, d: _notch_stiffness(E, G, d, circular_notch_compliances),
+                lambda E, G, d: _notch_six(E, G, d, circular_notch_compliances),
+                _rect_stress,
+                "stiffness: Lobontiu 2002 ch. 2 integrals (flexure_compliance; the rotation is Paros and Weisbord's "
+                "exact integral, 1965), the formulas the papers use, uncorrected; "
+                "stress: nominal 6M/(w t^2) at the thinnest section (the stress of Elgammal et al. 2016 "
+                "eq 38); peak: K_t x nominal",
+                kt=lambda d: circular_notch_kt(d["t"], d["r"]),
+                kt_source="Roark's Formulas for Stress and Strain, 7th ed., Table 17.1 case 2b (two U-notches, "
+                "in-plane bending), h/r = 1",
             ),
             HingeType(
                 "circular_rod",
@@ -373,6 +389,9 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
         )
     }
 )
+
+#: the circular notch hinges: one geometry, the default formula and the papers' (same checks)
+NOTCH_TYPES = ("circular_notch", "circular_notch_paros_weisbord")
 
 #: the hinge types that set a joint's rotation limit (a joint's ``flexure``, a mechanism's limits)
 LIMIT_TYPES = tuple(n for n, t in HINGE_TABLE.items() if t.rotation is not None)

@@ -53,6 +53,7 @@ TRANSLATION_FRACTION = 0.1
 #: hinge type -> (rotation limit [rad], the length translations are measured against)
 DEFLECTION_LIMITS = {
     "circular_notch": (ROTATION_LIMIT, lambda d: 2.0 * d["r"]),
+    "circular_notch_paros_weisbord": (ROTATION_LIMIT, lambda d: 2.0 * d["r"]),
     "leaf_spring": (ROTATION_LIMIT, lambda d: d["l"]),
     "circular_rod": (ROTATION_LIMIT, lambda d: d["l"]),
     "filleted_rod": (ROTATION_LIMIT, lambda d: d["l"] + 2.0 * d["r"]),
@@ -92,7 +93,7 @@ def hinge_geometry_warnings(hinges: Iterable[Any], where: str = "hinge") -> list
         seen.add(h.group)
         d = h.dims
         at = f"{where} {h.group}"
-        if h.kind in ("circular_notch", "leaf_spring") and d["t"] > d["w"]:
+        if h.kind in ("circular_notch", "circular_notch_paros_weisbord", "leaf_spring") and d["t"] > d["w"]:
             out.append(
                 ResultWarning(
                     "hinge_geometry",
@@ -104,7 +105,7 @@ def hinge_geometry_warnings(hinges: Iterable[Any], where: str = "hinge") -> list
                     d["w"],
                 )
             )
-        if h.kind == "circular_notch" and d["t"] + 2.0 * d["r"] > d["w"]:
+        if h.kind in ("circular_notch", "circular_notch_paros_weisbord") and d["t"] + 2.0 * d["r"] > d["w"]:
             h_end = d["t"] + 2.0 * d["r"]
             out.append(
                 ResultWarning(

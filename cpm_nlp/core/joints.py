@@ -108,7 +108,7 @@ class JointType:
 
 
 #: hinge types that realise a revolute (see the module's docstring for the sources)
-_REVOLUTE_HINGES = ("circular_notch", "cantilever_notch", "leaf_spring")
+_REVOLUTE_HINGES = ("circular_notch", "circular_notch_paros_weisbord", "cantilever_notch", "leaf_spring")
 
 #: the joint types, in the order the reader lists them
 JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
@@ -150,7 +150,7 @@ JOINT_TYPES: Mapping[str, JointType] = MappingProxyType(
                 (("R", 0), ("R", 1)),
                 n_axes=2,
                 sphere=True,
-                hinges=("circular_notch", "circular_rod", "filleted_rod"),
+                hinges=("circular_notch", "circular_notch_paros_weisbord", "circular_rod", "filleted_rod"),
             ),
             JointType(
                 "S",

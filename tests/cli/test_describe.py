@@ -136,7 +136,10 @@ def test_describe_prints_the_nested_schema_indented():
     joints = next(line for line in lines[hinge:] if line.strip().startswith("joints"))
     assert joints.startswith("      joints") and "[one of] optional" in joints
     assert any(line.startswith("      t ") and "[mm] optional" in line for line in lines)
-    assert "one of 'circular_notch', 'circular_rod', 'filleted_rod', 'leaf_spring'" in text
+    assert (
+        "one of 'circular_notch', 'circular_notch_paros_weisbord', 'circular_rod', 'filleted_rod', 'leaf_spring'"
+        in text
+    )
     assert "    x            [N] 0 N" in text  # load on x: a force, default 0
 
 

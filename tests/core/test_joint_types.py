@@ -255,8 +255,9 @@ def test_the_hinges_the_files_declare_sit_where_the_table_allows():
     # the RPR file's R and U flexures sit on its passive angles (eq 13), written as expressions
     # beside S-P-S legs: the table cannot check them (tests/corpus/rpr_joints.yaml has the joints)
     assert on_expressions == {"rpr.yaml R", "rpr.yaml U"}
-    # prs3 (notch at R, filleted rod at S), the five-bar and the 3-RRR (notches at planar R)
-    assert {("circular_notch", "R"), ("filleted_rod", "S"), ("circular_notch", "planar_R")} <= seen
+    # prs3 (notch at R, with the papers' formula; filleted rod at S), the five-bar and the 3-RRR
+    # (notches at planar R)
+    assert {("circular_notch_paros_weisbord", "R"), ("filleted_rod", "S"), ("circular_notch", "planar_R")} <= seen
 
 
 def test_the_guide_table_is_the_table():

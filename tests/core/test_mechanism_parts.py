@@ -88,13 +88,13 @@ def test_the_hinges_are_parsed_once_when_declared(monkeypatch):
     stiffness = cn.mechanism_type("prs3").part(cn.JointStiffness)
     rev = stiffness.records["revolute"]
     assert isinstance(rev, cm.HingeSpec)
-    assert (rev.joints, rev.type) == ("alpha", "circular_notch")
+    assert (rev.joints, rev.type) == ("alpha", "circular_notch_paros_weisbord")
     assert rev.dims == {"t": pytest.approx(2e-3), "r": pytest.approx(8e-3), "w": pytest.approx(10e-3)}
     # k stays as written until the joint it is on is known (N*m/rad on an angle, N/m on a length)
     assert rev.k == "98.37 N*m/rad" and stiffness.parsed_material.E == pytest.approx(72e9)
     # key by key: the problem's k over the declared geometry; a key given as null clears it
     over = cm.HingeSpec.parsed({"k": 50.0}).over(rev)
-    assert (over.k, over.type, over.dims["t"]) == (50.0, "circular_notch", pytest.approx(2e-3))
+    assert (over.k, over.type, over.dims["t"]) == (50.0, "circular_notch_paros_weisbord", pytest.approx(2e-3))
     assert cm.HingeSpec.parsed({"type": None}).over(rev).type is None
     model = cn.build_model("prs3", PRS3)
     seen = []

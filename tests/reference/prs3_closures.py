@@ -392,7 +392,7 @@ STIFFNESS = JointStiffness(
     hinges={
         "revolute": {
             "joints": "alpha",
-            "type": "circular_notch",
+            "type": "circular_notch_paros_weisbord",
             "t": "2 mm",
             "r": "8 mm",
             "w": "10 mm",

@@ -413,7 +413,7 @@ def test_describe_shipped_prs3_lists_hinges_and_its_example_values(cli):
     run = cli("describe", str(MECH / "prs3.yaml"))
     assert run.code == 0, run.err
     assert "prs3_forward_kinematics.yaml" in run.out  # the model's values come from its first example
-    assert "coordinates: alpha1  hinge: revolute (circular_notch)" in run.out
+    assert "coordinates: alpha1  hinge: revolute (circular_notch_paros_weisbord)" in run.out
     assert "coordinates: beta_m1, beta_n1, beta_l1  hinge: spherical (filleted_rod)" in run.out
     assert "leg leg1: 2 equation(s): plane of the R joint; radius about the R joint" in run.out
     assert "task pz, psi, theta; dependent px, py, phi" in run.out

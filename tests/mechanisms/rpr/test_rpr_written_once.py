@@ -281,10 +281,11 @@ def test_what_users_see_is_what_the_module_declared():
     names = {str(p).rsplit("/", 1)[-1] for p in mech.problem_files}
     for f in ("forward_kinematics", "screw_jacobian", "twists_eq47", "synthesis_fixed_P", "compliance"):
         assert f"rpr_{f}.yaml" in names
+    PW = "circular_notch_paros_weisbord"  # the beam integrals of its eq 29
     assert mech.part(JointStiffness) == JointStiffness(
         hinges={
-            "R": {"joints": "theta_R", "type": "circular_notch", "r": "4 mm", "t": "0.4 mm", "w": "12 mm"},
-            "U": {"joints": "theta_U", "type": "circular_notch", "r": "1 mm", "t": "0.4 mm", "w": "12 mm"},
+            "R": {"joints": "theta_R", "type": PW, "r": "4 mm", "t": "0.4 mm", "w": "12 mm"},
+            "U": {"joints": "theta_U", "type": PW, "r": "1 mm", "t": "0.4 mm", "w": "12 mm"},
         },
         material="Al 7075-T6",
         source="Zhang et al. 2022 Table 1 (joint dimensions) and section 5 (Al-7075)",
