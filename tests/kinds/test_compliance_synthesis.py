@@ -49,10 +49,11 @@ def _nlp(problem):
 
 
 #: the shipped files, and the 3-RRR's smallest peak stress (an epigraph objective) under a stiffness requirement
+#: (450 um/N: the stiffest x the stroke allows is 417.9 um/N with the 3-D-fitted circular_notch default)
 CASES = {
     "prs3": (PRS3_FILE, []),
     "rrr3": (RRR3_FILE, []),
-    "rrr3_min_stress": (RRR3_FILE, ["inputs.objective={minimize: stress}", "inputs.compliance_max={x: 400 um/N}"]),
+    "rrr3_min_stress": (RRR3_FILE, ["inputs.objective={minimize: stress}", "inputs.compliance_max={x: 450 um/N}"]),
     # the lateral (parasitic) compliance of the six-axis model with the sliders held, a requirement
     "prs3_six_axis": (
         PRS3_FILE,
