@@ -299,9 +299,7 @@ def spherical_closed_form(gen: Any, q: ca.SX) -> tuple[ca.Function | None, ca.Fu
     x0, x, disc, side, exact = parts
     names = ", ".join(f"RRR ({', '.join(dy.bodies)})" for dy in dec.dyads)
     if dec.complete and exact:
-        gen.closed_form_summary = (
-            f"forward kinematics in closed form: {len(dec.dyads)} spherical dyad(s) (axes meeting at one point), {names}"
-        )
+        gen.closed_form_summary = f"forward kinematics in closed form: {len(dec.dyads)} spherical dyad(s), {names}"
         outs = ca.cse([x, disc, side])
         fn = ca.Function("fk_closed", [q, x0, gen.p], outs, ["q", "x0", "p"], ["x", "disc", "side"])
         return fn, None
