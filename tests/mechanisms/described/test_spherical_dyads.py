@@ -192,3 +192,54 @@ def test_axes_that_no_longer_meet_are_left_to_newton():
     assert float(c.fk_closed(m.q_home, m.x_home, p)[1]) < 0
     bennett = _model(yaml.safe_load((ROOT / "tests" / "corpus" / "bennett.yaml").read_text()))
     assert bennett.closure.fk_closed is None and bennett.closure.fk_seed is None
+
+
+def _tip_numpy(P: dict, q: np.ndarray) -> np.ndarray:
+    """The five-bar's tip direction for crank angles q (N x 2), derived here: the crank axes a1, b1
+    turned about a0, b0 as the file draws them, and the unit c with c·a1 = c·b1 = cos(beta) (both
+    links' arcs equal) on the tip-up assembly: c = k (a1 + b1) + h (b1 × a1), by symmetry."""
+    g, al, be = P["gamma"], P["alpha"], P["beta"]
+    a0, b0 = np.array([-np.sin(g / 2), 0, np.cos(g / 2)]), np.array([np.sin(g / 2), 0, np.cos(g / 2)])
+    e, f, y = np.array([np.cos(g / 2), 0, np.sin(g / 2)]), np.array([np.cos(g / 2), 0, -np.sin(g / 2)]), np.eye(3)[1]
+    t1, t2 = q[:, :1], q[:, 1:]
+    a1 = np.cos(al) * a0 + np.sin(al) * (np.cos(t1) * e + np.sin(t1) * y)
+    b1 = np.cos(al) * b0 + np.sin(al) * (np.cos(t2) * f + np.sin(t2) * y)
+    s = a1 + b1
+    k = np.cos(be) / np.einsum("ij,ij->i", s, a1)[:, None]  # c·a1 = k (1 + a1·b1) = cos(beta)
+    n = np.cross(b1, a1)
+    h = np.sqrt((1 - k[:, 0] ** 2 * np.einsum("ij,ij->i", s, s)) / np.einsum("ij,ij->i", n, n))[:, None]
+    return k * s + h * n
+
+
+def test_five_bar_in_closed_form():
+    """The spherical five-bar (problems/mechanisms/spherical_five_bar.yaml: one spherical dyad placed
+    by the two cranks, the tip's coordinates by their linear rows): over +-25 deg of each crank
+    every pose is settled by the closed form, the tip on the direction derived in numpy (1e-12 m),
+    equal to Newton's from a guess near it (1e-10); the IK (Newton from the tip's x, y) gives the
+    cranks back; the AD Jacobian equals central differences and -Φ_x⁻¹ Φ_q."""
+    m = cn.build_model("spherical_five_bar")
+    c, P = m.closure, m.parameters
+    assert c.fk_closed is not None
+    q = m.q_home + np.random.default_rng(0).uniform(-np.deg2rad(25), np.deg2rad(25), (200, 2))
+    closed = _kernel(closed_fk_kernel(c, NEWTON), m, q, m.x_home)
+    assert np.all(closed["status"].ravel() == code_of(Status.SOLVED))
+    got = cn.batch_forward_kinematics(m, q)
+    assert got.ok.all()
+    names = list(c.x_names)
+    tip = got.x[:, [names.index(n) for n in "xyz"]]
+    np.testing.assert_allclose(tip, P["r"] * _tip_numpy(P, q), rtol=0, atol=1e-12)
+    scale = np.array([1e-3] * 3 + [1.0] * 4)  # 10 µm on the tip, 0.01 rad on the joints
+    ref = _newton(m, q, got.x + np.random.default_rng(1).uniform(-0.01, 0.01, got.x.shape) * scale)
+    assert ref.ok.all()
+    np.testing.assert_allclose(got.x, ref.x, rtol=0, atol=1e-10)
+    q_sym = ca.SX.sym("q", c.nq)
+    dx_dq = ca.Function("dx_dq", [q_sym], [ca.jacobian(c.fk_closed(q_sym, m.x_home, m.p)[0], q_sym)], ["q"], ["J"])
+    for qi in q[:8]:
+        xi = np.asarray(c.fk_closed(qi, m.x_home, m.p)[0]).ravel()
+        ik = cn.inverse_kinematics(m, xi[list(c.task_index)], NEWTON)
+        assert ik.status is Status.SOLVED
+        np.testing.assert_allclose(ik.q, qi, rtol=0, atol=1e-9)
+        jac = np.asarray(dx_dq(qi))
+        fd = central_difference(lambda v: np.asarray(c.fk_closed(v, m.x_home, m.p)[0]).ravel(), qi, 1e-6)
+        np.testing.assert_allclose(jac, fd, rtol=0, atol=1e-7)
+        np.testing.assert_allclose(jac, np.asarray(c.jacobian(xi, qi, m.p)), rtol=0, atol=1e-10)
