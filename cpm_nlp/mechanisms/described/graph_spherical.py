@@ -172,7 +172,7 @@ class SphericalDecomposition:
         # non-degenerate: each body's two axes apart (else its turn about a1 is not fixed by C)
         sin2 = ca.fmin(ca.dot(ca.cross(a1, c), ca.cross(a1, c)), ca.dot(ca.cross(a2, c), ca.cross(a2, c)))
         conc, _O = self._concurrency(g, b1, h1, k1, b2, h2, k2)
-        f = ca.Function("spherical_dyad_check", [gen.p, self.q], [conc, sin2])
+        f = ca.Function("spherical_dyad_check", [gen.p, self.q], [conc, sin2], ["p", "q"], ["concurrency", "sin2"])
         ref = gen.assembler
         v_conc, v_sin2 = (float(v) for v in f(gen.p_default, np.asarray(ref.q_ref, float)))
         if not (np.isfinite(v_conc) and v_conc <= CONCURRENT_TOL and v_sin2 > 1e-12):
@@ -251,7 +251,7 @@ class SphericalDecomposition:
         if ca.depends_on(J, xr):
             return False
         full = ca.vertcat(*[x0[k] if x[k] is None else x[k] for k in range(len(x))])
-        f = ca.Function("platform_rows", [gen.x, gen.p], [rows, J])
+        f = ca.Function("platform_rows", [gen.x, gen.p], [rows, J], ["x", "p"], ["rows", "J"])
         r, Jv = f(full, gen.p)
         z = ca.vertcat(*[x0[k] for k in rest]) - ca.solve(Jv, r)
         for i, k in enumerate(rest):
@@ -265,7 +265,7 @@ class SphericalDecomposition:
         x0 = ca.SX.sym("x0", gen.x.numel())
         signs = []
         for dy in self.dyads:
-            f = ca.Function("dyad_side", [gen.x, self.q, gen.p], [dy.side_x])
+            f = ca.Function("dyad_side", [gen.x, self.q, gen.p], [dy.side_x], ["x", "q", "p"], ["side"])
             v = float(f(x_ref, q_ref, p_ref))
             if not np.isfinite(v) or v == 0.0:
                 return None

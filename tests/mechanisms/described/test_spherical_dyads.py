@@ -243,3 +243,39 @@ def test_five_bar_in_closed_form():
         fd = central_difference(lambda v: np.asarray(c.fk_closed(v, m.x_home, m.p)[0]).ravel(), qi, 1e-6)
         np.testing.assert_allclose(jac, fd, rtol=0, atol=1e-7)
         np.testing.assert_allclose(jac, np.asarray(c.jacobian(xi, qi, m.p)), rtol=0, atol=1e-10)
+
+
+def test_a_slider_after_the_dyad_is_left_to_newton():
+    """The four-bar's follower drives a slider on the ground (a P joint along x) through a rod (a
+    distance joint from B1): no closed form of the whole, but a seed -- the spherical dyad's
+    coordinates in closed form, the slider's from the guess -- from which Newton solves the whole
+    turn: the follower's angle the four-bar's closed form's (1e-10 rad), the slider on the line-
+    sphere intersection derived here, s = B1_x + √(L² - B1_y² - B1_z²) (1e-12 m); Newton from home
+    without the seed fails on part of the turn."""
+    d = _data(name="spherical_four_bar_slider")
+    d["points"]["S"] = ["100 mm", "0 mm", "0 mm"]
+    d["bodies"]["slider"] = ["S"]
+    d["joints"] += [
+        {"type": "P", "between": ["ground", "slider"], "at": "S", "axis": [1, 0, 0], "coordinates": ["s"]},
+        {"type": "distance", "between": ["follower", "slider"], "at": "B1", "to": "S"},
+    ]
+    m = _model(d)
+    c = m.closure
+    assert c.fk_closed is None and c.fk_seed is not None
+    got = cn.batch_forward_kinematics(m, TURN)
+    assert got.ok.all()
+    four = cn.batch_forward_kinematics(cn.build_model("spherical_four_bar"), TURN)
+    names = list(c.x_names)
+    np.testing.assert_allclose(_wrapped(got.x[:, names.index("psi")] - four.x[:, 2]), 0, atol=1e-10)
+    B1 = four.passive  # B1_x, B1_y, B1_z of the four-bar at the same crank angles
+    L = float(np.linalg.norm(_b1_home(m) - [0.1, 0, 0]))  # the rod: its length in the drawing
+    want = B1[:, 0] + np.sqrt(L**2 - B1[:, 1] ** 2 - B1[:, 2] ** 2) - 0.1  # s: the slide from the drawing
+    np.testing.assert_allclose(got.x[:, names.index("s")], want, rtol=0, atol=1e-12)
+    home = _newton(m, TURN, np.tile(m.x_home, (len(TURN), 1)))
+    assert 0 < np.mean(home.ok) < 1
+
+
+def _b1_home(m) -> np.ndarray:
+    names = list(m.closure.passive_names)
+    pas = np.asarray(m.closure.passive(m.x_home, m.q_home, m.p)).ravel()
+    return pas[[names.index(f"B1_{k}") for k in "xyz"]]
