@@ -147,3 +147,16 @@ def test_batch_speed_benchmark_smoke(tmp_path, capsys):
     assert data["fivebar"]["closed_share"] == 1.0  # every five-bar pose by the closed-form dyad (a count)
     assert data["single"]["single_fk_function_us"] > 0 and "load" in data["single"]
     assert "written:" in capsys.readouterr().out
+
+
+def test_spherical_benchmark_smoke(tmp_path, capsys):
+    """benchmarks/bench_spherical.py runs end to end (small sizes; no timing is asserted, only that
+    every pose of the turn is solved, a count)."""
+    spec = importlib.util.spec_from_file_location("bench_spherical", ROOT / "benchmarks" / "bench_spherical.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = tmp_path / "bench_spherical.json"
+    assert bench.main(["--quick", "--rounds", "1", "-o", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["four_bar"]["statuses"] == {"solved": 360}
+    assert "written:" in capsys.readouterr().out

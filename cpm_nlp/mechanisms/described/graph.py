@@ -48,6 +48,7 @@ from .emit import closure_functions
 from .expand import InLeg
 from .graph_dyads import graph_closed_form
 from .graph_rows import Cut, axis_normals, cut_rows, cut_values
+from .graph_spherical import spherical_closed_form
 from .graph_tree import GraphJoint, spanning_tree
 from .mobility import GraphInfo
 from .motions import JOINT_DIMS, elementary_motions, rot
@@ -451,7 +452,8 @@ class GraphGenerator(ClosureBuilder):
         select_branch(self, added)
         self.check_task_count()
         fns = self.graph_functions(q)
-        fns["fk_closed"], fns["fk_seed"] = graph_closed_form(self, q)
+        closed_form = graph_closed_form if self.d.platform.planar else spherical_closed_form
+        fns["fk_closed"], fns["fk_seed"] = closed_form(self, q)
         self.info = self.assembler.info
         return fns
 
