@@ -186,10 +186,19 @@ class BeamSpec:
 class Element:
     """One beam element in the reference configuration (base frame, SI).
 
-    point: its spring point; axes: 3 x 3, columns x (along the beam), y (bend), z (bend2);
-    dofs: the indices of `DEFORMATIONS` it has; K: its stiffness over those dofs;
-    s0, s1, s_spring: its ends and spring point along the beam, from the beam's start
-    (x_centre: where the beam's profile centre is)."""
+    Attributes
+    ----------
+    point
+        its spring point;
+    axes
+        3 x 3, columns x (along the beam), y (bend), z (bend2);
+    dofs
+        the indices of `DEFORMATIONS` it has;
+    K
+        its stiffness over those dofs;
+    s0, s1, s_spring
+        its ends and spring point along the beam, from the beam's start (x_centre: where the
+        beam's profile centre is)."""
 
     point: np.ndarray
     axes: np.ndarray

@@ -70,12 +70,23 @@ METADATA = ("drawing_legs", "branch_names", "branch_descriptions", "row_names", 
 class Generated:
     """What a `Mechanism` of a legs file is made of, from its generator or from the cache.
 
-    x_coords, q_coords, passive_coords: the pose, actuator and reported passive coordinates;
-    limits: the joint-limit options; derived: (name, dimension, size) of each derived value;
-    symbol_dims: the dimension (`expr.Dim`) of each parameter and derived value; fns: the
-    Functions (`FUNCTIONS`) and their names (`METADATA`), as `closure.closure_parts` gives
-    them; chains: `chains.chain_parts` (None: the legs are no serial chains); gen: the
-    generator (None when read from the cache; a graph's drawing needs it)."""
+    Attributes
+    ----------
+    x_coords, q_coords, passive_coords
+        the pose, actuator and reported passive coordinates;
+    limits
+        the joint-limit options;
+    derived
+        (name, dimension, size) of each derived value;
+    symbol_dims
+        the dimension (`expr.Dim`) of each parameter and derived value;
+    fns
+        the Functions (`FUNCTIONS`) and their names (`METADATA`), as `closure.closure_parts`
+        gives them;
+    chains
+        `chains.chain_parts` (None: the legs are no serial chains);
+    gen
+        the generator (None when read from the cache; a graph's drawing needs it)."""
 
     __slots__ = ("x_coords", "q_coords", "passive_coords", "limits", "derived", "symbol_dims", "fns", "chains", "gen")
 
