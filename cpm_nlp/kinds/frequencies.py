@@ -342,7 +342,7 @@ class NaturalFrequencies(_HingeKind):
             models = sorted({mdl for b in sm.hs.bodies for mdl in b.beam.models})
             masses = " and ".join({"distributed": "consistent", "lumped": "lumped"}[mdl] for mdl in models)
             names = ", ".join(b.name for b in sm.hs.bodies)
-            msg += f"; flexible bodies {names} (beam elements, {masses} element masses)"
+            msg += f"; but the links that are flexible bodies ({names}) are beams with {masses} element masses"
         repeated = [idx for idx in clusters if len(idx) > 1]
         if repeated:
             msg += "; " + "; ".join(degenerate_note(idx) for idx in repeated)
