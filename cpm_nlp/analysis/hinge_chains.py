@@ -430,6 +430,10 @@ class SixAxisModel:
                 self._beam_joints.append((ja, m))
         return out
 
+    def beam_places(self) -> list[tuple[int, int]]:
+        """Per beam of `beams`: (leg, the joint its elements follow)."""
+        return [(li, ja) for (_, li, _), (ja, _) in zip(self.beams, self._beam_joints, strict=True)]
+
     def flexible_links(self) -> dict[tuple[int, int], str]:
         """(leg, first joint) -> the flexible body that is the link after that joint (``between``)."""
         beams = zip(self.beams, self._beam_joints, strict=True)
