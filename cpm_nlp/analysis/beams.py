@@ -35,9 +35,21 @@ Handbook, Springer 1990; the element here is a different one, described below):
     either side: the finite-segment (pseudo-rigid-body) discretisation, whose linear
     compliance converges as 1/n².
 
-* mass (for a dynamics model; the compliance does not use it): ``distributed`` is the
-  element's mass ρ∫A ds and its inertia as a slender beam spread along the element,
-  ``lumped`` is half the element's mass at each of its nodes.
+* mass (for the natural frequencies; the compliance does not use it), the element's 12 x 12
+  mass matrix over its two nodes' velocities (v_0, ω_0, v_1, ω_1), in the element axes
+  (`element_mass`), as the element's stiffness model declares:
+
+  - ``distributed``: the consistent mass matrix, M_e = ∫ ρ (A NᵀN + I_p n_φᵀn_φ) ds with
+    N the cubic Hermite interpolation of the two transverse displacements from the nodes'
+    displacements and rotations, linear axial displacement and twist n_φ (I_p = I_y + I_z
+    the polar moment), plus the sections' rotary inertia ρ (I_y θ_y² + I_z θ_z²) with
+    θ = the Hermite slopes for ``timoshenko`` (none for ``euler_bernoulli``, the classical
+    Euler-Bernoulli consistent mass); Gauss-Legendre quadrature, so a notch's varying
+    section too.  It moves every rigid motion of the element exactly (a rigid bar's
+    kinetic energy, for ``timoshenko``);
+  - ``lumped``: half the element's mass ρ∫A ds, as a point mass, and half its polar
+    inertia ρ∫I_p ds, about the beam's axis, at each node (no rotary inertia about the
+    bending axes: the classical lumped mass).
 
 Sections: a rectangle b x h (h the thickness across which the beam bends about its
 compliant axis y, b the width along y), a round d, given A, I (I2, J, kappa), or the
@@ -209,6 +221,15 @@ class Element:
     s_spring: float
     x_centre: float
     mass: float = 0.0
+    #: 12 x 12 mass over the nodes' velocities (v_0, ω_0, v_1, ω_1) in ``axes`` (`element_mass`;
+    #: None without a density)
+    M: np.ndarray | None = None
+
+    @property
+    def nodes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Its two nodes (start, end) in the reference configuration."""
+        x = self.axes[:, 0]
+        return self.point + (self.s0 - self.s_spring) * x, self.point + (self.s1 - self.s_spring) * x
 
 
 @functools.cache
@@ -245,6 +266,46 @@ def element_compliance(
         B = ca.vertcat(ca.horzcat(ca.DM.eye(3), ca.DM.zeros(3, 3)), ca.horzcat(_skew_x(a), ca.DM.eye(3)))
         C = C + 0.5 * ell * float(w) * ca.mtimes([B.T, ca.diag(ca.vertcat(*cs)), B])
     return C, s1
+
+
+def element_mass(
+    sec: Section, density: float, nu: float, s0: float, s1: float, x_centre: float, theory: str, model: str
+) -> np.ndarray:
+    """The element's 12 x 12 mass matrix over its nodes' velocities (v_0, ω_0, v_1, ω_1) in its
+    axes (x along it): ``distributed`` the consistent one (cubic Hermite transverse, linear axial
+    and twist; rotary inertia for ``timoshenko``), ``lumped`` half the mass and half the polar
+    inertia at each node (the module's docstring).  Numeric."""
+    ell = s1 - s0
+    nodes, weights = _gauss(6 if sec.kind != "circular_notch" else 24)
+    M = np.zeros((12, 12))
+    if model == "lumped":
+        m = ip = 0.0
+        for xi, w in zip(nodes, weights):
+            p = sec.properties(nu, s0 + 0.5 * (xi + 1.0) * ell - x_centre)
+            m += 0.5 * ell * w * density * float(p["A"])
+            ip += 0.5 * ell * w * density * float(p["I_y"] + p["I_z"])
+        M[np.diag_indices(12)] = [m / 2] * 3 + [ip / 2, 0.0, 0.0] + [m / 2] * 3 + [ip / 2, 0.0, 0.0]
+        return M
+    for xi, w in zip(nodes, weights):
+        u = 0.5 * (xi + 1.0)  # ξ in [0, 1]
+        p = sec.properties(nu, s0 + u * ell - x_centre)
+        A, Iy, Iz = (float(p[k]) for k in ("A", "I_y", "I_z"))
+        h = (1 - 3 * u**2 + 2 * u**3, ell * (u - 2 * u**2 + u**3), 3 * u**2 - 2 * u**3, ell * (-(u**2) + u**3))
+        dh = ((-6 * u + 6 * u**2) / ell, 1 - 4 * u + 3 * u**2, (6 * u - 6 * u**2) / ell, -2 * u + 3 * u**2)
+        N = np.zeros((3, 12))  # the centroid's velocity
+        N[0, [0, 6]] = 1 - u, u
+        N[1, [1, 5, 7, 11]] = h  # v, its slope θ_z
+        N[2, [2, 4, 8, 10]] = h[0], -h[1], h[2], -h[3]  # w, its slope -θ_y
+        twist = np.zeros(12)
+        twist[[3, 9]] = 1 - u, u
+        Mq = density * (A * N.T @ N + (Iy + Iz) * np.outer(twist, twist))
+        if theory == "timoshenko":  # the sections' rotary inertia, θ from the Hermite slopes
+            tz, ty = np.zeros(12), np.zeros(12)
+            tz[[1, 5, 7, 11]] = dh
+            ty[[2, 4, 8, 10]] = -dh[0], dh[1], -dh[2], dh[3]
+            Mq += density * (Iz * np.outer(tz, tz) + Iy * np.outer(ty, ty))
+        M += 0.5 * ell * w * Mq
+    return 0.5 * (M + M.T)
 
 
 def _skew_x(a: Any) -> Any:
@@ -298,12 +359,12 @@ def beam_elements(
         dofs = (0, 3, 4, 5) if model == "lumped" and spec.theory == "euler_bernoulli" else tuple(range(6))
         K = np.linalg.inv(C[np.ix_(dofs, dofs)]) if model == "lumped" else np.linalg.inv(C)
         K = 0.5 * (K + K.T)
-        mass = 0.0
+        mass, M = 0.0, None
         if density is not None:
-            mid = 0.5 * (s0 + s1)
-            mass = float(density * spec.section.properties(nu, mid - x_centre)["A"] * (s1 - s0))
+            M = element_mass(spec.section, density, nu, s0, s1, x_centre, spec.theory, model)
+            mass = float(M[0, 0] + M[0, 6])  # the axial row: a rigid translation carries the whole mass
         point = start + axes[:, 0] * float(s_spring)
-        out.append(Element(point, axes, dofs, K, float(s0), float(s1), float(s_spring), float(x_centre), mass))
+        out.append(Element(point, axes, dofs, K, float(s0), float(s1), float(s_spring), float(x_centre), mass, M))
     return out
 
 
@@ -431,6 +492,7 @@ __all__ = [
     "Section",
     "beam_elements",
     "element_compliance",
+    "element_mass",
     "element_motions",
     "product",
 ]

@@ -46,6 +46,7 @@ import scipy.linalg
 
 from ..core.model import Model
 from . import compliance as cm
+from .beams import Section, element_compliance
 from .hinge_chains import six_axis_model
 from .hinge_types import HINGE_TABLE
 from .link_masses import LinkBody, LinkSection, body_jacobians, rigid_velocity_map
@@ -60,6 +61,15 @@ EPIGRAPH = {
 #: round-off: a KKT residual or a relative deviation below it is reported as this value (the
 #: same on every machine; the digits below it depend on the BLAS kernel)
 ROUND_OFF = 1e-12
+
+
+def beam_section(link: LinkSection, declared: Section) -> Section:
+    """The beam section of a link's section (width -> b, height -> h, or d), keeping the declared
+    section's shear coefficient."""
+    extra = {"kappa": declared.values["kappa"]} if declared.values.get("kappa") is not None else {}
+    if link.d is not None:
+        return Section("round", {"d": link.d, **extra})
+    return Section("rectangle", {"b": link.width, "h": link.height, **extra})
 
 
 @dataclass(frozen=True)
@@ -175,6 +185,7 @@ class ComplianceSynthesisNLP:
         M_x: np.ndarray,
         M_q: np.ndarray,
         links: tuple[Any, Sequence[tuple[str, LinkBody]]] | None = None,
+        flexible: Mapping[str, tuple[str, LinkSection]] | None = None,
     ) -> None:
         c = model.closure
         self.model, self.hs, self.variables, self.req = model, hs, list(variables), req
@@ -184,6 +195,9 @@ class ComplianceSynthesisNLP:
         self.y = y
         values = {(v.owner, v.key): v.value(y[i]) for i, v in enumerate(self.variables)}
         self.k = self._stiffness(values)  # joint stiffness, SX over the joint vector
+        self._values = values
+        #: flexible body name -> (the links' label whose section it takes, that section)
+        self.flexible = dict(flexible or {})
         sp = cm.static_point(model, hs, model.x_home, model.q_home)
         self.J = sp.J
         G = stiffness_basis(model, hs, model.x_home, model.q_home)
@@ -257,13 +271,49 @@ class ComplianceSynthesisNLP:
                 six[hinge.group] = HINGE_TABLE[hinge.kind].six_axis(mat.E, mat.G, self.designed[hinge.name])
             for a, (zi, _) in fr.variables.items():
                 h[zi] = self.k[hinge.axes[a]] if a in hinge.axes else six[hinge.group][a]
+        Hs = self._home_hessian(sm, H, h)
         held = self.ka is None
         free = np.concatenate([np.arange(nx), np.arange(nx + nq, sm.nz)]) if held else np.arange(sm.nz)
         N = scipy.linalg.null_space(A[:, free])
-        hv = ca.vertcat(*[h[i] for i in free])
-        Kr = ca.mtimes([ca.DM(N.T), ca.diag(hv), ca.DM(N)])
+        Kr = ca.mtimes([ca.DM(N.T), Hs[free.tolist(), free.tolist()], ca.DM(N)])
         P = ca.DM(N[:nx])  # the pose coordinates come first among the free variables
         return ca.mtimes(P, ca.solve(Kr, P.T))
+
+    def _home_hessian(self, sm: Any, H: np.ndarray, h: Sequence[Any]) -> Any:
+        """H at home with the designed parts symbolic: the hinges' axes on the diagonal (``h``), the
+        designed flexible links' element blocks K_e (full: their energy ½ εᵀ K_e ε)."""
+        Hs = ca.SX(ca.DM(H))
+        for i, hi in enumerate(h):
+            Hs[i, i] = hi
+        for _, elements, K_sym in self._beam_stiffness(sm):
+            for (_, idx), K in zip(elements, K_sym, strict=True):
+                for a, ia in enumerate(idx):
+                    for b, ib in enumerate(idx):
+                        Hs[ia, ib] = K[a, b]
+        return Hs
+
+    def _beam_stiffness(self, sm: Any) -> list[tuple[Any, list, list[Any]]]:
+        """(body, its elements with their z indices, each element's symbolic K_e) of every flexible
+        body that is a designed link: its section is the link's (`LinkSection`: width along the first
+        joint's axis is the beam's b, height its h; or d), the designed dimensions symbols, so EA, EI,
+        GJ and κGA enter K_e = C_e⁻¹ (`cpm_nlp.analysis.beams.element_compliance`) symbolically."""
+        out = []
+        for body, _, elements in sm.beams:
+            if body.name not in self.flexible:
+                continue
+            label, sec = self.flexible[body.name]
+            given = {key: self._values.get((label, key), getattr(sec, key)) for key in ("width", "height", "d")}
+            section = beam_section(LinkSection(given["width"], given["height"], given["d"]), body.beam.section)
+            mat, spec = body.material, body.beam
+            Ks = []
+            for k, (el, _) in enumerate(elements):
+                model = spec.model_of(k)
+                C, _ = element_compliance(section, mat.E, mat.nu, el.s0, el.s1, el.x_centre, spec.theory, model)
+                dofs = list(el.dofs)
+                Ce = C[dofs, dofs]
+                Ks.append(ca.solve(Ce, ca.SX.eye(len(dofs))))
+            out.append((body, elements, Ks))
+        return out
 
     def _stresses(self) -> list[tuple[str, Any]]:
         """(label, σ) of every hinge with a type at every stroke pose where it deflects."""

@@ -161,6 +161,7 @@ class SixAxisModel:
         z = ca.vertcat(*self._z)
         self._legs, self._extra = legs, extra  # for the bodies' frames (`body_frames`)
         self._body_frames: ca.Function | None = None
+        self._beam_nodes: ca.Function | None = None
         g = self._closures(z, legs, extra)
         self.ng = g.numel()
         self._functions(z, g)
@@ -239,18 +240,67 @@ class SixAxisModel:
         for li, rows in enumerate(self._legs):
             Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
             for ji, (j, motions) in enumerate(rows):
-                for kind, axis, value in motions + self._extra.get((li, ji), []):
-                    if kind == "P":
-                        Rk, tk = ca.SX.eye(3), value * ca.DM(axis)
-                    else:
-                        Rk = _rot(axis, value)
-                        tk = ca.DM(j.at) - Rk @ ca.DM(j.at)
-                    Rm, tm = Rm @ Rk, Rm @ tk + tm
+                for kind, axis, value, *point in motions + self._extra.get((li, ji), []):
+                    Rm, tm = _apply(Rm, tm, kind, axis, value, point[0] if point else j.at)
                 Rs.append(Rm)
                 ts.append(tm)
         name = f"{self.model.closure.name}_body_frames"
         self._body_frames = ca.Function(name, [z], [ca.horzcat(*Rs), ca.horzcat(*ts)], ["z"], ["R", "t"])
         return self._body_frames
+
+    def beam_node_jacobians(self) -> ca.Function:
+        """``("<name>_beam_node_jacobians", [z], [J])``: per beam element (of `beams`, in order), the
+        12 x nz Jacobian of its nodes' velocities (v_0, ω_0, v_1, ω_1) read in the element's axes
+        turned with its start node (the axes of its mass matrix, `cpm_nlp.analysis.beams.element_mass`),
+        stacked.  The start node moves with the product up to the element's motions, the end node
+        with it and them.  Built once."""
+        if self._beam_nodes is not None:
+            return self._beam_nodes
+        z = ca.vertcat(*self._z)
+        zd = ca.SX.sym("zd", self.nz)
+        wanted = {(li, ja, p) for places in self._element_places for li, ja, p0, p1 in places for p in (p0, p1)}
+        snap: dict[tuple[int, int, int], tuple[Any, Any]] = {}
+        for li, rows in enumerate(self._legs):
+            Rm, tm = ca.SX.eye(3), ca.SX.zeros(3)
+            for ji, (j, motions) in enumerate(rows):
+                for p, (kind, axis, value, *point) in enumerate(motions + self._extra.get((li, ji), [])):
+                    if (li, ji, p) in wanted:
+                        snap[(li, ji, p)] = (Rm, tm)
+                    Rm, tm = _apply(Rm, tm, kind, axis, value, point[0] if point else j.at)
+                p = len(motions) + len(self._extra.get((li, ji), []))
+                if (li, ji, p) in wanted:
+                    snap[(li, ji, p)] = (Rm, tm)
+        rows_out = []
+        for (_, _, elements), places in zip(self.beams, self._element_places, strict=True):
+            for (el, _), (li, ja, p0, p1) in zip(elements, places, strict=True):
+                axes = snap[(li, ja, p0)][0] @ ca.DM(el.axes)
+                for (R, t), node in zip((snap[(li, ja, p0)], snap[(li, ja, p1)]), el.nodes):
+                    Jv = ca.jacobian(R @ ca.DM(node) + t, z)
+                    Rdot = ca.reshape(ca.jacobian(ca.reshape(R, 9, 1), z) @ zd, 3, 3)
+                    Jw = ca.jacobian(vee(Rdot @ R.T), zd)
+                    rows_out += [axes.T @ Jv, axes.T @ Jw]
+        J = ca.densify(ca.vertcat(*rows_out)) if rows_out else ca.DM.zeros(0, self.nz)
+        name = f"{self.model.closure.name}_beam_node_jacobians"
+        self._beam_nodes = ca.Function(name, [z], [J], ["z"], ["J"])
+        return self._beam_nodes
+
+    def beam_mass_matrix(self, z: np.ndarray) -> np.ndarray:
+        """M_z (nz x nz) of the flexible bodies' elements at z: Σ_e J_eᵀ M_e J_e with M_e the
+        element's mass matrix (`Element.M`) and J_e its nodes' velocity Jacobian
+        (`beam_node_jacobians`).  Raises ValueError when an element has no mass matrix (no density)."""
+        M = np.zeros((self.nz, self.nz))
+        if not self.beams:
+            return M
+        J = np.asarray(self.beam_node_jacobians()(z), dtype=float)
+        k = 0
+        for body, _, elements in self.beams:
+            for el, _ in elements:
+                if el.M is None:
+                    raise ValueError(f"body {body.name}: its material has no density")
+                Je = J[12 * k : 12 * k + 12]
+                M += Je.T @ el.M @ Je
+                k += 1
+        return 0.5 * (M + M.T)
 
     def _functions(self, z: Any, g: Any) -> None:
         """The energy of every axis of every hinge, and the named CasADi functions."""
@@ -337,6 +387,8 @@ class SixAxisModel:
         where = self._where
         out = []
         self._beam_joints: list[tuple[int, int]] = []
+        #: per beam of `beams`, per element: (leg, joint, its first and past-last place in the joint's product)
+        self._element_places: list[list[tuple[int, int, int, int]]] = []
         for body in hs.bodies:
             for m, (first, second) in enumerate(body.members):
                 if body.centred:
@@ -365,14 +417,27 @@ class SixAxisModel:
                         path=body.path + ("section" if body.beam.section.length is not None else "length",),
                     )
                 mat = body.material
-                elements = []
+                elements, places = [], []
                 for k, el in enumerate(beam_elements(body.beam, start, end, bend, mat.E, mat.nu, mat.density)):
                     idx = [self._new(f"{body.name}{m + 1}_e{k + 1}_{DEFORMATIONS[d]}", rest) for d in el.dofs]
+                    # where the element's motions sit in its joint's product (the joint's own, then extra)
+                    p0 = len(leg.joints[ja].motions) + len(extra.get((li, ja), []))
                     extra.setdefault((li, ja), []).extend(element_motions(el, [self._z[i] for i in idx]))
                     elements.append((el, idx))
+                    places.append((li, ja, p0, p0 + len(idx)))
                 out.append((body, li, elements))
+                self._element_places.append(places)
                 self._beam_joints.append((ja, m))
         return out
+
+    def beam_places(self) -> list[tuple[int, int]]:
+        """Per beam of `beams`: (leg, the joint its elements follow)."""
+        return [(li, ja) for (_, li, _), (ja, _) in zip(self.beams, self._beam_joints, strict=True)]
+
+    def flexible_links(self) -> dict[tuple[int, int], str]:
+        """(leg, first joint) -> the flexible body that is the link after that joint (``between``)."""
+        beams = zip(self.beams, self._beam_joints, strict=True)
+        return {(li, ja): body.name for (body, li, _), (ja, _) in beams if not body.centred}
 
     def body_stresses(self, z: np.ndarray) -> dict[str, float]:
         """The largest nominal stress of each flexible body (over its legs and elements; a given
@@ -574,6 +639,17 @@ class SixAxisModel:
         K[:n, n:] = A[:, free].T
         K[n:, :n] = A[:, free]
         return K
+
+
+def _apply(Rm: Any, tm: Any, kind: str, axis: np.ndarray, value: Any, at: np.ndarray) -> tuple[Any, Any]:
+    """(Rm, tm) followed by one elementary motion: a translation along ``axis``, or a rotation
+    about it through ``at``."""
+    if kind == "P":
+        Rk, tk = ca.SX.eye(3), value * ca.DM(axis)
+    else:
+        Rk = _rot(axis, value)
+        tk = ca.DM(at) - Rk @ ca.DM(at)
+    return Rm @ Rk, Rm @ tk + tm
 
 
 def _joint_places(chains: Chains) -> dict[str, tuple[int, int]]:

@@ -6,6 +6,7 @@ model).  Every hinge kind's inputs (hinges, material, masses, links, k_actuator)
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -14,12 +15,12 @@ import numpy as np
 import scipy.linalg
 
 from ..analysis import compliance as cm
-from ..analysis.compliance_synthesis import ROUND_OFF, ComplianceSynthesisNLP, Requirements, Variable
+from ..analysis.compliance_synthesis import ROUND_OFF, ComplianceSynthesisNLP, Requirements, Variable, beam_section
 from ..analysis.compliance_values import compliance_output, diagonal_output
 from ..analysis.hinge_chains import six_axis_model
 from ..analysis.hinge_models import HINGE_MODELS, has_chains
 from ..analysis.hinge_types import DIM_OPTIONS
-from ..analysis.link_masses import link_bodies
+from ..analysis.link_masses import LinkSection, link_bodies
 from ..core.errors import InputError, suggest
 from ..core.kind import ProblemKind, broadcast, require_ipopt, task_options, task_values
 from ..core.kinematics import inverse_kinematics
@@ -31,7 +32,7 @@ from ..core.schema import MappingOf, Quantity, Record
 from ..core.solver import SolverConfig
 from .compliance import _k_q_output
 from .frequencies import _coordinate_masses, _links_node, masses_node
-from .hinge_inputs import hinge_options, k_actuator_option
+from .hinge_inputs import bodies_option, hinge_options, k_actuator_option
 from .kinematic import _model_info
 
 #: the measures an objective may name, beyond the compliance of each pose coordinate
@@ -151,6 +152,7 @@ class ComplianceSynthesis(ProblemKind):
         ka = k_actuator_option(model)
         return [
             *hinge_options(),
+            bodies_option(),
             _design_node(),
             _links_node(),
             _link_design_node(),
@@ -217,8 +219,14 @@ class ComplianceSynthesis(ProblemKind):
 
     def resolve(self, inputs: dict[str, Any], model: Model, path: tuple) -> None:  # noqa: C901 - one check per input
         """The hinges, the design variables (checked against the hinges' types), the requirements."""
-        hs = cm.hinge_set(model, inputs["hinges"], inputs["material"], None, path)
+        hs = cm.hinge_set(model, inputs["hinges"], inputs["material"], None, path, inputs.get("bodies"))
         inputs["hinge_set"] = hs
+        if hs.bodies and inputs["hinge_axes"] != "all":
+            raise InputError(
+                f"flexible bodies ({', '.join(b.name for b in hs.bodies)}) enter the six-axis hinge model's "
+                "compliance only; give hinge_axes: all",
+                path=path + ("hinge_axes",),
+            )
         design = inputs["design"] or {}
         groups = {h.group: h for h in hs.hinges}
         variables: list[Variable] = []
@@ -258,6 +266,7 @@ class ComplianceSynthesis(ProblemKind):
                 for b in link_bodies(sm, {label: spec}, mat.density if mat else None, path + ("links",)):
                     bodies.append((label, b))
             inputs["links_resolved"] = (sm, bodies)
+        inputs["flexible"] = _flexible_links(inputs, hs, path)
         for label, dims in (inputs["link_design"] or {}).items():
             spec = (inputs["links"] or {}).get(label)
             if spec is None or spec.get("section") is None or spec.get("mass") is not None:
@@ -376,6 +385,7 @@ class ComplianceSynthesis(ProblemKind):
             inputs["M_x"],
             inputs["M_q"],
             inputs["links_resolved"],
+            inputs["flexible"],
         )
         y0 = np.array([_start(v, hs, inputs) for v in inputs["variables"]])
         res = nlp.solve(y0)
@@ -546,7 +556,56 @@ def designed_hinges(model: Model, inputs: Mapping[str, Any], design: Mapping[str
         entry[v.key] = float(design[v.name])  # a bare SI number
         entry["k"] = None
         raw[v.owner] = entry
-    return cm.hinge_set(model, raw, inputs["material"], None)
+    hs = cm.hinge_set(model, raw, inputs["material"], None, bodies=inputs.get("bodies"))
+    flexible = inputs.get("flexible") or {}
+    if flexible:  # a flexible link takes its link's section, with the designed dimensions
+        bodies = []
+        for b in hs.bodies:
+            if b.name in flexible:
+                label, sec = flexible[b.name]
+                given = {k: design.get(f"{k}_{label}", getattr(sec, k)) for k in LINK_KEYS}
+                section = beam_section(LinkSection(given["width"], given["height"], given["d"]), b.beam.section)
+                b = dataclasses.replace(b, beam=dataclasses.replace(b.beam, section=section))
+            bodies.append(b)
+        hs.bodies = bodies
+    return hs
+
+
+def _flexible_links(inputs: Mapping[str, Any], hs: cm.HingeSet, path: tuple) -> dict[str, tuple[str, LinkSection]]:
+    """Flexible body name -> (label, section) of the link of ``links`` it is (a link given by its
+    section, between the same two joints): its section is the beam's, so a link design changes
+    the beam's stiffness too.  The body's declared section must be that section."""
+    if not inputs["links_resolved"] or not hs.bodies:
+        return {}
+    sm, bodies = inputs["links_resolved"]
+    flexible = sm.flexible_links()
+    out: dict[str, tuple[str, LinkSection]] = {}
+    for label, b in bodies:
+        name = flexible.get((b.leg, b.joint))
+        sec = inputs["links"][label].get("section")
+        if name is None or sec is None:
+            continue
+        body = next(x for x in hs.bodies if x.name == name)
+        declared = body.beam.section
+        link = beam_section(sec, declared)
+        same = declared.kind == link.kind and all(
+            math.isclose(float(declared.values[k]), float(link.values[k]), rel_tol=1e-12)
+            for k in ("b", "h", "d")
+            if k in link.values
+        )
+        if not same:
+            raise InputError(
+                f"link {label} is the flexible body {name}, whose section must be the link's: {link.kind} "
+                + ", ".join(f"{k} = {float(v) * 1e3:g} mm" for k, v in link.values.items() if k != "kappa")
+                + " (width along the first joint's axis is the beam's b, height its h); the body gives "
+                + f"{declared.kind} "
+                + ", ".join(f"{k} = {float(v) * 1e3:g} mm" for k, v in declared.values.items() if k != "kappa"),
+                path=path + ("links", label, "section"),
+            )
+        if out.get(name, (label,))[0] != label:
+            raise InputError(f"flexible body {name} is two links, {out[name][0]} and {label}", path=path + ("links",))
+        out[name] = (label, sec)
+    return out
 
 
 def _start(v: Variable, hs: cm.HingeSet, inputs: Mapping[str, Any]) -> float:

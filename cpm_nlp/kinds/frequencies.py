@@ -7,7 +7,7 @@ kinematic or the six-axis hinge model); the hinge kinds' common parts are in
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -45,7 +45,7 @@ from .compliance import (
     _hinge_result,
     _HingeKind,
 )
-from .hinge_inputs import hinge_options, k_actuator_option, mass_node
+from .hinge_inputs import bodies_option, hinge_options, k_actuator_option, mass_node
 from .kinematic import _pose_outputs, _pose_values
 
 #: how many frequencies equal each mode's own
@@ -159,6 +159,18 @@ def _coordinate_masses(masses: Mapping[str, Any], model: Model, mat: Any, path: 
     return mx, mq
 
 
+def _check_flexible_links(sm: Any, bodies: Sequence[Any], path: tuple) -> None:
+    """A link that is a flexible body (between two joints) has its elements' masses: not a rigid link's too."""
+    flexible = sm.flexible_links()
+    for b in bodies:
+        if (b.leg, b.joint) in flexible:
+            raise InputError(
+                f"link {b.name} is the flexible body {flexible[(b.leg, b.joint)]}, whose elements carry its mass "
+                "(the material's density); remove the link",
+                path=path,
+            )
+
+
 class NaturalFrequencies(_HingeKind):
     name = "natural_frequencies"
     #: the hinges, and the legs as serial chains for the six-axis hinge model and the link masses
@@ -171,7 +183,7 @@ class NaturalFrequencies(_HingeKind):
     plots = ("modes",)
 
     def input_options(self, model: Model) -> list[Option]:
-        opts = task_options(model, "scalar") + actuator_options(model, "scalar") + hinge_options()
+        opts = task_options(model, "scalar") + actuator_options(model, "scalar") + hinge_options() + [bodies_option()]
         opts.append(masses_node(model))
         ka = k_actuator_option(model)
         return [
@@ -199,12 +211,20 @@ class NaturalFrequencies(_HingeKind):
         the hinge model and the links."""
         super().resolve(inputs, model, path)
         hs: cm.HingeSet = inputs["hinge_set"]
-        if hs.bodies:
+        if hs.bodies and inputs["hinge_axes"] != "all":
             raise InputError(
-                "natural_frequencies takes rigid links, and the mechanism declares flexible bodies "
-                f"({', '.join(b.name for b in hs.bodies)}); platform_compliance and actuator_forces take them",
+                "the kinematic hinge model takes rigid links, and the mechanism declares flexible bodies "
+                f"({', '.join(b.name for b in hs.bodies)}); give hinge_axes: all (the six-axis model with the "
+                "beams' elements)",
                 path=("mechanism", "stiffness", "bodies"),
             )
+        for b in hs.bodies:
+            if b.material.density is None:
+                raise InputError(
+                    f"body {b.name}: its elements' masses need the material's density "
+                    "(material: {E: ..., nu: ..., density: ...})",
+                    path=b.path + ("material",),
+                )
         mat = next((h.material for h in hs.hinges if h.material is not None), None)
         density = mat.density if mat else None
         mx, mq = inputs["M_x"], inputs["M_q"] = _coordinate_masses(inputs["masses"] or {}, model, mat, path)
@@ -230,10 +250,10 @@ class NaturalFrequencies(_HingeKind):
             inputs["hinge_model"] = HINGE_MODELS["all"].prepare(model, hs, where, True)
         inputs["link_bodies"] = []
         if inputs["links"]:
-            inputs["link_bodies"] = link_bodies(
-                inputs["hinge_model"].six_axis, inputs["links"], density, path + ("links",)
-            )
-        if not np.any(mx) and not np.any(mq) and not inputs["link_bodies"]:
+            sm = inputs["hinge_model"].six_axis
+            inputs["link_bodies"] = link_bodies(sm, inputs["links"], density, path + ("links",))
+            _check_flexible_links(sm, inputs["link_bodies"], path + ("links",))
+        if not np.any(mx) and not np.any(mq) and not inputs["link_bodies"] and not hs.bodies:
             raise InputError(
                 "expected masses: a mapping of coordinate -> mass or inertia, or links with mass",
                 path=path + ("masses",),
@@ -293,7 +313,7 @@ class NaturalFrequencies(_HingeKind):
         if not ok:
             msg = "six-axis hinge model: no equilibrium at the commanded actuators (Newton on the KKT)"
             return _hinge_result(self.name, model, Status.NOT_CONVERGED, out, info, msg)
-        M_z = link_mass_matrix(sm, inputs["link_bodies"], z)
+        M_z = link_mass_matrix(sm, inputs["link_bodies"], z) + sm.beam_mass_matrix(z)  # the beams' elements
         M_z[: c.nx, : c.nx] += np.diag(inputs["M_x"])
         M_z[c.nx : c.nx + c.nq, c.nx : c.nx + c.nq] += np.diag(inputs["M_q"])
         held = inputs["k_actuator"] is None
@@ -318,6 +338,11 @@ class NaturalFrequencies(_HingeKind):
             f"|K - (2 pi f)^2 M| = 0 on the motions that keep the closures; six-axis hinges: "
             f"{', '.join(sm.six_axis_hinges) or 'none'}; {sm.chains.note}"
         )
+        if sm.hs.bodies:
+            models = sorted({mdl for b in sm.hs.bodies for mdl in b.beam.models})
+            masses = " and ".join({"distributed": "consistent", "lumped": "lumped"}[mdl] for mdl in models)
+            names = ", ".join(b.name for b in sm.hs.bodies)
+            msg += f"; but the links that are flexible bodies ({names}) are beams with {masses} element masses"
         repeated = [idx for idx in clusters if len(idx) > 1]
         if repeated:
             msg += "; " + "; ".join(degenerate_note(idx) for idx in repeated)
