@@ -12,6 +12,7 @@ on disk by their source like the built-ins'.
 from __future__ import annotations
 
 import hashlib
+import json
 import logging
 import math
 import threading
@@ -120,6 +121,19 @@ def _cached(key: str, make: Any) -> Mechanism:
         with _LOCK:
             _CACHE[key] = mech
     return mech
+
+
+def inline(data: Any, *, base_dir: Path | None = None) -> Mechanism:
+    """The mechanism a problem file's inline ``description:`` describes: `from_dict`, once per
+    content (SHA-256 of the description's canonical JSON and of ``base_dir``), so that problems
+    of one description (a sweep, a test suite) share its closure and its built solvers.  A
+    description JSON cannot write (a key that is no string) is read every time."""
+    try:
+        canonical = json.dumps(data, sort_keys=True, allow_nan=True, default=repr)
+    except (TypeError, ValueError):
+        return from_dict(data, base_dir=base_dir)
+    key = "inline:" + hashlib.sha256(f"{canonical}\0{base_dir}".encode()).hexdigest()
+    return _cached(key, lambda: from_dict(data, base_dir=base_dir))
 
 
 def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Mechanism:
