@@ -41,6 +41,30 @@ def compiled_cache_dir(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def shipped_solve():
+    """``shipped_solve(name, whole=False)``: ``(problem, result)`` of problems/<name>.yaml,
+    solved once per session (per xdist worker) for every test that solves a shipped file (the
+    declared outputs, the plots).  ``whole``: with its outputs selection lifted, as ``cpm-nlp
+    solve FILE --plot`` draws it (the same solve for a file without a selection); the problem
+    returned is the file's own."""
+    from dataclasses import replace
+
+    problems: dict[str, cn.Problem] = {}
+    results: dict[tuple[str, bool], cn.Result] = {}
+
+    def get(name: str, whole: bool = False):
+        if name not in problems:
+            problems[name] = cn.load_problem(PROBLEMS / f"{name}.yaml")
+        problem = problems[name]
+        key = (name, whole and problem.outputs is not None)
+        if key not in results:
+            results[key] = cn.solve(replace(problem, outputs=None) if key[1] else problem)
+        return problem, results[key]
+
+    return get
+
+
+@pytest.fixture(scope="session")
 def prs3():
     return cn.build_model("prs3", PAPER_PRS3)
 

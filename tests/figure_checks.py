@@ -212,29 +212,88 @@ def _same_marker(handle, artist):
     return a.shape == b.shape and np.allclose(a, b, atol=1e-6)
 
 
-def _pixels(fig):
+def _pixels(fig, canvas=None):
+    """The figure rendered by Agg, as int16 RGBA rows; ``canvas``: one to render on again (its
+    renderer, and Matplotlib's text metrics cached for it, kept from one render to the next)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    canvas = FigureCanvasAgg(fig)
+    canvas = canvas or FigureCanvasAgg(fig)
     canvas.draw()
     return np.asarray(canvas.buffer_rgba()).astype(np.int16)
 
 
-def _draws_pixels(fig, artist, reference, min_pixels=3, min_step=8):
-    """Whether hiding the artist changes the rendered figure (at least `min_pixels`
-    pixels by more than `min_step` of 255): an artist that is invisible, fully
-    transparent, outside the view or covered by others changes nothing. The figure is
-    rendered without anti-aliasing, so that a curve drawn exactly on top of an equal
-    one changes no pixel (anti-aliased edges would darken where two equal curves overlap)."""
-    if not artist.get_visible():
-        return False
-    artist.set_visible(False)
-    try:
-        without = _pixels(fig)
-    finally:
-        artist.set_visible(True)
-    changed = (np.abs(without - reference) > min_step).any(axis=-1)
-    return int(changed.sum()) >= min_pixels
+class _Renders:
+    """The renders of one figure for the visibility checks, on one canvas: the figure with the
+    axes drawn that can touch a given artist's pixels, once per set of axes (the reference),
+    and again with the artist hidden.
+
+    Hiding an artist changes only the pixels it draws, inside its own axes' tight bounding box
+    (or its own window extent, if it is drawn outside them).  An axes whose tight bounding box
+    (everything it draws: patch, spines, ticks, labels, children) does not overlap that region
+    draws no pixel there, so it is left out of both renders: the pixels that hiding changes are
+    the same as on the whole figure, and an 8-panel figure renders 2 to 3 panels per entry.
+    Figure-level artists (legends, titles) are always drawn."""
+
+    def __init__(self, fig):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        self.fig = fig
+        self.canvas = FigureCanvasAgg(fig)
+        self.full = _pixels(fig, self.canvas)
+        self.renderer = self.canvas.get_renderer()
+        self.boxes = [(ax, ax.get_tightbbox(self.renderer, for_layout_only=False)) for ax in fig.axes]
+        self.references: dict[frozenset, np.ndarray] = {}
+
+    def _drawn_axes(self, artist) -> frozenset | None:
+        """The axes that can draw where ``artist`` does; None: every axes (not known)."""
+        from matplotlib.transforms import Bbox
+
+        ax = getattr(artist, "axes", None)
+        own = next((b for a, b in self.boxes if a is ax), None)
+        try:
+            extent = artist.get_window_extent(self.renderer)
+        except Exception:  # an artist without a usable extent: the whole figure
+            return None
+        if own is None or extent is None or not np.all(np.isfinite(extent.extents)):
+            return None
+        region = Bbox.union([own, extent]) if extent.width > 0 or extent.height > 0 else own
+        keep = frozenset(id(a) for a, b in self.boxes if b is not None and b.overlaps(region)) | {id(ax)}
+        return None if len(keep) == len(self.boxes) else keep  # every axes: the whole figure's render
+
+    def _render(self, keep: frozenset | None) -> np.ndarray:
+        if keep is None:
+            return _pixels(self.fig, self.canvas)
+        hidden = [a for a, _ in self.boxes if id(a) not in keep and a.get_visible()]
+        for a in hidden:
+            a.set_visible(False)
+        try:
+            return _pixels(self.fig, self.canvas)
+        finally:
+            for a in hidden:
+                a.set_visible(True)
+
+    def draws_pixels(self, artist, min_pixels=3, min_step=8) -> bool:
+        """Whether hiding the artist changes the rendered figure (at least `min_pixels`
+        pixels by more than `min_step` of 255): an artist that is invisible, fully
+        transparent, outside the view or covered by others changes nothing. The figure is
+        rendered without anti-aliasing, so that a curve drawn exactly on top of an equal
+        one changes no pixel (anti-aliased edges would darken where two equal curves overlap)."""
+        if not artist.get_visible():
+            return False
+        keep = self._drawn_axes(artist)
+        if keep is None:
+            reference = self.full
+        else:
+            if keep not in self.references:
+                self.references[keep] = self._render(keep)
+            reference = self.references[keep]
+        artist.set_visible(False)
+        try:
+            without = self._render(keep)
+        finally:
+            artist.set_visible(True)
+        changed = (np.abs(without - reference) > min_step).any(axis=-1)
+        return int(changed.sum()) >= min_pixels
 
 
 class _Aliased:
@@ -310,7 +369,7 @@ def _flat(container):
 
 
 def _check_legends(fig, artists, atol):
-    reference = _pixels(fig)
+    renders = _Renders(fig)
     for handle, label in _legend_entries(fig):
         if handle is None:
             continue
@@ -325,7 +384,7 @@ def _check_legends(fig, artists, atol):
                 problems.append(f"colour {np.round(missing[0], 3).tolist()} not among the artist's colours")
             elif not any(_same_marker(handle, a) for a in group):
                 problems.append("marker differs from the legend's")
-            elif not any(_draws_pixels(fig, a, reference) for a in group):
+            elif not any(renders.draws_pixels(a) for a in group):
                 problems.append("not visible (hidden, transparent, outside the view or covered)")
             else:
                 break

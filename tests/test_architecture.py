@@ -5,6 +5,7 @@ generic modules that name no mechanism."""
 from __future__ import annotations
 
 import ast
+import functools
 import re
 import subprocess
 import sys
@@ -35,6 +36,13 @@ MECHANISM_WORDS = ("prs3", "prc3", "rpr", "pantograph")
 TEXT_MODULES = ("cpm_nlp.cli.help",)
 
 
+@functools.cache
+def _parsed(path: Path) -> ast.Module:
+    """The syntax tree of a module of the package, parsed once per process (the tests below
+    only read it)."""
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
 def _modules() -> dict[str, Path]:
     out = {}
     for f in PKG.rglob("*.py"):
@@ -48,7 +56,7 @@ def _modules() -> dict[str, Path]:
 
 def _imports(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
     """Modules of cpm_nlp that ``name`` imports anywhere in its code."""
-    tree = ast.parse(path.read_text())
+    tree = _parsed(path)
     is_pkg = path.name == "__init__.py"
     package = name if is_pkg else name.rpartition(".")[0]
     found = set()
@@ -140,7 +148,7 @@ def test_library_never_imports_the_cli(graph):
 
 def _code_words(path: Path) -> set[str]:
     """Identifiers and string constants of a module, docstrings left out."""
-    tree = ast.parse(path.read_text())
+    tree = _parsed(path)
     docstrings = set()
     for node in ast.walk(tree):
         if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -221,7 +229,7 @@ def test_mechanism_file_modules_stay_small_and_simple():
     private = [
         f"{f.name}: {a.name}"
         for f in files
-        for node in ast.walk(ast.parse(f.read_text()))
+        for node in ast.walk(_parsed(f))
         if isinstance(node, ast.ImportFrom) and node.level and node.module != "__future__"
         for a in node.names
         if a.name.startswith("_")
@@ -236,7 +244,7 @@ def test_plot_modules_import_no_private_name():
     for name, path in _modules().items():
         if _layer(name) != "plot":
             continue
-        for node in ast.walk(ast.parse(path.read_text())):
+        for node in ast.walk(_parsed(path)):
             if isinstance(node, ast.ImportFrom) and node.module != "__future__":
                 bad += [f"{name}: {a.name}" for a in node.names if a.name.startswith("_")]
     assert not bad
@@ -401,7 +409,7 @@ def _core_mutable_assignments() -> dict[str, int]:
     found: dict[str, int] = {}
     for path in sorted((PKG / "core").rglob("*.py")):
         module = ".".join(path.relative_to(PKG.parent).with_suffix("").parts).removesuffix(".__init__")
-        for st in ast.parse(path.read_text(encoding="utf-8")).body:
+        for st in _parsed(path).body:
             if isinstance(st, ast.Assign):
                 targets, value = st.targets, st.value
             elif isinstance(st, (ast.AnnAssign, ast.AugAssign)):
@@ -451,7 +459,7 @@ def test_results_are_built_from_declared_outputs_only():
     for path in sorted(PKG.rglob("*.py")):
         if path.is_relative_to(PKG / "core"):
             continue
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(_parsed(path)):
             if isinstance(node, ast.Call):
                 f = node.func
                 name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
@@ -494,7 +502,7 @@ def _top_level_imports(name: str, path: Path, modules: dict[str, Path]) -> set[s
     """Modules of cpm_nlp that importing ``name`` imports (a package's parents too)."""
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found: set[str] = set()
-    for node in _executed(ast.parse(path.read_text()).body):
+    for node in _executed(_parsed(path).body):
         if isinstance(node, ast.Import):
             found |= {a.name for a in node.names}
             continue

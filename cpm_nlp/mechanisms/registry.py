@@ -410,7 +410,7 @@ def _section_described(section: Mapping[str, Any], base_dir: Any, path: tuple) -
             ) from None
         return mech
     try:
-        mech = described.from_dict(section["description"], base_dir=Path(base_dir) if base_dir else None)
+        mech = described.inline(section["description"], base_dir=Path(base_dir) if base_dir else None)
     except InputError as exc:
         raise exc.at(prefix=path + ("description",)) from None
     return mech

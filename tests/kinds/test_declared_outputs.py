@@ -114,9 +114,8 @@ def _shipped() -> list[str]:
 
 
 @pytest.mark.parametrize("name", _shipped())
-def test_a_shipped_problem_gives_exactly_the_declared_outputs(name):
-    problem = cn.load_problem(PROBLEMS / name)
-    res = cn.solve(problem)
+def test_a_shipped_problem_gives_exactly_the_declared_outputs(name, shipped_solve):
+    problem, res = shipped_solve(Path(name).stem)  # the file as it is, its outputs selection kept
     assert res.ok, (name, res.status, res.message)
     declared = problem.kind.outputs(problem.model)
     for out in res.outputs:

@@ -135,3 +135,27 @@ def test_readable_passes_a_sound_figure_and_fails_overlapping_or_clipped_labels(
     ax.set_xticks([0.0, 0.02], ["first long tick label", "second long tick label"])
     with pytest.raises(AssertionError, match="overlap"):
         assert_figure_readable(fig)
+
+
+def _panels(cover: bool):
+    """Three panels; the line of the first is covered by an opaque axes of its own when ``cover``
+    (the visibility check renders only the axes that can draw where an artist does)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6, 2.2), dpi=60, layout="constrained")
+    first, second, third = fig.subplots(1, 3)
+    first.plot([0, 1], [0, 1], color="C0", label="covered line")
+    second.plot([0, 1], [1, 0], color="C1", label="line beside")
+    third.scatter([0.5], [0.5], color="C2", label="point far away")
+    if cover:
+        over = fig.add_axes((0.0, 0.0, 0.36, 1.0), in_layout=False)  # the left third, opaque
+        over.set_xticks([])
+        over.set_yticks([])
+    fig.legend(loc="outside upper center", ncols=3)
+    return fig
+
+
+def test_the_visibility_check_sees_cover_from_another_axes_and_artists_in_other_panels():
+    assert_legend_matches_artists(_panels(cover=False))
+    with pytest.raises(AssertionError, match="'covered line'.*not visible"):
+        assert_legend_matches_artists(_panels(cover=True))

@@ -125,6 +125,21 @@ def _cached(key: str, make: Any) -> tuple[Mechanism, Description | None]:
     return mech, d
 
 
+def inline(data: Any, *, base_dir: Path | None = None) -> Mechanism:
+    """The mechanism a problem file's inline ``description:`` describes: `from_dict`, once per
+    content (SHA-256 of the description's canonical JSON and of ``base_dir``), so that problems
+    of one description (a sweep, a test suite) share its closure and its built solvers.  A
+    description JSON cannot write (a key that is no string) is read every time."""
+    import json  # only an inline description needs it (a solve of a mechanism file does not)
+
+    try:
+        canonical = json.dumps(data, sort_keys=True, allow_nan=True, default=repr)
+    except (TypeError, ValueError):
+        return from_dict(data, base_dir=base_dir)
+    key = "inline:" + sha256_hex(f"{canonical}\0{base_dir}".encode())
+    return _cached(key, lambda: _description_and_mechanism(data, None, base_dir, None))[0]
+
+
 def from_dict(data: Any, *, file: str | None = None, base_dir: Path | None = None) -> Mechanism:
     """The mechanism a parsed mapping describes."""
     return _description_and_mechanism(data, file, base_dir, None)[0]

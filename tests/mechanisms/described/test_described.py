@@ -404,3 +404,25 @@ def test_two_mechanisms_of_one_name_never_share_a_closure(tmp_path):
     for mech in (shipped, copy, shipped, copy):  # each its own closure (a described closure is the file's)
         assert REGISTRY.closure(mech) is mech.closure()
     assert shipped.closure() is not copy.closure()
+
+
+def test_problems_of_one_inline_description_share_its_closure():
+    """An inline ``description:`` is read once per content (described.inline): problems of the
+    same description share the closure and its built solvers; another description (a changed
+    length) or another base directory is a mechanism of its own, with its own numbers."""
+    import copy
+
+    import yaml
+
+    from cpm_nlp.mechanisms.registry import section_model
+
+    data = yaml.safe_load((MECH / "five_bar.yaml").read_text(encoding="utf-8"))
+    data["name"] = "five_bar_inline_probe"
+    first, again = section_model({"description": data}), section_model({"description": copy.deepcopy(data)})
+    assert again.closure is first.closure and again.mechanism is first.mechanism
+    assert section_model({"description": data}, ROOT).closure is not first.closure
+    changed = copy.deepcopy(data)
+    changed["parameters"]["l2"]["default"] = "160 mm"
+    other = section_model({"description": changed})
+    assert other.closure is not first.closure
+    assert other.x_home[1] > first.x_home[1] + 1e-3  # a longer distal link: P higher at home
