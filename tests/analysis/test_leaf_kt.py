@@ -128,3 +128,14 @@ def test_outside_the_fit_is_refused_with_its_key_path(tmp_path, extra, message):
     with pytest.raises(InputError, match=message) as err:
         _solve_with(tmp_path, "{" + LEAF + extra + "}")
     assert "inputs" in str(err.value) and "revolute" in str(err.value)
+
+
+def test_a_designed_fillet_radius_gives_the_same_kt_symbolically():
+    """compliance_synthesis may vary r: the fit on a CasADi symbol (both row sets, by if_else)
+    equals the float fit."""
+    import casadi as ca
+
+    r = ca.SX.sym("r")
+    f = ca.Function("kt", [r], [ht.leaf_fillet_kt(0.5e-3, r, 3e-3)], ["r"], ["kt"])
+    for value in (0.5e-3, 1e-3, 2e-3):  # h/r = 6, 3, 1.5
+        assert float(f(value)) == pytest.approx(ht.leaf_fillet_kt(0.5e-3, value, 3e-3), rel=1e-14)
