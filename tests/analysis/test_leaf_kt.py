@@ -139,3 +139,22 @@ def test_a_designed_fillet_radius_gives_the_same_kt_symbolically():
     f = ca.Function("kt", [r], [ht.leaf_fillet_kt(0.5e-3, r, 3e-3)], ["r"], ["kt"])
     for value in (0.5e-3, 1e-3, 2e-3):  # h/r = 6, 3, 1.5
         assert float(f(value)) == pytest.approx(ht.leaf_fillet_kt(0.5e-3, value, 3e-3), rel=1e-14)
+
+
+@pytest.mark.parametrize(("r_bounds", "refused"), [("[0.5 mm, 12 mm]", False), ("[0.2 mm, 12 mm]", True)])
+def test_a_designed_fillet_stays_within_the_fit(tmp_path, r_bounds, refused):
+    """compliance_synthesis varying a leaf's r with its block h fixed (6 mm): the bounds must keep
+    h/r within 0.1-20 (r = 0.2 mm gives 30: refused, naming inputs.design.revolute)."""
+    text = (ROOT / "problems" / "prs3_compliance_synthesis.yaml").read_text()
+    text = text.replace("revolute: {t: [0.5 mm, 4 mm], r: [2 mm, 12 mm]}", f"revolute: {{r: {r_bounds}}}")
+    text = text.replace(
+        "  k_actuator: 0 N/m", "  k_actuator: 0 N/m\n  hinges:\n    revolute: {" + LEAF + ", r: 2 mm, h: 6 mm}"
+    )
+    f = tmp_path / "design.yaml"
+    f.write_text(text)
+    if refused:
+        with pytest.raises(InputError, match=r"h/r = 30 is outside") as err:
+            load_problem(f)
+        assert "design" in str(err.value) and "revolute" in str(err.value)
+    else:
+        assert load_problem(f).kind.name == "compliance_synthesis"
