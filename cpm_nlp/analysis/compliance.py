@@ -61,7 +61,7 @@ from ..core.options import Option, validate_mapping
 from ..core.schema import Either, MappingOf, Quantity, Record
 from .beam_inputs import Body, bodies_of, merged_bodies, parse_bodies
 from .flexure import Material, material, material_node
-from .hinge_types import DIM_OPTIONS, HINGE_TABLE, NOTCH_TYPES, HingeType
+from .hinge_types import DIM_OPTIONS, HINGE_TABLE, NOTCH_TYPES, HingeType, check_leaf_fillet
 
 #: the axes of a hinge a joint coordinate may turn (or stretch) it about
 AXES = ("bend", "bend2", "torsion", "axial")
@@ -125,7 +125,7 @@ def _hinge_fields() -> tuple:
             "Kt",
             "dimensionless",
             "stress-concentration factor on the nominal stress, for the peak stress (default: the type's "
-            "published fit, circular_notch; else 1)",
+            "published fit: circular_notch, filleted_rod, leaf_spring with a fillet radius r; else 1)",
             default=None,
             lower=1.0,
         ),
@@ -154,7 +154,7 @@ def hinges_node(description: str) -> MappingOf:
 
 
 def _type_dims() -> str:
-    return "; ".join(f"{k}: {', '.join(t.dims)}" for k, t in HINGE_TYPES.items())
+    return "; ".join(f"{k}: {t.takes}" for k, t in HINGE_TYPES.items())
 
 
 #: hinge name -> hinge, as a problem file's ``inputs.hinges`` and a mechanism's declared hinges take them
@@ -247,7 +247,10 @@ class JointStiffness(Part):
 
 def check_geometry(kind: str, d: Mapping[str, float], path: tuple) -> None:
     """Reject a hinge that cannot exist (t >= 2r for a circular notch: the two
-    notches would not leave a thinnest section narrower than the blank)."""
+    notches would not leave a thinnest section narrower than the blank), or a leaf's fillet
+    outside its K_t fit (`check_leaf_fillet`)."""
+    if kind == "leaf_spring":
+        check_leaf_fillet(d, path)
     if kind in NOTCH_TYPES and d["t"] >= 2.0 * d["r"]:
         raise InputError(
             f"impossible circular notch: thickness t = {d['t'] * 1e3:g} mm must be below twice the notch radius "
@@ -386,15 +389,13 @@ def _hinge_dims(kind: str | None, spec: HingeSpec, path: tuple) -> dict[str, flo
     """The dimensions of a hinge type (and its Kt), from a parsed hinge."""
     if kind is None:
         return {}
-    need = HINGE_TYPES[kind].dims
-    extra = [d for d in DIM_OPTIONS if d not in need and spec.dims.get(d) is not None]
-    if extra:
-        raise InputError(
-            f"hinge type {kind} has no dimension {', '.join(extra)} (it takes {', '.join(need)})", path=path
-        )
-    dims = validate_mapping(
-        {d: spec.dims.get(d) for d in need}, [DIM_OPTIONS[d] for d in need], path, what="hinge dimension"
-    )
+    t = HINGE_TYPES[kind]
+    need, optional = t.dims, t.optional_dims
+    if extra := [d for d in DIM_OPTIONS if d not in need + optional and spec.dims.get(d) is not None]:
+        raise InputError(f"hinge type {kind} has no dimension {', '.join(extra)} (it takes {t.takes})", path=path)
+    options = [DIM_OPTIONS[d] for d in need] + [dataclasses.replace(DIM_OPTIONS[d], default=None) for d in optional]
+    dims = validate_mapping({d: spec.dims.get(d) for d in need + optional}, options, path, what="hinge dimension")
+    dims = {d: v for d, v in dims.items() if v is not None}  # an optional dimension not given is absent
     check_geometry(kind, dims, path)
     if spec.Kt is not None:  # else the type's published fit (Hinge.kt)
         dims["Kt"] = float(spec.Kt)

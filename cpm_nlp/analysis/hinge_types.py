@@ -103,6 +103,87 @@ def filleted_rod_kt(d, r):
     return c1 + c2 * x + c3 * x**2 + c4 * x**3
 
 
+#: the range of h/r over which Roark's shoulder-fillet fits hold (the transcription's "requirements")
+LEAF_KT_H_OVER_R = (0.1, 20.0)
+
+
+def leaf_fillet_kt(t, r, h=None):
+    """Stress-concentration factor K_t of a leaf spring (thickness t) whose ends run into its
+    blocks through corner fillets of radius r, in bending about its compliant axis, on the
+    nominal 6M/(w t²): each end is a square shoulder with a fillet in a member of rectangular
+    section, the block of height D = t + 2h standing h proud of each face of the leaf (h
+    default r, the filleted rod's assumption: a block just high enough to hold the fillet).
+    The fit is W. C. Young, R. G. Budynas, Roark's Formulas for Stress and Strain, 7th ed.
+    (2002), Table 17.1 (square shoulder with fillet in a member of rectangular section,
+    in-plane bending):
+        K_t = C1 + C2 (2h/D) + C3 (2h/D)² + C4 (2h/D)³,
+    for 0.1 <= h/r <= 2.0:
+        C1 = 1.007 + 1.000 √(h/r) - 0.031 h/r,   C2 = -0.270 - 2.404 √(h/r) + 0.749 h/r,
+        C3 = 0.677 + 1.133 √(h/r) - 0.904 h/r,   C4 = -0.414 + 0.271 √(h/r) + 0.186 h/r,
+    for 2.0 < h/r <= 20:
+        C1 = 1.042 + 0.982 √(h/r) - 0.036 h/r,   C2 = -3.599 + 1.619 √(h/r) - 0.431 h/r,
+        C3 = 6.084 - 5.607 √(h/r) + 1.158 h/r,   C4 = -2.527 + 3.006 √(h/r) - 0.691 h/r,
+    and L/D > 0.8/[r/(D - 2h)]^(1/4) with L the length of the wide part (the block) along the
+    leaf.  Coefficients as read in a transcription of that table (eng-calculations.com,
+    "Square shoulder with fillet in a member of rectangular section for elastic stress,
+    in-plane bending"), not in the book.  At h/r = 1 the coefficients sum to 1.000 (at 2,
+    1.000 and 0.9998): K_t -> 1 as t/r -> 0 (2h/D -> 1).  The caller checks h/r
+    (`LEAF_KT_H_OVER_R`, `cpm_nlp.analysis.compliance.check_geometry`)."""
+    h = r if h is None else h
+    hr = h / r
+    s = hr**0.5  # ** 0.5: also on CasADi symbols (a designed r)
+    low = (
+        1.007 + 1.000 * s - 0.031 * hr,
+        -0.270 - 2.404 * s + 0.749 * hr,
+        0.677 + 1.133 * s - 0.904 * hr,
+        -0.414 + 0.271 * s + 0.186 * hr,
+    )
+    high = (
+        1.042 + 0.982 * s - 0.036 * hr,
+        -3.599 + 1.619 * s - 0.431 * hr,
+        6.084 - 5.607 * s + 1.158 * hr,
+        -2.527 + 3.006 * s - 0.691 * hr,
+    )
+    x = 2.0 * h / (t + 2.0 * h)  # 2h/D
+
+    def kt(c):
+        return c[0] + c[1] * x + c[2] * x**2 + c[3] * x**3
+
+    if isinstance(hr, ca.SX | ca.MX):
+        return ca.if_else(hr <= 2.0, kt(low), kt(high))
+    return kt(low) if hr <= 2.0 else kt(high)
+
+
+def check_leaf_fillet(d: Mapping[str, float], path: tuple) -> None:
+    """Refuse a leaf spring's fillet outside its K_t fit: h without r, or h/r outside Roark's
+    `LEAF_KT_H_OVER_R` (the fit's other requirement, L/D > 0.8/[r/t]^(1/4) with L the block's
+    length along the leaf, is not checked: a hinge does not know its blocks' length)."""
+    if d.get("h") is not None and d.get("r") is None:
+        raise InputError(
+            "h is the shoulder height of a filleted leaf spring's blocks; give the fillet radius r too "
+            "(or leave h out: a sharp corner has no K_t fit)",
+            path=path + ("h",),
+        )
+    if d.get("r") is not None:
+        low, high = LEAF_KT_H_OVER_R
+        ratio = (d["r"] if d.get("h") is None else d["h"]) / d["r"]
+        if not low <= ratio <= high:
+            raise InputError(
+                f"leaf spring fillet: shoulder height over fillet radius h/r = {ratio:g} is outside the range of "
+                f"Roark's fit for its K_t (Table 17.1, square shoulder with fillet), {low:g} <= h/r <= {high:g}; "
+                "give Kt yourself, or h and r within it",
+                path=path + ("h",),
+            )
+
+
+def _leaf_kt(d: Mapping[str, float]) -> float:
+    """A leaf spring's K_t: Roark's shoulder fillet where its fillet radius r is given, else 1
+    (a sharp corner has no finite K_t; a hinge's ``Kt`` overrides both)."""
+    if d.get("r") is None:
+        return 1.0
+    return leaf_fillet_kt(d["t"], d["r"], d.get("h"))
+
+
 def _von_mises(sigma: float, tau: float) -> float:
     return (sigma**2 + 3.0 * tau**2) ** 0.5  # ** 0.5: also on CasADi symbols
 
@@ -249,6 +330,14 @@ DIM_OPTIONS: Mapping[str, Option] = MappingProxyType(
         "w": Option("w", "length", "hinge width (along its compliant axis)", lower=0.0, strict=True),
         "d": Option("d", "length", "neck diameter", lower=0.0, strict=True),
         "l": Option("l", "length", "hinge length", lower=0.0, strict=True),
+        "h": Option(
+            "h",
+            "length",
+            "shoulder height: how far the block stands proud of each face of a filleted leaf spring "
+            "(its K_t; default r)",
+            lower=0.0,
+            strict=True,
+        ),
     }
 )
 
@@ -284,6 +373,8 @@ class HingeType:
         joint's rotation limit), None if no source gives it.
     limit_source
         the source of ``rotation``.
+    optional_dims
+        the dimensions it may take besides (a leaf spring's fillet r and shoulder h, for its K_t).
     """
 
     name: str
@@ -297,11 +388,17 @@ class HingeType:
     limit_dims: tuple[str, ...] = ()
     rotation: Callable[..., float] | None = None
     limit_source: str = ""
+    optional_dims: tuple[str, ...] = ()
 
     @property
     def parameters(self) -> tuple[Option, ...]:
         """Its dimensions, each with its unit and meaning."""
-        return tuple(DIM_OPTIONS[d] for d in dict.fromkeys(self.dims + self.limit_dims))
+        return tuple(DIM_OPTIONS[d] for d in dict.fromkeys(self.dims + self.optional_dims + self.limit_dims))
+
+    @property
+    def takes(self) -> str:
+        """Its dimensions as a message names them: "t, l, w (optionally r, h)"."""
+        return ", ".join(self.dims) + (f" (optionally {', '.join(self.optional_dims)})" if self.optional_dims else "")
 
     @property
     def joints(self) -> tuple[str, ...]:
@@ -381,7 +478,12 @@ HINGE_TABLE: Mapping[str, HingeType] = MappingProxyType(
                 _leaf_six,
                 _rect_stress,
                 "stiffness: E w t^3/(12 l) (Euler-Bernoulli), G J/l with Roark's rectangle J; "
-                "stress: 6M/(w t^2), Roark Table 10.7 torsion, von Mises; peak: Kt x nominal (Kt given, default 1)",
+                "stress: 6M/(w t^2), Roark Table 10.7 torsion, von Mises; peak: K_t x nominal (Kt given, else "
+                "the fillet fit where a fillet radius r is given, else 1: a sharp corner has no finite K_t)",
+                kt=_leaf_kt,
+                kt_source="Roark's Formulas for Stress and Strain, 7th ed., Table 17.1 (square shoulder with fillet "
+                "in a member of rectangular section, in-plane bending), shoulder height h (default r)",
+                optional_dims=("r", "h"),
                 limit_dims=("l", "t"),
                 rotation=lambda E, sigma, d: leaf_spring_max_rotation(E, d["t"], d["l"], sigma),
                 limit_source="Euler-Bernoulli leaf spring under a pure moment",

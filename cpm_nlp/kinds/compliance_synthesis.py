@@ -19,7 +19,7 @@ from ..analysis.compliance_synthesis import ROUND_OFF, ComplianceSynthesisNLP, R
 from ..analysis.compliance_values import compliance_output, diagonal_output
 from ..analysis.hinge_chains import six_axis_model
 from ..analysis.hinge_models import HINGE_MODELS, has_chains
-from ..analysis.hinge_types import DIM_OPTIONS
+from ..analysis.hinge_types import DIM_OPTIONS, check_leaf_fillet
 from ..analysis.link_masses import LinkSection, link_bodies
 from ..core.errors import InputError, suggest
 from ..core.kind import ProblemKind, broadcast, require_ipopt, task_options, task_values
@@ -254,6 +254,10 @@ class ComplianceSynthesis(ProblemKind):
                 if not hi > lo:
                     raise InputError(f"expected [low, high] with high > low, got {rng}", path=path + ("design", g, d))
                 variables.append(Variable(f"{d}_{g}", g, d, lo, hi))
+            if h.kind == "leaf_spring" and h.dims.get("h") is not None:  # h/r within the K_t fit at the bounds
+                span = {d: (h.dims[d], h.dims[d]) if dims.get(d) is None else tuple(dims[d]) for d in ("r", "h")}
+                for r, sh in ((span["r"][1], span["h"][0]), (span["r"][0], span["h"][1])):
+                    check_leaf_fillet({"r": float(r), "h": float(sh)}, path + ("design", g))
         mat = next((h.material for h in hs.hinges if h.material is not None), None)
         inputs["M_x"], inputs["M_q"] = _coordinate_masses(inputs["masses"] or {}, model, mat, path)
         inputs["links_resolved"] = None

@@ -211,7 +211,9 @@ def _cases_of(path: Path, counter):  # noqa: C901 - one block per class of mutat
         mutated = {k: v for k, v in data.items() if k != key}
         yield f"{stem}-delete-{key}", dump(mutated), where
     # an unknown key, at a rotating place
-    places = [(), ("mechanism",), ("mechanism", "parameters")] + ([("inputs",)] if data.get("inputs") else [])
+    # (mechanism.parameters only where the file has it: a file mechanism may take none)
+    places = [(), ("mechanism",)] + ([("mechanism", "parameters")] if mech.get("parameters") else [])
+    places += [("inputs",)] if data.get("inputs") else []
     place = places[next(counter) % len(places)]
     mutated = json.loads(json.dumps(data, default=str))
     node = mutated

@@ -189,3 +189,18 @@ def test_the_leaf_as_a_beam_against_eq_55_and_58():
     assert prb["c_s"] is None and beam["c_s"] == pytest.approx(c_s, rel=1e-9)
     # what the bridge model leaves out: 9.4 times the stretch, a fifth of C_in
     assert beam["c_s"] / beam["c_t"] == pytest.approx(9.376, rel=1e-3)
+
+
+def test_the_shipped_leaf_beam_file_is_the_prb_file_with_the_beam():
+    """problems/rpr_compliance_leaf_beam.yaml: the inputs of problems/rpr_compliance.yaml with
+    leaf model: beam; C and C_in equal that file's (the eq 55, 58 model, to 1e-12), and c_s is
+    the Timoshenko transverse compliance of its leaf, 2.724e-8 m/N (the value
+    leaf_beam_compliances gives, checked written out above)."""
+    prb = cn.solve(cn.load_problem(ROOT / "problems" / "rpr_compliance.yaml"))
+    beam = cn.solve(cn.load_problem(ROOT / "problems" / "rpr_compliance_leaf_beam.yaml"))
+    assert prb.ok and beam.ok, (prb.message, beam.message)
+    np.testing.assert_allclose(beam.values["C"], prb.values["C"], rtol=1e-12, atol=1e-20)
+    np.testing.assert_allclose(beam.values["C_in"], prb.values["C_in"], rtol=1e-12, atol=1e-22)
+    assert beam.values["c_s"] == pytest.approx(rc.leaf_beam_compliances(AL, 1e-3, 0.4e-3, 12e-3)[2], rel=1e-12)
+    assert beam.values["c_s"] == pytest.approx(2.724e-8, rel=1e-3)
+    assert prb.values["c_s"] is None
