@@ -217,7 +217,7 @@ def _cases_of(path: Path, counter):  # noqa: C901 - one block per class of mutat
     place = places[next(counter) % len(places)]
     mutated = json.loads(json.dumps(data, default=str))
     node = mutated
-    for p in place:  # a file without mechanism parameters ({file: ...}) gets them, holding only the unknown key
+    for p in place:
         node = node.setdefault(p, {})
     node["zzz_unknown"] = 1
     yield f"{stem}-unknown-{_key_text(place) or 'top'}", dump(mutated), "zzz_unknown"
