@@ -420,23 +420,12 @@ class Decomposition:
         """(x0, x, disc, side) of the dyads placed, each its reference sign (None: see `function`)."""
         gen = self.gen
         x0 = ca.SX.sym("x0", gen.x.numel())
-        signs = []
-        for dy in self.dyads:
-            f = ca.Function("dyad_side", [gen.x, self.q, gen.p], [dy.side_x])
-            v = float(f(x_ref, q_ref, p_ref))
-            if not np.isfinite(v) or v == 0.0:
-                return None
-            dy.sign = 1.0 if v > 0 else -1.0
-            signs.append(dy.sign)
+        if not reference_signs(self.dyads, gen, self.q, (x_ref, q_ref, p_ref)):
+            return None
         x = self._coordinates(x0)
         if x is None:
             return None
-        syms = ca.vertcat(*[dy.symbol for dy in self.dyads])
-        sv = ca.DM(signs)
-        x = ca.substitute(x, syms, sv)
-        disc = ca.mmin(ca.vertcat(*[ca.substitute(dy.disc, syms, sv) for dy in self.dyads]))
-        side = ca.mmin(ca.vertcat(*[dy.sign * ca.substitute(dy.side_x, gen.x, x0) for dy in self.dyads]))
-        return x0, x, disc, side
+        return (x0, *with_signs(self.dyads, gen, x, x0))
 
 
 def graph_closed_form(gen: Any, q: ca.SX) -> tuple[ca.Function | None, ca.Function | None]:
@@ -467,3 +456,28 @@ def graph_closed_form(gen: Any, q: ca.SX) -> tuple[ca.Function | None, ca.Functi
 
 
 __all__ = ["Decomposition", "graph_closed_form"]
+
+
+def reference_signs(dyads: list[Any], gen: Any, q: Any, ref: tuple) -> bool:
+    """Each dyad's branch sign (``dy.sign``, +-1) from its side indicator ``dy.side_x`` at the
+    reference ``ref = (x, q, p)``; False where a dyad is singular there (its side zero or not
+    finite): no closed form.  Shared by the planar and the spherical dyads."""
+    for dy in dyads:
+        f = ca.Function("dyad_side", [gen.x, q, gen.p], [dy.side_x], ["x", "q", "p"], ["side"])
+        v = float(f(*ref))
+        if not np.isfinite(v) or v == 0.0:
+            return False
+        dy.sign = 1.0 if v > 0 else -1.0
+    return True
+
+
+def with_signs(dyads: list[Any], gen: Any, x: Any, x0: Any) -> tuple[Any, Any, Any]:
+    """(x, disc, side): the placed coordinates ``x`` with each dyad's sign symbol replaced by its
+    reference sign, the smallest discriminant (>= 0: every dyad assembles) and the smallest
+    signed side at the guess ``x0`` (> 0: the guess lies on the reference branches)."""
+    syms = ca.vertcat(*[dy.symbol for dy in dyads])
+    sv = ca.DM([dy.sign for dy in dyads])
+    x = ca.substitute(x, syms, sv)
+    disc = ca.mmin(ca.vertcat(*[ca.substitute(dy.disc, syms, sv) for dy in dyads]))
+    side = ca.mmin(ca.vertcat(*[dy.sign * ca.substitute(dy.side_x, gen.x, x0) for dy in dyads]))
+    return x, disc, side

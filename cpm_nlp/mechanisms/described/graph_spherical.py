@@ -43,6 +43,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from .graph_dyads import reference_signs, with_signs
 from .motions import rot
 
 #: how near the axes of a spherical dyad must meet, relative to the drawing's size (detection at
@@ -263,24 +264,13 @@ class SphericalDecomposition:
         dyad is singular at the reference)."""
         gen = self.gen
         x0 = ca.SX.sym("x0", gen.x.numel())
-        signs = []
-        for dy in self.dyads:
-            f = ca.Function("dyad_side", [gen.x, self.q, gen.p], [dy.side_x], ["x", "q", "p"], ["side"])
-            v = float(f(x_ref, q_ref, p_ref))
-            if not np.isfinite(v) or v == 0.0:
-                return None
-            dy.sign = 1.0 if v > 0 else -1.0
-            signs.append(dy.sign)
+        if not reference_signs(self.dyads, gen, self.q, (x_ref, q_ref, p_ref)):
+            return None
         coords = self._coordinates(x0)
         if coords is None:
             return None
         x, exact = coords
-        syms = ca.vertcat(*[dy.symbol for dy in self.dyads])
-        sv = ca.DM(signs)
-        x = ca.substitute(x, syms, sv)
-        disc = ca.mmin(ca.vertcat(*[ca.substitute(dy.disc, syms, sv) for dy in self.dyads]))
-        side = ca.mmin(ca.vertcat(*[dy.sign * ca.substitute(dy.side_x, gen.x, x0) for dy in self.dyads]))
-        return x0, x, disc, side, exact
+        return (x0, *with_signs(self.dyads, gen, x, x0), exact)
 
 
 def spherical_closed_form(gen: Any, q: ca.SX) -> tuple[ca.Function | None, ca.Function | None]:
