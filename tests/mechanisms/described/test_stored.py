@@ -277,7 +277,9 @@ def test_a_solve_with_the_closure_kept_loads_no_generator(tmp_path):
         "assert main(['solve', 'problems/prs3_forward_kinematics.yaml'], out=io.StringIO()) == 0; "
         f"print('loaded:' + ','.join(m for m in {watched!r} if m in sys.modules))"
     )
-    env = {**os.environ, "CPM_NLP_CACHE": str(tmp_path / "cache"), "PYTHONPATH": str(ROOT)}
+    # the child runs without pytest-cov's subprocess coverage (coverage itself imports hashlib)
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("COV_CORE_", "COVERAGE_"))}
+    env.update(CPM_NLP_CACHE=str(tmp_path / "cache"), PYTHONPATH=str(ROOT))
 
     def loaded() -> set[str]:
         run = subprocess.run([sys.executable, "-c", body], cwd=ROOT, env=env, capture_output=True, text=True)
