@@ -10,6 +10,11 @@ under another (OPENBLAS_CORETYPE), and compares.  Two numbers are the same when
 they agree to 1e-9 relative: of the larger of the two, or, in a list or matrix,
 of the largest entry of that list (so that an entry that is zero by symmetry and
 comes out as 1e-17 on one kernel and -3e-17 on the other is the same zero).  A
+length (m) or an angle (rad) that is zero by symmetry throughout its list (an
+equilibrium's pose at equal actuator inputs) has no scale of its own: two such
+values within `ZERO_FLOOR` of each other (1e-15 m, 1e-15 rad, against a pose's own
+round-off of about 2e-17 m in a 0.1 m mechanism, amplified by the linear solves of
+an equilibrium) are the same zero; the printed values are 0 on both.  A
 status, a string or a list length must be identical.  Wall-clock times (values
 named ``*seconds``) are left out.  The comparison is what
 "every number is identical under two BLAS kernels" means: the last bits of a
@@ -26,6 +31,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 RTOL = 1e-9
+#: the absolute floor below which two lengths (m) or angles (rad) are the same zero
+ZERO_FLOOR = {"m": 1e-15, "rad": 1e-15}
 #: files left out: none today (all 55 take about 60 s in one process on a loaded machine)
 SKIP: tuple[str, ...] = ()
 
@@ -63,7 +70,8 @@ def solve_all(out: Path) -> int:
         result = solve(load_problem(path))
         doc = json.loads(result.to_json())
         values = {k: v for k, v in doc["values"].items() if not k.endswith("seconds")}  # wall-clock times
-        found["problems"][path.name] = {"status": doc["status"], "values": values}
+        units = {k: doc.get("units", {}).get(k) for k in values}
+        found["problems"][path.name] = {"status": doc["status"], "values": values, "units": units}
     out.write_text(json.dumps(found, indent=1, sort_keys=True) + "\n")
     n = len(found["problems"])
     print(f"{n} problems solved under the {found['kernel']} kernel in {time.perf_counter() - start:.1f} s")
@@ -80,24 +88,38 @@ def _scale(value) -> float:
     return 0.0
 
 
-def differences(a, b, where: str = "", scale: float = 0.0) -> list[str]:
-    """Where ``a`` and ``b`` differ (see the module's docstring for 'differ')."""
+def differences(a, b, where: str = "", scale: float = 0.0, floor: float = 0.0, units=None) -> list[str]:
+    """Where ``a`` and ``b`` differ (see the module's docstring for 'differ').  ``units``: the
+    unit of each value, in a problem's ``values``; ``floor``: the value's `ZERO_FLOOR`."""
     if isinstance(a, dict) and isinstance(b, dict):
         out = [f"{where}.{k}: only in one run" for k in sorted(set(a) ^ set(b))]
+        problem = "values" in a and "units" in a
         for k in sorted(set(a) & set(b)):
-            out += differences(a[k], b[k], f"{where}.{k}" if where else k, 0.0)
+            path = f"{where}.{k}" if where else k
+            if problem and k == "units":
+                continue
+            if problem and k == "values":
+                out += differences(a[k], b[k], path, units=a["units"] or {})
+            elif units is not None:  # a problem's values: each its unit's floor
+                out += differences(a[k], b[k], path, floor=ZERO_FLOOR.get(units.get(k) or "", 0.0))
+            else:
+                out += differences(a[k], b[k], path)
         return out
     if isinstance(a, list) and isinstance(b, list):
         if len(a) != len(b):
             return [f"{where}: lengths {len(a)} and {len(b)}"]
         s = max(scale, _scale(a), _scale(b))
-        return [d for i, (x, y) in enumerate(zip(a, b)) for d in differences(x, y, f"{where}[{i}]", s)]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in differences(x, y, f"{where}[{i}]", s, floor)]
+    return [] if _same(a, b, scale, floor) else [f"{where}: {a!r} and {b!r}"]
+
+
+def _same(a, b, scale: float, floor: float) -> bool:
+    """Two leaves agree: numbers to `RTOL` of the larger or of ``scale``, or both within
+    ``floor`` of zero; anything else identical."""
     numbers = (int, float)
     if isinstance(a, numbers) and isinstance(b, numbers) and not isinstance(a, bool) and not isinstance(b, bool):
-        if a == b or abs(a - b) <= RTOL * max(abs(a), abs(b), scale):
-            return []
-        return [f"{where}: {a!r} and {b!r}"]
-    return [] if a == b else [f"{where}: {a!r} and {b!r}"]
+        return a == b or abs(a - b) <= RTOL * max(abs(a), abs(b), scale) or max(abs(a), abs(b)) <= floor
+    return a == b
 
 
 def compare(first: Path, second: Path) -> int:
