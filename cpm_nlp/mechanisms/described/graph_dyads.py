@@ -38,6 +38,7 @@ whose platform is placed by its coordinates, gets neither.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -122,16 +123,10 @@ class Decomposition:
 
     def _to_placed(self, b: str) -> list:
         """The joints between an unplaced body b and placed ones: (joint, placed body)."""
-        out = []
-        for g in self.joints:
-            if g.a == b and g.b in self.placed:
-                out.append((g, g.b))
-            elif g.b == b and g.a in self.placed:
-                out.append((g, g.a))
-        return out
+        return joints_to_placed(self.joints, self.placed, b)
 
     def _point_on(self, g: Any, body: str) -> ca.SX:
-        return g.pa if body == g.a else g.pb
+        return point_on(g, body)
 
     def _actuated(self) -> bool:
         for g in self.joints:
@@ -481,3 +476,23 @@ def with_signs(dyads: list[Any], gen: Any, x: Any, x0: Any) -> tuple[Any, Any, A
     disc = ca.mmin(ca.vertcat(*[ca.substitute(dy.disc, syms, sv) for dy in dyads]))
     side = ca.mmin(ca.vertcat(*[dy.sign * ca.substitute(dy.side_x, gen.x, x0) for dy in dyads]))
     return x, disc, side
+
+
+def point_on(g: Any, body: str) -> ca.SX:
+    """The point of joint ``g`` on ``body`` (one of its two bodies), in that body's frame."""
+    return g.pa if body == g.a else g.pb
+
+
+def joints_to_placed(joints: list[Any], placed: Mapping[str, Any], b: str, undriven: bool = False) -> list:
+    """The joints between an unplaced body ``b`` and placed ones, as (joint, placed body);
+    ``undriven``: only the joints no actuator drives.  Shared by the planar and the spherical
+    decompositions."""
+    out = []
+    for g in joints:
+        if undriven and g.drive is not None:
+            continue
+        if g.a == b and g.b in placed:
+            out.append((g, g.b))
+        elif g.b == b and g.a in placed:
+            out.append((g, g.a))
+    return out

@@ -43,7 +43,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from .graph_dyads import reference_signs, with_signs
+from .graph_dyads import joints_to_placed, point_on, reference_signs, with_signs
 from .motions import rot
 
 #: how near the axes of a spherical dyad must meet, relative to the drawing's size (detection at
@@ -105,7 +105,7 @@ class SphericalDecomposition:
         self.complete = self._decompose() and len(self.joints) == len(gen.gjoints)
 
     def _point_on(self, g: Any, body: str) -> ca.SX:
-        return g.pa if body == g.a else g.pb
+        return point_on(g, body)
 
     def _decompose(self) -> bool:
         bodies = [b.name for b in self.gen.d.bodies]
@@ -116,15 +116,7 @@ class SphericalDecomposition:
 
     def _to_placed(self, b: str) -> list:
         """The undriven R joints between an unplaced body b and placed ones: (joint, placed body)."""
-        out = []
-        for g in self.joints:
-            if g.drive is not None:
-                continue
-            if g.a == b and g.b in self.placed:
-                out.append((g, g.b))
-            elif g.b == b and g.a in self.placed:
-                out.append((g, g.a))
-        return out
+        return joints_to_placed(self.joints, self.placed, b, undriven=True)
 
     def _actuated(self) -> bool:
         """A body joined to a placed one by an actuated R joint: it turns by the actuator about the axis."""
